@@ -1,0 +1,12 @@
+//! Material point method (MPM) research code.
+//!
+//! One code path serves 2D plane strain (`D = 2`) and 3D (`D = 3`) through const
+//! generics. Tensors that exist in 3D even in plane strain (deformation gradient,
+//! Cauchy stress) are always stored as 3×3; vectors on the grid and particles have
+//! `D` components.
+
+pub mod dim;
+pub mod grid;
+pub mod material;
+pub mod particles;
+pub mod shape;

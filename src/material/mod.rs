@@ -1,0 +1,79 @@
+//! Constitutive models.
+//!
+//! A model maps the state at the start of an increment (deformation gradient, Cauchy
+//! stress, history) and the incremental deformation gradient ΔF to the Cauchy stress
+//! and history at its end. The update is a pure function of the start state, so an
+//! implicit solver can call it at every Newton iterate without drift, and it can ask
+//! for the derivative of the updated stress with respect to ΔF (the consistent
+//! tangent of the update).
+
+pub mod driver;
+pub mod linear_elastic;
+pub mod mooney_rivlin;
+pub mod neo_hookean;
+
+pub use linear_elastic::LinearElastic;
+pub use mooney_rivlin::MooneyRivlin;
+pub use neo_hookean::NeoHookean;
+
+use crate::dim::Mat3;
+use nalgebra::SMatrix;
+
+/// ∂σ_ij/∂ΔF_kl with (i,j) and (k,l) flattened row-major (index 3i + j).
+pub type StressDerivative = SMatrix<f64, 9, 9>;
+
+/// The state at the start of an increment and the increment itself.
+#[derive(Clone, Copy, Debug)]
+pub struct Increment<'a> {
+    /// Deformation gradient at the start of the increment.
+    pub f_old: Mat3,
+    /// Incremental deformation gradient: F_new = ΔF F_old.
+    pub df: Mat3,
+    /// Time increment (rate-dependent models; 0 for quasi-static calls).
+    pub dt: f64,
+    /// Cauchy stress at the start of the increment.
+    pub stress_old: Mat3,
+    /// History variables at the start of the increment (empty if the model has none).
+    pub history_old: &'a [f64],
+}
+
+pub trait Material: Send + Sync + std::fmt::Debug {
+    /// Model name as written in scene files.
+    fn model(&self) -> &'static str;
+
+    /// Reference mass density ρ0.
+    fn density(&self) -> f64;
+
+    /// Number of history variables per particle (0: none are allocated).
+    fn n_history(&self) -> usize {
+        0
+    }
+
+    /// Cauchy stress at the end of the increment; writes the new history.
+    fn update(&self, inc: &Increment, history_new: &mut [f64]) -> Mat3;
+
+    /// Small-strain P-wave modulus λ + 2G, for the CFL condition (2-45).
+    fn p_wave_modulus(&self) -> f64;
+
+    /// Stored (strain) energy per unit current volume at deformation `f` and stress
+    /// `stress`.
+    fn strain_energy_density(&self, f: &Mat3, stress: &Mat3, history: &[f64]) -> f64;
+
+    /// Exact derivative ∂σ_new/∂ΔF of `update`, or `None` if the model has no
+    /// analytic tangent (the matrix-free implicit path still serves it).
+    fn stress_derivative(&self, _inc: &Increment) -> Option<StressDerivative> {
+        None
+    }
+
+    /// Wave speed c = √(M/ρ) at the current Jacobian J (ρ = ρ0/J).
+    fn wave_speed(&self, j: f64) -> f64 {
+        (self.p_wave_modulus() * j / self.density()).sqrt()
+    }
+}
+
+/// Lamé constants from Young's modulus and Poisson's ratio.
+pub fn lame(youngs_modulus: f64, poisson_ratio: f64) -> (f64, f64) {
+    let g = youngs_modulus / (2.0 * (1.0 + poisson_ratio));
+    let lambda = youngs_modulus * poisson_ratio / ((1.0 + poisson_ratio) * (1.0 - 2.0 * poisson_ratio));
+    (lambda, g)
+}

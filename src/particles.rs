@@ -1,0 +1,108 @@
+//! Material points, stored as a struct of arrays.
+//!
+//! History variables exist only for particles whose material has them: `History`
+//! maps a particle to a slice of a flat buffer, and a scene of elastic bodies has an
+//! empty buffer.
+
+use crate::dim::{Mat3, Tensor, Vector};
+
+#[derive(Clone, Debug, Default)]
+pub struct Particles<const D: usize> {
+    /// Current position x.
+    pub x: Vec<Vector<D>>,
+    /// Reference position X (for output and for reference-configuration solutions).
+    pub x0: Vec<Vector<D>>,
+    pub v: Vec<Vector<D>>,
+    pub mass: Vec<f64>,
+    pub volume: Vec<f64>,
+    pub volume0: Vec<f64>,
+    /// Deformation gradient (3×3; plane strain keeps F_zz = 1).
+    pub f: Vec<Mat3>,
+    /// Cauchy stress (3×3; plane strain carries σ_zz).
+    pub stress: Vec<Mat3>,
+    /// Half-lengths of the particle domain in the reference configuration: the CPDI
+    /// domain vectors at t = 0 are r_i⁰ = lp0_i e_i, and now r_i = F r_i⁰; GIMP uses
+    /// them as the half-widths of the characteristic function.
+    pub half_length0: Vec<Vector<D>>,
+    pub body: Vec<u32>,
+    pub material: Vec<u32>,
+    /// Applied force on the particle (point loads and tractions), before load scaling.
+    pub load: Vec<Vector<D>>,
+    pub history: History,
+}
+
+/// Per-particle history variables, only for materials that declare some.
+#[derive(Clone, Debug, Default)]
+pub struct History {
+    /// Start of each particle's slice in `data`, or `NONE`.
+    pub offset: Vec<u32>,
+    pub len: Vec<u16>,
+    pub data: Vec<f64>,
+}
+
+impl History {
+    pub const NONE: u32 = u32::MAX;
+
+    pub fn get(&self, p: usize) -> &[f64] {
+        match self.offset[p] {
+            Self::NONE => &[],
+            o => &self.data[o as usize..o as usize + self.len[p] as usize],
+        }
+    }
+
+    /// Append a slot of `n` values for a new particle (no slot when n = 0).
+    pub fn push(&mut self, n: usize) {
+        if n == 0 {
+            self.offset.push(Self::NONE);
+            self.len.push(0);
+        } else {
+            self.offset.push(self.data.len() as u32);
+            self.len.push(n as u16);
+            self.data.resize(self.data.len() + n, 0.0);
+        }
+    }
+}
+
+impl<const D: usize> Particles<D> {
+    pub fn len(&self) -> usize {
+        self.x.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.x.is_empty()
+    }
+
+    /// Add one particle at rest, undeformed and unstressed.
+    #[allow(clippy::too_many_arguments)]
+    pub fn push(
+        &mut self,
+        x: Vector<D>,
+        v: Vector<D>,
+        mass: f64,
+        volume: f64,
+        half_length0: Vector<D>,
+        body: u32,
+        material: u32,
+        n_history: usize,
+    ) {
+        self.x.push(x);
+        self.x0.push(x);
+        self.v.push(v);
+        self.mass.push(mass);
+        self.volume.push(volume);
+        self.volume0.push(volume);
+        self.f.push(Mat3::identity());
+        self.stress.push(Mat3::zeros());
+        self.half_length0.push(half_length0);
+        self.body.push(body);
+        self.material.push(material);
+        self.load.push(Vector::<D>::zeros());
+        self.history.push(n_history);
+    }
+
+    /// Current CPDI domain vectors r_i = F r_i⁰ as the columns of a D×D matrix.
+    pub fn domain_vectors(&self, p: usize) -> Tensor<D> {
+        let f = crate::dim::restrict::<D>(&self.f[p]);
+        f * Tensor::<D>::from_diagonal(&self.half_length0[p])
+    }
+}
