@@ -1,0 +1,1 @@
+//! placeholder, replaced on the material branch
