@@ -8,5 +8,6 @@
 pub mod dim;
 pub mod grid;
 pub mod material;
+pub mod output;
 pub mod particles;
 pub mod shape;

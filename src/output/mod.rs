@@ -1,0 +1,1 @@
+//! Run outputs (placeholder, replaced on the output branch).
