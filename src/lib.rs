@@ -5,9 +5,15 @@
 //! Cauchy stress) are always stored as 3×3; vectors on the grid and particles have
 //! `D` components.
 
+pub mod boundary;
 pub mod dim;
+pub mod explicit;
 pub mod grid;
 pub mod material;
 pub mod output;
 pub mod particles;
+pub mod run;
+pub mod scene;
+pub mod setup;
 pub mod shape;
+pub mod transfer;

@@ -50,6 +50,25 @@ impl History {
         }
     }
 
+    /// One mutable slice per particle (empty for particles without history), for
+    /// updating all particles in parallel.
+    pub fn split_mut(&mut self) -> Vec<&mut [f64]> {
+        split_slots(&self.len, &mut self.data)
+    }
+
+    /// The per-particle slices of another buffer laid out like `data`.
+    pub fn slots<'a>(&self, data: &'a [f64]) -> Vec<&'a [f64]> {
+        let mut rest = data;
+        self.len
+            .iter()
+            .map(|&n| {
+                let (head, tail) = rest.split_at(n as usize);
+                rest = tail;
+                head
+            })
+            .collect()
+    }
+
     /// Append a slot of `n` values for a new particle (no slot when n = 0).
     pub fn push(&mut self, n: usize) {
         if n == 0 {
@@ -61,6 +80,18 @@ impl History {
             self.data.resize(self.data.len() + n, 0.0);
         }
     }
+}
+
+/// Split `data` into consecutive slices of the given lengths.
+fn split_slots<'a>(len: &[u16], data: &'a mut [f64]) -> Vec<&'a mut [f64]> {
+    let mut rest = data;
+    let mut out = Vec::with_capacity(len.len());
+    for &n in len {
+        let (head, tail) = std::mem::take(&mut rest).split_at_mut(n as usize);
+        out.push(head);
+        rest = tail;
+    }
+    out
 }
 
 impl<const D: usize> Particles<D> {

@@ -1,0 +1,247 @@
+//! Explicit MPM: central difference in time (thesis 2-29, 2-30) with the USF, USL
+//! and MUSL orderings of the stress update (§2.2.1), a PIC/FLIP blend, and local
+//! damping for dynamic relaxation.
+
+use crate::boundary::{node_constraint, Constraint};
+use crate::dim::{embed_deformation, Tensor, Vector};
+use crate::material::Increment;
+use crate::scene::{Scheme, SolverConfig};
+use crate::setup::Model;
+use crate::shape::{ShapeFunction, Stencils};
+use crate::transfer::{deterministic_sum, gradient, interpolate, mass_momentum, nodal_force, NodeMap};
+use rayon::prelude::*;
+
+/// Nodes lighter than this fraction of the lightest particle are treated as empty
+/// (zero velocity and acceleration): their velocity p_I/m_I is ill-conditioned.
+pub const TINY_MASS_FRACTION: f64 = 1e-9;
+
+/// Why a run stopped early.
+#[derive(Clone, Debug)]
+pub struct Divergence {
+    pub step: usize,
+    pub time: f64,
+    pub particle: usize,
+    pub message: String,
+}
+
+impl std::fmt::Display for Divergence {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "diverged at step {} (t = {:.6e}): particle {} {}", self.step, self.time, self.particle, self.message)
+    }
+}
+
+pub struct Explicit<const D: usize> {
+    pub shape: ShapeFunction,
+    pub scheme: Scheme,
+    pub cfl: f64,
+    pub fixed_dt: Option<f64>,
+    pub flip: f64,
+    pub damping: f64,
+    stencils: Stencils<D>,
+    map: NodeMap,
+}
+
+impl<const D: usize> Explicit<D> {
+    pub fn new(shape: ShapeFunction, s: &SolverConfig) -> Self {
+        Explicit {
+            shape,
+            scheme: s.scheme,
+            cfl: s.cfl,
+            fixed_dt: s.dt,
+            flip: s.flip,
+            damping: s.damping,
+            stencils: Stencils::default(),
+            map: NodeMap::default(),
+        }
+    }
+
+    /// Number of active nodes in the last step.
+    pub fn active_nodes(&self) -> usize {
+        self.map.len()
+    }
+
+    /// Critical time step min_p h / (c_p + |v_p|) (2-45).
+    pub fn critical_dt(m: &Model<D>) -> f64 {
+        let p = &m.particles;
+        let h = m.grid.h_min();
+        (0..p.len())
+            .into_par_iter()
+            .map(|q| {
+                let c = m.materials[p.material[q] as usize].wave_speed(p.f[q].determinant());
+                h / (c + p.v[q].norm())
+            })
+            .reduce(|| f64::INFINITY, f64::min)
+    }
+
+    /// The step to take now: the fixed one, or cfl × the critical one.
+    pub fn dt(&self, m: &Model<D>) -> f64 {
+        self.fixed_dt.unwrap_or_else(|| self.cfl * Self::critical_dt(m))
+    }
+
+    /// Advance the model from t to t + dt. Returns the work done by gravity and
+    /// applied loads over the step.
+    pub fn step(&mut self, m: &mut Model<D>, t: f64, dt: f64, step: usize) -> Result<f64, Divergence> {
+        let p = &m.particles;
+        self.stencils.compute(self.shape, &m.grid, &p.x, &p.half_length0, &p.f);
+        self.map.build(&self.stencils, m.grid.node_count());
+        let (st, map) = (&self.stencils, &self.map);
+        let constraint: Vec<Constraint<D>> =
+            map.active.par_iter().map(|&g| node_constraint(&m.grid, &m.faces, g as usize)).collect();
+        let tiny = TINY_MASS_FRACTION * p.mass.iter().cloned().fold(f64::INFINITY, f64::min);
+
+        // Nodal velocity at the start of the step, with the conditions applied.
+        let (mass, momentum) = mass_momentum(map, st, p);
+        let velocity = nodal_velocity(&mass, &momentum, &constraint, tiny);
+        if self.scheme == Scheme::Usf {
+            update_stress(m, st, map, &velocity, dt, step, t)?;
+        }
+        let p = &m.particles;
+
+        // Nodal forces, damping, acceleration and updated velocity (2-23, 2-29).
+        let scales = m.load_scales(t);
+        let load_factor = |q: usize| match m.load_ramp_of[q] {
+            u32::MAX => 0.0,
+            r => scales[r as usize],
+        };
+        let force = nodal_force(map, st, p, &m.gravity, &load_factor);
+        let accel: Vec<Vector<D>> = (0..map.len())
+            .into_par_iter()
+            .map(|a| {
+                if mass[a] <= tiny {
+                    return Vector::<D>::zeros();
+                }
+                let mut f = force[a];
+                for d in 0..D {
+                    f[d] -= self.damping * f[d].abs() * velocity[a][d].signum() * (velocity[a][d] != 0.0) as u8 as f64;
+                }
+                let mut acc = f / mass[a];
+                // Prescribed components: the acceleration that lands on the value.
+                let raw = momentum[a] / mass[a];
+                for d in 0..D {
+                    if constraint[a].fixed[d] {
+                        acc[d] = (constraint[a].value[d] - raw[d]) / dt;
+                    }
+                }
+                acc
+            })
+            .collect();
+        let raw_velocity: Vec<Vector<D>> =
+            (0..map.len()).map(|a| if mass[a] > tiny { momentum[a] / mass[a] } else { Vector::<D>::zeros() }).collect();
+        let velocity_new: Vec<Vector<D>> = (0..map.len()).map(|a| raw_velocity[a] + accel[a] * dt).collect();
+
+        // G2P: particle velocity (PIC/FLIP blend, 2-27) and position (2-26).
+        let flip = self.flip;
+        let mp = &mut m.particles;
+        let old_v = mp.v.clone();
+        mp.v.par_iter_mut().zip(mp.x.par_iter_mut()).enumerate().for_each(|(q, (v, x))| {
+            let v_flip = *v + interpolate(map, st, q, &accel) * dt;
+            let v_pic = interpolate(map, st, q, &velocity_new);
+            *v = v_flip * flip + v_pic * (1.0 - flip);
+            *x += v_pic * dt;
+        });
+        let p = &m.particles;
+        let work = dt
+            * deterministic_sum(p.len(), |q| {
+                let f = m.gravity * p.mass[q] + p.load[q] * load_factor(q);
+                f.dot(&(old_v[q] + p.v[q])) * 0.5
+            });
+
+        match self.scheme {
+            Scheme::Usf => {}
+            Scheme::Usl => update_stress(m, st, map, &velocity_new, dt, step, t)?,
+            Scheme::Musl => {
+                // Map the updated particle momentum back and use that velocity.
+                let (_, momentum) = mass_momentum(map, st, &m.particles);
+                let velocity = nodal_velocity(&mass, &momentum, &constraint, tiny);
+                update_stress(m, st, map, &velocity, dt, step, t)?;
+            }
+        }
+        check_state(m, step + 1, t + dt)?;
+        Ok(work)
+    }
+}
+
+/// v_I = p_I / m_I with prescribed components imposed; empty nodes at rest.
+fn nodal_velocity<const D: usize>(mass: &[f64], momentum: &[Vector<D>], c: &[Constraint<D>], tiny: f64) -> Vec<Vector<D>> {
+    (0..mass.len())
+        .map(|a| {
+            let mut v = if mass[a] > tiny { momentum[a] / mass[a] } else { Vector::<D>::zeros() };
+            c[a].apply_velocity(&mut v);
+            v
+        })
+        .collect()
+}
+
+/// Velocity gradient L_p = Σ v_I ⊗ ∇S_Ip, ΔF = I + Δt L, F ← ΔF F, V = det F V0,
+/// and the material's stress update from the start-of-step state (2-31, 2-32).
+fn update_stress<const D: usize>(
+    m: &mut Model<D>,
+    st: &Stencils<D>,
+    map: &NodeMap,
+    velocity: &[Vector<D>],
+    dt: f64,
+    step: usize,
+    t: f64,
+) -> Result<(), Divergence> {
+    let materials = &m.materials;
+    let p = &mut m.particles;
+    let history_data_old = p.history.data.clone();
+    let history_old = p.history.slots(&history_data_old);
+    let mut history = p.history.split_mut();
+    let inverted = p
+        .f
+        .par_iter_mut()
+        .zip(p.stress.par_iter_mut())
+        .zip(p.volume.par_iter_mut())
+        .zip(history.par_iter_mut())
+        .enumerate()
+        .map(|(q, (((f, stress), volume), hist))| {
+            let l: Tensor<D> = gradient(map, st, q, velocity);
+            let df = embed_deformation::<D>(&(Tensor::<D>::identity() + l * dt));
+            let inc = Increment { f_old: *f, df, dt, stress_old: *stress, history_old: history_old[q] };
+            *stress = materials[p.material[q] as usize].update(&inc, hist);
+            *f = df * *f;
+            let j = f.determinant();
+            *volume = j * p.volume0[q];
+            if j > 0.0 { usize::MAX } else { q }
+        })
+        .min()
+        .unwrap_or(usize::MAX);
+    if inverted != usize::MAX {
+        return Err(Divergence {
+            step: step + 1,
+            time: t + dt,
+            particle: inverted,
+            message: format!("inverted: det F = {:.3e} ≤ 0", p.f[inverted].determinant()),
+        });
+    }
+    Ok(())
+}
+
+/// Stop on non-finite state or particles outside the grid (first offender).
+pub fn check_state<const D: usize>(m: &Model<D>, step: usize, time: f64) -> Result<(), Divergence> {
+    let p = &m.particles;
+    let bad = (0..p.len()).into_par_iter().find_first(|&q| {
+        !(p.x[q].iter().all(|v| v.is_finite())
+            && p.v[q].iter().all(|v| v.is_finite())
+            && p.stress[q].iter().all(|v| v.is_finite())
+            && m.grid.contains(&p.x[q]))
+    });
+    match bad {
+        None => Ok(()),
+        Some(q) => {
+            let finite = p.x[q].iter().chain(p.v[q].iter()).chain(p.stress[q].iter()).all(|v| v.is_finite());
+            let message = if finite {
+                format!("(body {}) left the grid: x = {:?}", p.body[q], p.x[q].as_slice())
+            } else {
+                format!(
+                    "(body {}) has a non-finite state: x = {:?}, v = {:?}",
+                    p.body[q],
+                    p.x[q].as_slice(),
+                    p.v[q].as_slice()
+                )
+            };
+            Err(Divergence { step, time, particle: q, message })
+        }
+    }
+}

@@ -1,0 +1,157 @@
+//! Running a scene: build the model, advance it to the end time, write the outputs
+//! (history.csv, ParaView frames, particles_final.csv, summary.json). A divergence
+//! stops the run cleanly: everything written so far is flushed and summary.json
+//! records what happened where.
+
+use crate::explicit::{check_state, Divergence, Explicit};
+use crate::output::{body_centres, write_json, write_particles_csv, FrameWriter, HistoryWriter, Progress};
+use crate::scene::{Scene, SceneError};
+use crate::setup::Model;
+use crate::transfer::deterministic_sum;
+use serde_json::json;
+use std::path::Path;
+use std::time::Instant;
+
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    #[error("{0}")]
+    Scene(#[from] SceneError),
+    #[error("cannot write outputs: {0}")]
+    Io(#[from] std::io::Error),
+    #[error("{0}")]
+    Diverged(String),
+}
+
+/// What a finished run reports (also written to summary.json).
+#[derive(Clone, Debug)]
+pub struct RunSummary {
+    pub steps: usize,
+    pub end_time: f64,
+    pub particles: usize,
+    pub wall_seconds: f64,
+    pub json: serde_json::Value,
+}
+
+/// Options that do not belong in the scene.
+#[derive(Clone, Debug, Default)]
+pub struct RunOptions {
+    /// Show a progress bar (only drawn when stderr is a terminal).
+    pub progress: bool,
+}
+
+/// Run a scene, writing its outputs into `out`.
+pub fn run(scene: &Scene, out: &Path, opts: &RunOptions) -> Result<RunSummary, RunError> {
+    std::fs::create_dir_all(out)?;
+    match scene.config.dimension {
+        2 => run_dim::<2>(scene, out, opts),
+        3 => run_dim::<3>(scene, out, opts),
+        d => unreachable!("validated dimension {d}"),
+    }
+}
+
+/// Kinetic energy Σ ½ m |v|².
+pub fn kinetic_energy<const D: usize>(m: &Model<D>) -> f64 {
+    let p = &m.particles;
+    deterministic_sum(p.len(), |q| 0.5 * p.mass[q] * p.v[q].norm_squared())
+}
+
+/// Stored energy Σ V_p w_p.
+pub fn strain_energy<const D: usize>(m: &Model<D>) -> f64 {
+    let p = &m.particles;
+    deterministic_sum(p.len(), |q| {
+        let mat = &m.materials[p.material[q] as usize];
+        p.volume[q] * mat.strain_energy_density(&p.f[q], &p.stress[q], p.history.get(q))
+    })
+}
+
+fn run_dim<const D: usize>(scene: &Scene, out: &Path, opts: &RunOptions) -> Result<RunSummary, RunError> {
+    let cfg = &scene.config;
+    let mut model = Model::<D>::build(scene)?;
+    let mut solver = Explicit::<D>::new(cfg.grid.shape_function, &cfg.solver);
+    let end_time = cfg.solver.end_time;
+    let n_bodies = model.n_bodies();
+    let mut history = HistoryWriter::create(&out.join("history.csv"), D, n_bodies)?;
+    let mut frames = FrameWriter::new(out, "particles")?;
+    let frame_interval = (cfg.output.frames > 0).then(|| end_time / cfg.output.frames as f64);
+    let progress = opts.progress.then(|| Progress::new(end_time));
+    let dt_critical = Explicit::critical_dt(&model);
+    check_state(&model, 0, 0.0).map_err(|d| RunError::Diverged(d.to_string()))?;
+
+    let started = Instant::now();
+    let (mut t, mut step, mut external_work) = (0.0, 0usize, 0.0);
+    let (mut next_history, mut next_frame) = (0.0, 0.0);
+    let (mut last_history, mut last_frame) = (f64::NAN, f64::NAN);
+    let mut last_dt = 0.0;
+    // Write a history row and a frame when they are due (or forced, at the start and
+    // the end), never twice at the same time.
+    let mut record = |model: &Model<D>, t: f64, external_work: f64, force: bool| -> std::io::Result<()> {
+        if (force || t >= next_history) && t != last_history {
+            last_history = t;
+            let (com, vcom) = body_centres(&model.particles, n_bodies);
+            history.write_row(t, kinetic_energy(model), strain_energy(model), external_work, &com, &vcom)?;
+            history.flush()?;
+            next_history = t + cfg.output.history_interval;
+        }
+        if let Some(interval) = frame_interval {
+            if (force || t >= next_frame - 1e-12 * end_time) && t != last_frame {
+                last_frame = t;
+                frames.write_frame(t, &model.particles, &[])?;
+                while next_frame <= t + 1e-12 * end_time {
+                    next_frame += interval;
+                }
+            }
+        }
+        Ok(())
+    };
+    record(&model, t, external_work, true)?;
+    let outcome: Result<(), Divergence> = loop {
+        if t >= end_time * (1.0 - 1e-12) {
+            break Ok(());
+        }
+        let dt = solver.dt(&model).min(end_time - t);
+        last_dt = dt;
+        match solver.step(&mut model, t, dt, step) {
+            Ok(work) => external_work += work,
+            Err(d) => break Err(d),
+        }
+        t += dt;
+        step += 1;
+        record(&model, t, external_work, false)?;
+        if let Some(p) = &progress {
+            p.set(t, step);
+        }
+    };
+    if let Some(p) = &progress {
+        p.finish();
+    }
+    let wall = started.elapsed().as_secs_f64();
+    let particles = model.particles.len();
+    let mut summary = json!({
+        "scene": scene.file,
+        "dimension": D,
+        "solver": "explicit",
+        "scheme": cfg.solver.scheme.name(),
+        "shape_function": cfg.grid.shape_function.name(),
+        "particles": particles,
+        "active_nodes_last_step": solver.active_nodes(),
+        "steps": step,
+        "dt": last_dt,
+        "dt_critical": dt_critical,
+        "end_time": t,
+        "wall_seconds": wall,
+        "particle_steps_per_second": (particles * step) as f64 / wall.max(1e-9),
+        "status": "completed",
+    });
+    if let Err(d) = outcome {
+        summary["status"] = json!("diverged");
+        summary["message"] = json!(d.to_string());
+        summary["diverged_step"] = json!(d.step);
+        summary["diverged_particle"] = json!(d.particle);
+        write_json(&out.join("summary.json"), &summary)?;
+        return Err(RunError::Diverged(format!("{}: {d}; outputs written so far are in {}", scene.file, out.display())));
+    }
+    record(&model, t, external_work, true)?;
+    write_particles_csv(&out.join("particles_final.csv"), &model.particles)?;
+    write_json(&out.join("summary.json"), &summary)?;
+    Ok(RunSummary { steps: step, end_time: t, particles, wall_seconds: wall, json: summary })
+}

@@ -1,0 +1,251 @@
+//! The scene file's structure. Field names are the TOML keys; `docs/scene.md`
+//! documents each one. Every section is a plain struct with `deny_unknown_fields`
+//! (so TOML errors point at the offending key); which optional keys a given
+//! `model`, `shape` or `kind` needs is checked in `validate`. Vectors are arrays
+//! whose length must equal `dimension`.
+
+use crate::shape::ShapeFunction;
+use serde::Deserialize;
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneConfig {
+    /// 2 (plane strain) or 3.
+    pub dimension: usize,
+    /// Gravitational acceleration vector (default zero).
+    #[serde(default)]
+    pub gravity: Option<Vec<f64>>,
+    pub grid: GridConfig,
+    #[serde(default, rename = "material")]
+    pub materials: Vec<MaterialConfig>,
+    #[serde(default, rename = "body")]
+    pub bodies: Vec<BodyConfig>,
+    #[serde(default, rename = "boundary")]
+    pub boundaries: Vec<BoundaryConfig>,
+    #[serde(default, rename = "load")]
+    pub loads: Vec<LoadConfig>,
+    pub solver: SolverConfig,
+    #[serde(default)]
+    pub output: OutputConfig,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GridConfig {
+    pub min: Vec<f64>,
+    pub max: Vec<f64>,
+    pub cells: Vec<usize>,
+    #[serde(default = "default_shape")]
+    pub shape_function: ShapeFunction,
+}
+
+fn default_shape() -> ShapeFunction {
+    ShapeFunction::Linear
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MaterialModel {
+    /// Hypoelastic, Jaumann rate: youngs_modulus, poisson_ratio.
+    LinearElastic,
+    /// Compressible neo-Hookean: youngs_modulus, poisson_ratio.
+    NeoHookean,
+    /// Mooney-Rivlin (thesis 3-2): a, b, poisson_ratio; c and d follow (3-8, 3-17).
+    MooneyRivlin,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialConfig {
+    pub name: String,
+    pub model: MaterialModel,
+    pub density: f64,
+    pub youngs_modulus: Option<f64>,
+    pub poisson_ratio: Option<f64>,
+    pub a: Option<f64>,
+    pub b: Option<f64>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Shape {
+    /// 2D, `min` and `max` corners.
+    Rectangle,
+    /// 3D, `min` and `max` corners.
+    Box,
+    /// 2D, `centre` and `radius`.
+    Disk,
+    /// 3D, `centre` and `radius`.
+    Sphere,
+    /// 2D, `vertices` of a simple polygon in order.
+    Polygon,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodyConfig {
+    #[serde(default)]
+    pub name: Option<String>,
+    pub material: String,
+    pub shape: Shape,
+    pub min: Option<Vec<f64>>,
+    pub max: Option<Vec<f64>>,
+    pub centre: Option<Vec<f64>>,
+    pub radius: Option<f64>,
+    pub vertices: Option<Vec<Vec<f64>>>,
+    /// Particles per cell per direction: one number or one per direction.
+    #[serde(default = "default_ppc")]
+    pub particles_per_cell: PerDirection,
+    /// Uniform initial velocity.
+    #[serde(default)]
+    pub velocity: Option<Vec<f64>>,
+    /// Initial velocity as expressions in the reference position x, y, z (with
+    /// pi, sin, cos, exp, sqrt, abs), one per component; added to `velocity`.
+    #[serde(default)]
+    pub velocity_expr: Option<Vec<String>>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(untagged)]
+pub enum PerDirection {
+    Same(usize),
+    Each(Vec<usize>),
+}
+
+impl PerDirection {
+    pub fn get(&self, d: usize) -> usize {
+        match self {
+            PerDirection::Same(n) => *n,
+            PerDirection::Each(v) => v.get(d).copied().unwrap_or(0),
+        }
+    }
+}
+
+fn default_ppc() -> PerDirection {
+    PerDirection::Same(2)
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Condition {
+    /// All velocity components zero.
+    Fixed,
+    /// Normal velocity zero, tangential free.
+    Roller,
+    /// Prescribed `velocity` on the listed `components` (default all).
+    Velocity,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoundaryConfig {
+    /// Grid face: xmin, xmax, ymin, ymax, zmin, zmax.
+    pub face: String,
+    pub condition: Condition,
+    pub velocity: Option<Vec<f64>>,
+    /// Components the velocity condition acts on ("x", "y", "z"); default all.
+    pub components: Option<Vec<String>>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LoadKind {
+    /// `force`: a total force shared equally by the selected particles.
+    Point,
+    /// `traction` on the `face` side of each selected particle: force per unit area
+    /// of its reference face (unit thickness in 2D).
+    Traction,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadConfig {
+    pub kind: LoadKind,
+    /// Particles whose reference position lies in the box [region_min, region_max].
+    pub region_min: Vec<f64>,
+    pub region_max: Vec<f64>,
+    /// Only particles of this body (by name); default all bodies.
+    pub body: Option<String>,
+    pub force: Option<Vec<f64>>,
+    pub traction: Option<Vec<f64>>,
+    pub face: Option<String>,
+    /// Linear ramp from zero over this time (0: applied at once).
+    #[serde(default)]
+    pub ramp_time: f64,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SolverKind {
+    Explicit,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Scheme {
+    Usf,
+    Usl,
+    Musl,
+}
+
+impl Scheme {
+    pub fn name(&self) -> &'static str {
+        match self {
+            Scheme::Usf => "usf",
+            Scheme::Usl => "usl",
+            Scheme::Musl => "musl",
+        }
+    }
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolverConfig {
+    pub kind: SolverKind,
+    #[serde(default = "default_scheme")]
+    pub scheme: Scheme,
+    pub end_time: f64,
+    /// Time step as a fraction of the CFL limit (2-45), recomputed every step; ≤ 1.
+    #[serde(default = "default_cfl")]
+    pub cfl: f64,
+    /// Fixed time step instead of the CFL rule (not limited: for stability studies).
+    pub dt: Option<f64>,
+    /// FLIP fraction of the particle velocity update: 1 = FLIP, 0 = PIC.
+    #[serde(default = "default_flip")]
+    pub flip: f64,
+    /// Local (non-viscous) damping α in [0, 1): nodal force f ← f − α|f| sign(v),
+    /// for dynamic relaxation of quasi-static problems.
+    #[serde(default)]
+    pub damping: f64,
+}
+
+fn default_scheme() -> Scheme {
+    Scheme::Musl
+}
+fn default_cfl() -> f64 {
+    0.5
+}
+fn default_flip() -> f64 {
+    1.0
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputConfig {
+    /// Number of ParaView frames after the initial one (0: none at all).
+    #[serde(default = "default_frames")]
+    pub frames: usize,
+    /// Time between rows of history.csv (0: every step).
+    #[serde(default)]
+    pub history_interval: f64,
+}
+
+fn default_frames() -> usize {
+    10
+}
+
+impl Default for OutputConfig {
+    fn default() -> Self {
+        OutputConfig { frames: default_frames(), history_interval: 0.0 }
+    }
+}

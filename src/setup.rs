@@ -1,0 +1,209 @@
+//! From a validated scene to the objects a solver works on: grid, particles,
+//! materials, boundary conditions and loads.
+
+use crate::boundary::{Constraint, FaceCondition};
+use crate::dim::Vector;
+use crate::grid::{Face, Grid};
+use crate::material::{LinearElastic, Material, MooneyRivlin, NeoHookean};
+use crate::particles::Particles;
+use crate::scene::validate::{axis, body_bounds};
+use crate::scene::{expr, BodyConfig, Condition, LoadKind, MaterialConfig, MaterialModel, Scene, SceneError, Shape};
+
+/// Everything a solver needs, in dimension D.
+#[derive(Debug)]
+pub struct Model<const D: usize> {
+    pub grid: Grid<D>,
+    pub particles: Particles<D>,
+    pub materials: Vec<Box<dyn Material>>,
+    pub faces: Vec<FaceCondition<D>>,
+    pub gravity: Vector<D>,
+    /// Per load: selected particles, ramp time (the force is stored on the particles
+    /// grouped by ramp, see `load_scale`).
+    pub load_ramps: Vec<f64>,
+    /// For each particle, the index into `load_ramps` of its load (u32::MAX: none).
+    pub load_ramp_of: Vec<u32>,
+}
+
+impl<const D: usize> Model<D> {
+    pub fn build(scene: &Scene) -> Result<Model<D>, SceneError> {
+        let c = &scene.config;
+        assert_eq!(c.dimension, D, "caller dispatches on the scene dimension");
+        let err = |key: String, msg: String| SceneError { file: scene.file.clone(), key: Some(key), position: None, message: msg };
+        let vec = |v: &[f64]| Vector::<D>::from_fn(|d, _| v[d]);
+        let cells = std::array::from_fn(|d| c.grid.cells[d]);
+        let grid = Grid::new(vec(&c.grid.min), vec(&c.grid.max), cells, c.grid.shape_function.degree());
+        let materials: Vec<Box<dyn Material>> = c.materials.iter().map(material).collect();
+        let mut particles = Particles::default();
+        for (i, b) in c.bodies.iter().enumerate() {
+            let m = c.materials.iter().position(|m| m.name == b.material).expect("validated");
+            let added = fill_body(&mut particles, &grid, b, i, m as u32, materials[m].as_ref())
+                .map_err(|(k, msg)| err(k, msg))?;
+            if added == 0 {
+                return Err(err(format!("body.{i}.shape"), "the body holds no particle centre: refine the grid or raise particles_per_cell".into()));
+            }
+        }
+        let faces = c
+            .boundaries
+            .iter()
+            .map(|b| face_condition(b, D, &vec))
+            .collect();
+        let gravity = c.gravity.as_deref().map_or(Vector::<D>::zeros(), vec);
+        let mut load_ramp_of = vec![u32::MAX; particles.len()];
+        let mut load_ramps = Vec::new();
+        for (i, l) in c.loads.iter().enumerate() {
+            let body = l.body.as_ref().map(|n| c.bodies.iter().position(|b| b.name.as_deref() == Some(n)).unwrap() as u32);
+            let (lo, hi) = (vec(&l.region_min), vec(&l.region_max));
+            let selected: Vec<usize> = (0..particles.len())
+                .filter(|&p| body.is_none_or(|b| particles.body[p] == b))
+                .filter(|&p| (0..D).all(|d| particles.x0[p][d] >= lo[d] && particles.x0[p][d] <= hi[d]))
+                .collect();
+            if selected.is_empty() {
+                return Err(err(format!("load.{i}.region_min"), "the load region selects no particle".into()));
+            }
+            let ramp = load_ramps.iter().position(|&r| r == l.ramp_time).unwrap_or_else(|| {
+                load_ramps.push(l.ramp_time);
+                load_ramps.len() - 1
+            });
+            for &p in &selected {
+                if load_ramp_of[p] != u32::MAX && load_ramp_of[p] != ramp as u32 {
+                    return Err(err(format!("load.{i}.ramp_time"), format!("particle {p} already carries a load with another ramp_time")));
+                }
+                load_ramp_of[p] = ramp as u32;
+                particles.load[p] += match l.kind {
+                    LoadKind::Point => vec(l.force.as_ref().unwrap()) / selected.len() as f64,
+                    LoadKind::Traction => {
+                        let face = Face::parse(l.face.as_ref().unwrap(), D).unwrap();
+                        let half = particles.half_length0[p];
+                        let area: f64 = (0..D).filter(|&d| d != face.axis).map(|d| 2.0 * half[d]).product();
+                        vec(l.traction.as_ref().unwrap()) * area
+                    }
+                };
+            }
+        }
+        Ok(Model { grid, particles, materials, faces, gravity, load_ramps, load_ramp_of })
+    }
+
+    /// Load factor of each ramp at time t: min(t / ramp_time, 1).
+    pub fn load_scales(&self, t: f64) -> Vec<f64> {
+        self.load_ramps.iter().map(|&r| if r > 0.0 { (t / r).min(1.0) } else { 1.0 }).collect()
+    }
+
+    /// Number of bodies (for per-body outputs).
+    pub fn n_bodies(&self) -> usize {
+        self.particles.body.iter().map(|&b| b as usize + 1).max().unwrap_or(0)
+    }
+}
+
+fn material(m: &MaterialConfig) -> Box<dyn Material> {
+    let nu = m.poisson_ratio.unwrap();
+    match m.model {
+        MaterialModel::LinearElastic => Box::new(LinearElastic::new(m.density, m.youngs_modulus.unwrap(), nu)),
+        MaterialModel::NeoHookean => Box::new(NeoHookean::new(m.density, m.youngs_modulus.unwrap(), nu)),
+        MaterialModel::MooneyRivlin => Box::new(MooneyRivlin::from_thesis(m.density, m.a.unwrap(), m.b.unwrap(), nu)),
+    }
+}
+
+fn face_condition<const D: usize>(b: &crate::scene::BoundaryConfig, dim: usize, vec: &impl Fn(&[f64]) -> Vector<D>) -> FaceCondition<D> {
+    let face = Face::parse(&b.face, dim).unwrap();
+    let mut constraint = Constraint::<D>::free();
+    match b.condition {
+        Condition::Fixed => (0..D).for_each(|d| constraint.set(d, 0.0)),
+        Condition::Roller => constraint.set(face.axis, 0.0),
+        Condition::Velocity => {
+            let v = vec(b.velocity.as_ref().unwrap());
+            let comps: Vec<usize> = match &b.components {
+                Some(c) => c.iter().map(|a| axis(a).unwrap()).collect(),
+                None => (0..D).collect(),
+            };
+            comps.into_iter().for_each(|d| constraint.set(d, v[d]));
+        }
+    }
+    FaceCondition { face, constraint }
+}
+
+/// Put particles on the lattice of `particles_per_cell` points per cell direction
+/// (aligned with the grid) wherever the lattice point lies inside the body.
+fn fill_body<const D: usize>(
+    particles: &mut Particles<D>,
+    grid: &Grid<D>,
+    b: &BodyConfig,
+    i: usize,
+    material: u32,
+    model: &dyn Material,
+) -> Result<usize, (String, String)> {
+    let (lo, hi) = body_bounds(b, i, D)?;
+    let spacing = Vector::<D>::from_fn(|d, _| grid.h[d] / b.particles_per_cell.get(d) as f64);
+    let volume = spacing.product();
+    let mass = model.density() * volume;
+    // Lattice index range covering the bounding box.
+    let first: [usize; D] = std::array::from_fn(|d| (((lo[d] - grid.min[d]) / spacing[d]).floor().max(0.0)) as usize);
+    let last: [usize; D] = std::array::from_fn(|d| ((hi[d] - grid.min[d]) / spacing[d]).ceil() as usize);
+    let counts: Vec<usize> = (0..D).map(|d| last[d].saturating_sub(first[d])).collect();
+    let total: usize = counts.iter().product();
+    let uniform = b.velocity.as_deref().map_or(Vector::<D>::zeros(), |v| Vector::<D>::from_fn(|d, _| v[d]));
+    let mut added = 0;
+    for flat in 0..total {
+        let mut rem = flat;
+        let x = Vector::<D>::from_fn(|d, _| {
+            let k = first[d] + rem % counts[d];
+            rem /= counts[d];
+            grid.min[d] + (k as f64 + 0.5) * spacing[d]
+        });
+        if !inside(b, &x) {
+            continue;
+        }
+        let mut v = uniform;
+        if let Some(exprs) = &b.velocity_expr {
+            let mut pos = [0.0; 3];
+            (0..D).for_each(|d| pos[d] = x[d]);
+            for (d, e) in exprs.iter().enumerate() {
+                v[d] += expr::eval(e, &pos).map_err(|m| (format!("body.{i}.velocity_expr.{d}"), m))?;
+            }
+        }
+        particles.push(x, v, mass, volume, spacing / 2.0, i as u32, material, model.n_history());
+        added += 1;
+    }
+    Ok(added)
+}
+
+/// Is the lattice point x inside the body's geometry?
+fn inside<const D: usize>(b: &BodyConfig, x: &Vector<D>) -> bool {
+    match b.shape {
+        Shape::Rectangle | Shape::Box => {
+            let (lo, hi) = (b.min.as_ref().unwrap(), b.max.as_ref().unwrap());
+            (0..D).all(|d| x[d] > lo[d] && x[d] < hi[d])
+        }
+        Shape::Disk | Shape::Sphere => {
+            let c = b.centre.as_ref().unwrap();
+            let r2: f64 = (0..D).map(|d| (x[d] - c[d]).powi(2)).sum();
+            r2 < b.radius.unwrap().powi(2)
+        }
+        Shape::Polygon => point_in_polygon(x[0], x[1], b.vertices.as_ref().unwrap()),
+    }
+}
+
+/// Even-odd rule (ray crossing to +x).
+fn point_in_polygon(x: f64, y: f64, v: &[Vec<f64>]) -> bool {
+    let mut inside = false;
+    let n = v.len();
+    for k in 0..n {
+        let (a, b) = (&v[k], &v[(k + 1) % n]);
+        if (a[1] > y) != (b[1] > y) {
+            let xc = a[0] + (y - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
+            if x < xc {
+                inside = !inside;
+            }
+        }
+    }
+    inside
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn polygon_membership() {
+        let tri = vec![vec![0.0, 0.0], vec![2.0, 0.0], vec![0.0, 2.0]];
+        assert!(super::point_in_polygon(0.5, 0.5, &tri));
+        assert!(!super::point_in_polygon(1.5, 1.5, &tri));
+    }
+}
