@@ -109,6 +109,7 @@ impl Material for LinearElastic {
         let two_minus_g = Mat3::identity() * 2.0 - k.g;
         let q_plus_i = k.q + Mat3::identity();
         let s_qt = inc.stress_old * k.q.transpose();
+        let q_s = k.q * inc.stress_old;
         let mut d = StressDerivative::zeros();
         for kk in 0..3 {
             for l in 0..3 {
@@ -117,8 +118,7 @@ impl Material for LinearElastic {
                 let deps = (dg + dg.transpose()) * 0.5;
                 let half_dw = (dg - dg.transpose()) * 0.25;
                 let dq = k.a_inv * half_dw * q_plus_i;
-                let dq_s_qt = dq * s_qt;
-                let ds = dq_s_qt + dq_s_qt.transpose() + self.elastic(&deps);
+                let ds = dq * s_qt + q_s * dq.transpose() + self.elastic(&deps);
                 for i in 0..3 {
                     for j in 0..3 {
                         d[(3 * i + j, 3 * kk + l)] = ds[(i, j)];
