@@ -1,4 +1,327 @@
-//! B-splines (placeholder, replaced on the shape branch).
+//! B-splines of degree p on a clamped (open) uniform knot vector per direction
+//! (Piegl & Tiller, The NURBS Book, eq. 2.5 and 2.7; B-spline MPM: Steffen, Kirby &
+//! Berzins 2008). In cell units the knots are 0 (p+1 times), 1, …, n−1, n (p+1
+//! times) for n cells, giving n + p basis functions per direction, one per grid node
+//! (`grid.nodes = cells + degree`). The first and last functions interpolate the
+//! faces, the basis is a partition of unity, and Σ N_I X_I = x with X_I the Greville
+//! abscissae (`grid.node_position`), up to the faces included.
+
+use super::linear::{cell_coordinate, cell_index, tensor_product, AxisFactors, MAX_PER_AXIS};
 use crate::dim::Vector;
 use crate::grid::Grid;
-pub fn evaluate<const D: usize>(_grid: &Grid<D>, _x: &Vector<D>, _degree: usize, _node: &mut [u32], _w: &mut [f64], _grad: &mut [Vector<D>]) -> usize { todo!("shape::bspline") }
+
+/// Knot `k` (cell units) of the clamped uniform knot vector of degree `p` on `cells` cells.
+fn knot(k: usize, p: usize, cells: usize) -> f64 {
+    (k as f64 - p as f64).clamp(0.0, cells as f64)
+}
+
+/// num / den with the B-spline convention 0/0 = 0 (repeated knots).
+fn ratio(num: f64, den: f64) -> f64 {
+    if den == 0.0 {
+        0.0
+    } else {
+        num / den
+    }
+}
+
+/// The p + 1 basis functions that are nonzero on the knot span of `xi` (cell units),
+/// with their derivatives per cell; a point on the max face uses the last span.
+fn basis(xi: f64, p: usize, cells: usize) -> AxisFactors {
+    let first = cell_index(xi, cells);
+    let u = |k: usize| knot(k, p, cells);
+    // At degree q, value[r] = N_{first+p−q+r, q}(xi), r = 0..=q (Cox–de Boor, NURBS Book 2.5).
+    let mut value = [1.0, 0.0, 0.0, 0.0];
+    let mut lower = value;
+    for q in 1..=p {
+        lower = value;
+        for r in 0..=q {
+            let i = first + p - q + r;
+            let rising = if r > 0 {
+                ratio(xi - u(i), u(i + q) - u(i)) * lower[r - 1]
+            } else {
+                0.0
+            };
+            let falling = if r < q {
+                ratio(u(i + q + 1) - xi, u(i + q + 1) - u(i + 1)) * lower[r]
+            } else {
+                0.0
+            };
+            value[r] = rising + falling;
+        }
+    }
+    // N'_{i,p} = p N_{i,p−1}/(u_{i+p} − u_i) − p N_{i+1,p−1}/(u_{i+p+1} − u_{i+1}) (NURBS Book 2.7).
+    let mut slope = [0.0; MAX_PER_AXIS];
+    for (r, s) in slope.iter_mut().enumerate().take(p + 1) {
+        let i = first + r;
+        let from_left = if r > 0 {
+            ratio(lower[r - 1], u(i + p) - u(i))
+        } else {
+            0.0
+        };
+        let from_right = if r < p {
+            ratio(lower[r], u(i + p + 1) - u(i + 1))
+        } else {
+            0.0
+        };
+        *s = p as f64 * (from_left - from_right);
+    }
+    AxisFactors {
+        first,
+        count: p + 1,
+        weight: value,
+        slope,
+    }
+}
+
+/// B-spline weights and gradients of degree `degree` (1 to 3) of a particle at `x`
+/// (at most (degree + 1)^D entries).
+pub fn evaluate<const D: usize>(
+    grid: &Grid<D>,
+    x: &Vector<D>,
+    degree: usize,
+    node: &mut [u32],
+    w: &mut [f64],
+    grad: &mut [Vector<D>],
+) -> usize {
+    assert!(
+        (1..MAX_PER_AXIS).contains(&degree),
+        "B-spline degree {degree} not in 1..=3"
+    );
+    debug_assert_eq!(
+        grid.degree, degree,
+        "the grid must be laid out for this degree"
+    );
+    let axes: [AxisFactors; D] = std::array::from_fn(|d| {
+        let mut f = basis(cell_coordinate(grid, x, d), degree, grid.cells[d]);
+        // Derivatives from cell units to physical units.
+        f.slope.iter_mut().for_each(|s| *s /= grid.h[d]);
+        f
+    });
+    tensor_product(grid, &axes, node, w, grad)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shape::linear;
+    use crate::shape::tests::*;
+
+    fn eval<const D: usize>(g: &Grid<D>, x: &Vector<D>, p: usize) -> Stencil<D> {
+        Stencil::collect((p + 1).pow(D as u32), |n, w, gr| {
+            evaluate(g, x, p, n, w, gr)
+        })
+    }
+
+    fn sum_rules<const D: usize>(p: usize) {
+        let g = test_grid::<D>(p);
+        for x in sample_points(&g, 400) {
+            let s = eval(&g, &x, p);
+            s.check_partition_of_unity(&g);
+            // Greville abscissae reproduce linear fields everywhere, faces included.
+            s.check_linear_reproduction(&g, &x, 1e-12);
+            s.check_gradient_reproduction(&g, 1e-10);
+        }
+    }
+
+    #[test]
+    fn sum_rules_2d() {
+        (1..=3).for_each(sum_rules::<2>);
+    }
+
+    #[test]
+    fn sum_rules_3d() {
+        (1..=3).for_each(sum_rules::<3>);
+    }
+
+    /// Naive recursive Cox–de Boor N_{i,q}(ξ) over the whole knot vector, the last
+    /// nonempty span closed at ξ = n; an independent check of `basis`.
+    fn naive(i: usize, q: usize, xi: f64, p: usize, n: usize) -> f64 {
+        let u = |k: usize| knot(k, p, n);
+        if q == 0 {
+            let inside = u(i) <= xi && xi < u(i + 1);
+            let at_end = xi == n as f64 && u(i) < u(i + 1) && u(i + 1) == n as f64;
+            return if inside || at_end { 1.0 } else { 0.0 };
+        }
+        ratio(xi - u(i), u(i + q) - u(i)) * naive(i, q - 1, xi, p, n)
+            + ratio(u(i + q + 1) - xi, u(i + q + 1) - u(i + 1)) * naive(i + 1, q - 1, xi, p, n)
+    }
+
+    fn naive_slope(i: usize, xi: f64, p: usize, n: usize) -> f64 {
+        let u = |k: usize| knot(k, p, n);
+        p as f64
+            * (ratio(naive(i, p - 1, xi, p, n), u(i + p) - u(i))
+                - ratio(naive(i + 1, p - 1, xi, p, n), u(i + p + 1) - u(i + 1)))
+    }
+
+    fn matches_naive_recursion<const D: usize>(p: usize) {
+        let g = test_grid::<D>(p);
+        for x in sample_points(&g, 200) {
+            let s = eval(&g, &x, p);
+            for n in 0..g.node_count() {
+                let ijk = g.node_ijk(n);
+                let xi: [f64; D] = std::array::from_fn(|d| cell_coordinate(&g, &x, d));
+                let factor = |d: usize| naive(ijk[d], p, xi[d], p, g.cells[d]);
+                let w: f64 = (0..D).map(factor).product();
+                let grad = Vector::<D>::from_fn(|d, _| {
+                    let slope = naive_slope(ijk[d], xi[d], p, g.cells[d]) / g.h[d];
+                    (0..D)
+                        .map(|e| if e == d { slope } else { factor(e) })
+                        .product()
+                });
+                assert!((s.weight_of(n) - w).abs() < 1e-12, "p {p} node {n} at {x}");
+                assert!(
+                    (s.grad_of(n) - grad).norm() * g.h_min() < 1e-10,
+                    "p {p} node {n} at {x}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn matches_naive_recursion_2d() {
+        (1..=3).for_each(matches_naive_recursion::<2>);
+    }
+
+    #[test]
+    fn matches_naive_recursion_3d() {
+        (1..=3).for_each(matches_naive_recursion::<3>);
+    }
+
+    /// Central differences away from the knots (where the p-th derivative jumps).
+    fn finite_differences<const D: usize>(p: usize) {
+        let g = test_grid::<D>(p);
+        let mut checked = 0;
+        for x in sample_points(&g, 300) {
+            let step = 1e-5 * g.h_min();
+            let inside =
+                g.contains(&x.add_scalar(-2.0 * step)) && g.contains(&x.add_scalar(2.0 * step));
+            let knot_near = (0..D).any(|d| near_integer(cell_coordinate(&g, &x, d), 3e-5));
+            if inside && !knot_near {
+                check_finite_differences(&g, &x, step, 1e-8, |y| eval(&g, y, p));
+                checked += 1;
+            }
+        }
+        assert!(checked > 50, "only {checked} checked");
+    }
+
+    #[test]
+    fn finite_differences_2d() {
+        (1..=3).for_each(finite_differences::<2>);
+    }
+
+    #[test]
+    fn finite_differences_3d() {
+        (1..=3).for_each(finite_differences::<3>);
+    }
+
+    #[test]
+    fn degree_one_is_the_hat_basis() {
+        let g = test_grid::<3>(1);
+        for x in sample_points(&g, 200) {
+            let s = eval(&g, &x, 1);
+            let hats = Stencil::collect(8, |n, w, gr| linear::evaluate(&g, &x, n, w, gr));
+            for n in 0..g.node_count() {
+                assert!((s.weight_of(n) - hats.weight_of(n)).abs() < 1e-14);
+                assert!((s.grad_of(n) - hats.grad_of(n)).norm() * g.h_min() < 1e-12);
+            }
+        }
+    }
+
+    /// Known interior values on a uniform stretch of knots: tensor products of the
+    /// 1D values `w` and per-cell derivatives `dw` on nodes `first..`, at cell
+    /// coordinate `xi` along every axis.
+    fn known_values<const D: usize>(p: usize, xi: f64, first: usize, w: &[f64], dw: &[f64]) {
+        let h = Vector::<D>::from_fn(|d, _| [0.5, 0.25, 2.0][d]);
+        let cells = [9; D];
+        let g = Grid::new(Vector::<D>::zeros(), h * 9.0, cells, p);
+        let x = h * xi;
+        let s = eval(&g, &x, p);
+        let local_count = w.len().pow(D as u32);
+        for flat in 0..local_count {
+            let local: [usize; D] = std::array::from_fn(|d| flat / w.len().pow(d as u32) % w.len());
+            let n = g.node_index(std::array::from_fn(|d| first + local[d]));
+            let weight: f64 = local.iter().map(|&k| w[k]).product();
+            let grad = Vector::<D>::from_fn(|d, _| {
+                (0..D)
+                    .map(|e| {
+                        if e == d {
+                            dw[local[e]] / h[e]
+                        } else {
+                            w[local[e]]
+                        }
+                    })
+                    .product()
+            });
+            assert!((s.weight_of(n) - weight).abs() < 1e-14, "p {p} node {n}");
+            assert!((s.grad_of(n) - grad).norm() < 1e-12, "p {p} node {n}");
+        }
+        let listed: f64 = s.w.iter().sum();
+        assert!((listed - 1.0).abs() < 1e-14);
+    }
+
+    #[test]
+    fn quadratic_at_span_centre() {
+        // Span [4, 5]: functions 4, 5, 6 have knots 2..5, 3..6, 4..7 (all simple).
+        known_values::<2>(2, 4.5, 4, &[0.125, 0.75, 0.125], &[-0.5, 0.0, 0.5]);
+        known_values::<3>(2, 4.5, 4, &[0.125, 0.75, 0.125], &[-0.5, 0.0, 0.5]);
+    }
+
+    #[test]
+    fn cubic_at_knot() {
+        // Knot 4 (span [4, 5]): functions 4, 5, 6 are centred at 3, 4, 5; function 7 starts there.
+        known_values::<2>(
+            3,
+            4.0,
+            4,
+            &[1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0, 0.0],
+            &[-0.5, 0.0, 0.5, 0.0],
+        );
+        known_values::<3>(
+            3,
+            4.0,
+            4,
+            &[1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0, 0.0],
+            &[-0.5, 0.0, 0.5, 0.0],
+        );
+    }
+
+    /// The first and last control points interpolate the faces: on the face x_d = min
+    /// only nodes with i_d = 0 carry weight (and all of it at the corner).
+    fn faces_interpolate<const D: usize>(p: usize) {
+        let g = test_grid::<D>(p);
+        for (corner, node) in [(g.min, [0; D]), (g.max, g.nodes.map(|n| n - 1))] {
+            let s = eval(&g, &corner, p);
+            assert!(
+                (s.weight_of(g.node_index(node)) - 1.0).abs() < 1e-14,
+                "p {p} corner {corner}"
+            );
+        }
+        let mut rng = Rng::new(31);
+        for _ in 0..100 {
+            let axis = rng.below(D);
+            let upper = rng.below(2) == 1;
+            let mut x = Vector::<D>::from_fn(|d, _| rng.range(g.min[d], g.max[d]));
+            x[axis] = if upper { g.max[axis] } else { g.min[axis] };
+            let s = eval(&g, &x, p);
+            let face_layer = if upper { g.nodes[axis] - 1 } else { 0 };
+            let on_face: f64 = (0..s.len())
+                .filter(|&k| g.node_ijk(s.node[k] as usize)[axis] == face_layer)
+                .map(|k| s.w[k])
+                .sum();
+            assert!(
+                (on_face - 1.0).abs() < 1e-14,
+                "p {p}: {on_face} on the face at {x}"
+            );
+        }
+    }
+
+    #[test]
+    fn faces_interpolate_2d() {
+        (1..=3).for_each(faces_interpolate::<2>);
+    }
+
+    #[test]
+    fn faces_interpolate_3d() {
+        (1..=3).for_each(faces_interpolate::<3>);
+    }
+}

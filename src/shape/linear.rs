@@ -1,4 +1,194 @@
-//! Standard MPM hat functions (placeholder, replaced on the shape branch).
+//! Standard MPM hat functions: the tensor product of the 1D hats N(ξ) = 1 − |ξ| on
+//! the cell-corner nodes of a degree-1 grid (thesis 2-55).
+//!
+//! Also home of the tensor-product assembly shared by the separable families
+//! (linear, GIMP, B-splines).
+
 use crate::dim::Vector;
 use crate::grid::Grid;
-pub fn evaluate<const D: usize>(_grid: &Grid<D>, _x: &Vector<D>, _node: &mut [u32], _w: &mut [f64], _grad: &mut [Vector<D>]) -> usize { todo!("shape::linear") }
+
+/// Most nodes a separable family touches per direction (cubic B-spline).
+pub(super) const MAX_PER_AXIS: usize = 4;
+
+/// The 1D factors of a separable shape function along one axis: nodes
+/// `first .. first + count`, their weights and derivatives (per physical length).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct AxisFactors {
+    pub first: usize,
+    pub count: usize,
+    pub weight: [f64; MAX_PER_AXIS],
+    pub slope: [f64; MAX_PER_AXIS],
+}
+
+/// Position of `x` along axis `d` in cell units, clamped to [0, cells] so that
+/// round-off at the max face cannot push it outside.
+pub(super) fn cell_coordinate<const D: usize>(grid: &Grid<D>, x: &Vector<D>, d: usize) -> f64 {
+    ((x[d] - grid.min[d]) / grid.h[d]).clamp(0.0, grid.cells[d] as f64)
+}
+
+/// Cell containing cell coordinate `xi`; a point on the max face belongs to the last cell.
+pub(super) fn cell_index(xi: f64, cells: usize) -> usize {
+    (xi.floor() as usize).min(cells - 1)
+}
+
+/// The two hats of the cell containing `xi` along axis `d`.
+fn hat_factors<const D: usize>(grid: &Grid<D>, x: &Vector<D>, d: usize) -> AxisFactors {
+    let xi = cell_coordinate(grid, x, d);
+    let cell = cell_index(xi, grid.cells[d]);
+    let t = xi - cell as f64;
+    let slope = 1.0 / grid.h[d];
+    let mut f = AxisFactors {
+        first: cell,
+        count: 2,
+        weight: [0.0; MAX_PER_AXIS],
+        slope: [0.0; MAX_PER_AXIS],
+    };
+    f.weight[..2].copy_from_slice(&[1.0 - t, t]);
+    f.slope[..2].copy_from_slice(&[-slope, slope]);
+    f
+}
+
+/// Tensor product S_I = Π_d S_d, ∂S_I/∂x_d = S'_d Π_{e≠d} S_e of per-axis factors.
+/// Skips entries whose weight and gradient are exactly zero; returns the count.
+pub(super) fn tensor_product<const D: usize>(
+    grid: &Grid<D>,
+    axes: &[AxisFactors; D],
+    node: &mut [u32],
+    w: &mut [f64],
+    grad: &mut [Vector<D>],
+) -> usize {
+    let total: usize = axes.iter().map(|a| a.count).product();
+    let mut n = 0;
+    for flat in 0..total {
+        // Local multi-index, x fastest.
+        let mut rest = flat;
+        let local: [usize; D] = std::array::from_fn(|d| {
+            let k = rest % axes[d].count;
+            rest /= axes[d].count;
+            k
+        });
+        let weight: f64 = (0..D).map(|d| axes[d].weight[local[d]]).product();
+        let gradient = Vector::<D>::from_fn(|d, _| {
+            (0..D)
+                .map(|e| {
+                    if e == d {
+                        axes[e].slope[local[e]]
+                    } else {
+                        axes[e].weight[local[e]]
+                    }
+                })
+                .product()
+        });
+        if weight == 0.0 && gradient.iter().all(|g| *g == 0.0) {
+            continue;
+        }
+        node[n] = grid.node_index(std::array::from_fn(|d| axes[d].first + local[d])) as u32;
+        w[n] = weight;
+        grad[n] = gradient;
+        n += 1;
+    }
+    n
+}
+
+/// Hat-function weights and gradients of a particle at `x` (at most 2^D entries).
+pub fn evaluate<const D: usize>(
+    grid: &Grid<D>,
+    x: &Vector<D>,
+    node: &mut [u32],
+    w: &mut [f64],
+    grad: &mut [Vector<D>],
+) -> usize {
+    debug_assert_eq!(grid.degree, 1, "hat functions live on a degree-1 grid");
+    let axes: [AxisFactors; D] = std::array::from_fn(|d| hat_factors(grid, x, d));
+    tensor_product(grid, &axes, node, w, grad)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shape::tests::*;
+
+    fn eval<const D: usize>(g: &Grid<D>, x: &Vector<D>) -> Stencil<D> {
+        Stencil::collect(1 << D, |n, w, gr| evaluate(g, x, n, w, gr))
+    }
+
+    fn sum_rules<const D: usize>() {
+        let g = test_grid::<D>(1);
+        for x in sample_points(&g, 300) {
+            let s = eval(&g, &x);
+            assert!(s.len() <= 1 << D);
+            s.check_partition_of_unity(&g);
+            s.check_linear_reproduction(&g, &x, 1e-12);
+            s.check_gradient_reproduction(&g, 1e-10);
+        }
+    }
+
+    #[test]
+    fn sum_rules_2d() {
+        sum_rules::<2>();
+    }
+
+    #[test]
+    fn sum_rules_3d() {
+        sum_rules::<3>();
+    }
+
+    /// Central differences of the weights, away from the node lines (kinks).
+    fn finite_differences<const D: usize>() {
+        let g = test_grid::<D>(1);
+        let mut checked = 0;
+        for x in sample_points(&g, 300) {
+            let step = 1e-5 * g.h_min();
+            let kink = (0..D).any(|d| near_integer(cell_coordinate(&g, &x, d), 3e-5))
+                || !g.contains(&(x.add_scalar(-2.0 * step)))
+                || !g.contains(&(x.add_scalar(2.0 * step)));
+            if kink {
+                continue;
+            }
+            check_finite_differences(&g, &x, step, 1e-8, |y| eval(&g, y));
+            checked += 1;
+        }
+        assert!(checked > 50, "only {checked} checked");
+    }
+
+    #[test]
+    fn finite_differences_2d() {
+        finite_differences::<2>();
+    }
+
+    #[test]
+    fn finite_differences_3d() {
+        finite_differences::<3>();
+    }
+
+    #[test]
+    fn max_face_uses_last_cell() {
+        let g = test_grid::<3>(1);
+        let s = eval(&g, &g.max);
+        let last = g.node_index(std::array::from_fn(|d| g.nodes[d] - 1));
+        assert!((s.weight_of(last) - 1.0).abs() < 1e-12);
+        // The corner node and its neighbours in the last cell, nothing outside the grid.
+        assert!(s.nodes().iter().all(|&n| (n as usize) < g.node_count()));
+        s.check_partition_of_unity(&g);
+        s.check_gradient_reproduction(&g, 1e-10);
+    }
+
+    #[test]
+    fn known_bilinear_values() {
+        let g = test_grid::<2>(1);
+        // A quarter of the way across cell (1, 2) in x, three quarters in y.
+        let x = Vector::<2>::new(g.min[0] + 1.25 * g.h[0], g.min[1] + 2.75 * g.h[1]);
+        let s = eval(&g, &x);
+        let expect = [
+            ([1, 2], 0.75 * 0.25),
+            ([2, 2], 0.25 * 0.25),
+            ([1, 3], 0.75 * 0.75),
+            ([2, 3], 0.25 * 0.75),
+        ];
+        for (ijk, v) in expect {
+            assert!((s.weight_of(g.node_index(ijk)) - v).abs() < 1e-14);
+        }
+        let gx = s.grad_of(g.node_index([1, 2]));
+        assert!((gx[0] + 0.25 / g.h[0]).abs() < 1e-12 && (gx[1] + 0.75 / g.h[1]).abs() < 1e-12);
+    }
+}

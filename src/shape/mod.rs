@@ -142,3 +142,283 @@ impl<const D: usize> Stencils<D> {
         p * self.stride..p * self.stride + self.count[p] as usize
     }
 }
+
+#[cfg(test)]
+pub(crate) mod tests {
+    //! Helpers shared by the shape-function tests of every family, and checks across
+    //! families through the `ShapeFunction` dispatch.
+
+    use super::*;
+
+    /// Small deterministic generator (SplitMix64), so tests need no extra crate.
+    pub(crate) struct Rng(u64);
+
+    impl Rng {
+        pub(crate) fn new(seed: u64) -> Self {
+            Rng(seed)
+        }
+
+        fn next_u64(&mut self) -> u64 {
+            self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = self.0;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            z ^ (z >> 31)
+        }
+
+        /// Uniform in [0, 1).
+        pub(crate) fn unit(&mut self) -> f64 {
+            (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+        }
+
+        /// Uniform in [lo, hi).
+        pub(crate) fn range(&mut self, lo: f64, hi: f64) -> f64 {
+            lo + (hi - lo) * self.unit()
+        }
+
+        pub(crate) fn below(&mut self, n: usize) -> usize {
+            (self.next_u64() % n as u64) as usize
+        }
+    }
+
+    /// A grid with unequal cell sizes, an offset origin and few cells, for `degree`.
+    pub(crate) fn test_grid<const D: usize>(degree: usize) -> Grid<D> {
+        let min = Vector::<D>::from_fn(|d, _| [-1.0, 0.5, 2.0][d]);
+        let cells: [usize; D] = std::array::from_fn(|d| [6, 5, 4][d]);
+        let h = [0.3, 0.45, 0.25];
+        let max = Vector::<D>::from_fn(|d, _| min[d] + cells[d] as f64 * h[d]);
+        Grid::new(min, max, cells, degree)
+    }
+
+    /// One coordinate along axis d: random interior, exactly on a face, on a node
+    /// line, just inside a face, or just either side of a cell boundary.
+    pub(crate) fn sample_coordinate<const D: usize>(g: &Grid<D>, d: usize, rng: &mut Rng) -> f64 {
+        let (lo, hi, h) = (g.min[d], g.max[d], g.h[d]);
+        let line = lo + h * rng.below(g.cells[d] + 1) as f64;
+        let x = match rng.below(16) {
+            0 => lo,
+            1 => hi,
+            2 => line,
+            3 => lo + 1e-9 * h,
+            4 => hi - 1e-9 * h,
+            5 => line + 1e-7 * h * (rng.unit() - 0.5),
+            _ => rng.range(lo, hi),
+        };
+        x.clamp(lo, hi)
+    }
+
+    /// Deterministic particle positions over the closed grid box.
+    pub(crate) fn sample_points<const D: usize>(g: &Grid<D>, n: usize) -> Vec<Vector<D>> {
+        let mut rng = Rng::new(0x5EED + D as u64);
+        (0..n)
+            .map(|_| Vector::<D>::from_fn(|d, _| sample_coordinate(g, d, &mut rng)))
+            .collect()
+    }
+
+    /// Is `t` within `tol` of an integer?
+    pub(crate) fn near_integer(t: f64, tol: f64) -> bool {
+        (t - t.round()).abs() < tol
+    }
+
+    /// The entries one particle's evaluation wrote.
+    #[derive(Clone, Debug)]
+    pub(crate) struct Stencil<const D: usize> {
+        pub node: Vec<u32>,
+        pub w: Vec<f64>,
+        pub grad: Vec<Vector<D>>,
+    }
+
+    impl<const D: usize> Stencil<D> {
+        /// Run `eval` on output slices of exactly `capacity` entries (an overflow panics).
+        pub(crate) fn collect(
+            capacity: usize,
+            eval: impl FnOnce(&mut [u32], &mut [f64], &mut [Vector<D>]) -> usize,
+        ) -> Self {
+            let mut node = vec![u32::MAX; capacity];
+            let mut w = vec![f64::NAN; capacity];
+            let mut grad = vec![Vector::<D>::repeat(f64::NAN); capacity];
+            let n = eval(&mut node, &mut w, &mut grad);
+            assert!(n <= capacity, "wrote {n} entries into {capacity}");
+            node.truncate(n);
+            w.truncate(n);
+            grad.truncate(n);
+            Stencil { node, w, grad }
+        }
+
+        pub(crate) fn len(&self) -> usize {
+            self.node.len()
+        }
+
+        pub(crate) fn nodes(&self) -> &[u32] {
+            &self.node
+        }
+
+        pub(crate) fn weight_of(&self, n: usize) -> f64 {
+            self.node
+                .iter()
+                .zip(&self.w)
+                .filter(|(k, _)| **k as usize == n)
+                .map(|(_, w)| *w)
+                .sum()
+        }
+
+        pub(crate) fn grad_of(&self, n: usize) -> Vector<D> {
+            self.node
+                .iter()
+                .zip(&self.grad)
+                .filter(|(k, _)| **k as usize == n)
+                .map(|(_, g)| *g)
+                .sum()
+        }
+
+        /// Σ S_I = 1 (1e-12) and Σ ∇S_I = 0 (1e-10 / h); also checks the entries are
+        /// finite, inside the grid, non-trivial and on distinct nodes.
+        pub(crate) fn check_partition_of_unity(&self, g: &Grid<D>) {
+            self.check_entries(g);
+            let sum: f64 = self.w.iter().sum();
+            assert!((sum - 1.0).abs() < 1e-12, "Σ S = {sum}");
+            let grad: Vector<D> = self.grad.iter().sum();
+            assert!(grad.norm() * g.h_min() < 1e-10, "Σ ∇S = {grad}");
+        }
+
+        pub(crate) fn check_entries(&self, g: &Grid<D>) {
+            let mut seen = self.node.clone();
+            seen.sort_unstable();
+            seen.dedup();
+            assert_eq!(seen.len(), self.len(), "duplicate nodes {:?}", self.node);
+            assert!(self.node.iter().all(|&n| (n as usize) < g.node_count()));
+            for (w, gr) in self.w.iter().zip(&self.grad) {
+                assert!(w.is_finite() && gr.iter().all(|c| c.is_finite()));
+                assert!(*w != 0.0 || gr.iter().any(|c| *c != 0.0), "all-zero entry");
+            }
+        }
+
+        /// Σ S_I X_I = x.
+        pub(crate) fn check_linear_reproduction(&self, g: &Grid<D>, x: &Vector<D>, tol: f64) {
+            let xr: Vector<D> = self
+                .node
+                .iter()
+                .zip(&self.w)
+                .map(|(n, w)| g.node_position(g.node_ijk(*n as usize)) * *w)
+                .sum();
+            assert!(
+                (xr - x).norm() < tol * g.max.abs().max().max(1.0),
+                "Σ S X = {xr} ≠ {x}"
+            );
+        }
+
+        /// Σ ∇S_I ⊗ X_I = I.
+        pub(crate) fn check_gradient_reproduction(&self, g: &Grid<D>, tol: f64) {
+            let m: Tensor<D> = self
+                .node
+                .iter()
+                .zip(&self.grad)
+                .map(|(n, gr)| gr * g.node_position(g.node_ijk(*n as usize)).transpose())
+                .sum();
+            assert!((m - Tensor::<D>::identity()).norm() < tol, "Σ ∇S ⊗ X = {m}");
+        }
+    }
+
+    /// Central differences of the weights against the gradients at `x`:
+    /// |ΔS/Δx_d − ∂S/∂x_d| < tol / h_min for every node touched at x or x ± step e_d.
+    pub(crate) fn check_finite_differences<const D: usize>(
+        g: &Grid<D>,
+        x: &Vector<D>,
+        step: f64,
+        tol: f64,
+        eval: impl Fn(&Vector<D>) -> Stencil<D>,
+    ) {
+        let here = eval(x);
+        for d in 0..D {
+            let (mut xp, mut xm) = (*x, *x);
+            xp[d] += step;
+            xm[d] -= step;
+            let (plus, minus) = (eval(&xp), eval(&xm));
+            let nodes = here.nodes().iter().chain(plus.nodes()).chain(minus.nodes());
+            for &n in nodes {
+                let n = n as usize;
+                let fd = (plus.weight_of(n) - minus.weight_of(n)) / (2.0 * step);
+                let exact = here.grad_of(n)[d];
+                assert!(
+                    (fd - exact).abs() * g.h_min() < tol,
+                    "node {n} axis {d}: fd {fd} vs {exact} at {x}"
+                );
+            }
+        }
+    }
+
+    const FAMILIES: [ShapeFunction; 6] = [
+        ShapeFunction::Linear,
+        ShapeFunction::Ugimp,
+        ShapeFunction::Cpgimp,
+        ShapeFunction::Cpdi,
+        ShapeFunction::Bspline2,
+        ShapeFunction::Bspline3,
+    ];
+
+    /// A deformation gradient with rotation, shear and stretch, scaled so that the
+    /// CPDI domain r = F diag(h/4) reaches at most `reach` cell sizes from the
+    /// particle along each axis (Σ_i |r_di| ≤ reach h_d).
+    fn random_deformation<const D: usize>(rng: &mut Rng, h: &Vector<D>, reach: f64) -> Mat3 {
+        let mut f = Mat3::identity();
+        for i in 0..D {
+            for j in 0..D {
+                f[(i, j)] = if i == j {
+                    rng.range(0.3, 4.0)
+                } else {
+                    rng.range(-3.0, 3.0)
+                };
+            }
+        }
+        let half0 = h / 4.0;
+        let r: Tensor<D> = restrict::<D>(&f) * Tensor::<D>::from_diagonal(&half0);
+        let worst = (0..D)
+            .map(|d| (0..D).map(|i| r[(d, i)].abs()).sum::<f64>() / h[d])
+            .fold(0.0, f64::max);
+        let scale = reach / worst;
+        for i in 0..D {
+            for j in 0..D {
+                f[(i, j)] *= scale;
+            }
+        }
+        f
+    }
+
+    /// Every family, through the dispatch, never writes more than `max_support`
+    /// entries and keeps the partition of unity; CPDI with sheared, rotated domains
+    /// stretched until they reach one cell size from the particle.
+    fn all_families_respect_max_support<const D: usize>() {
+        let mut rng = Rng::new(77);
+        for shape in FAMILIES {
+            let g = test_grid::<D>(shape.degree());
+            let cap = shape.max_support(D);
+            for x in sample_points(&g, 400) {
+                let reach = if rng.below(4) == 0 {
+                    1.0
+                } else {
+                    rng.range(0.05, 1.0)
+                };
+                let mut f = random_deformation::<D>(&mut rng, &g.h, reach);
+                if shape == ShapeFunction::Cpgimp {
+                    // cpGIMP needs 2·half ≤ h, i.e. F_dd ≤ 2 for half0 = h/4.
+                    let widest = (0..D).map(|d| f[(d, d)]).fold(0.0, f64::max);
+                    f *= 2.0 * reach / widest;
+                }
+                let half0 = g.h / 4.0;
+                let s =
+                    Stencil::collect(cap, |n, w, gr| shape.evaluate(&g, &x, &half0, &f, n, w, gr));
+                s.check_partition_of_unity(&g);
+            }
+        }
+    }
+
+    #[test]
+    fn all_families_respect_max_support_2d() {
+        all_families_respect_max_support::<2>();
+    }
+
+    #[test]
+    fn all_families_respect_max_support_3d() {
+        all_families_respect_max_support::<3>();
+    }
+}
