@@ -1,1 +1,116 @@
-fn main(){}
+//! P2G and G2P kernels per shape function, 2D and 3D. Throughput is reported in
+//! particles per second (criterion's "elements").
+//!
+//! P2G = shape-function evaluation + active-node map + nodal mass, momentum and
+//! force. G2P = interpolation of nodal velocity and acceleration to particles and
+//! the velocity gradient (what the explicit step does per particle).
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use mpm::dim::{Mat3, Tensor, Vector};
+use mpm::grid::Grid;
+use mpm::particles::Particles;
+use mpm::shape::{ShapeFunction, Stencils};
+use mpm::transfer::{gradient, interpolate, mass_momentum, nodal_force, NodeMap};
+use rayon::prelude::*;
+
+const SHAPES: [ShapeFunction; 6] = [
+    ShapeFunction::Linear,
+    ShapeFunction::Ugimp,
+    ShapeFunction::Cpgimp,
+    ShapeFunction::Cpdi,
+    ShapeFunction::Bspline2,
+    ShapeFunction::Bspline3,
+];
+
+/// A block of particles, 2 per cell direction, filling the inner half of a grid of
+/// `n` cells per direction, slightly sheared so that CPDI domains are not axis-aligned.
+fn setup<const D: usize>(n: usize, shape: ShapeFunction) -> (Grid<D>, Particles<D>) {
+    let grid = Grid::<D>::new(
+        Vector::<D>::zeros(),
+        Vector::<D>::repeat(1.0),
+        [n; D],
+        shape.degree(),
+    );
+    let mut p = Particles::<D>::default();
+    let h = 1.0 / n as f64;
+    let per_dir = n; // 2 per cell over half the grid
+    let total = per_dir.pow(D as u32);
+    for k in 0..total {
+        let mut rem = k;
+        let x = Vector::<D>::from_fn(|_, _| {
+            let i = rem % per_dir;
+            rem /= per_dir;
+            0.25 + (i as f64 + 0.5) * h / 2.0
+        });
+        p.push(
+            x,
+            Vector::<D>::repeat(0.1),
+            1.0,
+            (h / 2.0).powi(D as i32),
+            Vector::<D>::repeat(h / 4.0),
+            0,
+            0,
+            0,
+        );
+    }
+    for f in p.f.iter_mut() {
+        *f = Mat3::identity();
+        f[(0, 1)] = 0.1;
+    }
+    for s in p.stress.iter_mut() {
+        *s = Mat3::new(1.0, 0.2, 0.0, 0.2, -1.0, 0.0, 0.0, 0.0, 0.5);
+    }
+    (grid, p)
+}
+
+fn bench_dim<const D: usize>(c: &mut Criterion, n: usize) {
+    let mut group = c.benchmark_group(format!("transfer_{D}d"));
+    group.sample_size(10);
+    for shape in SHAPES {
+        let (grid, p) = setup::<D>(n, shape);
+        group.throughput(Throughput::Elements(p.len() as u64));
+        let mut st = Stencils::<D>::default();
+        let mut map = NodeMap::default();
+        let gravity = Vector::<D>::zeros();
+        group.bench_with_input(
+            BenchmarkId::new("p2g", shape.name()),
+            &shape,
+            |b, &shape| {
+                b.iter(|| {
+                    st.compute(shape, &grid, &p.x, &p.half_length0, &p.f);
+                    map.build(&st, grid.node_count());
+                    let (m, mv) = mass_momentum(&map, &st, &p);
+                    let f = nodal_force(&map, &st, &p, &gravity, &|_| 0.0);
+                    (m.len(), mv.len(), f.len())
+                })
+            },
+        );
+        st.compute(shape, &grid, &p.x, &p.half_length0, &p.f);
+        map.build(&st, grid.node_count());
+        let nodal: Vec<Vector<D>> = (0..map.len())
+            .map(|a| Vector::<D>::repeat(a as f64 * 1e-3))
+            .collect();
+        group.bench_with_input(BenchmarkId::new("g2p", shape.name()), &shape, |b, _| {
+            b.iter(|| {
+                (0..p.len())
+                    .into_par_iter()
+                    .map(|q| {
+                        let v = interpolate(&map, &st, q, &nodal);
+                        let a = interpolate(&map, &st, q, &nodal);
+                        let l: Tensor<D> = gradient(&map, &st, q, &nodal);
+                        v.sum() + a.sum() + l.trace()
+                    })
+                    .sum::<f64>()
+            })
+        });
+    }
+    group.finish();
+}
+
+fn transfer(c: &mut Criterion) {
+    bench_dim::<2>(c, 256); // 65,536 particles
+    bench_dim::<3>(c, 40); // 64,000 particles
+}
+
+criterion_group!(benches, transfer);
+criterion_main!(benches);

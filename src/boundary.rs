@@ -14,7 +14,10 @@ pub struct Constraint<const D: usize> {
 
 impl<const D: usize> Constraint<D> {
     pub fn free() -> Self {
-        Constraint { fixed: [false; D], value: Vector::<D>::zeros() }
+        Constraint {
+            fixed: [false; D],
+            value: Vector::<D>::zeros(),
+        }
     }
 
     pub fn set(&mut self, d: usize, v: f64) {
@@ -53,7 +56,11 @@ pub struct FaceCondition<const D: usize> {
 
 /// The combined constraint of node `node` from all face conditions (a corner node
 /// collects the components of every face it lies on).
-pub fn node_constraint<const D: usize>(grid: &Grid<D>, faces: &[FaceCondition<D>], node: usize) -> Constraint<D> {
+pub fn node_constraint<const D: usize>(
+    grid: &Grid<D>,
+    faces: &[FaceCondition<D>],
+    node: usize,
+) -> Constraint<D> {
     let ijk = grid.node_ijk(node);
     let mut c = Constraint::free();
     for fc in faces.iter().filter(|fc| grid.on_face(ijk, fc.face)) {

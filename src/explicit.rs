@@ -8,7 +8,9 @@ use crate::material::Increment;
 use crate::scene::{Scheme, SolverConfig};
 use crate::setup::Model;
 use crate::shape::{ShapeFunction, Stencils};
-use crate::transfer::{deterministic_sum, gradient, interpolate, mass_momentum, nodal_force, NodeMap};
+use crate::transfer::{
+    deterministic_sum, gradient, interpolate, mass_momentum, nodal_force, NodeMap,
+};
 use rayon::prelude::*;
 
 /// Nodes lighter than this fraction of the lightest particle are treated as empty
@@ -26,7 +28,11 @@ pub struct Divergence {
 
 impl std::fmt::Display for Divergence {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "diverged at step {} (t = {:.6e}): particle {} {}", self.step, self.time, self.particle, self.message)
+        write!(
+            f,
+            "diverged at step {} (t = {:.6e}): particle {} {}",
+            self.step, self.time, self.particle, self.message
+        )
     }
 }
 
@@ -75,18 +81,29 @@ impl<const D: usize> Explicit<D> {
 
     /// The step to take now: the fixed one, or cfl × the critical one.
     pub fn dt(&self, m: &Model<D>) -> f64 {
-        self.fixed_dt.unwrap_or_else(|| self.cfl * Self::critical_dt(m))
+        self.fixed_dt
+            .unwrap_or_else(|| self.cfl * Self::critical_dt(m))
     }
 
     /// Advance the model from t to t + dt. Returns the work done by gravity and
     /// applied loads over the step.
-    pub fn step(&mut self, m: &mut Model<D>, t: f64, dt: f64, step: usize) -> Result<f64, Divergence> {
+    pub fn step(
+        &mut self,
+        m: &mut Model<D>,
+        t: f64,
+        dt: f64,
+        step: usize,
+    ) -> Result<f64, Divergence> {
         let p = &m.particles;
-        self.stencils.compute(self.shape, &m.grid, &p.x, &p.half_length0, &p.f);
+        self.stencils
+            .compute(self.shape, &m.grid, &p.x, &p.half_length0, &p.f);
         self.map.build(&self.stencils, m.grid.node_count());
         let (st, map) = (&self.stencils, &self.map);
-        let constraint: Vec<Constraint<D>> =
-            map.active.par_iter().map(|&g| node_constraint(&m.grid, &m.faces, g as usize)).collect();
+        let constraint: Vec<Constraint<D>> = map
+            .active
+            .par_iter()
+            .map(|&g| node_constraint(&m.grid, &m.faces, g as usize))
+            .collect();
         let tiny = TINY_MASS_FRACTION * p.mass.iter().cloned().fold(f64::INFINITY, f64::min);
 
         // Nodal velocity at the start of the step, with the conditions applied.
@@ -112,7 +129,10 @@ impl<const D: usize> Explicit<D> {
                 }
                 let mut f = force[a];
                 for d in 0..D {
-                    f[d] -= self.damping * f[d].abs() * velocity[a][d].signum() * (velocity[a][d] != 0.0) as u8 as f64;
+                    f[d] -= self.damping
+                        * f[d].abs()
+                        * velocity[a][d].signum()
+                        * (velocity[a][d] != 0.0) as u8 as f64;
                 }
                 let mut acc = f / mass[a];
                 // Prescribed components: the acceleration that lands on the value.
@@ -125,20 +145,32 @@ impl<const D: usize> Explicit<D> {
                 acc
             })
             .collect();
-        let raw_velocity: Vec<Vector<D>> =
-            (0..map.len()).map(|a| if mass[a] > tiny { momentum[a] / mass[a] } else { Vector::<D>::zeros() }).collect();
-        let velocity_new: Vec<Vector<D>> = (0..map.len()).map(|a| raw_velocity[a] + accel[a] * dt).collect();
+        let raw_velocity: Vec<Vector<D>> = (0..map.len())
+            .map(|a| {
+                if mass[a] > tiny {
+                    momentum[a] / mass[a]
+                } else {
+                    Vector::<D>::zeros()
+                }
+            })
+            .collect();
+        let velocity_new: Vec<Vector<D>> = (0..map.len())
+            .map(|a| raw_velocity[a] + accel[a] * dt)
+            .collect();
 
         // G2P: particle velocity (PIC/FLIP blend, 2-27) and position (2-26).
         let flip = self.flip;
         let mp = &mut m.particles;
         let old_v = mp.v.clone();
-        mp.v.par_iter_mut().zip(mp.x.par_iter_mut()).enumerate().for_each(|(q, (v, x))| {
-            let v_flip = *v + interpolate(map, st, q, &accel) * dt;
-            let v_pic = interpolate(map, st, q, &velocity_new);
-            *v = v_flip * flip + v_pic * (1.0 - flip);
-            *x += v_pic * dt;
-        });
+        mp.v.par_iter_mut()
+            .zip(mp.x.par_iter_mut())
+            .enumerate()
+            .for_each(|(q, (v, x))| {
+                let v_flip = *v + interpolate(map, st, q, &accel) * dt;
+                let v_pic = interpolate(map, st, q, &velocity_new);
+                *v = v_flip * flip + v_pic * (1.0 - flip);
+                *x += v_pic * dt;
+            });
         let p = &m.particles;
         let work = dt
             * deterministic_sum(p.len(), |q| {
@@ -162,10 +194,19 @@ impl<const D: usize> Explicit<D> {
 }
 
 /// v_I = p_I / m_I with prescribed components imposed; empty nodes at rest.
-fn nodal_velocity<const D: usize>(mass: &[f64], momentum: &[Vector<D>], c: &[Constraint<D>], tiny: f64) -> Vec<Vector<D>> {
+fn nodal_velocity<const D: usize>(
+    mass: &[f64],
+    momentum: &[Vector<D>],
+    c: &[Constraint<D>],
+    tiny: f64,
+) -> Vec<Vector<D>> {
     (0..mass.len())
         .map(|a| {
-            let mut v = if mass[a] > tiny { momentum[a] / mass[a] } else { Vector::<D>::zeros() };
+            let mut v = if mass[a] > tiny {
+                momentum[a] / mass[a]
+            } else {
+                Vector::<D>::zeros()
+            };
             c[a].apply_velocity(&mut v);
             v
         })
@@ -188,25 +229,34 @@ fn update_stress<const D: usize>(
     let history_data_old = p.history.data.clone();
     let history_old = p.history.slots(&history_data_old);
     let mut history = p.history.split_mut();
-    let inverted = p
-        .f
-        .par_iter_mut()
-        .zip(p.stress.par_iter_mut())
-        .zip(p.volume.par_iter_mut())
-        .zip(history.par_iter_mut())
-        .enumerate()
-        .map(|(q, (((f, stress), volume), hist))| {
-            let l: Tensor<D> = gradient(map, st, q, velocity);
-            let df = embed_deformation::<D>(&(Tensor::<D>::identity() + l * dt));
-            let inc = Increment { f_old: *f, df, dt, stress_old: *stress, history_old: history_old[q] };
-            *stress = materials[p.material[q] as usize].update(&inc, hist);
-            *f = df * *f;
-            let j = f.determinant();
-            *volume = j * p.volume0[q];
-            if j > 0.0 { usize::MAX } else { q }
-        })
-        .min()
-        .unwrap_or(usize::MAX);
+    let inverted =
+        p.f.par_iter_mut()
+            .zip(p.stress.par_iter_mut())
+            .zip(p.volume.par_iter_mut())
+            .zip(history.par_iter_mut())
+            .enumerate()
+            .map(|(q, (((f, stress), volume), hist))| {
+                let l: Tensor<D> = gradient(map, st, q, velocity);
+                let df = embed_deformation::<D>(&(Tensor::<D>::identity() + l * dt));
+                let inc = Increment {
+                    f_old: *f,
+                    df,
+                    dt,
+                    stress_old: *stress,
+                    history_old: history_old[q],
+                };
+                *stress = materials[p.material[q] as usize].update(&inc, hist);
+                *f = df * *f;
+                let j = f.determinant();
+                *volume = j * p.volume0[q];
+                if j > 0.0 {
+                    usize::MAX
+                } else {
+                    q
+                }
+            })
+            .min()
+            .unwrap_or(usize::MAX);
     if inverted != usize::MAX {
         return Err(Divergence {
             step: step + 1,
@@ -230,9 +280,17 @@ pub fn check_state<const D: usize>(m: &Model<D>, step: usize, time: f64) -> Resu
     match bad {
         None => Ok(()),
         Some(q) => {
-            let finite = p.x[q].iter().chain(p.v[q].iter()).chain(p.stress[q].iter()).all(|v| v.is_finite());
+            let finite = p.x[q]
+                .iter()
+                .chain(p.v[q].iter())
+                .chain(p.stress[q].iter())
+                .all(|v| v.is_finite());
             let message = if finite {
-                format!("(body {}) left the grid: x = {:?}", p.body[q], p.x[q].as_slice())
+                format!(
+                    "(body {}) left the grid: x = {:?}",
+                    p.body[q],
+                    p.x[q].as_slice()
+                )
             } else {
                 format!(
                     "(body {}) has a non-finite state: x = {:?}, v = {:?}",
@@ -241,7 +299,12 @@ pub fn check_state<const D: usize>(m: &Model<D>, step: usize, time: f64) -> Resu
                     p.v[q].as_slice()
                 )
             };
-            Err(Divergence { step, time, particle: q, message })
+            Err(Divergence {
+                step,
+                time,
+                particle: q,
+                message,
+            })
         }
     }
 }

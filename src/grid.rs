@@ -47,7 +47,11 @@ impl Face {
     }
 
     pub fn name(&self) -> String {
-        format!("{}{}", ["x", "y", "z"][self.axis], if self.upper { "max" } else { "min" })
+        format!(
+            "{}{}",
+            ["x", "y", "z"][self.axis],
+            if self.upper { "max" } else { "min" }
+        )
     }
 }
 
@@ -55,7 +59,14 @@ impl<const D: usize> Grid<D> {
     pub fn new(min: Vector<D>, max: Vector<D>, cells: [usize; D], degree: usize) -> Self {
         let h = Vector::<D>::from_fn(|d, _| (max[d] - min[d]) / cells[d] as f64);
         let nodes = std::array::from_fn(|d| cells[d] + degree);
-        Grid { min, max, cells, h, degree, nodes }
+        Grid {
+            min,
+            max,
+            cells,
+            h,
+            degree,
+            nodes,
+        }
     }
 
     pub fn node_count(&self) -> usize {
@@ -84,7 +95,9 @@ impl<const D: usize> Grid<D> {
     /// Position of a node: the cell corner for degree 1, the Greville abscissa of the
     /// control point for B-splines (the point it "belongs" to; Σ N_I x_I = x holds).
     pub fn node_position(&self, ijk: [usize; D]) -> Vector<D> {
-        Vector::<D>::from_fn(|d, _| self.min[d] + self.h[d] * greville(ijk[d], self.degree, self.cells[d]))
+        Vector::<D>::from_fn(|d, _| {
+            self.min[d] + self.h[d] * greville(ijk[d], self.degree, self.cells[d])
+        })
     }
 
     /// Is node `ijk` on `face`?
@@ -149,9 +162,21 @@ mod tests {
 
     #[test]
     fn faces_parse() {
-        assert_eq!(Face::parse("ymax", 2), Some(Face { axis: 1, upper: true }));
+        assert_eq!(
+            Face::parse("ymax", 2),
+            Some(Face {
+                axis: 1,
+                upper: true
+            })
+        );
         assert_eq!(Face::parse("zmin", 2), None);
-        assert_eq!(Face::parse("zmin", 3), Some(Face { axis: 2, upper: false }));
+        assert_eq!(
+            Face::parse("zmin", 3),
+            Some(Face {
+                axis: 2,
+                upper: false
+            })
+        );
         assert_eq!(Face::parse("xmid", 3), None);
     }
 }

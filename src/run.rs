@@ -4,7 +4,9 @@
 //! records what happened where.
 
 use crate::explicit::{check_state, Divergence, Explicit};
-use crate::output::{body_centres, write_json, write_particles_csv, FrameWriter, HistoryWriter, Progress};
+use crate::output::{
+    body_centres, write_json, write_particles_csv, FrameWriter, HistoryWriter, Progress,
+};
 use crate::scene::{Scene, SceneError};
 use crate::setup::Model;
 use crate::transfer::deterministic_sum;
@@ -64,7 +66,11 @@ pub fn strain_energy<const D: usize>(m: &Model<D>) -> f64 {
     })
 }
 
-fn run_dim<const D: usize>(scene: &Scene, out: &Path, opts: &RunOptions) -> Result<RunSummary, RunError> {
+fn run_dim<const D: usize>(
+    scene: &Scene,
+    out: &Path,
+    opts: &RunOptions,
+) -> Result<RunSummary, RunError> {
     let cfg = &scene.config;
     let mut model = Model::<D>::build(scene)?;
     let mut solver = Explicit::<D>::new(cfg.grid.shape_function, &cfg.solver);
@@ -84,25 +90,33 @@ fn run_dim<const D: usize>(scene: &Scene, out: &Path, opts: &RunOptions) -> Resu
     let mut last_dt = 0.0;
     // Write a history row and a frame when they are due (or forced, at the start and
     // the end), never twice at the same time.
-    let mut record = |model: &Model<D>, t: f64, external_work: f64, force: bool| -> std::io::Result<()> {
-        if (force || t >= next_history) && t != last_history {
-            last_history = t;
-            let (com, vcom) = body_centres(&model.particles, n_bodies);
-            history.write_row(t, kinetic_energy(model), strain_energy(model), external_work, &com, &vcom)?;
-            history.flush()?;
-            next_history = t + cfg.output.history_interval;
-        }
-        if let Some(interval) = frame_interval {
-            if (force || t >= next_frame - 1e-12 * end_time) && t != last_frame {
-                last_frame = t;
-                frames.write_frame(t, &model.particles, &[])?;
-                while next_frame <= t + 1e-12 * end_time {
-                    next_frame += interval;
+    let mut record =
+        |model: &Model<D>, t: f64, external_work: f64, force: bool| -> std::io::Result<()> {
+            if (force || t >= next_history) && t != last_history {
+                last_history = t;
+                let (com, vcom) = body_centres(&model.particles, n_bodies);
+                history.write_row(
+                    t,
+                    kinetic_energy(model),
+                    strain_energy(model),
+                    external_work,
+                    &com,
+                    &vcom,
+                )?;
+                history.flush()?;
+                next_history = t + cfg.output.history_interval;
+            }
+            if let Some(interval) = frame_interval {
+                if (force || t >= next_frame - 1e-12 * end_time) && t != last_frame {
+                    last_frame = t;
+                    frames.write_frame(t, &model.particles, &[])?;
+                    while next_frame <= t + 1e-12 * end_time {
+                        next_frame += interval;
+                    }
                 }
             }
-        }
-        Ok(())
-    };
+            Ok(())
+        };
     record(&model, t, external_work, true)?;
     let outcome: Result<(), Divergence> = loop {
         if t >= end_time * (1.0 - 1e-12) {
@@ -148,10 +162,20 @@ fn run_dim<const D: usize>(scene: &Scene, out: &Path, opts: &RunOptions) -> Resu
         summary["diverged_step"] = json!(d.step);
         summary["diverged_particle"] = json!(d.particle);
         write_json(&out.join("summary.json"), &summary)?;
-        return Err(RunError::Diverged(format!("{}: {d}; outputs written so far are in {}", scene.file, out.display())));
+        return Err(RunError::Diverged(format!(
+            "{}: {d}; outputs written so far are in {}",
+            scene.file,
+            out.display()
+        )));
     }
     record(&model, t, external_work, true)?;
     write_particles_csv(&out.join("particles_final.csv"), &model.particles)?;
     write_json(&out.join("summary.json"), &summary)?;
-    Ok(RunSummary { steps: step, end_time: t, particles, wall_seconds: wall, json: summary })
+    Ok(RunSummary {
+        steps: step,
+        end_time: t,
+        particles,
+        wall_seconds: wall,
+        json: summary,
+    })
 }

@@ -7,7 +7,9 @@ use crate::grid::{Face, Grid};
 use crate::material::{LinearElastic, Material, MooneyRivlin, NeoHookean};
 use crate::particles::Particles;
 use crate::scene::validate::{axis, body_bounds};
-use crate::scene::{expr, BodyConfig, Condition, LoadKind, MaterialConfig, MaterialModel, Scene, SceneError, Shape};
+use crate::scene::{
+    expr, BodyConfig, Condition, LoadKind, MaterialConfig, MaterialModel, Scene, SceneError, Shape,
+};
 
 /// Everything a solver needs, in dimension D.
 #[derive(Debug)]
@@ -28,14 +30,28 @@ impl<const D: usize> Model<D> {
     pub fn build(scene: &Scene) -> Result<Model<D>, SceneError> {
         let c = &scene.config;
         assert_eq!(c.dimension, D, "caller dispatches on the scene dimension");
-        let err = |key: String, msg: String| SceneError { file: scene.file.clone(), key: Some(key), position: None, message: msg };
+        let err = |key: String, msg: String| SceneError {
+            file: scene.file.clone(),
+            key: Some(key),
+            position: None,
+            message: msg,
+        };
         let vec = |v: &[f64]| Vector::<D>::from_fn(|d, _| v[d]);
         let cells = std::array::from_fn(|d| c.grid.cells[d]);
-        let grid = Grid::new(vec(&c.grid.min), vec(&c.grid.max), cells, c.grid.shape_function.degree());
+        let grid = Grid::new(
+            vec(&c.grid.min),
+            vec(&c.grid.max),
+            cells,
+            c.grid.shape_function.degree(),
+        );
         let materials: Vec<Box<dyn Material>> = c.materials.iter().map(material).collect();
         let mut particles = Particles::default();
         for (i, b) in c.bodies.iter().enumerate() {
-            let m = c.materials.iter().position(|m| m.name == b.material).expect("validated");
+            let m = c
+                .materials
+                .iter()
+                .position(|m| m.name == b.material)
+                .expect("validated");
             let added = fill_body(&mut particles, &grid, b, i, m as u32, materials[m].as_ref())
                 .map_err(|(k, msg)| err(k, msg))?;
             if added == 0 {
@@ -51,22 +67,38 @@ impl<const D: usize> Model<D> {
         let mut load_ramp_of = vec![u32::MAX; particles.len()];
         let mut load_ramps = Vec::new();
         for (i, l) in c.loads.iter().enumerate() {
-            let body = l.body.as_ref().map(|n| c.bodies.iter().position(|b| b.name.as_deref() == Some(n)).unwrap() as u32);
+            let body = l.body.as_ref().map(|n| {
+                c.bodies
+                    .iter()
+                    .position(|b| b.name.as_deref() == Some(n))
+                    .unwrap() as u32
+            });
             let (lo, hi) = (vec(&l.region_min), vec(&l.region_max));
             let selected: Vec<usize> = (0..particles.len())
                 .filter(|&p| body.is_none_or(|b| particles.body[p] == b))
-                .filter(|&p| (0..D).all(|d| particles.x0[p][d] >= lo[d] && particles.x0[p][d] <= hi[d]))
+                .filter(|&p| {
+                    (0..D).all(|d| particles.x0[p][d] >= lo[d] && particles.x0[p][d] <= hi[d])
+                })
                 .collect();
             if selected.is_empty() {
-                return Err(err(format!("load.{i}.region_min"), "the load region selects no particle".into()));
+                return Err(err(
+                    format!("load.{i}.region_min"),
+                    "the load region selects no particle".into(),
+                ));
             }
-            let ramp = load_ramps.iter().position(|&r| r == l.ramp_time).unwrap_or_else(|| {
-                load_ramps.push(l.ramp_time);
-                load_ramps.len() - 1
-            });
+            let ramp = load_ramps
+                .iter()
+                .position(|&r| r == l.ramp_time)
+                .unwrap_or_else(|| {
+                    load_ramps.push(l.ramp_time);
+                    load_ramps.len() - 1
+                });
             for &p in &selected {
                 if load_ramp_of[p] != u32::MAX && load_ramp_of[p] != ramp as u32 {
-                    return Err(err(format!("load.{i}.ramp_time"), format!("particle {p} already carries a load with another ramp_time")));
+                    return Err(err(
+                        format!("load.{i}.ramp_time"),
+                        format!("particle {p} already carries a load with another ramp_time"),
+                    ));
                 }
                 load_ramp_of[p] = ramp as u32;
                 particles.load[p] += match l.kind {
@@ -74,36 +106,68 @@ impl<const D: usize> Model<D> {
                     LoadKind::Traction => {
                         let face = Face::parse(l.face.as_ref().unwrap(), D).unwrap();
                         let half = particles.half_length0[p];
-                        let area: f64 = (0..D).filter(|&d| d != face.axis).map(|d| 2.0 * half[d]).product();
+                        let area: f64 = (0..D)
+                            .filter(|&d| d != face.axis)
+                            .map(|d| 2.0 * half[d])
+                            .product();
                         vec(l.traction.as_ref().unwrap()) * area
                     }
                 };
             }
         }
-        Ok(Model { grid, particles, materials, faces, gravity, load_ramps, load_ramp_of })
+        Ok(Model {
+            grid,
+            particles,
+            materials,
+            faces,
+            gravity,
+            load_ramps,
+            load_ramp_of,
+        })
     }
 
     /// Load factor of each ramp at time t: min(t / ramp_time, 1).
     pub fn load_scales(&self, t: f64) -> Vec<f64> {
-        self.load_ramps.iter().map(|&r| if r > 0.0 { (t / r).min(1.0) } else { 1.0 }).collect()
+        self.load_ramps
+            .iter()
+            .map(|&r| if r > 0.0 { (t / r).min(1.0) } else { 1.0 })
+            .collect()
     }
 
     /// Number of bodies (for per-body outputs).
     pub fn n_bodies(&self) -> usize {
-        self.particles.body.iter().map(|&b| b as usize + 1).max().unwrap_or(0)
+        self.particles
+            .body
+            .iter()
+            .map(|&b| b as usize + 1)
+            .max()
+            .unwrap_or(0)
     }
 }
 
 fn material(m: &MaterialConfig) -> Box<dyn Material> {
     let nu = m.poisson_ratio.unwrap();
     match m.model {
-        MaterialModel::LinearElastic => Box::new(LinearElastic::new(m.density, m.youngs_modulus.unwrap(), nu)),
-        MaterialModel::NeoHookean => Box::new(NeoHookean::new(m.density, m.youngs_modulus.unwrap(), nu)),
-        MaterialModel::MooneyRivlin => Box::new(MooneyRivlin::from_thesis(m.density, m.a.unwrap(), m.b.unwrap(), nu)),
+        MaterialModel::LinearElastic => {
+            Box::new(LinearElastic::new(m.density, m.youngs_modulus.unwrap(), nu))
+        }
+        MaterialModel::NeoHookean => {
+            Box::new(NeoHookean::new(m.density, m.youngs_modulus.unwrap(), nu))
+        }
+        MaterialModel::MooneyRivlin => Box::new(MooneyRivlin::from_thesis(
+            m.density,
+            m.a.unwrap(),
+            m.b.unwrap(),
+            nu,
+        )),
     }
 }
 
-fn face_condition<const D: usize>(b: &crate::scene::BoundaryConfig, dim: usize, vec: &impl Fn(&[f64]) -> Vector<D>) -> FaceCondition<D> {
+fn face_condition<const D: usize>(
+    b: &crate::scene::BoundaryConfig,
+    dim: usize,
+    vec: &impl Fn(&[f64]) -> Vector<D>,
+) -> FaceCondition<D> {
     let face = Face::parse(&b.face, dim).unwrap();
     let mut constraint = Constraint::<D>::free();
     match b.condition {
@@ -136,11 +200,16 @@ fn fill_body<const D: usize>(
     let volume = spacing.product();
     let mass = model.density() * volume;
     // Lattice index range covering the bounding box.
-    let first: [usize; D] = std::array::from_fn(|d| (((lo[d] - grid.min[d]) / spacing[d]).floor().max(0.0)) as usize);
-    let last: [usize; D] = std::array::from_fn(|d| ((hi[d] - grid.min[d]) / spacing[d]).ceil() as usize);
+    let first: [usize; D] =
+        std::array::from_fn(|d| (((lo[d] - grid.min[d]) / spacing[d]).floor().max(0.0)) as usize);
+    let last: [usize; D] =
+        std::array::from_fn(|d| ((hi[d] - grid.min[d]) / spacing[d]).ceil() as usize);
     let counts: Vec<usize> = (0..D).map(|d| last[d].saturating_sub(first[d])).collect();
     let total: usize = counts.iter().product();
-    let uniform = b.velocity.as_deref().map_or(Vector::<D>::zeros(), |v| Vector::<D>::from_fn(|d, _| v[d]));
+    let uniform = b
+        .velocity
+        .as_deref()
+        .map_or(Vector::<D>::zeros(), |v| Vector::<D>::from_fn(|d, _| v[d]));
     let mut added = 0;
     for flat in 0..total {
         let mut rem = flat;
@@ -157,10 +226,20 @@ fn fill_body<const D: usize>(
             let mut pos = [0.0; 3];
             (0..D).for_each(|d| pos[d] = x[d]);
             for (d, e) in exprs.iter().enumerate() {
-                v[d] += expr::eval(e, &pos).map_err(|m| (format!("body.{i}.velocity_expr.{d}"), m))?;
+                v[d] +=
+                    expr::eval(e, &pos).map_err(|m| (format!("body.{i}.velocity_expr.{d}"), m))?;
             }
         }
-        particles.push(x, v, mass, volume, spacing / 2.0, i as u32, material, model.n_history());
+        particles.push(
+            x,
+            v,
+            mass,
+            volume,
+            spacing / 2.0,
+            i as u32,
+            material,
+            model.n_history(),
+        );
         added += 1;
     }
     Ok(added)

@@ -103,9 +103,15 @@ impl NodeMap {
 }
 
 /// Nodal mass (2-24) and momentum (2-25).
-pub fn mass_momentum<const D: usize>(map: &NodeMap, st: &Stencils<D>, p: &Particles<D>) -> (Vec<f64>, Vec<Vector<D>>) {
+pub fn mass_momentum<const D: usize>(
+    map: &NodeMap,
+    st: &Stencils<D>,
+    p: &Particles<D>,
+) -> (Vec<f64>, Vec<Vector<D>>) {
     let mass = map.gather(st.stride, 0.0, |q, e| p.mass[q] * st.weight[e]);
-    let momentum = map.gather(st.stride, Vector::<D>::zeros(), |q, e| p.v[q] * (p.mass[q] * st.weight[e]));
+    let momentum = map.gather(st.stride, Vector::<D>::zeros(), |q, e| {
+        p.v[q] * (p.mass[q] * st.weight[e])
+    });
     (mass, momentum)
 }
 
@@ -127,12 +133,24 @@ pub fn nodal_force<const D: usize>(
 }
 
 /// Σ_I S_Ip u_I for particle p (interpolation of a nodal vector field).
-pub fn interpolate<const D: usize>(map: &NodeMap, st: &Stencils<D>, p: usize, u: &[Vector<D>]) -> Vector<D> {
-    st.range(p).fold(Vector::<D>::zeros(), |acc, e| acc + u[map.local[st.node[e] as usize] as usize] * st.weight[e])
+pub fn interpolate<const D: usize>(
+    map: &NodeMap,
+    st: &Stencils<D>,
+    p: usize,
+    u: &[Vector<D>],
+) -> Vector<D> {
+    st.range(p).fold(Vector::<D>::zeros(), |acc, e| {
+        acc + u[map.local[st.node[e] as usize] as usize] * st.weight[e]
+    })
 }
 
 /// Σ_I u_I ⊗ ∇S_Ip for particle p (gradient of a nodal vector field, e.g. L_p).
-pub fn gradient<const D: usize>(map: &NodeMap, st: &Stencils<D>, p: usize, u: &[Vector<D>]) -> Tensor<D> {
+pub fn gradient<const D: usize>(
+    map: &NodeMap,
+    st: &Stencils<D>,
+    p: usize,
+    u: &[Vector<D>],
+) -> Tensor<D> {
     st.range(p).fold(Tensor::<D>::zeros(), |acc, e| {
         acc + u[map.local[st.node[e] as usize] as usize] * st.grad[e].transpose()
     })

@@ -12,7 +12,12 @@ const RHO_G_L0: f64 = 80.0 * 10.0 * 50.0;
 fn column_error(shape: &str, cells: usize) -> f64 {
     let (result, dir) = run_problem(
         "column_explicit.toml",
-        &[&format!("grid.shape_function={shape}"), &format!("grid.cells=[1,{cells}]"), "output.frames=0", "output.history_interval=1.0"],
+        &[
+            &format!("grid.shape_function={shape}"),
+            &format!("grid.cells=[1,{cells}]"),
+            "output.frames=0",
+            "output.history_interval=1.0",
+        ],
     );
     result.unwrap();
     let p = Table::read(&dir.path().join("particles_final.csv"));
@@ -29,8 +34,15 @@ fn column_error(shape: &str, cells: usize) -> f64 {
 fn study(shape: &str, cells: &[usize]) -> Vec<f64> {
     let errors: Vec<f64> = cells.iter().map(|&n| column_error(shape, n)).collect();
     for i in 0..cells.len() {
-        let rate = if i > 0 { (errors[i - 1] / errors[i]).log2() } else { f64::NAN };
-        println!("{shape:>8} cells {:>4}: error {:.4e}  rate {rate:.2}", cells[i], errors[i]);
+        let rate = if i > 0 {
+            (errors[i - 1] / errors[i]).log2()
+        } else {
+            f64::NAN
+        };
+        println!(
+            "{shape:>8} cells {:>4}: error {:.4e}  rate {rate:.2}",
+            cells[i], errors[i]
+        );
     }
     errors
 }
@@ -54,14 +66,26 @@ fn cpdi_converges() {
 #[test]
 fn bsplines_converge() {
     let e = study("bspline2", &[8, 16, 32, 64]);
-    assert!(rate(&e) > 0.8, "quadratic B-spline mean rate {:.2} below 0.8", rate(&e));
+    assert!(
+        rate(&e) > 0.8,
+        "quadratic B-spline mean rate {:.2} below 0.8",
+        rate(&e)
+    );
 }
 
 /// Standard MPM: particles cross cells as the column settles, and the error stalls.
 #[test]
 fn standard_mpm_does_not_converge() {
     let e = study("linear", &[8, 16, 32, 64]);
-    assert!(rate(&e) < 0.5, "linear MPM mean rate {:.2}: expected no convergence", rate(&e));
+    assert!(
+        rate(&e) < 0.5,
+        "linear MPM mean rate {:.2}: expected no convergence",
+        rate(&e)
+    );
     let gimp = column_error("ugimp", 64);
-    assert!(e[3] > 2.0 * gimp, "at 64 cells linear MPM ({:.3e}) should be clearly worse than GIMP ({gimp:.3e})", e[3]);
+    assert!(
+        e[3] > 2.0 * gimp,
+        "at 64 cells linear MPM ({:.3e}) should be clearly worse than GIMP ({gimp:.3e})",
+        e[3]
+    );
 }

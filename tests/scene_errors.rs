@@ -31,7 +31,9 @@ cfl = 0.5
 "#;
 
 fn err(text: &str) -> String {
-    Scene::parse("scene.toml", text, &[]).expect_err("must be rejected").to_string()
+    Scene::parse("scene.toml", text, &[])
+        .expect_err("must be rejected")
+        .to_string()
 }
 
 #[test]
@@ -48,72 +50,119 @@ fn malformed_toml_gives_line_and_column() {
 #[test]
 fn unknown_key_is_named_with_its_line() {
     let e = err(&GOOD.replace("cfl = 0.5", "cfl = 0.5\nend_tme = 2.0"));
-    assert!(e.contains("scene.toml:25:1") && e.contains("unknown field `end_tme`"), "{e}");
+    assert!(
+        e.contains("scene.toml:25:1") && e.contains("unknown field `end_tme`"),
+        "{e}"
+    );
 }
 
 #[test]
 fn mistyped_value_points_at_the_value() {
     let e = err(&GOOD.replace("density = 1.0", "density = \"heavy\""));
-    assert!(e.contains("scene.toml:11:11") && e.contains("expected f64"), "{e}");
+    assert!(
+        e.contains("scene.toml:11:11") && e.contains("expected f64"),
+        "{e}"
+    );
 }
 
 #[test]
 fn unknown_model_is_named() {
     let e = err(&GOOD.replace("\"linear_elastic\"", "\"linear_elastc\""));
-    assert!(e.contains("scene.toml:10:9") && e.contains("unknown variant `linear_elastc`"), "{e}");
+    assert!(
+        e.contains("scene.toml:10:9") && e.contains("unknown variant `linear_elastc`"),
+        "{e}"
+    );
 }
 
 #[test]
 fn negative_density() {
     let e = err(&GOOD.replace("density = 1.0", "density = -1.0"));
-    assert!(e.contains("scene.toml:11:11") && e.contains("key `material.0.density`"), "{e}");
+    assert!(
+        e.contains("scene.toml:11:11") && e.contains("key `material.0.density`"),
+        "{e}"
+    );
 }
 
 #[test]
 fn negative_modulus() {
     let e = err(&GOOD.replace("youngs_modulus = 100.0", "youngs_modulus = -5.0"));
-    assert!(e.contains("scene.toml:12:18") && e.contains("key `material.0.youngs_modulus`"), "{e}");
+    assert!(
+        e.contains("scene.toml:12:18") && e.contains("key `material.0.youngs_modulus`"),
+        "{e}"
+    );
 }
 
 #[test]
 fn poisson_ratio_at_one_half_for_a_compressible_model() {
     let e = err(&GOOD.replace("poisson_ratio = 0.3", "poisson_ratio = 0.5"));
-    assert!(e.contains("scene.toml:13:17") && e.contains("poisson_ratio") && e.contains("compressible"), "{e}");
+    assert!(
+        e.contains("scene.toml:13:17") && e.contains("poisson_ratio") && e.contains("compressible"),
+        "{e}"
+    );
 }
 
 #[test]
 fn body_outside_the_grid() {
     let e = err(&GOOD.replace("max = [2.0, 1.0]", "max = [5.0, 1.0]"));
-    assert!(e.contains("key `body.0.shape`") && e.contains("outside the grid") && e.contains("scene.toml:17:9"), "{e}");
+    assert!(
+        e.contains("key `body.0.shape`")
+            && e.contains("outside the grid")
+            && e.contains("scene.toml:17:9"),
+        "{e}"
+    );
 }
 
 #[test]
 fn cfl_above_one() {
     let e = err(&GOOD.replace("cfl = 0.5", "cfl = 1.2"));
-    assert!(e.contains("scene.toml:24:7") && e.contains("key `solver.cfl`"), "{e}");
+    assert!(
+        e.contains("scene.toml:24:7") && e.contains("key `solver.cfl`"),
+        "{e}"
+    );
 }
 
 #[test]
 fn wrong_vector_length_and_missing_material() {
-    let e = err(&GOOD.replace("min = [0.0, 0.0]\nmax = [2.0, 1.0]", "min = [0.0, 0.0, 0.0]\nmax = [2.0, 1.0]"));
-    assert!(e.contains("key `body.0.min`") && e.contains("needs 2 components"), "{e}");
+    let e = err(&GOOD.replace(
+        "min = [0.0, 0.0]\nmax = [2.0, 1.0]",
+        "min = [0.0, 0.0, 0.0]\nmax = [2.0, 1.0]",
+    ));
+    assert!(
+        e.contains("key `body.0.min`") && e.contains("needs 2 components"),
+        "{e}"
+    );
     let e = err(&GOOD.replace("material = \"m\"", "material = \"steel\""));
-    assert!(e.contains("key `body.0.material`") && e.contains("no material is named `steel`"), "{e}");
+    assert!(
+        e.contains("key `body.0.material`") && e.contains("no material is named `steel`"),
+        "{e}"
+    );
 }
 
 #[test]
 fn keys_of_another_shape_are_rejected() {
     let e = err(&GOOD.replace("max = [2.0, 1.0]", "max = [2.0, 1.0]\nradius = 0.3"));
-    assert!(e.contains("key `body.0.radius`") && e.contains("does not apply"), "{e}");
+    assert!(
+        e.contains("key `body.0.radius`") && e.contains("does not apply"),
+        "{e}"
+    );
 }
 
 #[test]
 fn overrides_are_checked_like_the_file() {
-    let e = Scene::parse("scene.toml", GOOD, &["solver.cfl=3".into()]).unwrap_err().to_string();
+    let e = Scene::parse("scene.toml", GOOD, &["solver.cfl=3".into()])
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("key `solver.cfl`"), "{e}");
-    let e = Scene::parse("scene.toml", GOOD, &["solver.cfll=0.3".into()]).unwrap_err().to_string();
+    let e = Scene::parse("scene.toml", GOOD, &["solver.cfll=0.3".into()])
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("unknown field `cfll`"), "{e}");
-    let s = Scene::parse("scene.toml", GOOD, &["grid.cells=[8,2]".into(), "grid.shape_function=cpdi".into()]).unwrap();
+    let s = Scene::parse(
+        "scene.toml",
+        GOOD,
+        &["grid.cells=[8,2]".into(), "grid.shape_function=cpdi".into()],
+    )
+    .unwrap();
     assert_eq!(s.config.grid.cells, vec![8, 2]);
 }
 
@@ -123,14 +172,27 @@ fn cli_exits_non_zero_without_panicking() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("bad.toml");
     std::fs::write(&path, GOOD.replace("density = 1.0", "density = -1.0")).unwrap();
-    for args in [vec!["check"], vec!["run", "--out", dir.path().join("o").to_str().unwrap()]] {
-        let out = Command::new(env!("CARGO_BIN_EXE_mpm")).args(&args).arg(&path).output().unwrap();
+    for args in [
+        vec!["check"],
+        vec!["run", "--out", dir.path().join("o").to_str().unwrap()],
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_mpm"))
+            .args(&args)
+            .arg(&path)
+            .output()
+            .unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{stderr}");
-        assert!(stderr.contains("bad.toml:11:11") && stderr.contains("material.0.density"), "{stderr}");
+        assert!(
+            stderr.contains("bad.toml:11:11") && stderr.contains("material.0.density"),
+            "{stderr}"
+        );
         assert!(!stderr.contains("panicked"), "{stderr}");
     }
-    let out = Command::new(env!("CARGO_BIN_EXE_mpm")).args(["check", "/nonexistent/scene.toml"]).output().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_mpm"))
+        .args(["check", "/nonexistent/scene.toml"])
+        .output()
+        .unwrap();
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("cannot read"));
 }

@@ -13,7 +13,11 @@ fn run(threads: usize, shape: &str) -> (Vec<u8>, Vec<u8>) {
         .args(["--set", &format!("grid.shape_function={shape}")])
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let read = |f: &str| std::fs::read(dir.path().join(f)).unwrap();
     (read("particles_final.csv"), read("history.csv"))
 }
@@ -23,7 +27,13 @@ fn one_and_two_threads_give_identical_results() {
     for shape in ["linear", "cpdi", "bspline2"] {
         let (p1, h1) = run(1, shape);
         let (p2, h2) = run(2, shape);
-        assert!(p1 == p2, "{shape}: particles_final.csv differs between 1 and 2 threads");
-        assert!(h1 == h2, "{shape}: history.csv differs between 1 and 2 threads");
+        assert!(
+            p1 == p2,
+            "{shape}: particles_final.csv differs between 1 and 2 threads"
+        );
+        assert!(
+            h1 == h2,
+            "{shape}: history.csv differs between 1 and 2 threads"
+        );
     }
 }

@@ -8,7 +8,11 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "mpm", version, about = "Material point method: explicit MPM in 2D plane strain and 3D")]
+#[command(
+    name = "mpm",
+    version,
+    about = "Material point method: explicit MPM in 2D plane strain and 3D"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -60,9 +64,17 @@ fn main() -> ExitCode {
                 ExitCode::from(2)
             }
         },
-        Command::Run { scene, out, overrides, threads } => {
+        Command::Run {
+            scene,
+            out,
+            overrides,
+            threads,
+        } => {
             if let Some(n) = threads {
-                if let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n).build_global() {
+                if let Err(e) = rayon::ThreadPoolBuilder::new()
+                    .num_threads(n)
+                    .build_global()
+                {
                     eprintln!("error: cannot set up {n} threads: {e}");
                     return ExitCode::from(2);
                 }

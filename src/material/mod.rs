@@ -74,6 +74,7 @@ pub trait Material: Send + Sync + std::fmt::Debug {
 /// Lamé constants from Young's modulus and Poisson's ratio.
 pub fn lame(youngs_modulus: f64, poisson_ratio: f64) -> (f64, f64) {
     let g = youngs_modulus / (2.0 * (1.0 + poisson_ratio));
-    let lambda = youngs_modulus * poisson_ratio / ((1.0 + poisson_ratio) * (1.0 - 2.0 * poisson_ratio));
+    let lambda =
+        youngs_modulus * poisson_ratio / ((1.0 + poisson_ratio) * (1.0 - 2.0 * poisson_ratio));
     (lambda, g)
 }

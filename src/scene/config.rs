@@ -246,6 +246,9 @@ fn default_frames() -> usize {
 
 impl Default for OutputConfig {
     fn default() -> Self {
-        OutputConfig { frames: default_frames(), history_interval: 0.0 }
+        OutputConfig {
+            frames: default_frames(),
+            history_interval: 0.0,
+        }
     }
 }

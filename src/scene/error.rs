@@ -30,13 +30,23 @@ impl std::error::Error for SceneError {}
 
 impl SceneError {
     pub fn plain(file: &str, message: impl Into<String>) -> Self {
-        SceneError { file: file.into(), key: None, position: None, message: message.into() }
+        SceneError {
+            file: file.into(),
+            key: None,
+            position: None,
+            message: message.into(),
+        }
     }
 
     /// From a TOML syntax or deserialisation error, with its span.
     pub fn from_toml(file: &str, text: &str, e: &toml::de::Error) -> Self {
         let position = e.span().map(|s| line_col(text, s.start));
-        SceneError { file: file.into(), key: None, position, message: e.message().trim().to_string() }
+        SceneError {
+            file: file.into(),
+            key: None,
+            position,
+            message: e.message().trim().to_string(),
+        }
     }
 
     /// A validation error at a dotted key path; the position is looked up in the text.
@@ -77,7 +87,9 @@ fn locate(text: &str, path: &str) -> Option<(usize, usize)> {
             }
             Item::Value(Value::InlineTable(t)) => table = t,
             Item::ArrayOfTables(a) => {
-                let Some(t) = index.and_then(|i| a.get(i)) else { break };
+                let Some(t) = index.and_then(|i| a.get(i)) else {
+                    break;
+                };
                 segs.next();
                 span = t.span().or(span);
                 table = t;

@@ -27,7 +27,8 @@ pub fn eval(expr: &str, x: &[f64; 3]) -> Result<f64, String> {
         ("sqrt", f64::sqrt),
         ("abs", f64::abs),
     ] {
-        ctx.set_function(name.into(), unary(f)).map_err(|e| e.to_string())?;
+        ctx.set_function(name.into(), unary(f))
+            .map_err(|e| e.to_string())?;
     }
     let v = evalexpr::eval_number_with_context(expr, &ctx)
         .map_err(|e| format!("cannot evaluate expression `{expr}`: {e}"))?;

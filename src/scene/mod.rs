@@ -37,7 +37,11 @@ impl Scene {
         let text = overrides::apply(file, text, overrides)?;
         let config: SceneConfig =
             toml::from_str(&text).map_err(|e| SceneError::from_toml(file, &text, &e))?;
-        validate::validate(&config).map_err(|(path, msg)| SceneError::at_key(file, &text, &path, msg))?;
-        Ok(Scene { file: file.to_string(), config })
+        validate::validate(&config)
+            .map_err(|(path, msg)| SceneError::at_key(file, &text, &path, msg))?;
+        Ok(Scene {
+            file: file.to_string(),
+            config,
+        })
     }
 }

@@ -12,16 +12,27 @@ pub fn apply(file: &str, text: &str, overrides: &[String]) -> Result<String, Sce
     }
     let mut doc: DocumentMut = text.parse().map_err(|e: toml_edit::TomlError| {
         let position = e.span().map(|s| super::error::line_col(text, s.start));
-        SceneError { file: file.into(), key: None, position, message: e.message().trim().to_string() }
+        SceneError {
+            file: file.into(),
+            key: None,
+            position,
+            message: e.message().trim().to_string(),
+        }
     })?;
     for o in overrides {
         let bad = |m: String| SceneError::plain(file, m);
         let (key, value) = o
             .split_once('=')
             .ok_or_else(|| bad(format!("override `{o}` is not of the form KEY=VALUE")))?;
-        let value: Value = value.trim().parse().unwrap_or_else(|_| Value::from(value.trim()));
-        set(doc.as_table_mut(), key.trim(), value)
-            .ok_or_else(|| bad(format!("override `{o}`: the scene has no place for key `{key}`")))?;
+        let value: Value = value
+            .trim()
+            .parse()
+            .unwrap_or_else(|_| Value::from(value.trim()));
+        set(doc.as_table_mut(), key.trim(), value).ok_or_else(|| {
+            bad(format!(
+                "override `{o}`: the scene has no place for key `{key}`"
+            ))
+        })?;
     }
     Ok(doc.to_string())
 }
@@ -56,14 +67,26 @@ fn set(mut table: &mut dyn TableLike, path: &str, value: Value) -> Option<()> {
 mod tests {
     use super::*;
 
-    const SCENE: &str = "dimension = 2\n[grid]\ncells = [8, 1]\n[[material]]\nname = \"a\"\ndensity = 1.0\n";
+    const SCENE: &str =
+        "dimension = 2\n[grid]\ncells = [8, 1]\n[[material]]\nname = \"a\"\ndensity = 1.0\n";
 
     #[test]
     fn overrides_replace_nested_and_array_of_table_values() {
-        let out = apply("s.toml", SCENE, &["grid.cells=[64,1]".into(), "material.0.density=2.5".into()]).unwrap();
+        let out = apply(
+            "s.toml",
+            SCENE,
+            &["grid.cells=[64,1]".into(), "material.0.density=2.5".into()],
+        )
+        .unwrap();
         let doc: toml::Table = toml::from_str(&out).unwrap();
-        assert_eq!(doc["grid"]["cells"].as_array().unwrap()[0].as_integer(), Some(64));
-        assert_eq!(doc["material"].as_array().unwrap()[0]["density"].as_float(), Some(2.5));
+        assert_eq!(
+            doc["grid"]["cells"].as_array().unwrap()[0].as_integer(),
+            Some(64)
+        );
+        assert_eq!(
+            doc["material"].as_array().unwrap()[0]["density"].as_float(),
+            Some(2.5)
+        );
     }
 
     #[test]

@@ -15,8 +15,19 @@ fn ensure(ok: bool, path: impl Into<String>, msg: impl Into<String>) -> Check {
 }
 
 fn vector(v: &[f64], dim: usize, path: &str) -> Check {
-    ensure(v.len() == dim, path, format!("needs {dim} components (dimension = {dim}), has {}", v.len()))?;
-    ensure(v.iter().all(|x| x.is_finite()), path, "components must be finite numbers")
+    ensure(
+        v.len() == dim,
+        path,
+        format!(
+            "needs {dim} components (dimension = {dim}), has {}",
+            v.len()
+        ),
+    )?;
+    ensure(
+        v.iter().all(|x| x.is_finite()),
+        path,
+        "components must be finite numbers",
+    )
 }
 
 fn required<T>(v: &Option<T>, path: String, what: &str) -> Result<(), (String, String)> {
@@ -29,18 +40,34 @@ fn forbidden<T>(v: &Option<T>, path: String, what: &str) -> Check {
 
 pub fn validate(s: &SceneConfig) -> Check {
     let dim = s.dimension;
-    ensure(dim == 2 || dim == 3, "dimension", "must be 2 (plane strain) or 3")?;
+    ensure(
+        dim == 2 || dim == 3,
+        "dimension",
+        "must be 2 (plane strain) or 3",
+    )?;
     if let Some(g) = &s.gravity {
         vector(g, dim, "gravity")?;
     }
     grid(&s.grid, dim)?;
-    ensure(!s.materials.is_empty(), "material", "the scene defines no [[material]]")?;
+    ensure(
+        !s.materials.is_empty(),
+        "material",
+        "the scene defines no [[material]]",
+    )?;
     for (i, m) in s.materials.iter().enumerate() {
         material(m, i)?;
         let dup = s.materials[..i].iter().any(|o| o.name == m.name);
-        ensure(!dup, format!("material.{i}.name"), format!("material name `{}` is used twice", m.name))?;
+        ensure(
+            !dup,
+            format!("material.{i}.name"),
+            format!("material name `{}` is used twice", m.name),
+        )?;
     }
-    ensure(!s.bodies.is_empty(), "body", "the scene defines no [[body]]")?;
+    ensure(
+        !s.bodies.is_empty(),
+        "body",
+        "the scene defines no [[body]]",
+    )?;
     for (i, b) in s.bodies.iter().enumerate() {
         body(b, i, s)?;
     }
@@ -51,21 +78,37 @@ pub fn validate(s: &SceneConfig) -> Check {
         load(l, i, s)?;
     }
     solver(&s.solver)?;
-    ensure(s.output.history_interval >= 0.0, "output.history_interval", "must be ≥ 0")
+    ensure(
+        s.output.history_interval >= 0.0,
+        "output.history_interval",
+        "must be ≥ 0",
+    )
 }
 
 fn grid(g: &GridConfig, dim: usize) -> Check {
     vector(&g.min, dim, "grid.min")?;
     vector(&g.max, dim, "grid.max")?;
-    ensure(g.cells.len() == dim, "grid.cells", format!("needs {dim} entries"))?;
-    ensure(g.cells.iter().all(|&c| c >= 1), "grid.cells", "every direction needs at least one cell")?;
+    ensure(
+        g.cells.len() == dim,
+        "grid.cells",
+        format!("needs {dim} entries"),
+    )?;
+    ensure(
+        g.cells.iter().all(|&c| c >= 1),
+        "grid.cells",
+        "every direction needs at least one cell",
+    )?;
     let ok = (0..dim).all(|d| g.max[d] > g.min[d]);
     ensure(ok, "grid.max", "must exceed grid.min in every direction")
 }
 
 fn material(m: &MaterialConfig, i: usize) -> Check {
     let key = |k: &str| format!("material.{i}.{k}");
-    ensure(m.density > 0.0 && m.density.is_finite(), key("density"), "must be a positive number")?;
+    ensure(
+        m.density > 0.0 && m.density.is_finite(),
+        key("density"),
+        "must be a positive number",
+    )?;
     let what = format!("model `{}`", model_name(m.model));
     match m.model {
         MaterialModel::LinearElastic | MaterialModel::NeoHookean => {
@@ -73,14 +116,22 @@ fn material(m: &MaterialConfig, i: usize) -> Check {
             forbidden(&m.a, key("a"), &what)?;
             forbidden(&m.b, key("b"), &what)?;
             let e = m.youngs_modulus.unwrap_or(0.0);
-            ensure(e > 0.0 && e.is_finite(), key("youngs_modulus"), "must be a positive number")?;
+            ensure(
+                e > 0.0 && e.is_finite(),
+                key("youngs_modulus"),
+                "must be a positive number",
+            )?;
         }
         MaterialModel::MooneyRivlin => {
             required(&m.a, key("a"), &what)?;
             required(&m.b, key("b"), &what)?;
             forbidden(&m.youngs_modulus, key("youngs_modulus"), &what)?;
             let g = 2.0 * (m.a.unwrap_or(0.0) + m.b.unwrap_or(0.0));
-            ensure(g > 0.0 && g.is_finite(), key("a"), "a + b (= G/2, thesis 3-16) must be positive")?;
+            ensure(
+                g > 0.0 && g.is_finite(),
+                key("a"),
+                "a + b (= G/2, thesis 3-16) must be positive",
+            )?;
         }
     }
     required(&m.poisson_ratio, key("poisson_ratio"), &what)?;
@@ -104,13 +155,20 @@ fn body(b: &BodyConfig, i: usize, s: &SceneConfig) -> Check {
     let dim = s.dimension;
     let key = |k: &str| format!("body.{i}.{k}");
     let known = s.materials.iter().any(|m| m.name == b.material);
-    ensure(known, key("material"), format!("no material is named `{}`", b.material))?;
+    ensure(
+        known,
+        key("material"),
+        format!("no material is named `{}`", b.material),
+    )?;
     let (lo, hi) = body_bounds(b, i, dim)?;
     let inside = (0..dim).all(|d| lo[d] >= s.grid.min[d] && hi[d] <= s.grid.max[d]);
     ensure(
         inside,
         key("shape"),
-        format!("the body spans {lo:?}..{hi:?}, outside the grid {:?}..{:?}", s.grid.min, s.grid.max),
+        format!(
+            "the body spans {lo:?}..{hi:?}, outside the grid {:?}..{:?}",
+            s.grid.min, s.grid.max
+        ),
     )?;
     match &b.particles_per_cell {
         PerDirection::Same(n) => ensure(*n >= 1, key("particles_per_cell"), "must be at least 1")?,
@@ -124,23 +182,36 @@ fn body(b: &BodyConfig, i: usize, s: &SceneConfig) -> Check {
         vector(v, dim, &key("velocity"))?;
     }
     if let Some(exprs) = &b.velocity_expr {
-        ensure(exprs.len() == dim, key("velocity_expr"), format!("needs {dim} expressions"))?;
+        ensure(
+            exprs.len() == dim,
+            key("velocity_expr"),
+            format!("needs {dim} expressions"),
+        )?;
         for (c, e) in exprs.iter().enumerate() {
-            crate::scene::expr::eval(e, &[0.0; 3]).map_err(|m| (format!("body.{i}.velocity_expr.{c}"), m))?;
+            crate::scene::expr::eval(e, &[0.0; 3])
+                .map_err(|m| (format!("body.{i}.velocity_expr.{c}"), m))?;
         }
     }
     Ok(())
 }
 
 /// Bounding box of a body's geometry, checking the keys its shape needs.
-pub fn body_bounds(b: &BodyConfig, i: usize, dim: usize) -> Result<(Vec<f64>, Vec<f64>), (String, String)> {
+pub fn body_bounds(
+    b: &BodyConfig,
+    i: usize,
+    dim: usize,
+) -> Result<(Vec<f64>, Vec<f64>), (String, String)> {
     let key = |k: &str| format!("body.{i}.{k}");
     let what = format!("shape `{:?}`", b.shape).to_lowercase();
     let shape_dim = match b.shape {
         Shape::Rectangle | Shape::Disk | Shape::Polygon => 2,
         Shape::Box | Shape::Sphere => 3,
     };
-    ensure(shape_dim == dim, key("shape"), format!("{what} is a {shape_dim}D shape but dimension = {dim}"))?;
+    ensure(
+        shape_dim == dim,
+        key("shape"),
+        format!("{what} is a {shape_dim}D shape but dimension = {dim}"),
+    )?;
     match b.shape {
         Shape::Rectangle | Shape::Box => {
             required(&b.min, key("min"), &what)?;
@@ -151,7 +222,11 @@ pub fn body_bounds(b: &BodyConfig, i: usize, dim: usize) -> Result<(Vec<f64>, Ve
             let (lo, hi) = (b.min.clone().unwrap(), b.max.clone().unwrap());
             vector(&lo, dim, &key("min"))?;
             vector(&hi, dim, &key("max"))?;
-            ensure((0..dim).all(|d| hi[d] > lo[d]), key("max"), "must exceed min in every direction")?;
+            ensure(
+                (0..dim).all(|d| hi[d] > lo[d]),
+                key("max"),
+                "must exceed min in every direction",
+            )?;
             Ok((lo, hi))
         }
         Shape::Disk | Shape::Sphere => {
@@ -163,8 +238,15 @@ pub fn body_bounds(b: &BodyConfig, i: usize, dim: usize) -> Result<(Vec<f64>, Ve
             let c = b.centre.clone().unwrap();
             vector(&c, dim, &key("centre"))?;
             let r = b.radius.unwrap();
-            ensure(r > 0.0 && r.is_finite(), key("radius"), "must be a positive number")?;
-            Ok((c.iter().map(|x| x - r).collect(), c.iter().map(|x| x + r).collect()))
+            ensure(
+                r > 0.0 && r.is_finite(),
+                key("radius"),
+                "must be a positive number",
+            )?;
+            Ok((
+                c.iter().map(|x| x - r).collect(),
+                c.iter().map(|x| x + r).collect(),
+            ))
         }
         Shape::Polygon => {
             required(&b.vertices, key("vertices"), &what)?;
@@ -173,12 +255,20 @@ pub fn body_bounds(b: &BodyConfig, i: usize, dim: usize) -> Result<(Vec<f64>, Ve
             forbidden(&b.centre, key("centre"), &what)?;
             forbidden(&b.radius, key("radius"), &what)?;
             let v = b.vertices.as_ref().unwrap();
-            ensure(v.len() >= 3, key("vertices"), "a polygon needs at least 3 vertices")?;
+            ensure(
+                v.len() >= 3,
+                key("vertices"),
+                "a polygon needs at least 3 vertices",
+            )?;
             for (k, p) in v.iter().enumerate() {
                 vector(p, 2, &format!("body.{i}.vertices.{k}"))?;
             }
-            let lo = (0..2).map(|d| v.iter().map(|p| p[d]).fold(f64::INFINITY, f64::min)).collect();
-            let hi = (0..2).map(|d| v.iter().map(|p| p[d]).fold(f64::NEG_INFINITY, f64::max)).collect();
+            let lo = (0..2)
+                .map(|d| v.iter().map(|p| p[d]).fold(f64::INFINITY, f64::min))
+                .collect();
+            let hi = (0..2)
+                .map(|d| v.iter().map(|p| p[d]).fold(f64::NEG_INFINITY, f64::max))
+                .collect();
             Ok((lo, hi))
         }
     }
@@ -186,19 +276,35 @@ pub fn body_bounds(b: &BodyConfig, i: usize, dim: usize) -> Result<(Vec<f64>, Ve
 
 fn boundary(b: &BoundaryConfig, i: usize, dim: usize) -> Check {
     let key = |k: &str| format!("boundary.{i}.{k}");
-    let face_names = if dim == 2 { "xmin, xmax, ymin, ymax" } else { "xmin, xmax, ymin, ymax, zmin, zmax" };
-    ensure(Face::parse(&b.face, dim).is_some(), key("face"), format!("must be one of {face_names}"))?;
+    let face_names = if dim == 2 {
+        "xmin, xmax, ymin, ymax"
+    } else {
+        "xmin, xmax, ymin, ymax, zmin, zmax"
+    };
+    ensure(
+        Face::parse(&b.face, dim).is_some(),
+        key("face"),
+        format!("must be one of {face_names}"),
+    )?;
     match b.condition {
         Condition::Fixed | Condition::Roller => {
             forbidden(&b.velocity, key("velocity"), "fixed or roller conditions")?;
-            forbidden(&b.components, key("components"), "fixed or roller conditions")
+            forbidden(
+                &b.components,
+                key("components"),
+                "fixed or roller conditions",
+            )
         }
         Condition::Velocity => {
             required(&b.velocity, key("velocity"), "a velocity condition")?;
             vector(b.velocity.as_ref().unwrap(), dim, &key("velocity"))?;
             for (k, c) in b.components.iter().flatten().enumerate() {
                 let ok = axis(c).is_some_and(|a| a < dim);
-                ensure(ok, format!("boundary.{i}.components.{k}"), "must be \"x\", \"y\" or (3D) \"z\"")?;
+                ensure(
+                    ok,
+                    format!("boundary.{i}.components.{k}"),
+                    "must be \"x\", \"y\" or (3D) \"z\"",
+                )?;
             }
             Ok(())
         }
@@ -218,7 +324,11 @@ fn load(l: &LoadConfig, i: usize, s: &SceneConfig) -> Check {
         let known = s.bodies.iter().any(|x| x.name.as_deref() == Some(b));
         ensure(known, key("body"), format!("no body is named `{b}`"))?;
     }
-    ensure(l.ramp_time >= 0.0 && l.ramp_time.is_finite(), key("ramp_time"), "must be ≥ 0")?;
+    ensure(
+        l.ramp_time >= 0.0 && l.ramp_time.is_finite(),
+        key("ramp_time"),
+        "must be ≥ 0",
+    )?;
     match l.kind {
         LoadKind::Point => {
             required(&l.force, key("force"), "a point load")?;
@@ -232,21 +342,44 @@ fn load(l: &LoadConfig, i: usize, s: &SceneConfig) -> Check {
             forbidden(&l.force, key("force"), "a traction")?;
             vector(l.traction.as_ref().unwrap(), dim, &key("traction"))?;
             let ok = Face::parse(l.face.as_ref().unwrap(), dim).is_some();
-            ensure(ok, key("face"), "must name a particle face: xmin, xmax, ymin, ymax (zmin, zmax)")
+            ensure(
+                ok,
+                key("face"),
+                "must name a particle face: xmin, xmax, ymin, ymax (zmin, zmax)",
+            )
         }
     }
 }
 
 fn solver(s: &SolverConfig) -> Check {
-    ensure(s.end_time > 0.0 && s.end_time.is_finite(), "solver.end_time", "must be a positive number")?;
+    ensure(
+        s.end_time > 0.0 && s.end_time.is_finite(),
+        "solver.end_time",
+        "must be a positive number",
+    )?;
     ensure(
         s.cfl > 0.0 && s.cfl <= 1.0,
         "solver.cfl",
-        format!("must lie in (0, 1]: the explicit step is cfl × the critical step; got {}", s.cfl),
+        format!(
+            "must lie in (0, 1]: the explicit step is cfl × the critical step; got {}",
+            s.cfl
+        ),
     )?;
     if let Some(dt) = s.dt {
-        ensure(dt > 0.0 && dt.is_finite(), "solver.dt", "must be a positive number")?;
+        ensure(
+            dt > 0.0 && dt.is_finite(),
+            "solver.dt",
+            "must be a positive number",
+        )?;
     }
-    ensure((0.0..=1.0).contains(&s.flip), "solver.flip", "must lie in [0, 1] (1 = FLIP, 0 = PIC)")?;
-    ensure((0.0..1.0).contains(&s.damping), "solver.damping", "must lie in [0, 1)")
+    ensure(
+        (0.0..=1.0).contains(&s.flip),
+        "solver.flip",
+        "must lie in [0, 1] (1 = FLIP, 0 = PIC)",
+    )?;
+    ensure(
+        (0.0..1.0).contains(&s.damping),
+        "solver.damping",
+        "must lie in [0, 1)",
+    )
 }

@@ -84,7 +84,11 @@ impl ShapeFunction {
             ShapeFunction::Linear => linear::evaluate(grid, x, node, w, grad),
             ShapeFunction::Ugimp => gimp::evaluate(grid, x, half_length0, node, w, grad),
             ShapeFunction::Cpgimp => {
-                let half = Vector::<D>::from_fn(|d, _| half_length0[d] * f[(d, d)]);
+                // Stretched by F_dd, kept within (0, h/2] so the support stays 3^D
+                // nodes: a domain stretched beyond a cell is capped at one cell.
+                let half = Vector::<D>::from_fn(|d, _| {
+                    (half_length0[d] * f[(d, d)]).clamp(1e-3 * half_length0[d], 0.5 * grid.h[d])
+                });
                 gimp::evaluate(grid, x, &half, node, w, grad)
             }
             ShapeFunction::Cpdi => {

@@ -8,11 +8,16 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 pub fn problem(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("problems").join(name)
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("problems")
+        .join(name)
 }
 
 /// Run `problems/NAME` with overrides; returns the summary and the output directory.
-pub fn run_problem(name: &str, overrides: &[&str]) -> (Result<RunSummary, RunError>, tempfile::TempDir) {
+pub fn run_problem(
+    name: &str,
+    overrides: &[&str],
+) -> (Result<RunSummary, RunError>, tempfile::TempDir) {
     let dir = tempfile::tempdir().unwrap();
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     let scene = Scene::load(&problem(name), &overrides).expect("scene loads");
@@ -28,10 +33,17 @@ pub struct Table {
 
 impl Table {
     pub fn read(path: &Path) -> Table {
-        let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let text =
+            std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let mut lines = text.lines();
-        let header: Vec<String> = lines.next().unwrap().split(',').map(|s| s.trim().to_string()).collect();
-        let mut columns: HashMap<String, Vec<f64>> = header.iter().map(|h| (h.clone(), Vec::new())).collect();
+        let header: Vec<String> = lines
+            .next()
+            .unwrap()
+            .split(',')
+            .map(|s| s.trim().to_string())
+            .collect();
+        let mut columns: HashMap<String, Vec<f64>> =
+            header.iter().map(|h| (h.clone(), Vec::new())).collect();
         for line in lines.filter(|l| !l.trim().is_empty()) {
             for (h, v) in header.iter().zip(line.split(',')) {
                 columns.get_mut(h).unwrap().push(v.trim().parse().unwrap());
@@ -41,7 +53,9 @@ impl Table {
     }
 
     pub fn col(&self, name: &str) -> &[f64] {
-        self.columns.get(name).unwrap_or_else(|| panic!("no column {name} in {:?}", self.header))
+        self.columns
+            .get(name)
+            .unwrap_or_else(|| panic!("no column {name} in {:?}", self.header))
     }
 }
 
