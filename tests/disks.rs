@@ -17,7 +17,10 @@ struct Collision {
 }
 
 fn disks(scheme: &str) -> Collision {
-    let (result, dir) = run_problem("disks.toml", &[&format!("solver.scheme={scheme}"), "output.frames=0"]);
+    let (result, dir) = run_problem(
+        "disks.toml",
+        &[&format!("solver.scheme={scheme}"), "output.frames=0"],
+    );
     result.unwrap();
     let h = Table::read(&dir.path().join("history.csv"));
     let (k, s) = (h.col("kinetic"), h.col("strain"));
@@ -43,18 +46,50 @@ fn energy_is_exchanged_and_conserved() {
     for scheme in ["usf", "musl"] {
         let c = disks(scheme);
         // 2 · ½ ρ A |v|² with A = πr² = 0.1257 (the particle lattice covers 3.5 % more).
-        assert!((c.e0 / 2.513 - 1.0).abs() < 0.05, "initial kinetic energy {}", c.e0);
-        assert!(c.k_min < 0.1, "{scheme}: kinetic energy should nearly vanish at peak compression, min {:.3} E0", c.k_min);
-        assert!(c.s_max > 0.8, "{scheme}: strain energy should take most of it, max {:.3} E0", c.s_max);
-        assert!(c.e_min > 0.9, "{scheme}: total energy dips to {:.4} E0 during contact (bound 10 %)", c.e_min);
-        assert!((c.e_end - 1.0).abs() < 0.015, "{scheme}: total energy after rebound {:.4} E0 (bound 1.5 %)", c.e_end);
-        assert!(c.vx_end < -0.09, "{scheme}: lower disk should rebound at ~0.1 m/s, final vx {}", c.vx_end);
+        assert!(
+            (c.e0 / 2.513 - 1.0).abs() < 0.05,
+            "initial kinetic energy {}",
+            c.e0
+        );
+        assert!(
+            c.k_min < 0.1,
+            "{scheme}: kinetic energy should nearly vanish at peak compression, min {:.3} E0",
+            c.k_min
+        );
+        assert!(
+            c.s_max > 0.8,
+            "{scheme}: strain energy should take most of it, max {:.3} E0",
+            c.s_max
+        );
+        assert!(
+            c.e_min > 0.9,
+            "{scheme}: total energy dips to {:.4} E0 during contact (bound 10 %)",
+            c.e_min
+        );
+        assert!(
+            (c.e_end - 1.0).abs() < 0.015,
+            "{scheme}: total energy after rebound {:.4} E0 (bound 1.5 %)",
+            c.e_end
+        );
+        assert!(
+            c.vx_end < -0.09,
+            "{scheme}: lower disk should rebound at ~0.1 m/s, final vx {}",
+            c.vx_end
+        );
     }
 }
 
 #[test]
 fn usl_dissipates_in_the_collision() {
     let c = disks("usl");
-    assert!(c.e_end < 0.97, "USL should lose energy in the impact, final {:.4} E0", c.e_end);
-    assert!(c.vx_end < -0.05, "USL disks still rebound, final vx {}", c.vx_end);
+    assert!(
+        c.e_end < 0.97,
+        "USL should lose energy in the impact, final {:.4} E0",
+        c.e_end
+    );
+    assert!(
+        c.vx_end < -0.05,
+        "USL disks still rebound, final vx {}",
+        c.vx_end
+    );
 }

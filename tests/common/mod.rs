@@ -66,3 +66,15 @@ pub fn zero_crossings(t: &[f64], y: &[f64]) -> Vec<f64> {
         .map(|i| t[i - 1] + (t[i] - t[i - 1]) * y[i - 1] / (y[i - 1] - y[i]))
         .collect()
 }
+
+/// Run scene text (named `scene.toml` in errors) with overrides.
+pub fn run_text(
+    text: &str,
+    overrides: &[&str],
+) -> (Result<RunSummary, RunError>, tempfile::TempDir) {
+    let dir = tempfile::tempdir().unwrap();
+    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    let scene = Scene::parse("scene.toml", text, &overrides).expect("scene parses");
+    let result = run(&scene, dir.path(), &RunOptions::default());
+    (result, dir)
+}
