@@ -84,12 +84,11 @@ impl<const D: usize> Grid<D> {
 
     /// Multi-index of a flat node index.
     pub fn node_ijk(&self, mut idx: usize) -> [usize; D] {
-        let mut ijk = [0; D];
-        for d in 0..D {
-            ijk[d] = idx % self.nodes[d];
+        std::array::from_fn(|d| {
+            let i = idx % self.nodes[d];
             idx /= self.nodes[d];
-        }
-        ijk
+            i
+        })
     }
 
     /// Position of a node: the cell corner for degree 1, the Greville abscissa of the

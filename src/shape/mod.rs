@@ -70,6 +70,7 @@ impl ShapeFunction {
     /// `max_support` entries into the output slices and returns how many it wrote.
     /// `half_length0` is the reference half-size of the particle domain and `f` its
     /// deformation gradient (used by cpGIMP and CPDI).
+    #[allow(clippy::too_many_arguments)]
     pub fn evaluate<const D: usize>(
         &self,
         grid: &Grid<D>,
