@@ -107,10 +107,38 @@ fn bench_dim<const D: usize>(c: &mut Criterion, n: usize) {
     group.finish();
 }
 
+/// P2G split into its parts (2D, linear and CPDI): shape-function evaluation, the
+/// active-node map (sequential), and the nodal gathers.
+fn p2g_parts(c: &mut Criterion) {
+    let mut group = c.benchmark_group("p2g_parts_2d");
+    group.sample_size(10);
+    for shape in [ShapeFunction::Linear, ShapeFunction::Cpdi] {
+        let (grid, p) = setup::<2>(256, shape);
+        group.throughput(Throughput::Elements(p.len() as u64));
+        let mut st = Stencils::<2>::default();
+        let mut map = NodeMap::default();
+        group.bench_function(BenchmarkId::new("stencils", shape.name()), |b| {
+            b.iter(|| st.compute(shape, &grid, &p.x, &p.half_length0, &p.f))
+        });
+        group.bench_function(BenchmarkId::new("node_map", shape.name()), |b| {
+            b.iter(|| map.build(&st, grid.node_count()))
+        });
+        let gravity = Vector::<2>::zeros();
+        group.bench_function(BenchmarkId::new("gathers", shape.name()), |b| {
+            b.iter(|| {
+                let (m, mv) = mass_momentum(&map, &st, &p);
+                let f = nodal_force(&map, &st, &p, &gravity, &|_| 0.0);
+                (m.len(), mv.len(), f.len())
+            })
+        });
+    }
+    group.finish();
+}
+
 fn transfer(c: &mut Criterion) {
     bench_dim::<2>(c, 256); // 65,536 particles
     bench_dim::<3>(c, 40); // 64,000 particles
 }
 
-criterion_group!(benches, transfer);
+criterion_group!(benches, transfer, p2g_parts);
 criterion_main!(benches);

@@ -9,12 +9,13 @@ use crate::scene::{Scheme, SolverConfig};
 use crate::setup::Model;
 use crate::shape::{ShapeFunction, Stencils};
 use crate::transfer::{
-    deterministic_sum, gradient, interpolate, mass_momentum, nodal_force, NodeMap,
+    deterministic_sum, gradient, interpolate, mass_momentum, nodal_force, NodeMap, MIN_PARALLEL_LEN,
 };
 use rayon::prelude::*;
 
-/// Nodes lighter than this fraction of the lightest particle are treated as empty
-/// (zero velocity and acceleration): their velocity p_I/m_I is ill-conditioned.
+/// Nodes lighter than this fraction of the lightest particle get no acceleration:
+/// f_I/m_I is ill-conditioned there (f_I need not vanish with m_I), while the
+/// velocity p_I/m_I, a mass-weighted average of particle velocities, is always kept.
 pub const TINY_MASS_FRACTION: f64 = 1e-9;
 
 /// Why a run stopped early.
@@ -72,6 +73,7 @@ impl<const D: usize> Explicit<D> {
         let h = m.grid.h_min();
         (0..p.len())
             .into_par_iter()
+            .with_min_len(MIN_PARALLEL_LEN)
             .map(|q| {
                 let c = m.materials[p.material[q] as usize].wave_speed(p.f[q].determinant());
                 h / (c + p.v[q].norm())
@@ -102,13 +104,15 @@ impl<const D: usize> Explicit<D> {
         let constraint: Vec<Constraint<D>> = map
             .active
             .par_iter()
+            .with_min_len(MIN_PARALLEL_LEN)
             .map(|&g| node_constraint(&m.grid, &m.faces, g as usize))
             .collect();
         let tiny = TINY_MASS_FRACTION * p.mass.iter().cloned().fold(f64::INFINITY, f64::min);
 
         // Nodal velocity at the start of the step, with the conditions applied.
         let (mass, momentum) = mass_momentum(map, st, p);
-        let velocity = nodal_velocity(&mass, &momentum, &constraint, tiny);
+        let raw_velocity = mass_average(&mass, &momentum);
+        let velocity = constrained(&raw_velocity, &constraint);
         if self.scheme == Scheme::Usf {
             update_stress(m, st, map, &velocity, dt, step, t)?;
         }
@@ -123,35 +127,18 @@ impl<const D: usize> Explicit<D> {
         let force = nodal_force(map, st, p, &m.gravity, &load_factor);
         let accel: Vec<Vector<D>> = (0..map.len())
             .into_par_iter()
+            .with_min_len(MIN_PARALLEL_LEN)
             .map(|a| {
-                if mass[a] <= tiny {
-                    return Vector::<D>::zeros();
-                }
-                let mut f = force[a];
-                for d in 0..D {
-                    f[d] -= self.damping
-                        * f[d].abs()
-                        * velocity[a][d].signum()
-                        * (velocity[a][d] != 0.0) as u8 as f64;
-                }
-                let mut acc = f / mass[a];
-                // Prescribed components: the acceleration that lands on the value.
-                let raw = momentum[a] / mass[a];
-                for d in 0..D {
-                    if constraint[a].fixed[d] {
-                        acc[d] = (constraint[a].value[d] - raw[d]) / dt;
-                    }
-                }
-                acc
-            })
-            .collect();
-        let raw_velocity: Vec<Vector<D>> = (0..map.len())
-            .map(|a| {
-                if mass[a] > tiny {
-                    momentum[a] / mass[a]
+                let mut acc = if mass[a] > tiny {
+                    local_damping(&force[a], &velocity[a], self.damping) / mass[a]
                 } else {
                     Vector::<D>::zeros()
+                };
+                // Prescribed components: the acceleration that lands on the value.
+                for d in (0..D).filter(|&d| constraint[a].fixed[d]) {
+                    acc[d] = (constraint[a].value[d] - raw_velocity[a][d]) / dt;
                 }
+                acc
             })
             .collect();
         let velocity_new: Vec<Vector<D>> = (0..map.len())
@@ -165,6 +152,7 @@ impl<const D: usize> Explicit<D> {
         mp.v.par_iter_mut()
             .zip(mp.x.par_iter_mut())
             .enumerate()
+            .with_min_len(MIN_PARALLEL_LEN)
             .for_each(|(q, (v, x))| {
                 let v_flip = *v + interpolate(map, st, q, &accel) * dt;
                 let v_pic = interpolate(map, st, q, &velocity_new);
@@ -184,7 +172,7 @@ impl<const D: usize> Explicit<D> {
             Scheme::Musl => {
                 // Map the updated particle momentum back and use that velocity.
                 let (_, momentum) = mass_momentum(map, st, &m.particles);
-                let velocity = nodal_velocity(&mass, &momentum, &constraint, tiny);
+                let velocity = constrained(&mass_average(&mass, &momentum), &constraint);
                 update_stress(m, st, map, &velocity, dt, step, t)?;
             }
         }
@@ -193,21 +181,41 @@ impl<const D: usize> Explicit<D> {
     }
 }
 
-/// v_I = p_I / m_I with prescribed components imposed; empty nodes at rest.
-fn nodal_velocity<const D: usize>(
-    mass: &[f64],
-    momentum: &[Vector<D>],
-    c: &[Constraint<D>],
-    tiny: f64,
-) -> Vec<Vector<D>> {
+/// Local (non-viscous) damping of a nodal force: f − α |f| sign(v), component by
+/// component, with sign(0) = 0.
+fn local_damping<const D: usize>(f: &Vector<D>, v: &Vector<D>, alpha: f64) -> Vector<D> {
+    let sign = |x: f64| {
+        if x > 0.0 {
+            1.0
+        } else if x < 0.0 {
+            -1.0
+        } else {
+            0.0
+        }
+    };
+    Vector::<D>::from_fn(|d, _| f[d] - alpha * f[d].abs() * sign(v[d]))
+}
+
+/// v_I = p_I / m_I (2-25); zero on a node whose mass is exactly zero.
+fn mass_average<const D: usize>(mass: &[f64], momentum: &[Vector<D>]) -> Vec<Vector<D>> {
     (0..mass.len())
         .map(|a| {
-            let mut v = if mass[a] > tiny {
+            if mass[a] > 0.0 {
                 momentum[a] / mass[a]
             } else {
                 Vector::<D>::zeros()
-            };
-            c[a].apply_velocity(&mut v);
+            }
+        })
+        .collect()
+}
+
+/// Nodal velocities with the prescribed components imposed.
+fn constrained<const D: usize>(v: &[Vector<D>], c: &[Constraint<D>]) -> Vec<Vector<D>> {
+    v.iter()
+        .zip(c)
+        .map(|(v, c)| {
+            let mut v = *v;
+            c.apply_velocity(&mut v);
             v
         })
         .collect()
@@ -235,6 +243,7 @@ fn update_stress<const D: usize>(
             .zip(p.volume.par_iter_mut())
             .zip(history.par_iter_mut())
             .enumerate()
+            .with_min_len(MIN_PARALLEL_LEN)
             .map(|(q, (((f, stress), volume), hist))| {
                 let l: Tensor<D> = gradient(map, st, q, velocity);
                 let df = embed_deformation::<D>(&(Tensor::<D>::identity() + l * dt));
@@ -271,12 +280,15 @@ fn update_stress<const D: usize>(
 /// Stop on non-finite state or particles outside the grid (first offender).
 pub fn check_state<const D: usize>(m: &Model<D>, step: usize, time: f64) -> Result<(), Divergence> {
     let p = &m.particles;
-    let bad = (0..p.len()).into_par_iter().find_first(|&q| {
-        !(p.x[q].iter().all(|v| v.is_finite())
-            && p.v[q].iter().all(|v| v.is_finite())
-            && p.stress[q].iter().all(|v| v.is_finite())
-            && m.grid.contains(&p.x[q]))
-    });
+    let bad = (0..p.len())
+        .into_par_iter()
+        .with_min_len(MIN_PARALLEL_LEN)
+        .find_first(|&q| {
+            !(p.x[q].iter().all(|v| v.is_finite())
+                && p.v[q].iter().all(|v| v.is_finite())
+                && p.stress[q].iter().all(|v| v.is_finite())
+                && m.grid.contains(&p.x[q]))
+        });
     match bad {
         None => Ok(()),
         Some(q) => {

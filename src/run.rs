@@ -103,7 +103,6 @@ fn run_dim<const D: usize>(
                     &com,
                     &vcom,
                 )?;
-                history.flush()?;
                 next_history = t + cfg.output.history_interval;
             }
             if let Some(interval) = frame_interval {

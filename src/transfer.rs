@@ -10,6 +10,10 @@ use crate::particles::Particles;
 use crate::shape::Stencils;
 use rayon::prelude::*;
 
+/// Smallest number of items a parallel loop hands to one task: below it, the
+/// cost of waking threads exceeds the work (small scenes run serially).
+pub const MIN_PARALLEL_LEN: usize = 512;
+
 /// Active nodes of one step and, for each, the stencil entries that touch it.
 #[derive(Clone, Debug, Default)]
 pub struct NodeMap {
@@ -93,6 +97,7 @@ impl NodeMap {
     {
         (0..self.len())
             .into_par_iter()
+            .with_min_len(MIN_PARALLEL_LEN)
             .map(|a| {
                 self.node_entries(a)
                     .iter()

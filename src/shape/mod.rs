@@ -137,6 +137,7 @@ impl<const D: usize> Stencils<D> {
             .zip(self.weight.par_chunks_mut(stride))
             .zip(self.grad.par_chunks_mut(stride))
             .enumerate()
+            .with_min_len(crate::transfer::MIN_PARALLEL_LEN)
             .for_each(|(p, (((c, nd), w), g))| {
                 *c = shape.evaluate(grid, &x[p], &half_length0[p], &f[p], nd, w, g) as u32;
             });
