@@ -3,13 +3,13 @@
 //! damping for dynamic relaxation.
 
 use crate::boundary::{node_constraint, Constraint};
-use crate::dim::{embed_deformation, Tensor, Vector};
-use crate::material::Increment;
+use crate::deformation::Trial;
+use crate::dim::Vector;
 use crate::scene::{Scheme, SolverConfig};
 use crate::setup::Model;
 use crate::shape::{ShapeFunction, Stencils};
 use crate::transfer::{
-    deterministic_sum, gradient, interpolate, mass_momentum, nodal_force, NodeMap, MIN_PARALLEL_LEN,
+    deterministic_sum, interpolate, mass_momentum, nodal_force, NodeMap, MIN_PARALLEL_LEN,
 };
 use rayon::prelude::*;
 
@@ -46,6 +46,7 @@ pub struct Explicit<const D: usize> {
     pub damping: f64,
     stencils: Stencils<D>,
     map: NodeMap,
+    trial: Trial,
 }
 
 impl<const D: usize> Explicit<D> {
@@ -59,6 +60,7 @@ impl<const D: usize> Explicit<D> {
             damping: s.damping,
             stencils: Stencils::default(),
             map: NodeMap::default(),
+            trial: Trial::default(),
         }
     }
 
@@ -114,7 +116,7 @@ impl<const D: usize> Explicit<D> {
         let raw_velocity = mass_average(&mass, &momentum);
         let velocity = constrained(&raw_velocity, &constraint);
         if self.scheme == Scheme::Usf {
-            update_stress(m, st, map, &velocity, dt, step, t)?;
+            update_stress(m, &mut self.trial, st, map, &velocity, dt, step, t)?;
         }
         let p = &m.particles;
 
@@ -168,12 +170,12 @@ impl<const D: usize> Explicit<D> {
 
         match self.scheme {
             Scheme::Usf => {}
-            Scheme::Usl => update_stress(m, st, map, &velocity_new, dt, step, t)?,
+            Scheme::Usl => update_stress(m, &mut self.trial, st, map, &velocity_new, dt, step, t)?,
             Scheme::Musl => {
                 // Map the updated particle momentum back and use that velocity.
                 let (_, momentum) = mass_momentum(map, st, &m.particles);
                 let velocity = constrained(&mass_average(&mass, &momentum), &constraint);
-                update_stress(m, st, map, &velocity, dt, step, t)?;
+                update_stress(m, &mut self.trial, st, map, &velocity, dt, step, t)?;
             }
         }
         check_state(m, step + 1, t + dt)?;
@@ -221,10 +223,11 @@ fn constrained<const D: usize>(v: &[Vector<D>], c: &[Constraint<D>]) -> Vec<Vect
         .collect()
 }
 
-/// Velocity gradient L_p = Σ v_I ⊗ ∇S_Ip, ΔF = I + Δt L, F ← ΔF F, V = det F V0,
-/// and the material's stress update from the start-of-step state (2-31, 2-32).
+/// ΔF = I + Δt L with L_p = Σ v_I ⊗ ∇S_Ip, then F, V and the stress (2-31, 2-32):
+/// the shared deformation update with the nodal displacement u_I = Δt v_I.
 fn update_stress<const D: usize>(
     m: &mut Model<D>,
+    trial: &mut Trial,
     st: &Stencils<D>,
     map: &NodeMap,
     velocity: &[Vector<D>],
@@ -232,48 +235,16 @@ fn update_stress<const D: usize>(
     step: usize,
     t: f64,
 ) -> Result<(), Divergence> {
-    let materials = &m.materials;
-    let p = &mut m.particles;
-    let history_data_old = p.history.data.clone();
-    let history_old = p.history.slots(&history_data_old);
-    let mut history = p.history.split_mut();
-    let inverted =
-        p.f.par_iter_mut()
-            .zip(p.stress.par_iter_mut())
-            .zip(p.volume.par_iter_mut())
-            .zip(history.par_iter_mut())
-            .enumerate()
-            .with_min_len(MIN_PARALLEL_LEN)
-            .map(|(q, (((f, stress), volume), hist))| {
-                let l: Tensor<D> = gradient(map, st, q, velocity);
-                let df = embed_deformation::<D>(&(Tensor::<D>::identity() + l * dt));
-                let inc = Increment {
-                    f_old: *f,
-                    df,
-                    dt,
-                    stress_old: *stress,
-                    history_old: history_old[q],
-                };
-                *stress = materials[p.material[q] as usize].update(&inc, hist);
-                *f = df * *f;
-                let j = f.determinant();
-                *volume = j * p.volume0[q];
-                if j > 0.0 {
-                    usize::MAX
-                } else {
-                    q
-                }
-            })
-            .min()
-            .unwrap_or(usize::MAX);
-    if inverted != usize::MAX {
+    let u: Vec<Vector<D>> = velocity.iter().map(|v| v * dt).collect();
+    if let Some(q) = trial.evaluate(&m.particles, &m.materials, st, map, &u, dt) {
         return Err(Divergence {
             step: step + 1,
             time: t + dt,
-            particle: inverted,
-            message: format!("inverted: det F = {:.3e} ≤ 0", p.f[inverted].determinant()),
+            particle: q,
+            message: format!("inverted: det F = {:.3e} ≤ 0", trial.f[q].determinant()),
         });
     }
+    trial.commit(&mut m.particles);
     Ok(())
 }
 

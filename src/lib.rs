@@ -6,6 +6,7 @@
 //! `D` components.
 
 pub mod boundary;
+pub mod deformation;
 pub mod dim;
 pub mod explicit;
 pub mod grid;

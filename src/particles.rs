@@ -56,6 +56,11 @@ impl History {
         split_slots(&self.len, &mut self.data)
     }
 
+    /// The per-particle mutable slices of another buffer laid out like `data`.
+    pub fn slots_mut<'a>(&self, data: &'a mut [f64]) -> Vec<&'a mut [f64]> {
+        split_slots(&self.len, data)
+    }
+
     /// The per-particle slices of another buffer laid out like `data`.
     pub fn slots<'a>(&self, data: &'a [f64]) -> Vec<&'a [f64]> {
         let mut rest = data;

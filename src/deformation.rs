@@ -1,0 +1,88 @@
+//! Particle deformation from a nodal displacement increment, shared by the explicit
+//! and implicit solvers: ΔF_p = I + Σ_I u_I ⊗ ∇S_Ip (the explicit step uses
+//! u_I = Δt v_I, i.e. ΔF = I + Δt L, thesis 2-31), F ← ΔF F, V = det F V0, and the
+//! material's stress update from the start-of-increment state. The result is a
+//! trial state, so an implicit solver can evaluate it at every Newton iterate
+//! without drift and commit it once the step has converged.
+
+use crate::dim::{embed_deformation, Mat3, Tensor, Vector};
+use crate::material::{Increment, Material};
+use crate::particles::Particles;
+use crate::shape::Stencils;
+use crate::transfer::{gradient, NodeMap, MIN_PARALLEL_LEN};
+use rayon::prelude::*;
+
+/// The state the particles would reach under a displacement increment.
+#[derive(Clone, Debug, Default)]
+pub struct Trial {
+    /// Incremental deformation gradient ΔF_p.
+    pub df: Vec<Mat3>,
+    pub f: Vec<Mat3>,
+    pub stress: Vec<Mat3>,
+    pub volume: Vec<f64>,
+    /// History variables, laid out like `Particles::history.data`.
+    pub history: Vec<f64>,
+}
+
+impl Trial {
+    /// Evaluate the trial state under nodal displacements `u` (one per active node).
+    /// Returns the first particle whose deformation inverts (det F ≤ 0), if any.
+    pub fn evaluate<const D: usize>(
+        &mut self,
+        p: &Particles<D>,
+        materials: &[Box<dyn Material>],
+        st: &Stencils<D>,
+        map: &NodeMap,
+        u: &[Vector<D>],
+        dt: f64,
+    ) -> Option<usize> {
+        let n = p.len();
+        self.df.resize(n, Mat3::identity());
+        self.f.resize(n, Mat3::identity());
+        self.stress.resize(n, Mat3::zeros());
+        self.volume.resize(n, 0.0);
+        self.history.clone_from(&p.history.data);
+        let history_old = p.history.slots(&p.history.data);
+        let mut history = p.history.slots_mut(&mut self.history);
+        let inverted = self
+            .df
+            .par_iter_mut()
+            .zip(self.f.par_iter_mut())
+            .zip(self.stress.par_iter_mut())
+            .zip(self.volume.par_iter_mut())
+            .zip(history.par_iter_mut())
+            .enumerate()
+            .with_min_len(MIN_PARALLEL_LEN)
+            .map(|(q, ((((df, f), stress), volume), hist))| {
+                let grad_u: Tensor<D> = gradient(map, st, q, u);
+                *df = embed_deformation::<D>(&(Tensor::<D>::identity() + grad_u));
+                let inc = Increment {
+                    f_old: p.f[q],
+                    df: *df,
+                    dt,
+                    stress_old: p.stress[q],
+                    history_old: history_old[q],
+                };
+                *stress = materials[p.material[q] as usize].update(&inc, hist);
+                *f = *df * p.f[q];
+                let j = f.determinant();
+                *volume = j * p.volume0[q];
+                if j > 0.0 {
+                    usize::MAX
+                } else {
+                    q
+                }
+            })
+            .min()
+            .unwrap_or(usize::MAX);
+        (inverted != usize::MAX).then_some(inverted)
+    }
+
+    /// Make the trial state the particles' state (buffers are swapped, not copied).
+    pub fn commit<const D: usize>(&mut self, p: &mut Particles<D>) {
+        std::mem::swap(&mut p.f, &mut self.f);
+        std::mem::swap(&mut p.stress, &mut self.stress);
+        std::mem::swap(&mut p.volume, &mut self.volume);
+        std::mem::swap(&mut p.history.data, &mut self.history);
+    }
+}
