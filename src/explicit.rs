@@ -23,17 +23,18 @@ pub const TINY_MASS_FRACTION: f64 = 1e-9;
 pub struct Divergence {
     pub step: usize,
     pub time: f64,
-    pub particle: usize,
+    /// The offending particle, when there is one (not for a Newton failure).
+    pub particle: Option<usize>,
     pub message: String,
 }
 
 impl std::fmt::Display for Divergence {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "diverged at step {} (t = {:.6e}): particle {} {}",
-            self.step, self.time, self.particle, self.message
-        )
+        write!(f, "diverged at step {} (t = {:.6e}): ", self.step, self.time)?;
+        if let Some(q) = self.particle {
+            write!(f, "particle {q} ")?;
+        }
+        write!(f, "{}", self.message)
     }
 }
 
@@ -53,11 +54,11 @@ impl<const D: usize> Explicit<D> {
     pub fn new(shape: ShapeFunction, s: &SolverConfig) -> Self {
         Explicit {
             shape,
-            scheme: s.scheme,
-            cfl: s.cfl,
+            scheme: s.scheme(),
+            cfl: s.cfl(),
             fixed_dt: s.dt,
-            flip: s.flip,
-            damping: s.damping,
+            flip: s.flip(),
+            damping: s.damping(),
             stencils: Stencils::default(),
             map: NodeMap::default(),
             trial: Trial::default(),
@@ -240,7 +241,7 @@ fn update_stress<const D: usize>(
         return Err(Divergence {
             step: step + 1,
             time: t + dt,
-            particle: q,
+            particle: Some(q),
             message: format!("inverted: det F = {:.3e} ≤ 0", trial.f[q].determinant()),
         });
     }
@@ -285,7 +286,7 @@ pub fn check_state<const D: usize>(m: &Model<D>, step: usize, time: f64) -> Resu
             Err(Divergence {
                 step,
                 time,
-                particle: q,
+                particle: Some(q),
                 message,
             })
         }

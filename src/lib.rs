@@ -10,6 +10,7 @@ pub mod deformation;
 pub mod dim;
 pub mod explicit;
 pub mod grid;
+pub mod implicit;
 pub mod material;
 pub mod output;
 pub mod particles;

@@ -4,6 +4,9 @@
 //! records what happened where.
 
 use crate::explicit::{check_state, Divergence, Explicit};
+use crate::implicit::{Implicit, NEWTON_CSV_HEADER};
+use crate::scene::{Integrator, SolverKind};
+use std::io::Write;
 use crate::output::{
     body_centres, write_json, write_particles_csv, FrameWriter, HistoryWriter, Progress,
 };
@@ -66,6 +69,78 @@ pub fn strain_energy<const D: usize>(m: &Model<D>) -> f64 {
     })
 }
 
+/// The time stepper of a run: explicit, or implicit with its newton.csv.
+enum Stepper<const D: usize> {
+    Explicit(Explicit<D>),
+    Implicit(Box<Implicit<D>>, std::io::BufWriter<std::fs::File>),
+}
+
+impl<const D: usize> Stepper<D> {
+    fn new(cfg: &crate::scene::SceneConfig, out: &Path) -> std::io::Result<Self> {
+        let shape = cfg.grid.shape_function;
+        Ok(match cfg.solver.kind {
+            SolverKind::Explicit => Stepper::Explicit(Explicit::new(shape, &cfg.solver)),
+            SolverKind::Implicit => {
+                let mut log = std::io::BufWriter::new(std::fs::File::create(out.join("newton.csv"))?);
+                writeln!(log, "{NEWTON_CSV_HEADER}")?;
+                Stepper::Implicit(Box::new(Implicit::new(shape, &cfg.solver)), log)
+            }
+        })
+    }
+
+    fn dt(&self, m: &Model<D>, s: &crate::scene::SolverConfig) -> f64 {
+        match self {
+            Stepper::Explicit(e) => e.dt(m),
+            Stepper::Implicit(..) => s.implicit_dt(),
+        }
+    }
+
+    /// One step; the outer error is an output failure, the inner one a divergence.
+    fn step(&mut self, m: &mut Model<D>, t: f64, dt: f64, step: usize) -> std::io::Result<Result<f64, Divergence>> {
+        Ok(match self {
+            Stepper::Explicit(e) => e.step(m, t, dt, step),
+            Stepper::Implicit(i, log) => {
+                let result = i.advance(m, t, dt, step);
+                for row in i.take_log() {
+                    writeln!(log, "{}", row.csv())?;
+                }
+                log.flush()?;
+                result
+            }
+        })
+    }
+
+    fn active_nodes(&self) -> usize {
+        match self {
+            Stepper::Explicit(e) => e.active_nodes(),
+            Stepper::Implicit(i, _) => i.active_nodes(),
+        }
+    }
+
+    /// Solver fields of summary.json.
+    fn describe(&self, s: &crate::scene::SolverConfig, summary: &mut serde_json::Value) {
+        match self {
+            Stepper::Explicit(_) => {
+                summary["solver"] = json!("explicit");
+                summary["scheme"] = json!(s.scheme().name());
+            }
+            Stepper::Implicit(i, _) => {
+                summary["solver"] = json!("implicit");
+                summary["integrator"] = json!(match s.integrator() {
+                    Integrator::Newmark => "newmark",
+                    Integrator::QuasiStatic => "quasi_static",
+                });
+                summary["newton_iterations"] = json!(i.newton_iterations);
+                summary["cutbacks"] = json!(i.cutbacks);
+                if s.integrator() == Integrator::Newmark {
+                    summary["beta"] = json!(s.beta());
+                    summary["gamma"] = json!(s.gamma());
+                }
+            }
+        }
+    }
+}
+
 fn run_dim<const D: usize>(
     scene: &Scene,
     out: &Path,
@@ -73,7 +148,7 @@ fn run_dim<const D: usize>(
 ) -> Result<RunSummary, RunError> {
     let cfg = &scene.config;
     let mut model = Model::<D>::build(scene)?;
-    let mut solver = Explicit::<D>::new(cfg.grid.shape_function, &cfg.solver);
+    let mut solver = Stepper::<D>::new(cfg, out)?;
     let end_time = cfg.solver.end_time;
     let n_bodies = model.n_bodies();
     let mut history = HistoryWriter::create(&out.join("history.csv"), D, n_bodies)?;
@@ -121,9 +196,9 @@ fn run_dim<const D: usize>(
         if t >= end_time * (1.0 - 1e-12) {
             break Ok(());
         }
-        let dt = solver.dt(&model).min(end_time - t);
+        let dt = solver.dt(&model, &cfg.solver).min(end_time - t);
         last_dt = dt;
-        match solver.step(&mut model, t, dt, step) {
+        match solver.step(&mut model, t, dt, step)? {
             Ok(work) => external_work += work,
             Err(d) => break Err(d),
         }
@@ -142,8 +217,6 @@ fn run_dim<const D: usize>(
     let mut summary = json!({
         "scene": scene.file,
         "dimension": D,
-        "solver": "explicit",
-        "scheme": cfg.solver.scheme.name(),
         "shape_function": cfg.grid.shape_function.name(),
         "particles": particles,
         "active_nodes_last_step": solver.active_nodes(),
@@ -155,6 +228,7 @@ fn run_dim<const D: usize>(
         "particle_steps_per_second": (particles * step) as f64 / wall.max(1e-9),
         "status": "completed",
     });
+    solver.describe(&cfg.solver, &mut summary);
     if let Err(d) = outcome {
         summary["status"] = json!("diverged");
         summary["message"] = json!(d.to_string());

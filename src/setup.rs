@@ -4,7 +4,7 @@
 use crate::boundary::{Constraint, FaceCondition};
 use crate::dim::Vector;
 use crate::grid::{Face, Grid};
-use crate::material::{LinearElastic, Material, MooneyRivlin, NeoHookean};
+use crate::material::{Hencky, LinearElastic, Material, MooneyRivlin, NeoHookean};
 use crate::particles::Particles;
 use crate::scene::validate::{axis, body_bounds};
 use crate::scene::{
@@ -151,6 +151,7 @@ fn material(m: &MaterialConfig) -> Box<dyn Material> {
         MaterialModel::LinearElastic => {
             Box::new(LinearElastic::new(m.density, m.youngs_modulus.unwrap(), nu))
         }
+        MaterialModel::Hencky => Box::new(Hencky::new(m.density, m.youngs_modulus.unwrap(), nu)),
         MaterialModel::NeoHookean => {
             Box::new(NeoHookean::new(m.density, m.youngs_modulus.unwrap(), nu))
         }

@@ -137,6 +137,19 @@ pub fn nodal_force<const D: usize>(
     })
 }
 
+/// External nodal force Σ_p S_Ip (m_p g + s_p f_p) (2-52), s_p the load factor.
+pub fn external_force<const D: usize>(
+    map: &NodeMap,
+    st: &Stencils<D>,
+    p: &Particles<D>,
+    gravity: &Vector<D>,
+    load_factor: &(impl Fn(usize) -> f64 + Sync),
+) -> Vec<Vector<D>> {
+    map.gather(st.stride, Vector::<D>::zeros(), |q, e| {
+        (gravity * p.mass[q] + p.load[q] * load_factor(q)) * st.weight[e]
+    })
+}
+
 /// Σ_I S_Ip u_I for particle p (interpolation of a nodal vector field).
 pub fn interpolate<const D: usize>(
     map: &NodeMap,

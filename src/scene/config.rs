@@ -50,6 +50,8 @@ pub enum MaterialModel {
     LinearElastic,
     /// Compressible neo-Hookean: youngs_modulus, poisson_ratio.
     NeoHookean,
+    /// Hencky (logarithmic strain, Kirchhoff stress): youngs_modulus, poisson_ratio.
+    Hencky,
     /// Mooney-Rivlin (thesis 3-2): a, b, poisson_ratio; c and d follow (3-8, 3-17).
     MooneyRivlin,
 }
@@ -178,6 +180,7 @@ pub struct LoadConfig {
 #[serde(rename_all = "snake_case")]
 pub enum SolverKind {
     Explicit,
+    Implicit,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, serde::Serialize)]
@@ -198,35 +201,105 @@ impl Scheme {
     }
 }
 
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Integrator {
+    /// Newmark with Newton-Raphson (thesis 2-33…2-38).
+    Newmark,
+    /// No inertia: gravity and loads scaled by the load factor t / end_time.
+    QuasiStatic,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MassMatrix {
+    Lumped,
+    Consistent,
+}
+
+/// The `[solver]` table. Keys that belong to the other kind are rejected by
+/// `validate`; the accessors give the documented defaults.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SolverConfig {
     pub kind: SolverKind,
-    #[serde(default = "default_scheme")]
-    pub scheme: Scheme,
+    /// End of the run (implicit quasi-static: the pseudo-time of full load).
     pub end_time: f64,
-    /// Time step as a fraction of the CFL limit (2-45), recomputed every step; ≤ 1.
-    #[serde(default = "default_cfl")]
-    pub cfl: f64,
-    /// Fixed time step instead of the CFL rule (not limited: for stability studies).
+    /// Explicit: fixed step instead of the CFL rule. Implicit: the step (required
+    /// for Newmark; quasi-static may give `load_steps` instead).
     pub dt: Option<f64>,
-    /// FLIP fraction of the particle velocity update: 1 = FLIP, 0 = PIC.
-    #[serde(default = "default_flip")]
-    pub flip: f64,
-    /// Local (non-viscous) damping α in [0, 1): nodal force f ← f − α|f| sign(v),
-    /// for dynamic relaxation of quasi-static problems.
-    #[serde(default)]
-    pub damping: f64,
+    // Explicit keys.
+    pub scheme: Option<Scheme>,
+    pub cfl: Option<f64>,
+    pub flip: Option<f64>,
+    pub damping: Option<f64>,
+    // Implicit keys.
+    pub integrator: Option<Integrator>,
+    pub beta: Option<f64>,
+    pub gamma: Option<f64>,
+    pub mass: Option<MassMatrix>,
+    pub load_steps: Option<usize>,
+    pub residual_tolerance: Option<f64>,
+    pub displacement_tolerance: Option<f64>,
+    pub max_iterations: Option<usize>,
+    pub line_search: Option<bool>,
+    pub max_cutbacks: Option<usize>,
 }
 
-fn default_scheme() -> Scheme {
-    Scheme::Musl
-}
-fn default_cfl() -> f64 {
-    0.5
-}
-fn default_flip() -> f64 {
-    1.0
+impl SolverConfig {
+    pub fn scheme(&self) -> Scheme {
+        self.scheme.unwrap_or(Scheme::Musl)
+    }
+    /// Fraction of the CFL limit (2-45); default 0.5.
+    pub fn cfl(&self) -> f64 {
+        self.cfl.unwrap_or(0.5)
+    }
+    /// FLIP fraction: 1 = FLIP (default), 0 = PIC.
+    pub fn flip(&self) -> f64 {
+        self.flip.unwrap_or(1.0)
+    }
+    /// Local damping α (default 0).
+    pub fn damping(&self) -> f64 {
+        self.damping.unwrap_or(0.0)
+    }
+    pub fn integrator(&self) -> Integrator {
+        self.integrator.unwrap_or(Integrator::Newmark)
+    }
+    /// Newmark β (default 1/4, trapezoidal).
+    pub fn beta(&self) -> f64 {
+        self.beta.unwrap_or(0.25)
+    }
+    /// Newmark γ (default 1/2).
+    pub fn gamma(&self) -> f64 {
+        self.gamma.unwrap_or(0.5)
+    }
+    pub fn mass(&self) -> MassMatrix {
+        self.mass.unwrap_or(MassMatrix::Lumped)
+    }
+    /// Implicit step: `dt`, or end_time / load_steps.
+    pub fn implicit_dt(&self) -> f64 {
+        self.dt.unwrap_or_else(|| self.end_time / self.load_steps.unwrap_or(1) as f64)
+    }
+    /// Newton converges when ‖R‖ ≤ this × the reference force (default 1e-9).
+    pub fn residual_tolerance(&self) -> f64 {
+        self.residual_tolerance.unwrap_or(1e-9)
+    }
+    /// … and ‖δu‖ ≤ this × ‖u‖ (default 1e-9).
+    pub fn displacement_tolerance(&self) -> f64 {
+        self.displacement_tolerance.unwrap_or(1e-9)
+    }
+    /// Newton iteration cap per attempt (default 25).
+    pub fn max_iterations(&self) -> usize {
+        self.max_iterations.unwrap_or(25)
+    }
+    /// Backtracking line search on the residual norm (default off).
+    pub fn line_search(&self) -> bool {
+        self.line_search.unwrap_or(false)
+    }
+    /// Times a failing step may be halved before the run stops (default 5).
+    pub fn max_cutbacks(&self) -> usize {
+        self.max_cutbacks.unwrap_or(5)
+    }
 }
 
 #[derive(Clone, Debug, Deserialize)]

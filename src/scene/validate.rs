@@ -111,7 +111,7 @@ fn material(m: &MaterialConfig, i: usize) -> Check {
     )?;
     let what = format!("model `{}`", model_name(m.model));
     match m.model {
-        MaterialModel::LinearElastic | MaterialModel::NeoHookean => {
+        MaterialModel::LinearElastic | MaterialModel::NeoHookean | MaterialModel::Hencky => {
             required(&m.youngs_modulus, key("youngs_modulus"), &what)?;
             forbidden(&m.a, key("a"), &what)?;
             forbidden(&m.b, key("b"), &what)?;
@@ -147,6 +147,7 @@ pub fn model_name(m: MaterialModel) -> &'static str {
     match m {
         MaterialModel::LinearElastic => "linear_elastic",
         MaterialModel::NeoHookean => "neo_hookean",
+        MaterialModel::Hencky => "hencky",
         MaterialModel::MooneyRivlin => "mooney_rivlin",
     }
 }
@@ -352,34 +353,63 @@ fn load(l: &LoadConfig, i: usize, s: &SceneConfig) -> Check {
 }
 
 fn solver(s: &SolverConfig) -> Check {
-    ensure(
-        s.end_time > 0.0 && s.end_time.is_finite(),
-        "solver.end_time",
-        "must be a positive number",
-    )?;
-    ensure(
-        s.cfl > 0.0 && s.cfl <= 1.0,
-        "solver.cfl",
-        format!(
-            "must lie in (0, 1]: the explicit step is cfl × the critical step; got {}",
-            s.cfl
-        ),
-    )?;
+    ensure(s.end_time > 0.0 && s.end_time.is_finite(), "solver.end_time", "must be a positive number")?;
     if let Some(dt) = s.dt {
-        ensure(
-            dt > 0.0 && dt.is_finite(),
-            "solver.dt",
-            "must be a positive number",
-        )?;
+        ensure(dt > 0.0 && dt.is_finite(), "solver.dt", "must be a positive number")?;
     }
+    match s.kind {
+        SolverKind::Explicit => explicit(s),
+        SolverKind::Implicit => implicit(s),
+    }
+}
+
+fn explicit(s: &SolverConfig) -> Check {
+    let what = "the explicit solver";
+    forbidden(&s.integrator, "solver.integrator".into(), what)?;
+    forbidden(&s.beta, "solver.beta".into(), what)?;
+    forbidden(&s.gamma, "solver.gamma".into(), what)?;
+    forbidden(&s.mass, "solver.mass".into(), what)?;
+    forbidden(&s.load_steps, "solver.load_steps".into(), what)?;
+    forbidden(&s.residual_tolerance, "solver.residual_tolerance".into(), what)?;
+    forbidden(&s.displacement_tolerance, "solver.displacement_tolerance".into(), what)?;
+    forbidden(&s.max_iterations, "solver.max_iterations".into(), what)?;
+    forbidden(&s.line_search, "solver.line_search".into(), what)?;
+    forbidden(&s.max_cutbacks, "solver.max_cutbacks".into(), what)?;
+    let cfl = s.cfl();
     ensure(
-        (0.0..=1.0).contains(&s.flip),
-        "solver.flip",
-        "must lie in [0, 1] (1 = FLIP, 0 = PIC)",
+        cfl > 0.0 && cfl <= 1.0,
+        "solver.cfl",
+        format!("must lie in (0, 1]: the explicit step is cfl × the critical step; got {cfl}"),
     )?;
-    ensure(
-        (0.0..1.0).contains(&s.damping),
-        "solver.damping",
-        "must lie in [0, 1)",
-    )
+    ensure((0.0..=1.0).contains(&s.flip()), "solver.flip", "must lie in [0, 1] (1 = FLIP, 0 = PIC)")?;
+    ensure((0.0..1.0).contains(&s.damping()), "solver.damping", "must lie in [0, 1)")
+}
+
+fn implicit(s: &SolverConfig) -> Check {
+    let what = "the implicit solver";
+    forbidden(&s.scheme, "solver.scheme".into(), what)?;
+    forbidden(&s.cfl, "solver.cfl".into(), what)?;
+    forbidden(&s.flip, "solver.flip".into(), what)?;
+    forbidden(&s.damping, "solver.damping".into(), what)?;
+    match s.integrator() {
+        Integrator::Newmark => {
+            required(&s.dt, "solver.dt".into(), "the Newmark integrator")?;
+            forbidden(&s.load_steps, "solver.load_steps".into(), "the Newmark integrator (give dt)")?;
+            ensure(s.beta() > 0.0 && s.beta() <= 1.0, "solver.beta", "must lie in (0, 1]")?;
+            ensure(s.gamma() >= 0.0 && s.gamma() <= 1.5, "solver.gamma", "must lie in [0, 1.5]")?;
+        }
+        Integrator::QuasiStatic => {
+            forbidden(&s.beta, "solver.beta".into(), "the quasi-static integrator")?;
+            forbidden(&s.gamma, "solver.gamma".into(), "the quasi-static integrator")?;
+            forbidden(&s.mass, "solver.mass".into(), "the quasi-static integrator")?;
+            ensure(s.dt.is_some() != s.load_steps.is_some(), "solver.load_steps", "give either load_steps or dt")?;
+            if let Some(n) = s.load_steps {
+                ensure(n >= 1, "solver.load_steps", "must be at least 1")?;
+            }
+        }
+    }
+    for (key, v) in [("residual_tolerance", s.residual_tolerance()), ("displacement_tolerance", s.displacement_tolerance())] {
+        ensure(v > 0.0 && v < 1.0, format!("solver.{key}"), "must lie in (0, 1)")?;
+    }
+    ensure(s.max_iterations() >= 1, "solver.max_iterations", "must be at least 1")
 }

@@ -1,0 +1,489 @@
+//! Implicit MPM: Newmark with Newton-Raphson, or quasi-static load stepping, on the
+//! same particles, grid, shape functions, transfers, boundary conditions and
+//! material updates as the explicit solver (thesis §2.2.2).
+//!
+//! One step: shape functions at the step-start positions; unknowns are the nodal
+//! displacement increments u of the free components; residual (2-37)
+//! r(u) = M (u − ũ)/(βΔt²) + f_int(u) − f_ext (no inertia when quasi-static);
+//! Newton (2-38) with the assembled consistent tangent (2-40), Dirichlet
+//! components eliminated, sparse direct solves. Every iterate's stresses are
+//! recomputed from the step-start state (`deformation::Trial`). A step whose Newton
+//! iteration fails is halved and retried, up to `max_cutbacks` times.
+
+pub mod newmark;
+pub mod tangent;
+
+use crate::boundary::{node_constraint, Constraint};
+use crate::deformation::Trial;
+use crate::dim::Vector;
+use crate::explicit::{check_state, Divergence};
+use crate::linear::direct::{DirectSolver, Structure};
+use crate::material::Increment;
+use crate::scene::{Integrator, MassMatrix, SolverConfig};
+use crate::setup::Model;
+use crate::shape::{ShapeFunction, Stencils};
+use crate::transfer::{external_force, interpolate, mass_momentum, nodal_force, NodeMap, MIN_PARALLEL_LEN};
+use newmark::Newmark;
+use rayon::prelude::*;
+use std::time::Instant;
+use tangent::{internal_force, pk1_derivative, relative_pk1, stiffness_triplets, Dofs, Pk1Derivative};
+
+/// One Newton iteration, as written to newton.csv.
+#[derive(Clone, Debug)]
+pub struct NewtonRow {
+    pub step: usize,
+    pub time: f64,
+    pub dt: f64,
+    /// How many times this step was halved.
+    pub cutback: usize,
+    pub iteration: usize,
+    /// ‖r‖ / reference force.
+    pub residual: f64,
+    /// ‖δu‖ / ‖u‖ of the correction that follows (NaN on the converged row).
+    pub increment: f64,
+    pub wall_seconds: f64,
+    pub linear_solver: &'static str,
+}
+
+pub const NEWTON_CSV_HEADER: &str = "step,time,dt,cutback,iteration,residual,increment,wall_seconds,linear_solver";
+
+impl NewtonRow {
+    pub fn csv(&self) -> String {
+        format!(
+            "{},{},{},{},{},{:e},{:e},{:e},{}",
+            self.step,
+            self.time,
+            self.dt,
+            self.cutback,
+            self.iteration,
+            self.residual,
+            self.increment,
+            self.wall_seconds,
+            self.linear_solver
+        )
+    }
+}
+
+/// Why one attempt at a step failed.
+#[derive(Clone, Debug)]
+struct Failure {
+    particle: Option<usize>,
+    message: String,
+}
+
+pub struct Implicit<const D: usize> {
+    shape: ShapeFunction,
+    integrator: Integrator,
+    newmark: Newmark,
+    mass_matrix: MassMatrix,
+    end_time: f64,
+    residual_tolerance: f64,
+    displacement_tolerance: f64,
+    max_iterations: usize,
+    line_search: bool,
+    max_cutbacks: usize,
+    stencils: Stencils<D>,
+    map: NodeMap,
+    trial: Trial,
+    solver: DirectSolver,
+    /// Particle accelerations (Newmark only; empty otherwise).
+    accel: Vec<Vector<D>>,
+    /// Newton iterations since the last `take_log`.
+    log: Vec<NewtonRow>,
+    pub newton_iterations: usize,
+    pub cutbacks: usize,
+}
+
+impl<const D: usize> Implicit<D> {
+    pub fn new(shape: ShapeFunction, s: &SolverConfig) -> Self {
+        Implicit {
+            shape,
+            integrator: s.integrator(),
+            newmark: Newmark { beta: s.beta(), gamma: s.gamma() },
+            mass_matrix: s.mass(),
+            end_time: s.end_time,
+            residual_tolerance: s.residual_tolerance(),
+            displacement_tolerance: s.displacement_tolerance(),
+            max_iterations: s.max_iterations(),
+            line_search: s.line_search(),
+            max_cutbacks: s.max_cutbacks(),
+            stencils: Stencils::default(),
+            map: NodeMap::default(),
+            trial: Trial::default(),
+            solver: DirectSolver::new(),
+            accel: Vec::new(),
+            log: Vec::new(),
+            newton_iterations: 0,
+            cutbacks: 0,
+        }
+    }
+
+    /// Newton rows logged since the last call.
+    pub fn take_log(&mut self) -> Vec<NewtonRow> {
+        std::mem::take(&mut self.log)
+    }
+
+    pub fn active_nodes(&self) -> usize {
+        self.map.len()
+    }
+
+    /// Advance from t to t + dt, halving the step on Newton failure. Returns the
+    /// work of gravity and applied loads.
+    pub fn advance(&mut self, m: &mut Model<D>, t: f64, dt: f64, step: usize) -> Result<f64, Divergence> {
+        self.advance_level(m, t, dt, step, 0)
+    }
+
+    fn advance_level(&mut self, m: &mut Model<D>, t: f64, dt: f64, step: usize, level: usize) -> Result<f64, Divergence> {
+        match self.attempt(m, t, dt, step, level) {
+            Ok(work) => Ok(work),
+            Err(f) if level < self.max_cutbacks => {
+                self.cutbacks += 1;
+                let first = self.advance_level(m, t, dt / 2.0, step, level + 1)?;
+                Ok(first + self.advance_level(m, t + dt / 2.0, dt / 2.0, step, level + 1)?)
+            }
+            Err(f) => Err(Divergence {
+                step: step + 1,
+                time: t + dt,
+                particle: f.particle,
+                message: format!("{} (after {} cut-backs of the step, now Δt = {dt:.3e})", f.message, level),
+            }),
+        }
+    }
+
+    /// Load factor of gravity and loads at time t: t / end_time when quasi-static,
+    /// otherwise 1 for gravity and the ramp of each load.
+    fn load_factors(&self, m: &Model<D>, t: f64) -> (f64, Vec<f64>) {
+        match self.integrator {
+            Integrator::QuasiStatic => {
+                let lambda = (t / self.end_time).min(1.0);
+                (lambda, vec![lambda; m.load_ramps.len()])
+            }
+            Integrator::Newmark => (1.0, m.load_scales(t)),
+        }
+    }
+
+    /// Particle accelerations at t = 0 from M a = f_ext − f_int (lumped).
+    fn initial_acceleration(&mut self, m: &Model<D>) {
+        let p = &m.particles;
+        let (g, scales) = self.load_factors(m, 0.0);
+        let load = |q: usize| match m.load_ramp_of[q] {
+            u32::MAX => 0.0,
+            r => scales[r as usize],
+        };
+        let force = nodal_force(&self.map, &self.stencils, p, &(m.gravity * g), &load);
+        let (mass, _) = mass_momentum(&self.map, &self.stencils, p);
+        let a: Vec<Vector<D>> = force.iter().zip(&mass).map(|(f, m)| if *m > 0.0 { f / *m } else { f * 0.0 }).collect();
+        self.accel = (0..p.len()).map(|q| interpolate(&self.map, &self.stencils, q, &a)).collect();
+    }
+
+    /// One attempt at the step t → t + dt. Leaves the model untouched on failure.
+    fn attempt(&mut self, m: &mut Model<D>, t: f64, dt: f64, step: usize, level: usize) -> Result<f64, Failure> {
+        let started = Instant::now();
+        let dynamic = self.integrator == Integrator::Newmark;
+        let p = &m.particles;
+        self.stencils.compute(self.shape, &m.grid, &p.x, &p.half_length0, &p.f);
+        self.map.build(&self.stencils, m.grid.node_count());
+        if dynamic && self.accel.len() != p.len() {
+            self.initial_acceleration(m);
+        }
+        let p = &m.particles;
+        let (st, map) = (&self.stencils, &self.map);
+        let constraint: Vec<Constraint<D>> = map
+            .active
+            .par_iter()
+            .with_min_len(MIN_PARALLEL_LEN)
+            .map(|&g| node_constraint(&m.grid, &m.faces, g as usize))
+            .collect();
+        let dofs = Dofs::new(constraint.iter().map(|c| c.fixed));
+        let n = map.len();
+
+        // External force at the end of the step; inertia terms (Newmark).
+        let (g_new, scales_new) = self.load_factors(m, t + dt);
+        let load_new = |q: usize| match m.load_ramp_of[q] {
+            u32::MAX => 0.0,
+            r => scales_new[r as usize],
+        };
+        let f_ext = external_force(map, st, p, &(m.gravity * g_new), &load_new);
+        let (mass, momentum) = mass_momentum(map, st, p);
+        let nodal = |w: &[f64], a: usize| if w[a] > 0.0 { 1.0 / w[a] } else { 0.0 };
+        let (v_n, a_n, u_tilde) = if dynamic {
+            let am = map.gather(st.stride, Vector::<D>::zeros(), |q, e| self.accel[q] * (p.mass[q] * st.weight[e]));
+            let v: Vec<Vector<D>> = (0..n).map(|a| momentum[a] * nodal(&mass, a)).collect();
+            let acc: Vec<Vector<D>> = (0..n).map(|a| am[a] * nodal(&mass, a)).collect();
+            let ut = (0..n).map(|a| self.newmark.predictor(dt, &v[a], &acc[a])).collect();
+            (v, acc, ut)
+        } else {
+            (vec![Vector::<D>::zeros(); n], vec![Vector::<D>::zeros(); n], vec![Vector::<D>::zeros(); n])
+        };
+        let inertia = if dynamic { self.newmark.inertia(dt) } else { 0.0 };
+
+        // Initial iterate: the predictor, with the prescribed components imposed.
+        let mut u = u_tilde.clone();
+        for a in 0..n {
+            for d in (0..D).filter(|&d| constraint[a].fixed[d]) {
+                u[a][d] = constraint[a].value[d] * dt;
+            }
+        }
+        let free = |r: &[Vector<D>]| -> Vec<f64> {
+            let mut out = vec![0.0; dofs.free];
+            for a in 0..n {
+                for d in 0..D {
+                    if let Some(i) = dofs.of(a, d, D) {
+                        out[i] = r[a][d];
+                    }
+                }
+            }
+            out
+        };
+        let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let reference = norm(&free(&f_ext)).max(norm(&free(&self.inertial_force(map, st, p, &mass, &u_tilde, inertia))));
+        let mut method = "none";
+        let mut converged = false;
+        let mut last_increment = f64::NAN;
+        for iteration in 0..=self.max_iterations {
+            // Residual at the current iterate, from the step-start state.
+            let r = self.residual(m, &u, &u_tilde, &mass, &f_ext, inertia, dt)?;
+            let r_free = free(&r);
+            let r_norm = norm(&r_free);
+            let scale = reference.max(f64::MIN_POSITIVE);
+            let residual_ok = r_norm <= self.residual_tolerance * scale || r_norm == 0.0;
+            let u_norm = norm(&free(&u));
+            let increment_ok = iteration == 0 || last_increment <= self.displacement_tolerance;
+            if !r_norm.is_finite() {
+                return Err(Failure { particle: None, message: format!("non-finite residual in Newton iteration {iteration}") });
+            }
+            let mut row = NewtonRow {
+                step: step + 1,
+                time: t + dt,
+                dt,
+                cutback: level,
+                iteration,
+                residual: r_norm / scale,
+                increment: f64::NAN,
+                wall_seconds: started.elapsed().as_secs_f64(),
+                linear_solver: method,
+            };
+            if residual_ok && increment_ok {
+                self.log.push(row);
+                converged = true;
+                break;
+            }
+            if iteration == self.max_iterations {
+                self.log.push(row);
+                break;
+            }
+            // Tangent and correction.
+            let (triplets, symmetric) = self.tangent(m, &dofs, &mass, inertia)?;
+            let structure = if symmetric { Structure::Symmetric } else { Structure::General };
+            let used = self
+                .solver
+                .factorize(dofs.free, &triplets, structure)
+                .map_err(|e| Failure { particle: None, message: format!("linear solve failed: {e}") })?;
+            method = used.name();
+            let rhs: Vec<f64> = r_free.iter().map(|x| -x).collect();
+            let du = self.solver.solve(&rhs).map_err(|e| Failure { particle: None, message: format!("linear solve failed: {e}") })?;
+            let mut step_length = 1.0;
+            if self.line_search {
+                step_length = self.line_search(m, &u, &du, &dofs, &u_tilde, &mass, &f_ext, inertia, dt, r_norm)?;
+            }
+            apply_correction(&mut u, &du, &dofs, step_length);
+            last_increment = step_length * norm(&du) / norm(&free(&u)).max(u_norm).max(f64::MIN_POSITIVE);
+            row.increment = last_increment;
+            row.linear_solver = method;
+            row.wall_seconds = started.elapsed().as_secs_f64();
+            self.log.push(row);
+            self.newton_iterations += 1;
+        }
+        if !converged {
+            return Err(Failure {
+                particle: None,
+                message: format!("Newton did not converge in {} iterations", self.max_iterations),
+            });
+        }
+
+        // Commit: stresses of the converged iterate (the last residual evaluation),
+        // positions, and the Newmark update of velocities and accelerations.
+        let (g_old, scales_old) = self.load_factors(m, t);
+        let load_old = |q: usize| match m.load_ramp_of[q] {
+            u32::MAX => 0.0,
+            r => scales_old[r as usize],
+        };
+        let (map, st) = (&self.map, &self.stencils);
+        let p = &mut m.particles;
+        self.trial.commit(p);
+        let dx: Vec<Vector<D>> = (0..p.len()).map(|q| interpolate(map, st, q, &u)).collect();
+        let work: f64 = (0..p.len())
+            .map(|q| {
+                let f_old = m.gravity * (p.mass[q] * g_old) + p.load[q] * load_old(q);
+                let f_new = m.gravity * (p.mass[q] * g_new) + p.load[q] * load_new(q);
+                (f_old + f_new).dot(&dx[q]) * 0.5
+            })
+            .sum();
+        for (x, d) in p.x.iter_mut().zip(&dx) {
+            *x += d;
+        }
+        if dynamic {
+            let a_new: Vec<Vector<D>> = (0..n).map(|a| self.newmark.acceleration(dt, &u[a], &u_tilde[a])).collect();
+            let dv: Vec<Vector<D>> = (0..n).map(|a| self.newmark.velocity_increment(dt, &a_n[a], &a_new[a])).collect();
+            for q in 0..p.len() {
+                p.v[q] += interpolate(map, st, q, &dv);
+                self.accel[q] = interpolate(map, st, q, &a_new);
+            }
+            let _ = &v_n;
+        }
+        check_state(m, step + 1, t + dt).map_err(|d| Failure { particle: d.particle, message: d.message })?;
+        Ok(work)
+    }
+
+    /// M (u − ũ) / (βΔt²) at the active nodes (lumped or consistent M).
+    fn inertial_force(
+        &self,
+        map: &NodeMap,
+        st: &Stencils<D>,
+        p: &crate::particles::Particles<D>,
+        mass: &[f64],
+        w: &[Vector<D>],
+        inertia: f64,
+    ) -> Vec<Vector<D>> {
+        if inertia == 0.0 {
+            return vec![Vector::<D>::zeros(); mass.len()];
+        }
+        match self.mass_matrix {
+            MassMatrix::Lumped => w.iter().zip(mass).map(|(w, m)| w * (m * inertia)).collect(),
+            MassMatrix::Consistent => {
+                let at_particles: Vec<Vector<D>> = (0..p.len()).map(|q| interpolate(map, st, q, w)).collect();
+                map.gather(st.stride, Vector::<D>::zeros(), |q, e| at_particles[q] * (p.mass[q] * st.weight[e] * inertia))
+            }
+        }
+    }
+
+    /// r(u) at the active nodes; evaluates the trial state of the particles.
+    #[allow(clippy::too_many_arguments)]
+    fn residual(
+        &mut self,
+        m: &Model<D>,
+        u: &[Vector<D>],
+        u_tilde: &[Vector<D>],
+        mass: &[f64],
+        f_ext: &[Vector<D>],
+        inertia: f64,
+        dt: f64,
+    ) -> Result<Vec<Vector<D>>, Failure> {
+        let p = &m.particles;
+        if let Some(q) = self.trial.evaluate(p, &m.materials, &self.stencils, &self.map, u, dt) {
+            return Err(Failure { particle: Some(q), message: "inverted (det F ≤ 0) in a Newton iterate".into() });
+        }
+        let pk1: Vec<_> = (0..p.len()).map(|q| relative_pk1(&self.trial.df[q], &self.trial.stress[q])).collect();
+        let f_int = internal_force(&self.map, &self.stencils, &p.volume, &pk1);
+        let w: Vec<Vector<D>> = u.iter().zip(u_tilde).map(|(a, b)| a - b).collect();
+        let f_inertia = self.inertial_force(&self.map, &self.stencils, p, mass, &w, inertia);
+        Ok((0..u.len()).map(|a| f_inertia[a] + f_int[a] - f_ext[a]).collect())
+    }
+
+    /// Consistent tangent triplets over the free unknowns, and whether it is symmetric.
+    fn tangent(&self, m: &Model<D>, dofs: &Dofs, mass: &[f64], inertia: f64) -> Result<(Vec<(usize, usize, f64)>, bool), Failure> {
+        let p = &m.particles;
+        let history_old = p.history.slots(&p.history.data);
+        let a: Vec<Option<Pk1Derivative>> = (0..p.len())
+            .into_par_iter()
+            .with_min_len(MIN_PARALLEL_LEN)
+            .map(|q| {
+                let inc = Increment {
+                    f_old: p.f[q],
+                    df: self.trial.df[q],
+                    dt: 0.0,
+                    stress_old: p.stress[q],
+                    history_old: history_old[q],
+                };
+                let mat = &m.materials[p.material[q] as usize];
+                mat.stress_derivative(&inc).map(|ds| pk1_derivative(&self.trial.df[q], &self.trial.stress[q], &ds))
+            })
+            .collect();
+        if let Some(q) = a.iter().position(|x| x.is_none()) {
+            let model = m.materials[p.material[q] as usize].model();
+            return Err(Failure {
+                particle: Some(q),
+                message: format!("material model `{model}` has no analytic tangent for the direct solver"),
+            });
+        }
+        let a: Vec<Pk1Derivative> = a.into_iter().map(|x| x.unwrap()).collect();
+        let (mut triplets, symmetric) = stiffness_triplets(&self.map, &self.stencils, dofs, &p.volume, &a);
+        if inertia > 0.0 {
+            match self.mass_matrix {
+                MassMatrix::Lumped => {
+                    for (node, m_i) in mass.iter().enumerate() {
+                        for d in 0..D {
+                            if let Some(i) = dofs.of(node, d, D) {
+                                triplets.push((i, i, m_i * inertia));
+                            }
+                        }
+                    }
+                }
+                MassMatrix::Consistent => {
+                    let st = &self.stencils;
+                    for q in 0..p.len() {
+                        for e1 in st.range(q) {
+                            for e2 in st.range(q) {
+                                let (n1, n2) = (self.map.local[st.node[e1] as usize] as usize, self.map.local[st.node[e2] as usize] as usize);
+                                let v = p.mass[q] * st.weight[e1] * st.weight[e2] * inertia;
+                                for d in 0..D {
+                                    if let (Some(i), Some(j)) = (dofs.of(n1, d, D), dofs.of(n2, d, D)) {
+                                        triplets.push((i, j, v));
+                                    }
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        Ok((triplets, symmetric))
+    }
+
+    /// Backtracking on ‖r‖: halve the step length until the residual decreases
+    /// (at most 6 halvings; the last length is taken anyway).
+    #[allow(clippy::too_many_arguments)]
+    fn line_search(
+        &mut self,
+        m: &Model<D>,
+        u: &[Vector<D>],
+        du: &[f64],
+        dofs: &Dofs,
+        u_tilde: &[Vector<D>],
+        mass: &[f64],
+        f_ext: &[Vector<D>],
+        inertia: f64,
+        dt: f64,
+        r_norm: f64,
+    ) -> Result<f64, Failure> {
+        let mut length = 1.0;
+        for _ in 0..6 {
+            let mut trial_u = u.to_vec();
+            apply_correction(&mut trial_u, du, dofs, length);
+            let r = self.residual(m, &trial_u, u_tilde, mass, f_ext, inertia, dt);
+            if let Ok(r) = r {
+                let n: f64 = (0..r.len())
+                    .flat_map(|a| (0..D).filter_map(move |d| dofs.of(a, d, D).map(|_| (a, d))))
+                    .map(|(a, d)| r[a][d] * r[a][d])
+                    .sum::<f64>()
+                    .sqrt();
+                if n < r_norm {
+                    return Ok(length);
+                }
+            }
+            length *= 0.5;
+        }
+        Ok(length)
+    }
+}
+
+/// u_free += length · du.
+fn apply_correction<const D: usize>(u: &mut [Vector<D>], du: &[f64], dofs: &Dofs, length: f64) {
+    for (a, ua) in u.iter_mut().enumerate() {
+        for d in 0..D {
+            if let Some(i) = dofs.of(a, d, D) {
+                ua[d] += length * du[i];
+            }
+        }
+    }
+}
