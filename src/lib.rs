@@ -9,6 +9,7 @@ pub mod boundary;
 pub mod dim;
 pub mod explicit;
 pub mod grid;
+pub mod linear;
 pub mod material;
 pub mod output;
 pub mod particles;
