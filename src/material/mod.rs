@@ -8,10 +8,12 @@
 //! tangent of the update).
 
 pub mod driver;
+pub mod hencky;
 pub mod linear_elastic;
 pub mod mooney_rivlin;
 pub mod neo_hookean;
 
+pub use hencky::Hencky;
 pub use linear_elastic::LinearElastic;
 pub use mooney_rivlin::MooneyRivlin;
 pub use neo_hookean::NeoHookean;
