@@ -30,7 +30,11 @@ pub struct Divergence {
 
 impl std::fmt::Display for Divergence {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "diverged at step {} (t = {:.6e}): ", self.step, self.time)?;
+        write!(
+            f,
+            "diverged at step {} (t = {:.6e}): ",
+            self.step, self.time
+        )?;
         if let Some(q) = self.particle {
             write!(f, "particle {q} ")?;
         }

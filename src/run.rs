@@ -5,15 +5,15 @@
 
 use crate::explicit::{check_state, Divergence, Explicit};
 use crate::implicit::{Implicit, NEWTON_CSV_HEADER};
-use crate::scene::{Integrator, SolverKind};
-use std::io::Write;
 use crate::output::{
     body_centres, write_json, write_particles_csv, FrameWriter, HistoryWriter, Progress,
 };
+use crate::scene::{Integrator, SolverKind};
 use crate::scene::{Scene, SceneError};
 use crate::setup::Model;
 use crate::transfer::deterministic_sum;
 use serde_json::json;
+use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
 
@@ -81,7 +81,8 @@ impl<const D: usize> Stepper<D> {
         Ok(match cfg.solver.kind {
             SolverKind::Explicit => Stepper::Explicit(Explicit::new(shape, &cfg.solver)),
             SolverKind::Implicit => {
-                let mut log = std::io::BufWriter::new(std::fs::File::create(out.join("newton.csv"))?);
+                let mut log =
+                    std::io::BufWriter::new(std::fs::File::create(out.join("newton.csv"))?);
                 writeln!(log, "{NEWTON_CSV_HEADER}")?;
                 Stepper::Implicit(Box::new(Implicit::new(shape, &cfg.solver)), log)
             }
@@ -96,7 +97,13 @@ impl<const D: usize> Stepper<D> {
     }
 
     /// One step; the outer error is an output failure, the inner one a divergence.
-    fn step(&mut self, m: &mut Model<D>, t: f64, dt: f64, step: usize) -> std::io::Result<Result<f64, Divergence>> {
+    fn step(
+        &mut self,
+        m: &mut Model<D>,
+        t: f64,
+        dt: f64,
+        step: usize,
+    ) -> std::io::Result<Result<f64, Divergence>> {
         Ok(match self {
             Stepper::Explicit(e) => e.step(m, t, dt, step),
             Stepper::Implicit(i, log) => {

@@ -17,26 +17,41 @@ struct Run {
 }
 
 fn column(shape: &str, cells: usize, extra: &[&str]) -> Run {
-    let mut args = vec![format!("grid.shape_function={shape}"), format!("grid.cells=[1,{cells}]"), "output.frames=0".into()];
+    let mut args = vec![
+        format!("grid.shape_function={shape}"),
+        format!("grid.cells=[1,{cells}]"),
+        "output.frames=0".into(),
+    ];
     args.extend(extra.iter().map(|s| s.to_string()));
     let args: Vec<&str> = args.iter().map(|s| s.as_str()).collect();
     let (result, dir) = run_problem("column.toml", &args);
     result.unwrap_or_else(|e| panic!("{shape} {cells}: {e}"));
     let particles = Table::read(&dir.path().join("particles_final.csv"));
     let newton = read_newton(&dir.path().join("newton.csv"));
-    let (y0, syy, v0) = (particles.col("Y0"), particles.col("syy"), particles.col("volume0"));
+    let (y0, syy, v0) = (
+        particles.col("Y0"),
+        particles.col("syy"),
+        particles.col("volume0"),
+    );
     let (mut num, mut vol) = (0.0, 0.0);
     for i in 0..y0.len() {
         num += v0[i] * (syy[i] + RHO_G * (L0 - y0[i])).powi(2);
         vol += v0[i];
     }
-    Run { error: (num / vol).sqrt() / (RHO_G * L0), particles, newton }
+    Run {
+        error: (num / vol).sqrt() / (RHO_G * L0),
+        particles,
+        newton,
+    }
 }
 
 /// newton.csv has a text column (the factorisation); keep the numeric ones.
 fn read_newton(path: &std::path::Path) -> Table {
     let text = std::fs::read_to_string(path).unwrap();
-    let cleaned: String = text.lines().map(|l| l.rsplit_once(',').unwrap().0.to_string() + "\n").collect();
+    let cleaned: String = text
+        .lines()
+        .map(|l| l.rsplit_once(',').unwrap().0.to_string() + "\n")
+        .collect();
     let tmp = tempfile::NamedTempFile::new().unwrap();
     std::fs::write(tmp.path(), cleaned).unwrap();
     Table::read(tmp.path())
@@ -47,8 +62,15 @@ const CELLS: [usize; 6] = [4, 8, 16, 32, 64, 128];
 fn study(shape: &str) -> Vec<f64> {
     let e: Vec<f64> = CELLS.iter().map(|&n| column(shape, n, &[]).error).collect();
     for i in 0..e.len() {
-        let rate = if i > 0 { (e[i - 1] / e[i]).log2() } else { f64::NAN };
-        println!("{shape:>8} cells {:>4}: error {:.4e}  rate {rate:.2}", CELLS[i], e[i]);
+        let rate = if i > 0 {
+            (e[i - 1] / e[i]).log2()
+        } else {
+            f64::NAN
+        };
+        println!(
+            "{shape:>8} cells {:>4}: error {:.4e}  rate {rate:.2}",
+            CELLS[i], e[i]
+        );
     }
     e
 }
@@ -57,22 +79,46 @@ fn mean_rate(e: &[f64]) -> f64 {
     (e[0] / e[e.len() - 1]).log2() / (e.len() - 1) as f64
 }
 
+// Measured (20 load steps, 4…128 cells): CPDI converges at a rate of about 1.5
+// throughout; uGIMP at 1.2–1.5 up to 32 cells and quadratic B-splines at 1.5 up to
+// 16 cells, after which both stall near 2e-3: particles that crossed a cell
+// boundary during loading carry a locked-in quadrature error (Steffen, Kirby &
+// Berzins 2008), which more load steps do not remove (64 cells, B-spline: 2.0e-3,
+// 2.0e-3, 1.8e-3 with 20, 80, 320 steps). CPDI integrates over its tracked domain
+// and does not stall here.
+
 #[test]
-fn gimp_converges() {
+fn gimp_converges_then_stalls_on_quadrature_error() {
     let e = study("ugimp");
-    assert!(mean_rate(&e) > 0.9, "uGIMP mean rate {:.2}", mean_rate(&e));
+    assert!(
+        mean_rate(&e[..4]) > 1.1,
+        "uGIMP rate over 4…32 cells {:.2}",
+        mean_rate(&e[..4])
+    );
+    assert!(e[5] < 2.5e-3, "uGIMP error at 128 cells {:.3e}", e[5]);
 }
 
 #[test]
 fn cpdi_converges() {
     let e = study("cpdi");
-    assert!(mean_rate(&e) > 0.9, "CPDI mean rate {:.2}", mean_rate(&e));
+    assert!(mean_rate(&e) > 1.2, "CPDI mean rate {:.2}", mean_rate(&e));
 }
 
 #[test]
-fn bsplines_converge() {
+fn bsplines_converge_then_stall_on_quadrature_error() {
     let e = study("bspline2");
-    assert!(mean_rate(&e) > 0.9, "quadratic B-spline mean rate {:.2}", mean_rate(&e));
+    assert!(
+        mean_rate(&e[..3]) > 1.3,
+        "B-spline rate over 4…16 cells {:.2}",
+        mean_rate(&e[..3])
+    );
+    let gimp = column("ugimp", 4, &[]).error;
+    assert!(
+        e[0] < 0.25 * gimp,
+        "at 4 cells B-spline {:.3e} vs GIMP {gimp:.3e}",
+        e[0]
+    );
+    assert!(e[5] < 3e-3, "B-spline error at 128 cells {:.3e}", e[5]);
 }
 
 /// Quadratic convergence: in each load step the residual at least squares (up to a
@@ -83,29 +129,51 @@ fn newton_converges_quadratically() {
     let (step, res) = (run.newton.col("step"), run.newton.col("residual"));
     let mut orders = Vec::new();
     for s in 1..=20 {
-        let r: Vec<f64> = (0..step.len()).filter(|&i| step[i] == s as f64).map(|i| res[i]).collect();
-        assert!(r.len() <= 8, "step {s} needed {} iterations: {r:?}", r.len());
-        assert!(*r.last().unwrap() < 1e-9, "step {s} did not converge: {r:?}");
+        let r: Vec<f64> = (0..step.len())
+            .filter(|&i| step[i] == s as f64)
+            .map(|i| res[i])
+            .collect();
+        assert!(
+            r.len() <= 8,
+            "step {s} needed {} iterations: {r:?}",
+            r.len()
+        );
+        assert!(
+            *r.last().unwrap() < 1e-9,
+            "step {s} did not converge: {r:?}"
+        );
         for k in 2..r.len() {
-            if r[k] > 1e-13 && r[k - 1] < 0.1 {
+            // Only pairs well above the round-off floor (≈ 1e-12 here) and inside
+            // the region of quadratic convergence.
+            if r[k] > 1e-10 && r[k - 1] < 0.1 {
                 orders.push((r[k] / r[k - 1]).ln() / (r[k - 1] / r[k - 2]).ln());
             }
         }
     }
     println!("observed convergence orders: {orders:?}");
-    assert!(!orders.is_empty(), "no iteration pairs above round-off to measure the order");
+    assert!(
+        !orders.is_empty(),
+        "no iteration pairs above round-off to measure the order"
+    );
     let mean = orders.iter().sum::<f64>() / orders.len() as f64;
-    assert!(mean > 1.7, "mean observed Newton order {mean:.2} (quadratic: 2)");
+    assert!(
+        mean > 1.7,
+        "mean observed Newton order {mean:.2} (quadratic: 2)"
+    );
 }
 
-/// E = 10 kPa, 40 load steps: the base stretch is λ ≈ 0.2 and the column ends at
-/// about 30 % of its height. For Hencky with ν = 0 and lateral rollers the stretch
+/// E = 10 kPa, 40 load steps: the base shortens to λ ≈ 0.30 of its length and the
+/// top ends at 0.48 l0. For Hencky with ν = 0 and lateral rollers the stretch
 /// solves E ln λ + ρ g (l0 − Y) λ = 0; the current height of the material point from Y
 /// is y(Y) = ∫₀^Y λ. Both stress and position are compared.
 #[test]
 fn large_deformation_matches_the_hencky_column() {
     let e_mod = 1.0e4;
-    let run = column("cpdi", 64, &["material.0.youngs_modulus=1e4", "solver.load_steps=40"]);
+    let run = column(
+        "cpdi",
+        64,
+        &["material.0.youngs_modulus=1e4", "solver.load_steps=40"],
+    );
     let stretch = |y: f64| {
         let w = RHO_G * (L0 - y) / e_mod;
         let mut l: f64 = 1.0;
@@ -116,19 +184,31 @@ fn large_deformation_matches_the_hencky_column() {
     };
     let height = |y: f64| {
         let n = 2000;
-        (0..n).map(|k| stretch((k as f64 + 0.5) * y / n as f64) * y / n as f64).sum::<f64>()
+        (0..n)
+            .map(|k| stretch((k as f64 + 0.5) * y / n as f64) * y / n as f64)
+            .sum::<f64>()
     };
     let p = &run.particles;
     let (y0, y, syy) = (p.col("Y0"), p.col("y"), p.col("syy"));
     let top = height(L0) / L0;
-    println!("exact top at {:.4} of l0; stress error {:.3e}", top, run.error);
-    assert!((0.25..0.35).contains(&top), "exact solution sanity: top at {top}");
+    println!(
+        "exact top at {:.4} of l0; stress error {:.3e}",
+        top, run.error
+    );
+    assert!(
+        (stretch(0.0) - 0.30).abs() < 0.01 && (top - 0.48).abs() < 0.01,
+        "exact: base stretch {}, top {top}",
+        stretch(0.0)
+    );
     let mut worst_y: f64 = 0.0;
     for i in 0..y0.len() {
         worst_y = worst_y.max((y[i] - height(y0[i])).abs());
         let _ = syy[i];
     }
-    println!("max |y − y_exact| = {worst_y:.4e} m (column height {:.2} m)", top * L0);
+    println!(
+        "max |y − y_exact| = {worst_y:.4e} m (column height {:.2} m)",
+        top * L0
+    );
     assert!(worst_y < 0.01 * top * L0, "positions off by {worst_y} m");
     assert!(run.error < 0.02, "stress error {:.3e}", run.error);
 }

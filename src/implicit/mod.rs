@@ -22,11 +22,15 @@ use crate::material::Increment;
 use crate::scene::{Integrator, MassMatrix, SolverConfig};
 use crate::setup::Model;
 use crate::shape::{ShapeFunction, Stencils};
-use crate::transfer::{external_force, interpolate, mass_momentum, nodal_force, NodeMap, MIN_PARALLEL_LEN};
+use crate::transfer::{
+    external_force, interpolate, mass_momentum, nodal_force, NodeMap, MIN_PARALLEL_LEN,
+};
 use newmark::Newmark;
 use rayon::prelude::*;
 use std::time::Instant;
-use tangent::{internal_force, pk1_derivative, relative_pk1, stiffness_triplets, Dofs, Pk1Derivative};
+use tangent::{
+    internal_force, pk1_derivative, relative_pk1, stiffness_triplets, Dofs, Pk1Derivative,
+};
 
 /// One Newton iteration, as written to newton.csv.
 #[derive(Clone, Debug)]
@@ -45,7 +49,8 @@ pub struct NewtonRow {
     pub linear_solver: &'static str,
 }
 
-pub const NEWTON_CSV_HEADER: &str = "step,time,dt,cutback,iteration,residual,increment,wall_seconds,linear_solver";
+pub const NEWTON_CSV_HEADER: &str =
+    "step,time,dt,cutback,iteration,residual,increment,wall_seconds,linear_solver";
 
 impl NewtonRow {
     pub fn csv(&self) -> String {
@@ -99,7 +104,10 @@ impl<const D: usize> Implicit<D> {
         Implicit {
             shape,
             integrator: s.integrator(),
-            newmark: Newmark { beta: s.beta(), gamma: s.gamma() },
+            newmark: Newmark {
+                beta: s.beta(),
+                gamma: s.gamma(),
+            },
             mass_matrix: s.mass(),
             end_time: s.end_time,
             residual_tolerance: s.residual_tolerance(),
@@ -129,14 +137,27 @@ impl<const D: usize> Implicit<D> {
 
     /// Advance from t to t + dt, halving the step on Newton failure. Returns the
     /// work of gravity and applied loads.
-    pub fn advance(&mut self, m: &mut Model<D>, t: f64, dt: f64, step: usize) -> Result<f64, Divergence> {
+    pub fn advance(
+        &mut self,
+        m: &mut Model<D>,
+        t: f64,
+        dt: f64,
+        step: usize,
+    ) -> Result<f64, Divergence> {
         self.advance_level(m, t, dt, step, 0)
     }
 
-    fn advance_level(&mut self, m: &mut Model<D>, t: f64, dt: f64, step: usize, level: usize) -> Result<f64, Divergence> {
+    fn advance_level(
+        &mut self,
+        m: &mut Model<D>,
+        t: f64,
+        dt: f64,
+        step: usize,
+        level: usize,
+    ) -> Result<f64, Divergence> {
         match self.attempt(m, t, dt, step, level) {
             Ok(work) => Ok(work),
-            Err(f) if level < self.max_cutbacks => {
+            Err(_) if level < self.max_cutbacks => {
                 self.cutbacks += 1;
                 let first = self.advance_level(m, t, dt / 2.0, step, level + 1)?;
                 Ok(first + self.advance_level(m, t + dt / 2.0, dt / 2.0, step, level + 1)?)
@@ -145,7 +166,10 @@ impl<const D: usize> Implicit<D> {
                 step: step + 1,
                 time: t + dt,
                 particle: f.particle,
-                message: format!("{} (after {} cut-backs of the step, now Δt = {dt:.3e})", f.message, level),
+                message: format!(
+                    "{} (after {} cut-backs of the step, now Δt = {dt:.3e})",
+                    f.message, level
+                ),
             }),
         }
     }
@@ -172,16 +196,30 @@ impl<const D: usize> Implicit<D> {
         };
         let force = nodal_force(&self.map, &self.stencils, p, &(m.gravity * g), &load);
         let (mass, _) = mass_momentum(&self.map, &self.stencils, p);
-        let a: Vec<Vector<D>> = force.iter().zip(&mass).map(|(f, m)| if *m > 0.0 { f / *m } else { f * 0.0 }).collect();
-        self.accel = (0..p.len()).map(|q| interpolate(&self.map, &self.stencils, q, &a)).collect();
+        let a: Vec<Vector<D>> = force
+            .iter()
+            .zip(&mass)
+            .map(|(f, m)| if *m > 0.0 { f / *m } else { f * 0.0 })
+            .collect();
+        self.accel = (0..p.len())
+            .map(|q| interpolate(&self.map, &self.stencils, q, &a))
+            .collect();
     }
 
     /// One attempt at the step t → t + dt. Leaves the model untouched on failure.
-    fn attempt(&mut self, m: &mut Model<D>, t: f64, dt: f64, step: usize, level: usize) -> Result<f64, Failure> {
+    fn attempt(
+        &mut self,
+        m: &mut Model<D>,
+        t: f64,
+        dt: f64,
+        step: usize,
+        level: usize,
+    ) -> Result<f64, Failure> {
         let started = Instant::now();
         let dynamic = self.integrator == Integrator::Newmark;
         let p = &m.particles;
-        self.stencils.compute(self.shape, &m.grid, &p.x, &p.half_length0, &p.f);
+        self.stencils
+            .compute(self.shape, &m.grid, &p.x, &p.half_length0, &p.f);
         self.map.build(&self.stencils, m.grid.node_count());
         if dynamic && self.accel.len() != p.len() {
             self.initial_acceleration(m);
@@ -207,15 +245,34 @@ impl<const D: usize> Implicit<D> {
         let (mass, momentum) = mass_momentum(map, st, p);
         let nodal = |w: &[f64], a: usize| if w[a] > 0.0 { 1.0 / w[a] } else { 0.0 };
         let (v_n, a_n, u_tilde) = if dynamic {
-            let am = map.gather(st.stride, Vector::<D>::zeros(), |q, e| self.accel[q] * (p.mass[q] * st.weight[e]));
-            let v: Vec<Vector<D>> = (0..n).map(|a| momentum[a] * nodal(&mass, a)).collect();
-            let acc: Vec<Vector<D>> = (0..n).map(|a| am[a] * nodal(&mass, a)).collect();
-            let ut = (0..n).map(|a| self.newmark.predictor(dt, &v[a], &acc[a])).collect();
+            let am = map.gather(st.stride, Vector::<D>::zeros(), |q, e| {
+                self.accel[q] * (p.mass[q] * st.weight[e])
+            });
+            // Prescribed components move at their value with no acceleration; the
+            // projection from nearby particles must not leak into them (with
+            // β < 1/4 such a leak grows by (½ − β)/β every step).
+            let mut v: Vec<Vector<D>> = (0..n).map(|a| momentum[a] * nodal(&mass, a)).collect();
+            let mut acc: Vec<Vector<D>> = (0..n).map(|a| am[a] * nodal(&mass, a)).collect();
+            for a in 0..n {
+                constraint[a].apply_velocity(&mut v[a]);
+                constraint[a].apply_rate(&mut acc[a]);
+            }
+            let ut = (0..n)
+                .map(|a| self.newmark.predictor(dt, &v[a], &acc[a]))
+                .collect();
             (v, acc, ut)
         } else {
-            (vec![Vector::<D>::zeros(); n], vec![Vector::<D>::zeros(); n], vec![Vector::<D>::zeros(); n])
+            (
+                vec![Vector::<D>::zeros(); n],
+                vec![Vector::<D>::zeros(); n],
+                vec![Vector::<D>::zeros(); n],
+            )
         };
-        let inertia = if dynamic { self.newmark.inertia(dt) } else { 0.0 };
+        let inertia = if dynamic {
+            self.newmark.inertia(dt)
+        } else {
+            0.0
+        };
 
         // Initial iterate: the predictor, with the prescribed components imposed.
         let mut u = u_tilde.clone();
@@ -236,7 +293,9 @@ impl<const D: usize> Implicit<D> {
             out
         };
         let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
-        let reference = norm(&free(&f_ext)).max(norm(&free(&self.inertial_force(map, st, p, &mass, &u_tilde, inertia))));
+        let reference = norm(&free(&f_ext)).max(norm(&free(
+            &self.inertial_force(map, st, p, &mass, &u_tilde, inertia),
+        )));
         let mut method = "none";
         let mut converged = false;
         let mut last_increment = f64::NAN;
@@ -250,7 +309,10 @@ impl<const D: usize> Implicit<D> {
             let u_norm = norm(&free(&u));
             let increment_ok = iteration == 0 || last_increment <= self.displacement_tolerance;
             if !r_norm.is_finite() {
-                return Err(Failure { particle: None, message: format!("non-finite residual in Newton iteration {iteration}") });
+                return Err(Failure {
+                    particle: None,
+                    message: format!("non-finite residual in Newton iteration {iteration}"),
+                });
             }
             let mut row = NewtonRow {
                 step: step + 1,
@@ -274,20 +336,33 @@ impl<const D: usize> Implicit<D> {
             }
             // Tangent and correction.
             let (triplets, symmetric) = self.tangent(m, &dofs, &mass, inertia)?;
-            let structure = if symmetric { Structure::Symmetric } else { Structure::General };
+            let structure = if symmetric {
+                Structure::Symmetric
+            } else {
+                Structure::General
+            };
             let used = self
                 .solver
                 .factorize(dofs.free, &triplets, structure)
-                .map_err(|e| Failure { particle: None, message: format!("linear solve failed: {e}") })?;
+                .map_err(|e| Failure {
+                    particle: None,
+                    message: format!("linear solve failed: {e}"),
+                })?;
             method = used.name();
             let rhs: Vec<f64> = r_free.iter().map(|x| -x).collect();
-            let du = self.solver.solve(&rhs).map_err(|e| Failure { particle: None, message: format!("linear solve failed: {e}") })?;
+            let du = self.solver.solve(&rhs).map_err(|e| Failure {
+                particle: None,
+                message: format!("linear solve failed: {e}"),
+            })?;
             let mut step_length = 1.0;
             if self.line_search {
-                step_length = self.line_search(m, &u, &du, &dofs, &u_tilde, &mass, &f_ext, inertia, dt, r_norm)?;
+                step_length = self.line_search(
+                    m, &u, &du, &dofs, &u_tilde, &mass, &f_ext, inertia, dt, r_norm,
+                )?;
             }
             apply_correction(&mut u, &du, &dofs, step_length);
-            last_increment = step_length * norm(&du) / norm(&free(&u)).max(u_norm).max(f64::MIN_POSITIVE);
+            last_increment =
+                step_length * norm(&du) / norm(&free(&u)).max(u_norm).max(f64::MIN_POSITIVE);
             row.increment = last_increment;
             row.linear_solver = method;
             row.wall_seconds = started.elapsed().as_secs_f64();
@@ -297,7 +372,10 @@ impl<const D: usize> Implicit<D> {
         if !converged {
             return Err(Failure {
                 particle: None,
-                message: format!("Newton did not converge in {} iterations", self.max_iterations),
+                message: format!(
+                    "Newton did not converge in {} iterations",
+                    self.max_iterations
+                ),
             });
         }
 
@@ -323,15 +401,25 @@ impl<const D: usize> Implicit<D> {
             *x += d;
         }
         if dynamic {
-            let a_new: Vec<Vector<D>> = (0..n).map(|a| self.newmark.acceleration(dt, &u[a], &u_tilde[a])).collect();
-            let dv: Vec<Vector<D>> = (0..n).map(|a| self.newmark.velocity_increment(dt, &a_n[a], &a_new[a])).collect();
+            let a_new: Vec<Vector<D>> = (0..n)
+                .map(|a| self.newmark.acceleration(dt, &u[a], &u_tilde[a]))
+                .collect();
+            let dv: Vec<Vector<D>> = (0..n)
+                .map(|a| self.newmark.velocity_increment(dt, &a_n[a], &a_new[a]))
+                .collect();
+            // FLIP-style increments for both: the particles keep what the grid
+            // cannot represent, and the grid's Newmark update is not re-projected.
+            let da: Vec<Vector<D>> = (0..n).map(|a| a_new[a] - a_n[a]).collect();
             for q in 0..p.len() {
                 p.v[q] += interpolate(map, st, q, &dv);
-                self.accel[q] = interpolate(map, st, q, &a_new);
+                self.accel[q] += interpolate(map, st, q, &da);
             }
             let _ = &v_n;
         }
-        check_state(m, step + 1, t + dt).map_err(|d| Failure { particle: d.particle, message: d.message })?;
+        check_state(m, step + 1, t + dt).map_err(|d| Failure {
+            particle: d.particle,
+            message: d.message,
+        })?;
         Ok(work)
     }
 
@@ -351,8 +439,11 @@ impl<const D: usize> Implicit<D> {
         match self.mass_matrix {
             MassMatrix::Lumped => w.iter().zip(mass).map(|(w, m)| w * (m * inertia)).collect(),
             MassMatrix::Consistent => {
-                let at_particles: Vec<Vector<D>> = (0..p.len()).map(|q| interpolate(map, st, q, w)).collect();
-                map.gather(st.stride, Vector::<D>::zeros(), |q, e| at_particles[q] * (p.mass[q] * st.weight[e] * inertia))
+                let at_particles: Vec<Vector<D>> =
+                    (0..p.len()).map(|q| interpolate(map, st, q, w)).collect();
+                map.gather(st.stride, Vector::<D>::zeros(), |q, e| {
+                    at_particles[q] * (p.mass[q] * st.weight[e] * inertia)
+                })
             }
         }
     }
@@ -370,18 +461,34 @@ impl<const D: usize> Implicit<D> {
         dt: f64,
     ) -> Result<Vec<Vector<D>>, Failure> {
         let p = &m.particles;
-        if let Some(q) = self.trial.evaluate(p, &m.materials, &self.stencils, &self.map, u, dt) {
-            return Err(Failure { particle: Some(q), message: "inverted (det F ≤ 0) in a Newton iterate".into() });
+        if let Some(q) = self
+            .trial
+            .evaluate(p, &m.materials, &self.stencils, &self.map, u, dt)
+        {
+            return Err(Failure {
+                particle: Some(q),
+                message: "inverted (det F ≤ 0) in a Newton iterate".into(),
+            });
         }
-        let pk1: Vec<_> = (0..p.len()).map(|q| relative_pk1(&self.trial.df[q], &self.trial.stress[q])).collect();
+        let pk1: Vec<_> = (0..p.len())
+            .map(|q| relative_pk1(&self.trial.df[q], &self.trial.stress[q]))
+            .collect();
         let f_int = internal_force(&self.map, &self.stencils, &p.volume, &pk1);
         let w: Vec<Vector<D>> = u.iter().zip(u_tilde).map(|(a, b)| a - b).collect();
         let f_inertia = self.inertial_force(&self.map, &self.stencils, p, mass, &w, inertia);
-        Ok((0..u.len()).map(|a| f_inertia[a] + f_int[a] - f_ext[a]).collect())
+        Ok((0..u.len())
+            .map(|a| f_inertia[a] + f_int[a] - f_ext[a])
+            .collect())
     }
 
     /// Consistent tangent triplets over the free unknowns, and whether it is symmetric.
-    fn tangent(&self, m: &Model<D>, dofs: &Dofs, mass: &[f64], inertia: f64) -> Result<(Vec<(usize, usize, f64)>, bool), Failure> {
+    fn tangent(
+        &self,
+        m: &Model<D>,
+        dofs: &Dofs,
+        mass: &[f64],
+        inertia: f64,
+    ) -> Result<(Vec<(usize, usize, f64)>, bool), Failure> {
         let p = &m.particles;
         let history_old = p.history.slots(&p.history.data);
         let a: Vec<Option<Pk1Derivative>> = (0..p.len())
@@ -396,18 +503,22 @@ impl<const D: usize> Implicit<D> {
                     history_old: history_old[q],
                 };
                 let mat = &m.materials[p.material[q] as usize];
-                mat.stress_derivative(&inc).map(|ds| pk1_derivative(&self.trial.df[q], &self.trial.stress[q], &ds))
+                mat.stress_derivative(&inc)
+                    .map(|ds| pk1_derivative(&self.trial.df[q], &self.trial.stress[q], &ds))
             })
             .collect();
         if let Some(q) = a.iter().position(|x| x.is_none()) {
             let model = m.materials[p.material[q] as usize].model();
             return Err(Failure {
                 particle: Some(q),
-                message: format!("material model `{model}` has no analytic tangent for the direct solver"),
+                message: format!(
+                    "material model `{model}` has no analytic tangent for the direct solver"
+                ),
             });
         }
         let a: Vec<Pk1Derivative> = a.into_iter().map(|x| x.unwrap()).collect();
-        let (mut triplets, symmetric) = stiffness_triplets(&self.map, &self.stencils, dofs, &p.volume, &a);
+        let (mut triplets, symmetric) =
+            stiffness_triplets(&self.map, &self.stencils, dofs, &p.volume, &a);
         if inertia > 0.0 {
             match self.mass_matrix {
                 MassMatrix::Lumped => {
@@ -424,10 +535,15 @@ impl<const D: usize> Implicit<D> {
                     for q in 0..p.len() {
                         for e1 in st.range(q) {
                             for e2 in st.range(q) {
-                                let (n1, n2) = (self.map.local[st.node[e1] as usize] as usize, self.map.local[st.node[e2] as usize] as usize);
+                                let (n1, n2) = (
+                                    self.map.local[st.node[e1] as usize] as usize,
+                                    self.map.local[st.node[e2] as usize] as usize,
+                                );
                                 let v = p.mass[q] * st.weight[e1] * st.weight[e2] * inertia;
                                 for d in 0..D {
-                                    if let (Some(i), Some(j)) = (dofs.of(n1, d, D), dofs.of(n2, d, D)) {
+                                    if let (Some(i), Some(j)) =
+                                        (dofs.of(n1, d, D), dofs.of(n2, d, D))
+                                    {
                                         triplets.push((i, j, v));
                                     }
                                 }

@@ -16,12 +16,22 @@ impl Newmark {
     }
 
     /// a_{n+1} = (u − ũ) / (β Δt²) (2-34).
-    pub fn acceleration<const D: usize>(&self, dt: f64, u: &Vector<D>, u_tilde: &Vector<D>) -> Vector<D> {
+    pub fn acceleration<const D: usize>(
+        &self,
+        dt: f64,
+        u: &Vector<D>,
+        u_tilde: &Vector<D>,
+    ) -> Vector<D> {
         (u - u_tilde) / (self.beta * dt * dt)
     }
 
     /// Velocity increment v_{n+1} − v_n = Δt ((1 − γ) a_n + γ a_{n+1}) (2-33, 2-35).
-    pub fn velocity_increment<const D: usize>(&self, dt: f64, a: &Vector<D>, a_new: &Vector<D>) -> Vector<D> {
+    pub fn velocity_increment<const D: usize>(
+        &self,
+        dt: f64,
+        a: &Vector<D>,
+        a_new: &Vector<D>,
+    ) -> Vector<D> {
         (a * (1.0 - self.gamma) + a_new * self.gamma) * dt
     }
 
@@ -45,7 +55,10 @@ mod tests {
     /// energy ½v² + ½ω²x² exactly and its period error is (ωΔt)²/12 to leading order.
     #[test]
     fn trapezoidal_rule_on_an_oscillator() {
-        let nm = Newmark { beta: 0.25, gamma: 0.5 };
+        let nm = Newmark {
+            beta: 0.25,
+            gamma: 0.5,
+        };
         let (omega, dt) = (1.0, 0.1);
         let (mut x, mut v, mut a) = (1.0, 0.0, -1.0);
         let mut crossings = Vec::new();
@@ -66,9 +79,21 @@ mod tests {
         let period = (crossings[crossings.len() - 1] - crossings[0]) / (crossings.len() - 1) as f64;
         let exact = 2.0 * std::f64::consts::PI;
         let predicted = (omega * dt).powi(2) / 12.0;
-        assert!(((period / exact - 1.0) / predicted - 1.0).abs() < 0.01, "period error {}", period / exact - 1.0);
+        assert!(
+            ((period / exact - 1.0) / predicted - 1.0).abs() < 0.01,
+            "period error {}",
+            period / exact - 1.0
+        );
         assert!(nm.unconditionally_stable());
-        assert!(!Newmark { beta: 0.25, gamma: 0.4 }.unconditionally_stable());
-        assert!(!Newmark { beta: 0.2, gamma: 0.5 }.unconditionally_stable());
+        assert!(!Newmark {
+            beta: 0.25,
+            gamma: 0.4
+        }
+        .unconditionally_stable());
+        assert!(!Newmark {
+            beta: 0.2,
+            gamma: 0.5
+        }
+        .unconditionally_stable());
     }
 }

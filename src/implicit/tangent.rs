@@ -38,7 +38,12 @@ pub fn pk1_derivative(df: &Mat3, sigma: &Mat3, dsigma: &StressDerivative) -> Pk1
 }
 
 /// Internal force at the active nodes: f_I = Σ_p V_p P_p ∇S_Ip.
-pub fn internal_force<const D: usize>(map: &NodeMap, st: &Stencils<D>, volume: &[f64], pk1: &[Mat3]) -> Vec<Vector<D>> {
+pub fn internal_force<const D: usize>(
+    map: &NodeMap,
+    st: &Stencils<D>,
+    volume: &[f64],
+    pk1: &[Mat3],
+) -> Vec<Vector<D>> {
     map.gather(st.stride, Vector::<D>::zeros(), |q, e| {
         let p: Tensor<D> = restrict::<D>(&pk1[q]);
         p * st.grad[e] * volume[q]
@@ -91,7 +96,8 @@ pub fn stiffness_triplets<const D: usize>(
         .with_min_len(MIN_PARALLEL_LEN / 8)
         .map(|q| {
             let ap = &a[q];
-            let symmetric = (ap - ap.transpose()).amax() <= 1e-10 * ap.amax().max(f64::MIN_POSITIVE);
+            let symmetric =
+                (ap - ap.transpose()).amax() <= 1e-10 * ap.amax().max(f64::MIN_POSITIVE);
             let mut out = Vec::new();
             for e1 in st.range(q) {
                 let n1 = map.local[st.node[e1] as usize] as usize;
@@ -104,7 +110,9 @@ pub fn stiffness_triplets<const D: usize>(
                             let mut v = 0.0;
                             for j in 0..D {
                                 for l in 0..D {
-                                    v += st.grad[e1][j] * ap[(3 * i + j, 3 * k + l)] * st.grad[e2][l];
+                                    v += st.grad[e1][j]
+                                        * ap[(3 * i + j, 3 * k + l)]
+                                        * st.grad[e2][l];
                                 }
                             }
                             out.push((r, c, v * volume[q]));
@@ -116,7 +124,10 @@ pub fn stiffness_triplets<const D: usize>(
         })
         .collect();
     let symmetric = per_particle.iter().all(|(_, s)| *s);
-    (per_particle.into_iter().flat_map(|(t, _)| t).collect(), symmetric)
+    (
+        per_particle.into_iter().flat_map(|(t, _)| t).collect(),
+        symmetric,
+    )
 }
 
 #[cfg(test)]
@@ -132,11 +143,27 @@ mod tests {
         let df = Mat3::new(1.02, 0.05, 0.01, -0.03, 0.97, 0.02, 0.01, -0.02, 1.01);
         let stress_old = m.cauchy(&f_old);
         let pk1 = |df: &Mat3| {
-            let inc = Increment { f_old, df: *df, dt: 0.0, stress_old, history_old: &[] };
+            let inc = Increment {
+                f_old,
+                df: *df,
+                dt: 0.0,
+                stress_old,
+                history_old: &[],
+            };
             relative_pk1(df, &m.update(&inc, &mut []))
         };
-        let inc = Increment { f_old, df, dt: 0.0, stress_old, history_old: &[] };
-        let a = pk1_derivative(&df, &m.update(&inc, &mut []), &m.stress_derivative(&inc).unwrap());
+        let inc = Increment {
+            f_old,
+            df,
+            dt: 0.0,
+            stress_old,
+            history_old: &[],
+        };
+        let a = pk1_derivative(
+            &df,
+            &m.update(&inc, &mut []),
+            &m.stress_derivative(&inc).unwrap(),
+        );
         let h = 1e-6;
         let mut worst: f64 = 0.0;
         for col in 0..9 {
@@ -149,6 +176,10 @@ mod tests {
                 worst = worst.max((fd[(row / 3, row % 3)] - a[(row, col)]).abs());
             }
         }
-        assert!(worst < 1e-6 * a.amax(), "max |A − A_fd| = {worst:.3e} (scale {:.3e})", a.amax());
+        assert!(
+            worst < 1e-6 * a.amax(),
+            "max |A − A_fd| = {worst:.3e} (scale {:.3e})",
+            a.amax()
+        );
     }
 }

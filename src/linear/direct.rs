@@ -47,6 +47,17 @@ pub enum Method {
     Lu,
 }
 
+impl Method {
+    /// Short name for logs (newton.csv).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Method::Llt => "llt",
+            Method::Ldlt => "ldlt",
+            Method::Lu => "lu",
+        }
+    }
+}
+
 /// Errors of the direct solver.
 #[derive(Debug, thiserror::Error)]
 pub enum SolveError {

@@ -278,7 +278,8 @@ impl SolverConfig {
     }
     /// Implicit step: `dt`, or end_time / load_steps.
     pub fn implicit_dt(&self) -> f64 {
-        self.dt.unwrap_or_else(|| self.end_time / self.load_steps.unwrap_or(1) as f64)
+        self.dt
+            .unwrap_or_else(|| self.end_time / self.load_steps.unwrap_or(1) as f64)
     }
     /// Newton converges when ‖R‖ ≤ this × the reference force (default 1e-9).
     pub fn residual_tolerance(&self) -> f64 {

@@ -353,9 +353,17 @@ fn load(l: &LoadConfig, i: usize, s: &SceneConfig) -> Check {
 }
 
 fn solver(s: &SolverConfig) -> Check {
-    ensure(s.end_time > 0.0 && s.end_time.is_finite(), "solver.end_time", "must be a positive number")?;
+    ensure(
+        s.end_time > 0.0 && s.end_time.is_finite(),
+        "solver.end_time",
+        "must be a positive number",
+    )?;
     if let Some(dt) = s.dt {
-        ensure(dt > 0.0 && dt.is_finite(), "solver.dt", "must be a positive number")?;
+        ensure(
+            dt > 0.0 && dt.is_finite(),
+            "solver.dt",
+            "must be a positive number",
+        )?;
     }
     match s.kind {
         SolverKind::Explicit => explicit(s),
@@ -370,8 +378,16 @@ fn explicit(s: &SolverConfig) -> Check {
     forbidden(&s.gamma, "solver.gamma".into(), what)?;
     forbidden(&s.mass, "solver.mass".into(), what)?;
     forbidden(&s.load_steps, "solver.load_steps".into(), what)?;
-    forbidden(&s.residual_tolerance, "solver.residual_tolerance".into(), what)?;
-    forbidden(&s.displacement_tolerance, "solver.displacement_tolerance".into(), what)?;
+    forbidden(
+        &s.residual_tolerance,
+        "solver.residual_tolerance".into(),
+        what,
+    )?;
+    forbidden(
+        &s.displacement_tolerance,
+        "solver.displacement_tolerance".into(),
+        what,
+    )?;
     forbidden(&s.max_iterations, "solver.max_iterations".into(), what)?;
     forbidden(&s.line_search, "solver.line_search".into(), what)?;
     forbidden(&s.max_cutbacks, "solver.max_cutbacks".into(), what)?;
@@ -381,8 +397,16 @@ fn explicit(s: &SolverConfig) -> Check {
         "solver.cfl",
         format!("must lie in (0, 1]: the explicit step is cfl × the critical step; got {cfl}"),
     )?;
-    ensure((0.0..=1.0).contains(&s.flip()), "solver.flip", "must lie in [0, 1] (1 = FLIP, 0 = PIC)")?;
-    ensure((0.0..1.0).contains(&s.damping()), "solver.damping", "must lie in [0, 1)")
+    ensure(
+        (0.0..=1.0).contains(&s.flip()),
+        "solver.flip",
+        "must lie in [0, 1] (1 = FLIP, 0 = PIC)",
+    )?;
+    ensure(
+        (0.0..1.0).contains(&s.damping()),
+        "solver.damping",
+        "must lie in [0, 1)",
+    )
 }
 
 fn implicit(s: &SolverConfig) -> Check {
@@ -394,22 +418,53 @@ fn implicit(s: &SolverConfig) -> Check {
     match s.integrator() {
         Integrator::Newmark => {
             required(&s.dt, "solver.dt".into(), "the Newmark integrator")?;
-            forbidden(&s.load_steps, "solver.load_steps".into(), "the Newmark integrator (give dt)")?;
-            ensure(s.beta() > 0.0 && s.beta() <= 1.0, "solver.beta", "must lie in (0, 1]")?;
-            ensure(s.gamma() >= 0.0 && s.gamma() <= 1.5, "solver.gamma", "must lie in [0, 1.5]")?;
+            forbidden(
+                &s.load_steps,
+                "solver.load_steps".into(),
+                "the Newmark integrator (give dt)",
+            )?;
+            ensure(
+                s.beta() > 0.0 && s.beta() <= 1.0,
+                "solver.beta",
+                "must lie in (0, 1]",
+            )?;
+            ensure(
+                s.gamma() >= 0.0 && s.gamma() <= 1.5,
+                "solver.gamma",
+                "must lie in [0, 1.5]",
+            )?;
         }
         Integrator::QuasiStatic => {
             forbidden(&s.beta, "solver.beta".into(), "the quasi-static integrator")?;
-            forbidden(&s.gamma, "solver.gamma".into(), "the quasi-static integrator")?;
+            forbidden(
+                &s.gamma,
+                "solver.gamma".into(),
+                "the quasi-static integrator",
+            )?;
             forbidden(&s.mass, "solver.mass".into(), "the quasi-static integrator")?;
-            ensure(s.dt.is_some() != s.load_steps.is_some(), "solver.load_steps", "give either load_steps or dt")?;
+            ensure(
+                s.dt.is_some() != s.load_steps.is_some(),
+                "solver.load_steps",
+                "give either load_steps or dt",
+            )?;
             if let Some(n) = s.load_steps {
                 ensure(n >= 1, "solver.load_steps", "must be at least 1")?;
             }
         }
     }
-    for (key, v) in [("residual_tolerance", s.residual_tolerance()), ("displacement_tolerance", s.displacement_tolerance())] {
-        ensure(v > 0.0 && v < 1.0, format!("solver.{key}"), "must lie in (0, 1)")?;
+    for (key, v) in [
+        ("residual_tolerance", s.residual_tolerance()),
+        ("displacement_tolerance", s.displacement_tolerance()),
+    ] {
+        ensure(
+            v > 0.0 && v < 1.0,
+            format!("solver.{key}"),
+            "must lie in (0, 1)",
+        )?;
     }
-    ensure(s.max_iterations() >= 1, "solver.max_iterations", "must be at least 1")
+    ensure(
+        s.max_iterations() >= 1,
+        "solver.max_iterations",
+        "must be at least 1",
+    )
 }
