@@ -8,7 +8,7 @@ use crate::implicit::{Implicit, NEWTON_CSV_HEADER};
 use crate::output::{
     body_centres, write_json, write_particles_csv, FrameWriter, HistoryWriter, Progress,
 };
-use crate::scene::{Integrator, SolverKind};
+use crate::scene::{Integrator, SolverConfig, SolverKind};
 use crate::scene::{Scene, SceneError};
 use crate::setup::Model;
 use crate::transfer::deterministic_sum;
@@ -69,30 +69,27 @@ pub fn strain_energy<const D: usize>(m: &Model<D>) -> f64 {
     })
 }
 
-/// The time stepper of a run: explicit, or implicit with its newton.csv.
+/// The time stepper of one stage.
 enum Stepper<const D: usize> {
     Explicit(Explicit<D>),
-    Implicit(Box<Implicit<D>>, std::io::BufWriter<std::fs::File>),
+    Implicit(Box<Implicit<D>>),
 }
 
+/// newton.csv, opened when the run has an implicit stage.
+type NewtonLog = Option<std::io::BufWriter<std::fs::File>>;
+
 impl<const D: usize> Stepper<D> {
-    fn new(cfg: &crate::scene::SceneConfig, out: &Path) -> std::io::Result<Self> {
-        let shape = cfg.grid.shape_function;
-        Ok(match cfg.solver.kind {
-            SolverKind::Explicit => Stepper::Explicit(Explicit::new(shape, &cfg.solver)),
-            SolverKind::Implicit => {
-                let mut log =
-                    std::io::BufWriter::new(std::fs::File::create(out.join("newton.csv"))?);
-                writeln!(log, "{NEWTON_CSV_HEADER}")?;
-                Stepper::Implicit(Box::new(Implicit::new(shape, &cfg.solver)), log)
-            }
-        })
+    fn new(shape: crate::shape::ShapeFunction, s: &SolverConfig, t_start: f64) -> Self {
+        match s.kind {
+            SolverKind::Explicit => Stepper::Explicit(Explicit::new(shape, s)),
+            SolverKind::Implicit => Stepper::Implicit(Box::new(Implicit::new(shape, s, t_start))),
+        }
     }
 
-    fn dt(&self, m: &Model<D>, s: &crate::scene::SolverConfig) -> f64 {
+    fn dt(&self, m: &Model<D>, s: &SolverConfig) -> f64 {
         match self {
             Stepper::Explicit(e) => e.dt(m),
-            Stepper::Implicit(..) => s.implicit_dt(),
+            Stepper::Implicit(_) => s.implicit_dt(),
         }
     }
 
@@ -103,15 +100,18 @@ impl<const D: usize> Stepper<D> {
         t: f64,
         dt: f64,
         step: usize,
+        log: &mut NewtonLog,
     ) -> std::io::Result<Result<f64, Divergence>> {
         Ok(match self {
             Stepper::Explicit(e) => e.step(m, t, dt, step),
-            Stepper::Implicit(i, log) => {
+            Stepper::Implicit(i) => {
                 let result = i.advance(m, t, dt, step);
-                for row in i.take_log() {
-                    writeln!(log, "{}", row.csv())?;
+                if let Some(log) = log {
+                    for row in i.take_log() {
+                        writeln!(log, "{}", row.csv())?;
+                    }
+                    log.flush()?;
                 }
-                log.flush()?;
                 result
             }
         })
@@ -120,18 +120,18 @@ impl<const D: usize> Stepper<D> {
     fn active_nodes(&self) -> usize {
         match self {
             Stepper::Explicit(e) => e.active_nodes(),
-            Stepper::Implicit(i, _) => i.active_nodes(),
+            Stepper::Implicit(i) => i.active_nodes(),
         }
     }
 
     /// Solver fields of summary.json.
-    fn describe(&self, s: &crate::scene::SolverConfig, summary: &mut serde_json::Value) {
+    fn describe(&self, s: &SolverConfig, summary: &mut serde_json::Value) {
         match self {
             Stepper::Explicit(_) => {
                 summary["solver"] = json!("explicit");
                 summary["scheme"] = json!(s.scheme().name());
             }
-            Stepper::Implicit(i, _) => {
+            Stepper::Implicit(i) => {
                 summary["solver"] = json!("implicit");
                 summary["integrator"] = json!(match s.integrator() {
                     Integrator::Newmark => "newmark",
@@ -155,11 +155,17 @@ fn run_dim<const D: usize>(
 ) -> Result<RunSummary, RunError> {
     let cfg = &scene.config;
     let mut model = Model::<D>::build(scene)?;
-    let mut solver = Stepper::<D>::new(cfg, out)?;
-    let end_time = cfg.solver.end_time;
+    let stages = cfg.stages();
+    let end_time = cfg.total_time();
     let n_bodies = model.n_bodies();
     let mut history = HistoryWriter::create(&out.join("history.csv"), D, n_bodies)?;
     let mut frames = FrameWriter::new(out, "particles")?;
+    let mut newton_log: NewtonLog = None;
+    if stages.iter().any(|s| s.kind == SolverKind::Implicit) {
+        let mut log = std::io::BufWriter::new(std::fs::File::create(out.join("newton.csv"))?);
+        writeln!(log, "{NEWTON_CSV_HEADER}")?;
+        newton_log = Some(log);
+    }
     let frame_interval = (cfg.output.frames > 0).then(|| end_time / cfg.output.frames as f64);
     let progress = opts.progress.then(|| Progress::new(end_time));
     let dt_critical = Explicit::critical_dt(&model);
@@ -169,7 +175,6 @@ fn run_dim<const D: usize>(
     let (mut t, mut step, mut external_work) = (0.0, 0usize, 0.0);
     let (mut next_history, mut next_frame) = (0.0, 0.0);
     let (mut last_history, mut last_frame) = (f64::NAN, f64::NAN);
-    let mut last_dt = 0.0;
     // Write a history row and a frame when they are due (or forced, at the start and
     // the end), never twice at the same time.
     let mut record =
@@ -199,43 +204,81 @@ fn run_dim<const D: usize>(
             Ok(())
         };
     record(&model, t, external_work, true)?;
-    let outcome: Result<(), Divergence> = loop {
-        if t >= end_time * (1.0 - 1e-12) {
-            break Ok(());
+    let mut stage_summaries = Vec::new();
+    let mut outcome: Result<(), Divergence> = Ok(());
+    let mut summary = json!({});
+    let (mut newton_total, mut cutbacks_total) = (0u64, 0u64);
+    for (k, sc) in stages.iter().enumerate() {
+        let mut stepper = Stepper::<D>::new(cfg.grid.shape_function, sc, t);
+        let (stage_start, stage_end) = (t, t + sc.end_time);
+        let (stage_clock, steps_before) = (Instant::now(), step);
+        let mut last_dt = 0.0;
+        outcome = loop {
+            if t >= stage_end - 1e-12 * end_time {
+                t = stage_end;
+                break Ok(());
+            }
+            let dt = stepper.dt(&model, sc).min(stage_end - t);
+            last_dt = dt;
+            match stepper.step(&mut model, t, dt, step, &mut newton_log)? {
+                Ok(work) => external_work += work,
+                Err(d) => break Err(d),
+            }
+            t += dt;
+            step += 1;
+            record(&model, t, external_work, false)?;
+            if let Some(p) = &progress {
+                p.set(t, step);
+            }
+        };
+        let mut stage = json!({
+            "name": sc.name.clone().unwrap_or_else(|| format!("stage{k}")),
+            "start_time": stage_start,
+            "end_time": t,
+            "steps": step - steps_before,
+            "dt": last_dt,
+            "wall_seconds": stage_clock.elapsed().as_secs_f64(),
+            "active_nodes_last_step": stepper.active_nodes(),
+        });
+        stepper.describe(sc, &mut stage);
+        newton_total += stage["newton_iterations"].as_u64().unwrap_or(0);
+        cutbacks_total += stage["cutbacks"].as_u64().unwrap_or(0);
+        // The top level carries the solver fields of the last stage that ran.
+        stepper.describe(sc, &mut summary);
+        summary["dt"] = json!(last_dt);
+        summary["active_nodes_last_step"] = json!(stepper.active_nodes());
+        stage_summaries.push(stage);
+        if outcome.is_err() {
+            break;
         }
-        let dt = solver.dt(&model, &cfg.solver).min(end_time - t);
-        last_dt = dt;
-        match solver.step(&mut model, t, dt, step)? {
-            Ok(work) => external_work += work,
-            Err(d) => break Err(d),
-        }
-        t += dt;
-        step += 1;
-        record(&model, t, external_work, false)?;
-        if let Some(p) = &progress {
-            p.set(t, step);
-        }
-    };
+    }
     if let Some(p) = &progress {
         p.finish();
     }
     let wall = started.elapsed().as_secs_f64();
     let particles = model.particles.len();
-    let mut summary = json!({
-        "scene": scene.file,
-        "dimension": D,
-        "shape_function": cfg.grid.shape_function.name(),
-        "particles": particles,
-        "active_nodes_last_step": solver.active_nodes(),
-        "steps": step,
-        "dt": last_dt,
-        "dt_critical": dt_critical,
-        "end_time": t,
-        "wall_seconds": wall,
-        "particle_steps_per_second": (particles * step) as f64 / wall.max(1e-9),
-        "status": "completed",
-    });
-    solver.describe(&cfg.solver, &mut summary);
+    for (key, value) in [
+        ("scene", json!(scene.file)),
+        ("dimension", json!(D)),
+        ("shape_function", json!(cfg.grid.shape_function.name())),
+        ("particles", json!(particles)),
+        ("steps", json!(step)),
+        ("dt_critical", json!(dt_critical)),
+        ("end_time", json!(t)),
+        ("wall_seconds", json!(wall)),
+        (
+            "particle_steps_per_second",
+            json!((particles * step) as f64 / wall.max(1e-9)),
+        ),
+        ("status", json!("completed")),
+        ("stages", json!(stage_summaries)),
+    ] {
+        summary[key] = value;
+    }
+    if newton_log.is_some() {
+        summary["newton_iterations"] = json!(newton_total);
+        summary["cutbacks"] = json!(cutbacks_total);
+    }
     if let Err(d) = outcome {
         summary["status"] = json!("diverged");
         summary["message"] = json!(d.to_string());

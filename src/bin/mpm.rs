@@ -46,8 +46,13 @@ fn main() -> ExitCode {
         Command::Check { scene, overrides } => match Scene::load(&scene, &overrides) {
             Ok(s) => {
                 let c = &s.config;
+                let stages: Vec<String> = c
+                    .stages()
+                    .iter()
+                    .map(|st| format!("{:?}", st.kind).to_lowercase())
+                    .collect();
                 println!(
-                    "{}: ok ({}D, {} material(s), {} body(ies), {} boundary condition(s), {} load(s), shape function {}, {:?} solver)",
+                    "{}: ok ({}D, {} material(s), {} body(ies), {} boundary condition(s), {} load(s), shape function {}, solver stages: {})",
                     s.file,
                     c.dimension,
                     c.materials.len(),
@@ -55,7 +60,7 @@ fn main() -> ExitCode {
                     c.boundaries.len(),
                     c.loads.len(),
                     c.grid.shape_function.name(),
-                    c.solver.kind
+                    stages.join(" → ")
                 );
                 ExitCode::SUCCESS
             }

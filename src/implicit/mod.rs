@@ -101,6 +101,8 @@ pub struct Implicit<const D: usize> {
     integrator: Integrator,
     newmark: Newmark,
     mass_matrix: MassMatrix,
+    /// Start and duration of the run or stage (quasi-static load factor).
+    t_start: f64,
     end_time: f64,
     residual_tolerance: f64,
     displacement_tolerance: f64,
@@ -120,8 +122,10 @@ pub struct Implicit<const D: usize> {
 }
 
 impl<const D: usize> Implicit<D> {
-    pub fn new(shape: ShapeFunction, s: &SolverConfig) -> Self {
+    /// A solver for a run or stage that starts at time `t_start`.
+    pub fn new(shape: ShapeFunction, s: &SolverConfig, t_start: f64) -> Self {
         Implicit {
+            t_start,
             shape,
             integrator: s.integrator(),
             newmark: Newmark {
@@ -194,12 +198,12 @@ impl<const D: usize> Implicit<D> {
         }
     }
 
-    /// Load factor of gravity and loads at time t: t / end_time when quasi-static,
-    /// otherwise 1 for gravity and the ramp of each load.
+    /// Load factor of gravity and loads at time t: (t − t_start) / duration when
+    /// quasi-static, otherwise 1 for gravity and the ramp of each load.
     fn load_factors(&self, m: &Model<D>, t: f64) -> (f64, Vec<f64>) {
         match self.integrator {
             Integrator::QuasiStatic => {
-                let lambda = (t / self.end_time).min(1.0);
+                let lambda = ((t - self.t_start) / self.end_time).clamp(0.0, 1.0);
                 (lambda, vec![lambda; m.load_ramps.len()])
             }
             Integrator::Newmark => (1.0, m.load_scales(t)),
@@ -209,7 +213,7 @@ impl<const D: usize> Implicit<D> {
     /// Particle accelerations at t = 0 from M a = f_ext − f_int (lumped).
     fn initial_acceleration(&mut self, m: &Model<D>) {
         let p = &m.particles;
-        let (g, scales) = self.load_factors(m, 0.0);
+        let (g, scales) = self.load_factors(m, self.t_start);
         let load = |q: usize| match m.load_ramp_of[q] {
             u32::MAX => 0.0,
             r => scales[r as usize],

@@ -24,7 +24,11 @@ pub struct SceneConfig {
     pub boundaries: Vec<BoundaryConfig>,
     #[serde(default, rename = "load")]
     pub loads: Vec<LoadConfig>,
-    pub solver: SolverConfig,
+    /// A single solver for the whole run …
+    pub solver: Option<SolverConfig>,
+    /// … or a sequence of stages on the same particles, each with its own solver.
+    #[serde(default, rename = "stage")]
+    pub stages: Vec<SolverConfig>,
     #[serde(default)]
     pub output: OutputConfig,
 }
@@ -222,8 +226,11 @@ pub enum MassMatrix {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SolverConfig {
+    /// Stage name (for `[[stage]]` tables; optional).
+    pub name: Option<String>,
     pub kind: SolverKind,
-    /// End of the run (implicit quasi-static: the pseudo-time of full load).
+    /// Duration of the run or stage (implicit quasi-static: the pseudo-time over
+    /// which the loads rise to full value).
     pub end_time: f64,
     /// Explicit: fixed step instead of the CFL rule. Implicit: the step (required
     /// for Newmark; quasi-static may give `load_steps` instead).
@@ -244,6 +251,21 @@ pub struct SolverConfig {
     pub max_iterations: Option<usize>,
     pub line_search: Option<bool>,
     pub max_cutbacks: Option<usize>,
+}
+
+impl SceneConfig {
+    /// The stages of the run: the `[solver]` table alone, or the `[[stage]]` tables.
+    pub fn stages(&self) -> Vec<&SolverConfig> {
+        match &self.solver {
+            Some(s) => vec![s],
+            None => self.stages.iter().collect(),
+        }
+    }
+
+    /// Total simulated time: the sum of the stage durations.
+    pub fn total_time(&self) -> f64 {
+        self.stages().iter().map(|s| s.end_time).sum()
+    }
 }
 
 impl SolverConfig {

@@ -77,7 +77,26 @@ pub fn validate(s: &SceneConfig) -> Check {
     for (i, l) in s.loads.iter().enumerate() {
         load(l, i, s)?;
     }
-    solver(&s.solver)?;
+    match (&s.solver, s.stages.is_empty()) {
+        (Some(solver_config), true) => solver(solver_config, "solver")?,
+        (None, false) => {
+            for (k, st) in s.stages.iter().enumerate() {
+                solver(st, &format!("stage.{k}"))?;
+            }
+        }
+        (Some(_), false) => {
+            return Err((
+                "stage".into(),
+                "give either [solver] or [[stage]] tables, not both".into(),
+            ))
+        }
+        (None, true) => {
+            return Err((
+                "solver".into(),
+                "the scene needs a [solver] table or [[stage]] tables".into(),
+            ))
+        }
+    }
     ensure(
         s.output.history_interval >= 0.0,
         "output.history_interval",
@@ -352,103 +371,111 @@ fn load(l: &LoadConfig, i: usize, s: &SceneConfig) -> Check {
     }
 }
 
-fn solver(s: &SolverConfig) -> Check {
+fn solver(s: &SolverConfig, prefix: &str) -> Check {
     ensure(
         s.end_time > 0.0 && s.end_time.is_finite(),
-        "solver.end_time",
+        format!("{prefix}.end_time"),
         "must be a positive number",
     )?;
     if let Some(dt) = s.dt {
         ensure(
             dt > 0.0 && dt.is_finite(),
-            "solver.dt",
+            format!("{prefix}.dt"),
             "must be a positive number",
         )?;
     }
     match s.kind {
-        SolverKind::Explicit => explicit(s),
-        SolverKind::Implicit => implicit(s),
+        SolverKind::Explicit => explicit(s, prefix),
+        SolverKind::Implicit => implicit(s, prefix),
     }
 }
 
-fn explicit(s: &SolverConfig) -> Check {
+fn explicit(s: &SolverConfig, prefix: &str) -> Check {
     let what = "the explicit solver";
-    forbidden(&s.integrator, "solver.integrator".into(), what)?;
-    forbidden(&s.beta, "solver.beta".into(), what)?;
-    forbidden(&s.gamma, "solver.gamma".into(), what)?;
-    forbidden(&s.mass, "solver.mass".into(), what)?;
-    forbidden(&s.load_steps, "solver.load_steps".into(), what)?;
+    forbidden(&s.integrator, format!("{prefix}.integrator"), what)?;
+    forbidden(&s.beta, format!("{prefix}.beta"), what)?;
+    forbidden(&s.gamma, format!("{prefix}.gamma"), what)?;
+    forbidden(&s.mass, format!("{prefix}.mass"), what)?;
+    forbidden(&s.load_steps, format!("{prefix}.load_steps"), what)?;
     forbidden(
         &s.residual_tolerance,
-        "solver.residual_tolerance".into(),
+        format!("{prefix}.residual_tolerance"),
         what,
     )?;
     forbidden(
         &s.displacement_tolerance,
-        "solver.displacement_tolerance".into(),
+        format!("{prefix}.displacement_tolerance"),
         what,
     )?;
-    forbidden(&s.max_iterations, "solver.max_iterations".into(), what)?;
-    forbidden(&s.line_search, "solver.line_search".into(), what)?;
-    forbidden(&s.max_cutbacks, "solver.max_cutbacks".into(), what)?;
+    forbidden(&s.max_iterations, format!("{prefix}.max_iterations"), what)?;
+    forbidden(&s.line_search, format!("{prefix}.line_search"), what)?;
+    forbidden(&s.max_cutbacks, format!("{prefix}.max_cutbacks"), what)?;
     let cfl = s.cfl();
     ensure(
         cfl > 0.0 && cfl <= 1.0,
-        "solver.cfl",
+        format!("{prefix}.cfl"),
         format!("must lie in (0, 1]: the explicit step is cfl × the critical step; got {cfl}"),
     )?;
     ensure(
         (0.0..=1.0).contains(&s.flip()),
-        "solver.flip",
+        format!("{prefix}.flip"),
         "must lie in [0, 1] (1 = FLIP, 0 = PIC)",
     )?;
     ensure(
         (0.0..1.0).contains(&s.damping()),
-        "solver.damping",
+        format!("{prefix}.damping"),
         "must lie in [0, 1)",
     )
 }
 
-fn implicit(s: &SolverConfig) -> Check {
+fn implicit(s: &SolverConfig, prefix: &str) -> Check {
     let what = "the implicit solver";
-    forbidden(&s.scheme, "solver.scheme".into(), what)?;
-    forbidden(&s.cfl, "solver.cfl".into(), what)?;
-    forbidden(&s.flip, "solver.flip".into(), what)?;
-    forbidden(&s.damping, "solver.damping".into(), what)?;
+    forbidden(&s.scheme, format!("{prefix}.scheme"), what)?;
+    forbidden(&s.cfl, format!("{prefix}.cfl"), what)?;
+    forbidden(&s.flip, format!("{prefix}.flip"), what)?;
+    forbidden(&s.damping, format!("{prefix}.damping"), what)?;
     match s.integrator() {
         Integrator::Newmark => {
-            required(&s.dt, "solver.dt".into(), "the Newmark integrator")?;
+            required(&s.dt, format!("{prefix}.dt"), "the Newmark integrator")?;
             forbidden(
                 &s.load_steps,
-                "solver.load_steps".into(),
+                format!("{prefix}.load_steps"),
                 "the Newmark integrator (give dt)",
             )?;
             ensure(
                 s.beta() > 0.0 && s.beta() <= 1.0,
-                "solver.beta",
+                format!("{prefix}.beta"),
                 "must lie in (0, 1]",
             )?;
             ensure(
                 s.gamma() >= 0.0 && s.gamma() <= 1.5,
-                "solver.gamma",
+                format!("{prefix}.gamma"),
                 "must lie in [0, 1.5]",
             )?;
         }
         Integrator::QuasiStatic => {
-            forbidden(&s.beta, "solver.beta".into(), "the quasi-static integrator")?;
             forbidden(
-                &s.gamma,
-                "solver.gamma".into(),
+                &s.beta,
+                format!("{prefix}.beta"),
                 "the quasi-static integrator",
             )?;
-            forbidden(&s.mass, "solver.mass".into(), "the quasi-static integrator")?;
+            forbidden(
+                &s.gamma,
+                format!("{prefix}.gamma"),
+                "the quasi-static integrator",
+            )?;
+            forbidden(
+                &s.mass,
+                format!("{prefix}.mass"),
+                "the quasi-static integrator",
+            )?;
             ensure(
                 s.dt.is_some() != s.load_steps.is_some(),
-                "solver.load_steps",
+                format!("{prefix}.load_steps"),
                 "give either load_steps or dt",
             )?;
             if let Some(n) = s.load_steps {
-                ensure(n >= 1, "solver.load_steps", "must be at least 1")?;
+                ensure(n >= 1, format!("{prefix}.load_steps"), "must be at least 1")?;
             }
         }
     }
@@ -458,13 +485,13 @@ fn implicit(s: &SolverConfig) -> Check {
     ] {
         ensure(
             v > 0.0 && v < 1.0,
-            format!("solver.{key}"),
+            format!("{prefix}.{key}"),
             "must lie in (0, 1)",
         )?;
     }
     ensure(
         s.max_iterations() >= 1,
-        "solver.max_iterations",
+        format!("{prefix}.max_iterations"),
         "must be at least 1",
     )
 }
