@@ -228,6 +228,7 @@ fn constrained<const D: usize>(v: &[Vector<D>], c: &[Constraint<D>]) -> Vec<Vect
         .collect()
 }
 
+#[allow(clippy::too_many_arguments)]
 /// ΔF = I + Δt L with L_p = Σ v_I ⊗ ∇S_Ip, then F, V and the stress (2-31, 2-32):
 /// the shared deformation update with the nodal displacement u_I = Δt v_I.
 fn update_stress<const D: usize>(

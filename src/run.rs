@@ -71,7 +71,7 @@ pub fn strain_energy<const D: usize>(m: &Model<D>) -> f64 {
 
 /// The time stepper of one stage.
 enum Stepper<const D: usize> {
-    Explicit(Explicit<D>),
+    Explicit(Box<Explicit<D>>),
     Implicit(Box<Implicit<D>>),
 }
 
@@ -81,7 +81,7 @@ type NewtonLog = Option<std::io::BufWriter<std::fs::File>>;
 impl<const D: usize> Stepper<D> {
     fn new(shape: crate::shape::ShapeFunction, s: &SolverConfig, t_start: f64) -> Self {
         match s.kind {
-            SolverKind::Explicit => Stepper::Explicit(Explicit::new(shape, s)),
+            SolverKind::Explicit => Stepper::Explicit(Box::new(Explicit::new(shape, s))),
             SolverKind::Implicit => Stepper::Implicit(Box::new(Implicit::new(shape, s, t_start))),
         }
     }

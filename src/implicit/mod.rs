@@ -278,25 +278,25 @@ impl<const D: usize> Implicit<D> {
         }
         let free = |r: &[Vector<D>]| -> Vec<f64> {
             let mut out = vec![0.0; dofs.free];
-            for a in 0..n {
+            for (a, ra) in r.iter().enumerate() {
                 for d in 0..D {
                     if let Some(i) = dofs.of(a, d, D) {
-                        out[i] = r[a][d];
+                        out[i] = ra[d];
                     }
                 }
             }
             out
         };
         let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
-        let reference = norm(&free(&f_ext)).max(norm(&free(
-            &self.inertial_force(map, st, p, &mass, &u_tilde, inertia),
+        let reference = norm(&free(f_ext)).max(norm(&free(
+            &self.inertial_force(map, st, p, mass, u_tilde, inertia),
         )));
         let mut method = "none";
         let mut converged = false;
         let mut last_increment = f64::NAN;
         for iteration in 0..=self.max_iterations {
             // Residual at the current iterate, from the step-start state.
-            let r = self.residual(m, &u, &u_tilde, &mass, &f_ext, inertia, dt)?;
+            let r = self.residual(m, &u, u_tilde, mass, f_ext, inertia, dt)?;
             let r_free = free(&r);
             let r_norm = norm(&r_free);
             let scale = reference.max(f64::MIN_POSITIVE);
@@ -330,7 +330,7 @@ impl<const D: usize> Implicit<D> {
                 break;
             }
             // Tangent and correction.
-            let (triplets, symmetric) = self.tangent(m, &dofs, &mass, inertia)?;
+            let (triplets, symmetric) = self.tangent(m, dofs, mass, inertia)?;
             let structure = if symmetric {
                 Structure::Symmetric
             } else {
@@ -351,11 +351,10 @@ impl<const D: usize> Implicit<D> {
             })?;
             let mut step_length = 1.0;
             if self.line_search {
-                step_length = self.line_search(
-                    m, &u, &du, &dofs, &u_tilde, &mass, &f_ext, inertia, dt, r_norm,
-                )?;
+                step_length =
+                    self.line_search(m, &u, &du, dofs, u_tilde, mass, f_ext, inertia, dt, r_norm)?;
             }
-            apply_correction(&mut u, &du, &dofs, step_length);
+            apply_correction(&mut u, &du, dofs, step_length);
             last_increment =
                 step_length * norm(&du) / norm(&free(&u)).max(u_norm).max(f64::MIN_POSITIVE);
             row.increment = last_increment;
@@ -559,7 +558,7 @@ impl<const D: usize> Implicit<D> {
         dofs: &Dofs,
         mass: &[f64],
         inertia: f64,
-    ) -> Result<(Vec<(usize, usize, f64)>, bool), Failure> {
+    ) -> Result<(tangent::Triplets, bool), Failure> {
         let p = &m.particles;
         let history_old = p.history.slots(&p.history.data);
         let a: Vec<Option<Pk1Derivative>> = (0..p.len())
@@ -745,8 +744,11 @@ dt = 0.01
             ];
             let scene = Scene::parse("block.toml", BLOCK, &overrides).unwrap();
             let m = Model::<2>::build(&scene).unwrap();
-            let mut solver =
-                Implicit::<2>::new(scene.config.grid.shape_function, &scene.config.solver);
+            let mut solver = Implicit::<2>::new(
+                scene.config.grid.shape_function,
+                scene.config.stages()[0],
+                0.0,
+            );
             let sys = solver.prepare(&m, 0.0, 0.01);
             // A smooth, finite-strain iterate (strains of a few per cent).
             let nodes: Vec<usize> = solver.map.active.iter().map(|&g| g as usize).collect();

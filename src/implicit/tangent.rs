@@ -81,6 +81,9 @@ impl Dofs {
     }
 }
 
+/// (row, column, value) entries of a sparse matrix.
+pub type Triplets = Vec<(usize, usize, f64)>;
+
 /// Triplets of Σ_p V_p ∇S_I A_p ∇S_J over the free unknowns, particle by particle
 /// in order (deterministic). Also reports whether every A_p has major symmetry
 /// (A_ijkl = A_klij), i.e. whether the assembled matrix is symmetric.
@@ -90,8 +93,8 @@ pub fn stiffness_triplets<const D: usize>(
     dofs: &Dofs,
     volume: &[f64],
     a: &[Pk1Derivative],
-) -> (Vec<(usize, usize, f64)>, bool) {
-    let per_particle: Vec<(Vec<(usize, usize, f64)>, bool)> = (0..volume.len())
+) -> (Triplets, bool) {
+    let per_particle: Vec<(Triplets, bool)> = (0..volume.len())
         .into_par_iter()
         .with_min_len(MIN_PARALLEL_LEN / 8)
         .map(|q| {

@@ -84,6 +84,7 @@ struct Pattern {
 }
 
 /// Numeric factors of the last successful factorization.
+#[allow(clippy::large_enum_variant)] // one instance per solver: size is irrelevant
 enum Numeric {
     None,
     Llt(Vec<f64>),
