@@ -124,11 +124,7 @@ pub fn numerical_stress_derivative<M: Material + ?Sized>(
             minus.df[(k, l)] -= h;
             let ds = (material.update(&plus, &mut hist) - material.update(&minus, &mut hist))
                 / (2.0 * h);
-            for i in 0..3 {
-                for j in 0..3 {
-                    d[(3 * i + j, 3 * k + l)] = ds[(i, j)];
-                }
-            }
+            crate::material::set_derivative_column(&mut d, k, l, &ds);
         }
     }
     d

@@ -204,11 +204,7 @@ impl Material for Hencky {
                 let dtau = Mat3::identity() * (lambda * deps.trace()) + deps * (2.0 * mu);
                 let dlnj = df_inv[(l, k)];
                 let ds = dtau / j - sigma * dlnj;
-                for i in 0..3 {
-                    for jj in 0..3 {
-                        d[(3 * i + jj, 3 * k + l)] = ds[(i, jj)];
-                    }
-                }
+                super::set_derivative_column(&mut d, k, l, &ds);
             }
         }
         Some(d)

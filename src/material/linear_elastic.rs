@@ -119,11 +119,7 @@ impl Material for LinearElastic {
                 let half_dw = (dg - dg.transpose()) * 0.25;
                 let dq = k.a_inv * half_dw * q_plus_i;
                 let ds = dq * s_qt + q_s * dq.transpose() + self.elastic(&deps);
-                for i in 0..3 {
-                    for j in 0..3 {
-                        d[(3 * i + j, 3 * kk + l)] = ds[(i, j)];
-                    }
-                }
+                super::set_derivative_column(&mut d, kk, l, &ds);
             }
         }
         Some(d)

@@ -73,6 +73,15 @@ pub trait Material: Send + Sync + std::fmt::Debug {
     }
 }
 
+/// Write ∂σ/∂ΔF_kl (a 3×3 tensor) into column 3k + l of the stress derivative.
+pub fn set_derivative_column(d: &mut StressDerivative, k: usize, l: usize, ds: &Mat3) {
+    for i in 0..3 {
+        for j in 0..3 {
+            d[(3 * i + j, 3 * k + l)] = ds[(i, j)];
+        }
+    }
+}
+
 /// Lamé constants from Young's modulus and Poisson's ratio.
 pub fn lame(youngs_modulus: f64, poisson_ratio: f64) -> (f64, f64) {
     let g = youngs_modulus / (2.0 * (1.0 + poisson_ratio));

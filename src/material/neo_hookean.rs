@@ -94,11 +94,7 @@ impl Material for NeoHookean {
                 let db = dff + dff.transpose();
                 let ds = (db - b_minus_i * dlnj) * (mu / j)
                     + Mat3::identity() * (lambda * (1.0 - ln_j) / j * dlnj);
-                for i in 0..3 {
-                    for jj in 0..3 {
-                        d[(3 * i + jj, 3 * k + l)] = ds[(i, jj)];
-                    }
-                }
+                super::set_derivative_column(&mut d, k, l, &ds);
             }
         }
         Some(d)
