@@ -14,12 +14,18 @@
 //! Run: `cargo bench --bench implicit -- --noplot` (see docs/performance.md).
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering,
+};
+use faer::sparse::{SparseColMat, Triplet};
+use faer::Side;
 use mpm::boundary::node_constraint;
 use mpm::deformation::Trial;
 use mpm::dim::Vector;
 use mpm::implicit::tangent::{pk1_derivative, stiffness_triplets, Dofs, Pk1Derivative};
 use mpm::linear::direct::{DirectSolver, Structure};
-use mpm::material::{Increment, Material};
+use mpm::material::Increment;
 use mpm::scene::Scene;
 use mpm::setup::Model;
 use mpm::shape::{ShapeFunction, Stencils};
@@ -203,27 +209,46 @@ fn rhs(p: &Problem, w: &Workspace, dofs: &Dofs) -> Vec<f64> {
     out
 }
 
-/// Number of stored entries of the factor, estimated through faer's symbolic
-/// Cholesky of the same lower triangle (for the fill-in figure printed below).
-fn fill_in(n: usize, triplets: &[(usize, usize, f64)]) -> (usize, usize) {
-    use faer::sparse::linalg::cholesky::{
-        factorize_symbolic_cholesky, CholeskySymbolicParams, SymmetricOrdering,
-    };
-    use faer::sparse::{SparseColMat, Triplet};
+/// The lower triangle of K in CSC form, as the direct solver builds it from the
+/// triplets (duplicates summed).
+fn lower_csc(n: usize, triplets: &[(usize, usize, f64)]) -> SparseColMat<usize, f64> {
     let lower: Vec<Triplet<usize, usize, f64>> = triplets
         .iter()
         .filter(|t| t.0 >= t.1)
         .map(|&(r, c, v)| Triplet::new(r, c, v))
         .collect();
-    let a = SparseColMat::try_new_from_triplets(n, n, &lower).expect("csc");
-    let sym = factorize_symbolic_cholesky(
+    SparseColMat::try_new_from_triplets(n, n, &lower).expect("csc")
+}
+
+/// faer's symbolic Cholesky with AMD ordering (what `DirectSolver` computes once
+/// per pattern).
+fn symbolic(a: &SparseColMat<usize, f64>) -> SymbolicCholesky<usize> {
+    factorize_symbolic_cholesky(
         a.symbolic(),
-        faer::Side::Lower,
+        Side::Lower,
         SymmetricOrdering::Amd,
         CholeskySymbolicParams::default(),
     )
-    .expect("symbolic");
-    (a.compute_nnz(), sym.len_val())
+    .expect("symbolic")
+}
+
+/// faer's numeric LLᵀ alone, with a given symbolic factorization.
+fn numeric_llt(sym: &SymbolicCholesky<usize>, a: &SparseColMat<usize, f64>) -> Vec<f64> {
+    let par = faer::get_global_parallelism();
+    let mut values = vec![0.0; sym.len_val()];
+    let req = sym.factorize_numeric_llt_scratch::<f64>(par, Default::default());
+    let mut mem = MemBuffer::new(req);
+    sym.factorize_numeric_llt(
+        &mut values,
+        a.as_ref(),
+        Side::Lower,
+        Default::default(),
+        par,
+        MemStack::new(&mut mem),
+        Default::default(),
+    )
+    .expect("positive definite");
+    values
 }
 
 fn bench_problem(c: &mut Criterion, p: &Problem) {
@@ -231,7 +256,9 @@ fn bench_problem(c: &mut Criterion, p: &Problem) {
     let (dofs, triplets, structure) = assemble(p, &mut w);
     let b = rhs(p, &w, &dofs);
     let n = dofs.free;
-    let (nnz_lower, nnz_factor) = fill_in(n, &triplets);
+    let lower = lower_csc(n, &triplets);
+    let sym = symbolic(&lower);
+    let (nnz_lower, nnz_factor) = (lower.compute_nnz(), sym.len_val());
     let mut solver = DirectSolver::new();
     let method = solver
         .factorize(n, &triplets, structure)
@@ -295,6 +322,21 @@ fn bench_problem(c: &mut Criterion, p: &Problem) {
         })
     });
     assert_eq!(solver.symbolic_count(), 1, "the pattern was reused");
+
+    // Where the factorization time goes: faer alone, outside `DirectSolver`
+    // (which adds the pattern comparison and a probe solve with three products).
+    if structure == Structure::Symmetric {
+        group.bench_function(
+            BenchmarkId::new("factorize_part", "triplets_to_csc"),
+            |bch| bch.iter(|| black_box(lower_csc(n, &triplets).compute_nnz())),
+        );
+        group.bench_function(BenchmarkId::new("factorize_part", "symbolic_amd"), |bch| {
+            bch.iter(|| black_box(symbolic(&lower).len_val()))
+        });
+        group.bench_function(BenchmarkId::new("factorize_part", "numeric_llt"), |bch| {
+            bch.iter(|| black_box(numeric_llt(&sym, &lower).len()))
+        });
+    }
 
     // (c) Solve with the factors.
     group.bench_function("solve", |bch| {
