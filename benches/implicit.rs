@@ -25,7 +25,7 @@ use mpm::deformation::Trial;
 use mpm::dim::Vector;
 use mpm::implicit::tangent::{pk1_derivative, stiffness_triplets, Dofs, Pk1Derivative};
 use mpm::linear::direct::{DirectSolver, Structure};
-use mpm::material::Increment;
+use mpm::material::{Increment, StressDerivative};
 use mpm::scene::Scene;
 use mpm::setup::Model;
 use mpm::shape::{ShapeFunction, Stencils};
@@ -176,6 +176,28 @@ fn pk1_derivatives(p: &Problem, w: &Workspace) -> Vec<Pk1Derivative> {
         .collect()
 }
 
+/// ∂σ/∂ΔF of every particle alone (the material part of `pk1_derivatives`).
+fn stress_derivatives(p: &Problem, w: &Workspace) -> Vec<StressDerivative> {
+    let x = &p.model.particles;
+    let history_old = x.history.slots(&x.history.data);
+    (0..x.len())
+        .into_par_iter()
+        .with_min_len(512)
+        .map(|q| {
+            let inc = Increment {
+                f_old: x.f[q],
+                df: w.trial.df[q],
+                dt: 0.0,
+                stress_old: x.stress[q],
+                history_old: history_old[q],
+            };
+            p.model.materials[x.material[q] as usize]
+                .stress_derivative(&inc)
+                .expect("analytic tangent")
+        })
+        .collect()
+}
+
 /// The whole assembly of one Newton iteration.
 fn assemble(p: &Problem, w: &mut Workspace) -> (Dofs, Vec<(usize, usize, f64)>, Structure) {
     stencils_and_map(p, w);
@@ -295,6 +317,10 @@ fn bench_problem(c: &mut Criterion, p: &Problem) {
     group.bench_function(BenchmarkId::new("assembly_part", "pk1_derivative"), |bch| {
         bch.iter(|| black_box(pk1_derivatives(p, &w).len()))
     });
+    group.bench_function(
+        BenchmarkId::new("assembly_part", "stress_derivative_only"),
+        |bch| bch.iter(|| black_box(stress_derivatives(p, &w).len())),
+    );
     let a = pk1_derivatives(p, &w);
     group.bench_function(BenchmarkId::new("assembly_part", "triplets"), |bch| {
         bch.iter(|| {
