@@ -311,10 +311,11 @@ fn bench_problem(c: &mut Criterion, p: &Problem) {
         .factorize(n, &triplets, structure)
         .expect("factorize");
     eprintln!(
-        "{}: {} particles, {} active nodes, {} unknowns, {} triplets, {:?}, method {}, \
+        "{}: {} particles, {:.2} nodes per particle, {} active nodes, {} unknowns, {} triplets, {:?}, method {}, \
          nnz(lower K) {}, nnz(L) {} (fill ratio {:.2})",
         p.name,
         p.model.particles.len(),
+        w.stencils.count.iter().map(|&k| k as f64).sum::<f64>() / p.model.particles.len() as f64,
         w.map.len(),
         n,
         triplets.len(),
