@@ -1,0 +1,216 @@
+#!/usr/bin/env python3
+"""Large-deflection cantilever: elastica reference and mpm runs.
+
+Standard library only. Usage:
+
+    python3 elastica.py table              # elastica v/L, u/L along the load path
+    python3 elastica.py check              # against Mattiasson (1981), k = 1, 2, 5, 10
+    python3 elastica.py runs [SHAPE ...]   # run mpm at several end loads and compare
+
+The mpm binary is taken from $MPM, else ../../target/release/mpm relative to
+this folder, else $CARGO_TARGET_DIR/release/mpm. Runs go to $OUT (default a
+temporary directory).
+
+Reference: a vertical dead load P at the tip of a cantilever of length L,
+    EI theta''(s) = -P cos(theta),  theta(0) = 0,  theta'(L) = 0,
+    v = int_0^L sin(theta) ds,  u = L - int_0^L cos(theta) ds.
+In s/L the equation is theta'' = -k cos(theta) with k = P L^2 / EI. We shoot on
+theta'(0) with classical RK4 and bisect: theta'(1) is negative for theta'(0) = 0
+and positive for theta'(0) = k, so [0, k] brackets the root.
+
+With extension and shear (Reissner's beam; used only to size those effects)
+the section force (0, -P) gives N = P sin(theta), Q = P cos(theta), strains
+eps = N/EA and gamma = Q/(kappa G A), so with a_e = P/EA and a_s = P/(kappa G A):
+    x' = cos + (a_e - a_s) sin cos,  v' = sin + a_e sin^2 + a_s cos^2,
+    EI theta'' = -P x'.
+"""
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+
+# Published elastica values (Mattiasson 1981), k: (v/L, u/L).
+MATTIASSON = {1: (0.30172, 0.05643), 2: (0.49346, 0.16064),
+              5: (0.71379, 0.38763), 10: (0.81061, 0.55500)}
+
+# The problem (reference README item 3), SI units, unit thickness.
+L, DEPTH, E, NU, P_END = 10.0, 1.0, 12.0e6, 0.2, 100.0e3
+I = DEPTH ** 3 / 12.0
+EI_PLANE_STRAIN = E / (1.0 - NU * NU) * I   # the choice used for comparisons
+EI_PLANE_STRESS = E * I
+G = E / (2.0 * (1.0 + NU))
+KAPPA = 5.0 / 6.0
+
+
+def shoot(k, kappa0, a_e=0.0, a_s=0.0, n=2000):
+    """Integrate from s = 0 to 1; returns (theta(1), theta'(1), v/L, x/L)."""
+    h = 1.0 / n
+    c = a_e - a_s
+
+    def f(y):
+        t, w = y[0], y[1]
+        ct, st = math.cos(t), math.sin(t)
+        xp = ct + c * st * ct
+        return (w, -k * xp, st + a_e * st * st + a_s * ct * ct, xp)
+
+    y = (0.0, kappa0, 0.0, 0.0)
+    for _ in range(n):
+        k1 = f(y)
+        k2 = f(tuple(a + 0.5 * h * b for a, b in zip(y, k1)))
+        k3 = f(tuple(a + 0.5 * h * b for a, b in zip(y, k2)))
+        k4 = f(tuple(a + h * b for a, b in zip(y, k3)))
+        y = tuple(a + h / 6.0 * (b1 + 2 * b2 + 2 * b3 + b4)
+                  for a, b1, b2, b3, b4 in zip(y, k1, k2, k3, k4))
+    return y
+
+
+def elastica(k, a_e=0.0, a_s=0.0, n=2000):
+    """(v/L, u/L, tip rotation) for load parameter k = P L^2 / EI."""
+    if k == 0.0:
+        return 0.0, 0.0, 0.0
+    lo, hi = 0.0, k * (1.0 + abs(a_e - a_s))
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if shoot(k, mid, a_e, a_s, n)[1] > 0.0:
+            hi = mid
+        else:
+            lo = mid
+    t, _, v, x = shoot(k, 0.5 * (lo + hi), a_e, a_s, n)
+    return v, 1.0 - x, t
+
+
+def tip_reference(p, h, ppc, ei=EI_PLANE_STRAIN):
+    """Elastica displacement (v, u) in metres of the loaded particle column.
+
+    The load is carried by the last column of particles, centred at
+    a = L - h / (2 ppc); the beam beyond it is unloaded, so the loaded point
+    moves as the tip of a cantilever of length a."""
+    a = L - 0.5 * h / ppc
+    v, u, _ = elastica(p * a * a / ei)
+    return v * a, u * a
+
+
+def find_mpm():
+    here = os.path.dirname(os.path.abspath(__file__))
+    candidates = [os.environ.get("MPM", "")]
+    if os.environ.get("CARGO_TARGET_DIR"):
+        candidates.append(os.path.join(os.environ["CARGO_TARGET_DIR"], "release", "mpm"))
+    candidates.append(os.path.join(here, "..", "..", "target", "release", "mpm"))
+    for c in candidates:
+        if c and os.path.exists(c):
+            return c
+    sys.exit("mpm binary not found: set MPM or CARGO_TARGET_DIR (cargo build --release)")
+
+
+def read_csv(path):
+    with open(path) as f:
+        header = f.readline().strip().split(",")
+        rows = [dict(zip(header, map(float, line.split(",")))) for line in f if line.strip()]
+    return rows
+
+
+def run_mpm(shape, cells_per_depth, ppc, p, steps, out):
+    """Run problems/cantilever.toml; returns (status, wall seconds, v, u, message)."""
+    h = DEPTH / cells_per_depth
+    nx, ny = round(11.0 / h), round(12.0 / h)
+    here = os.path.dirname(os.path.abspath(__file__))
+    scene = os.path.join(here, "..", "..", "problems", "cantilever.toml")
+    x_min = L - h / ppc
+    args = [find_mpm(), "run", scene, "--out", out,
+            "--set", f"grid.shape_function={shape}",
+            "--set", f"grid.cells=[{nx},{ny}]",
+            "--set", f"body.0.particles_per_cell={ppc}",
+            "--set", f"load.0.region_min=[{x_min!r},0.0]",
+            "--set", f"load.0.force=[0.0,{-p!r}]",
+            "--set", f"solver.load_steps={steps}"]
+    proc = subprocess.run(args, capture_output=True, text=True)
+    with open(os.path.join(out, "summary.json")) as f:
+        summary = json.load(f)
+    if summary["status"] != "completed":
+        return summary["status"], summary["wall_seconds"], None, None, summary.get("message", "")
+    rows = read_csv(os.path.join(out, "particles_final.csv"))
+    tip = [r for r in rows if r["X0"] >= x_min]
+    v = -sum(r["y"] - r["Y0"] for r in tip) / len(tip)
+    u = -sum(r["x"] - r["X0"] for r in tip) / len(tip)
+    return "completed", summary["wall_seconds"], v, u, proc.stderr.strip()
+
+
+def cmd_table():
+    print("| P (kN) | k (E) | k (plane strain) | v/L | u/L | tip angle (rad) |")
+    print("|---|---|---|---|---|---|")
+    for i in range(1, 11):
+        p = P_END * i / 10
+        k = p * L * L / EI_PLANE_STRAIN
+        v, u, t = elastica(k)
+        print(f"| {p / 1e3:.0f} | {p * L * L / EI_PLANE_STRESS:.1f} | {k:.2f} | "
+              f"{v:.5f} | {u:.5f} | {t:.4f} |")
+    k = P_END * L * L / EI_PLANE_STRAIN
+    a_e = P_END / (E / (1 - NU * NU) * DEPTH)
+    a_s = P_END / (KAPPA * G * DEPTH)
+    v0, u0, _ = elastica(k)
+    v1, u1, _ = elastica(k, a_e, 0.0)
+    v2, u2, _ = elastica(k, 0.0, a_s)
+    v3, u3, _ = elastica(k, a_e, a_s)
+    v10, u10, _ = elastica(P_END * L * L / EI_PLANE_STRESS)
+    print()
+    print(f"final load: k = 10 (E) v/L = {v10:.5f}, u/L = {u10:.5f}; "
+          f"k = 9.6 (E/(1-nu^2)) v/L = {v0:.5f}, u/L = {u0:.5f}")
+    print(f"  stiffness choice changes v by {100 * (v10 / v0 - 1):+.2f} %, u by {100 * (u10 / u0 - 1):+.2f} %")
+    print(f"  extension (P/EA = {a_e:.4f}): v {100 * (v1 / v0 - 1):+.2f} %, u {100 * (u1 / u0 - 1):+.2f} %")
+    print(f"  shear (P/(kappa G A) = {a_s:.4f}): v {100 * (v2 / v0 - 1):+.2f} %, u {100 * (u2 / u0 - 1):+.2f} %")
+    print(f"  both: v/L = {v3:.5f} ({100 * (v3 / v0 - 1):+.2f} %), u/L = {u3:.5f} ({100 * (u3 / u0 - 1):+.2f} %)")
+    lin = 3.0 * EI_PLANE_STRAIN / (KAPPA * G * DEPTH * L * L)
+    print(f"  small-deflection Timoshenko estimate: shear/bending deflection = {100 * lin:.2f} %")
+
+
+def cmd_check():
+    worst = 0.0
+    for k, (v_pub, u_pub) in MATTIASSON.items():
+        v, u, t = elastica(float(k))
+        worst = max(worst, abs(v - v_pub), abs(u - u_pub))
+        print(f"k = {k:>2}: v/L {v:.5f} (Mattiasson {v_pub:.5f}), u/L {u:.5f} (Mattiasson {u_pub:.5f})")
+    print(f"largest difference {worst:.1e}")
+
+
+def cmd_runs(shapes):
+    shapes = shapes or ["bspline2", "ugimp", "cpdi"]
+    out_root = os.environ.get("OUT") or tempfile.mkdtemp(prefix="cantilever_")
+    resolutions = [(4, 3), (8, 3)]
+    loads = [10e3, 25e3, 50e3, 75e3, 100e3]
+    print("| shape | cells/depth | ppc | P (kN) | k | elastica v/L | ours v/L | error v | "
+          "elastica u/L | ours u/L | error u | wall (s) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for shape in shapes:
+        for cells, ppc in resolutions:
+            for p in loads:
+                steps = max(1, round(50 * p / P_END))
+                out = os.path.join(out_root, f"{shape}_{cells}_{ppc}_{p / 1e3:.0f}")
+                os.makedirs(out, exist_ok=True)
+                status, wall, v, u, msg = run_mpm(shape, cells, ppc, p, steps, out)
+                k = p * L * L / EI_PLANE_STRAIN
+                h = DEPTH / cells
+                a = L - 0.5 * h / ppc
+                v_ref, u_ref = tip_reference(p, h, ppc)
+                if status != "completed":
+                    print(f"| {shape} | {cells} | {ppc} | {p / 1e3:.0f} | {k:.2f} | "
+                          f"{v_ref / a:.5f} | {status} | | {u_ref / a:.5f} | | | {wall:.2f} |")
+                    print(f"<!-- {msg} -->")
+                    continue
+                print(f"| {shape} | {cells} | {ppc} | {p / 1e3:.0f} | {k:.2f} | "
+                      f"{v_ref / a:.5f} | {v / a:.5f} | {100 * (v / v_ref - 1):+.2f} % | "
+                      f"{u_ref / a:.5f} | {u / a:.5f} | {100 * (u / u_ref - 1):+.2f} % | {wall:.2f} |")
+                sys.stdout.flush()
+
+
+if __name__ == "__main__":
+    cmd = sys.argv[1] if len(sys.argv) > 1 else "table"
+    if cmd == "table":
+        cmd_table()
+    elif cmd == "check":
+        cmd_check()
+    elif cmd == "runs":
+        cmd_runs(sys.argv[2:])
+    else:
+        sys.exit(__doc__)
