@@ -101,8 +101,8 @@ impl Problem {
         Problem {
             name,
             shape: c.grid.shape_function,
-            dt: c.solver.implicit_dt(),
-            load_steps: c.solver.load_steps.unwrap_or(1),
+            dt: c.stages()[0].implicit_dt(),
+            load_steps: c.stages()[0].load_steps.unwrap_or(1),
             model: Model::<2>::build(&scene).expect("model"),
             scene,
         }
@@ -125,7 +125,7 @@ impl Problem {
     /// matrix of the first Newton iteration of load step `steps + 1` (non-zero
     /// stress, F ≠ I, particles moved).
     fn after_steps(mut self, steps: usize) -> Problem {
-        let mut solver = Implicit::<2>::new(self.shape, &self.scene.config.solver);
+        let mut solver = Implicit::<2>::new(self.shape, self.scene.config.stages()[0], 0.0);
         for step in 0..steps {
             solver
                 .advance(&mut self.model, step as f64 * self.dt, self.dt, step)
