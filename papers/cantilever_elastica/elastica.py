@@ -5,7 +5,9 @@ Standard library only. Usage:
 
     python3 elastica.py table              # elastica v/L, u/L along the load path
     python3 elastica.py check              # against Mattiasson (1981), k = 1, 2, 5, 10
-    python3 elastica.py runs [SHAPE ...]   # run mpm at several end loads and compare
+    python3 elastica.py runs [SHAPE ...]   # mpm along the load path (4 cells/depth, 3 ppc)
+    python3 elastica.py refine [SHAPE ...] # mpm at full load, several resolutions
+    python3 elastica.py small [SHAPE ...]  # mpm at P = 100 N against the linear beam
 
 The mpm binary is taken from $MPM, else ../../target/release/mpm relative to
 this folder, else $CARGO_TARGET_DIR/release/mpm. Runs go to $OUT (default a
@@ -138,14 +140,18 @@ def run_mpm(shape, cells_per_depth, ppc, p, steps, out):
 
 
 def cmd_table():
-    print("| P (kN) | k (E) | k (plane strain) | v/L | u/L | tip angle (rad) |")
-    print("|---|---|---|---|---|---|")
+    print("| P (kN) | k = PL²/EI, E/(1-ν²) | v/L | u/L | tip angle (rad) | "
+          "k with E | v/L with E | u/L with E | v/L, u/L with extension and shear |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for i in range(1, 11):
         p = P_END * i / 10
         k = p * L * L / EI_PLANE_STRAIN
+        k_e = p * L * L / EI_PLANE_STRESS
         v, u, t = elastica(k)
-        print(f"| {p / 1e3:.0f} | {p * L * L / EI_PLANE_STRESS:.1f} | {k:.2f} | "
-              f"{v:.5f} | {u:.5f} | {t:.4f} |")
+        ve, ue, _ = elastica(k_e)
+        vr, ur, _ = elastica(k, p / (E / (1 - NU * NU) * DEPTH), p / (KAPPA * G * DEPTH))
+        print(f"| {p / 1e3:.0f} | {k:.2f} | {v:.5f} | {u:.5f} | {t:.4f} | {k_e:.1f} | "
+              f"{ve:.5f} | {ue:.5f} | {vr:.5f}, {ur:.5f} |")
     k = P_END * L * L / EI_PLANE_STRAIN
     a_e = P_END / (E / (1 - NU * NU) * DEPTH)
     a_s = P_END / (KAPPA * G * DEPTH)
@@ -174,34 +180,87 @@ def cmd_check():
     print(f"largest difference {worst:.1e}")
 
 
+def reissner_reference(p, h, ppc, ei=EI_PLANE_STRAIN):
+    """As tip_reference, with extension and shear (plane-strain EA, kappa G A)."""
+    a = L - 0.5 * h / ppc
+    a_e = p / (E / (1.0 - NU * NU) * DEPTH)
+    a_s = p / (KAPPA * G * DEPTH)
+    v, u, _ = elastica(p * a * a / ei, a_e, a_s)
+    return v * a, u * a
+
+
+HEADER = ("| shape | cells/depth | ppc | P (kN) | k = PL²/EI | elastica v/a | ours v/a | error v | "
+          "elastica u/a | ours u/a | error u | error v, u vs Reissner | wall (s) |\n"
+          "|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+
+
+def row(shape, cells, ppc, p, out_root):
+    steps = max(1, round(50 * p / P_END))
+    out = os.path.join(out_root, f"{shape}_{cells}_{ppc}_{p / 1e3:.0f}")
+    os.makedirs(out, exist_ok=True)
+    status, wall, v, u, msg = run_mpm(shape, cells, ppc, p, steps, out)
+    h = DEPTH / cells
+    a = L - 0.5 * h / ppc
+    k = p * L * L / EI_PLANE_STRAIN
+    v_ref, u_ref = tip_reference(p, h, ppc)
+    v_r, u_r = reissner_reference(p, h, ppc)
+    head = f"| {shape} | {cells} | {ppc} | {p / 1e3:.0f} | {k:.2f} | {v_ref / a:.5f} |"
+    if status != "completed":
+        line = msg.splitlines()[-1] if msg else ""
+        print(f"{head} {status} | | {u_ref / a:.5f} | | | | {wall:.2f} |")
+        print(f"<!-- {line} -->")
+    else:
+        print(f"{head} {v / a:.5f} | {100 * (v / v_ref - 1):+.2f} % | "
+              f"{u_ref / a:.5f} | {u / a:.5f} | {100 * (u / u_ref - 1):+.2f} % | "
+              f"{100 * (v / v_r - 1):+.2f} %, {100 * (u / u_r - 1):+.2f} % | {wall:.2f} |")
+    sys.stdout.flush()
+
+
 def cmd_runs(shapes):
+    """Load path at 4 cells through the depth, 3x3 particles per cell."""
     shapes = shapes or ["bspline2", "ugimp", "cpdi"]
     out_root = os.environ.get("OUT") or tempfile.mkdtemp(prefix="cantilever_")
-    resolutions = [(4, 3), (8, 3)]
-    loads = [10e3, 25e3, 50e3, 75e3, 100e3]
-    print("| shape | cells/depth | ppc | P (kN) | k | elastica v/L | ours v/L | error v | "
-          "elastica u/L | ours u/L | error u | wall (s) |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    print(HEADER)
     for shape in shapes:
-        for cells, ppc in resolutions:
-            for p in loads:
-                steps = max(1, round(50 * p / P_END))
-                out = os.path.join(out_root, f"{shape}_{cells}_{ppc}_{p / 1e3:.0f}")
-                os.makedirs(out, exist_ok=True)
-                status, wall, v, u, msg = run_mpm(shape, cells, ppc, p, steps, out)
-                k = p * L * L / EI_PLANE_STRAIN
-                h = DEPTH / cells
-                a = L - 0.5 * h / ppc
-                v_ref, u_ref = tip_reference(p, h, ppc)
-                if status != "completed":
-                    print(f"| {shape} | {cells} | {ppc} | {p / 1e3:.0f} | {k:.2f} | "
-                          f"{v_ref / a:.5f} | {status} | | {u_ref / a:.5f} | | | {wall:.2f} |")
-                    print(f"<!-- {msg} -->")
-                    continue
-                print(f"| {shape} | {cells} | {ppc} | {p / 1e3:.0f} | {k:.2f} | "
-                      f"{v_ref / a:.5f} | {v / a:.5f} | {100 * (v / v_ref - 1):+.2f} % | "
-                      f"{u_ref / a:.5f} | {u / a:.5f} | {100 * (u / u_ref - 1):+.2f} % | {wall:.2f} |")
-                sys.stdout.flush()
+        for p in [10e3, 20e3, 40e3, 60e3, 80e3, 100e3]:
+            row(shape, 4, 3, p, out_root)
+
+
+def cmd_refine(shapes):
+    """Full load at several resolutions."""
+    shapes = shapes or ["bspline2", "ugimp", "cpdi"]
+    out_root = os.environ.get("OUT") or tempfile.mkdtemp(prefix="cantilever_")
+    print(HEADER)
+    for shape in shapes:
+        for cells, ppc in [(4, 2), (4, 3), (4, 4), (8, 2), (8, 3)]:
+            row(shape, cells, ppc, P_END, out_root)
+
+
+def cmd_small(shapes):
+    """P = 100 N in one step: linear Timoshenko beam (plane strain) and EB with E."""
+    shapes = shapes or ["bspline2", "ugimp", "cpdi"]
+    out_root = os.environ.get("OUT") or tempfile.mkdtemp(prefix="cantilever_")
+    p = 100.0
+    print("| shape | cells/depth | ppc | ours v (mm) | Timoshenko, E/(1-nu^2) | error | "
+          "Euler-Bernoulli, E | error | wall (s) |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for shape in shapes:
+        for cells, ppc in [(4, 2), (4, 3), (4, 4), (8, 2), (8, 3)]:
+            out = os.path.join(out_root, f"small_{shape}_{cells}_{ppc}")
+            os.makedirs(out, exist_ok=True)
+            status, wall, v, _, msg = run_mpm(shape, cells, ppc, p, 1, out)
+            a = L - 0.5 * DEPTH / cells / ppc
+            timo = p * a ** 3 / (3 * EI_PLANE_STRAIN) + p * a / (KAPPA * G * DEPTH)
+            eb_e = p * a ** 3 / (3 * EI_PLANE_STRESS)
+            if v is None:
+                print(f"| {shape} | {cells} | {ppc} | {status} | {1e3 * timo:.4f} | | "
+                      f"{1e3 * eb_e:.4f} | | {wall:.2f} |")
+                print(f"<!-- {msg.splitlines()[-1] if msg else ''} -->")
+                continue
+            print(f"| {shape} | {cells} | {ppc} | {1e3 * v:.4f} | {1e3 * timo:.4f} | "
+                  f"{100 * (v / timo - 1):+.2f} % | {1e3 * eb_e:.4f} | {100 * (v / eb_e - 1):+.2f} % | "
+                  f"{wall:.2f} |")
+            sys.stdout.flush()
 
 
 if __name__ == "__main__":
@@ -212,5 +271,9 @@ if __name__ == "__main__":
         cmd_check()
     elif cmd == "runs":
         cmd_runs(sys.argv[2:])
+    elif cmd == "small":
+        cmd_small(sys.argv[2:])
+    elif cmd == "refine":
+        cmd_refine(sys.argv[2:])
     else:
         sys.exit(__doc__)
