@@ -24,7 +24,7 @@ use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering,
 };
-use faer::sparse::{SparseColMat, Triplet};
+use faer::sparse::{Pair, SparseColMat, SymbolicSparseColMat, Triplet};
 use faer::Side;
 use mpm::boundary::node_constraint;
 use mpm::deformation::Trial;
@@ -381,6 +381,30 @@ fn bench_problem(c: &mut Criterion, p: &Problem) {
         group.bench_function(
             BenchmarkId::new("factorize_part", "triplets_to_csc"),
             |bch| bch.iter(|| black_box(lower_csc(n, &triplets).compute_nnz())),
+        );
+        // What-if: the same CSC matrix when the pattern and the value order
+        // (faer's argsort) are cached, i.e. only the values are scattered.
+        let pairs: Vec<Pair<usize, usize>> = triplets
+            .iter()
+            .filter(|t| t.0 >= t.1)
+            .map(|&(row, col, _)| Pair { row, col })
+            .collect();
+        let (pattern, order) =
+            SymbolicSparseColMat::try_new_from_indices(n, n, &pairs).expect("pattern");
+        group.bench_function(
+            BenchmarkId::new("factorize_part", "csc_from_cached_order"),
+            |bch| {
+                bch.iter(|| {
+                    let values: Vec<f64> = triplets
+                        .iter()
+                        .filter(|t| t.0 >= t.1)
+                        .map(|t| t.2)
+                        .collect();
+                    let a = SparseColMat::new_from_argsort(pattern.clone(), &order, &values)
+                        .expect("csc");
+                    black_box(a.compute_nnz())
+                })
+            },
         );
         group.bench_function(BenchmarkId::new("factorize_part", "symbolic_amd"), |bch| {
             bch.iter(|| black_box(symbolic(&lower).len_val()))
