@@ -84,8 +84,7 @@ struct StepSystem<const D: usize> {
     mass: Vec<f64>,
     /// External force at the end of the step.
     f_ext: Vec<Vector<D>>,
-    /// Nodal velocity and acceleration at the step start (Newmark; zero otherwise).
-    v_n: Vec<Vector<D>>,
+    /// Nodal acceleration at the step start (Newmark; zero otherwise).
     a_n: Vec<Vector<D>>,
     /// Newmark predictor ũ (zero when quasi-static).
     u_tilde: Vec<Vector<D>>,
@@ -247,7 +246,6 @@ impl<const D: usize> Implicit<D> {
             dofs,
             mass,
             f_ext,
-            v_n,
             a_n,
             u_tilde,
             inertia,
@@ -408,7 +406,6 @@ impl<const D: usize> Implicit<D> {
                 p.v[q] += interpolate(map, st, q, &dv);
                 self.accel[q] += interpolate(map, st, q, &da);
             }
-            let _ = &v_n;
         }
         check_state(m, step + 1, t + dt).map_err(|d| Failure {
             particle: d.particle,
@@ -449,7 +446,7 @@ impl<const D: usize> Implicit<D> {
         let f_ext = external_force(map, st, p, &(m.gravity * g_new), &load_new);
         let (mass, momentum) = mass_momentum(map, st, p);
         let nodal = |w: &[f64], a: usize| if w[a] > 0.0 { 1.0 / w[a] } else { 0.0 };
-        let (v_n, a_n, u_tilde) = if dynamic {
+        let (a_n, u_tilde) = if dynamic {
             let am = map.gather(st.stride, Vector::<D>::zeros(), |q, e| {
                 self.accel[q] * (p.mass[q] * st.weight[e])
             });
@@ -465,13 +462,9 @@ impl<const D: usize> Implicit<D> {
             let ut = (0..n)
                 .map(|a| self.newmark.predictor(dt, &v[a], &acc[a]))
                 .collect();
-            (v, acc, ut)
+            (acc, ut)
         } else {
-            (
-                vec![Vector::<D>::zeros(); n],
-                vec![Vector::<D>::zeros(); n],
-                vec![Vector::<D>::zeros(); n],
-            )
+            (vec![Vector::<D>::zeros(); n], vec![Vector::<D>::zeros(); n])
         };
         let inertia = if dynamic {
             self.newmark.inertia(dt)
@@ -484,7 +477,6 @@ impl<const D: usize> Implicit<D> {
             dofs,
             mass,
             f_ext,
-            v_n,
             a_n,
             u_tilde,
             inertia,

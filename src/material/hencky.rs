@@ -111,12 +111,7 @@ fn log_divided_difference(x: f64, y: f64) -> f64 {
 
 impl Hencky {
     pub fn new(density: f64, youngs_modulus: f64, poisson_ratio: f64) -> Self {
-        debug_assert!(density > 0.0, "density must be positive");
-        debug_assert!(youngs_modulus > 0.0, "Young's modulus must be positive");
-        debug_assert!(
-            poisson_ratio > -1.0 && poisson_ratio < 0.5,
-            "Poisson's ratio must lie in (-1, 0.5)"
-        );
+        super::debug_check_elastic(density, youngs_modulus, poisson_ratio);
         Self {
             density,
             youngs_modulus,

@@ -82,6 +82,17 @@ pub fn set_derivative_column(d: &mut StressDerivative, k: usize, l: usize, ds: &
     }
 }
 
+/// Debug checks of the (ρ0, E, ν) constructors; the scene validation gives the
+/// user-facing errors.
+pub(crate) fn debug_check_elastic(density: f64, youngs_modulus: f64, poisson_ratio: f64) {
+    debug_assert!(density > 0.0, "density must be positive");
+    debug_assert!(youngs_modulus > 0.0, "Young's modulus must be positive");
+    debug_assert!(
+        poisson_ratio > -1.0 && poisson_ratio < 0.5,
+        "Poisson's ratio must lie in (-1, 0.5)"
+    );
+}
+
 /// Lamé constants from Young's modulus and Poisson's ratio.
 pub fn lame(youngs_modulus: f64, poisson_ratio: f64) -> (f64, f64) {
     let g = youngs_modulus / (2.0 * (1.0 + poisson_ratio));
