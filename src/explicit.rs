@@ -6,10 +6,11 @@ use crate::boundary::{node_constraint, Constraint};
 use crate::deformation::Trial;
 use crate::dim::Vector;
 use crate::scene::{Scheme, SolverConfig};
-use crate::setup::Model;
+use crate::setup::{load_factor, Model};
 use crate::shape::{ShapeFunction, Stencils};
 use crate::transfer::{
-    deterministic_sum, interpolate, mass_momentum, nodal_force, NodeMap, MIN_PARALLEL_LEN,
+    applied_force, deterministic_sum, interpolate, mass_momentum, nodal_force, NodeMap,
+    MIN_PARALLEL_LEN,
 };
 use rayon::prelude::*;
 
@@ -127,10 +128,7 @@ impl<const D: usize> Explicit<D> {
 
         // Nodal forces, damping, acceleration and updated velocity (2-23, 2-29).
         let scales = m.load_scales(t);
-        let load_factor = |q: usize| match m.load_ramp_of[q] {
-            u32::MAX => 0.0,
-            r => scales[r as usize],
-        };
+        let load_factor = |q: usize| load_factor(&m.load_ramp_of, q, &scales);
         let force = nodal_force(map, st, p, &m.gravity, &load_factor);
         let accel: Vec<Vector<D>> = (0..map.len())
             .into_par_iter()
@@ -169,7 +167,7 @@ impl<const D: usize> Explicit<D> {
         let p = &m.particles;
         let work = dt
             * deterministic_sum(p.len(), |q| {
-                let f = m.gravity * p.mass[q] + p.load[q] * load_factor(q);
+                let f = applied_force(p, q, &m.gravity, &load_factor);
                 f.dot(&(old_v[q] + p.v[q])) * 0.5
             });
 

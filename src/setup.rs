@@ -145,6 +145,15 @@ impl<const D: usize> Model<D> {
     }
 }
 
+/// Load factor of particle q from its ramp (`Model::load_ramp_of`) and the factor
+/// of each ramp (0: the particle carries no load).
+pub fn load_factor(ramp_of: &[u32], q: usize, scales: &[f64]) -> f64 {
+    match ramp_of[q] {
+        u32::MAX => 0.0,
+        r => scales[r as usize],
+    }
+}
+
 fn material(m: &MaterialConfig) -> Box<dyn Material> {
     let nu = m.poisson_ratio.unwrap();
     match m.model {

@@ -132,9 +132,19 @@ pub fn nodal_force<const D: usize>(
     map.gather(st.stride, Vector::<D>::zeros(), |q, e| {
         let sigma: Tensor<D> = crate::dim::restrict::<D>(&p.stress[q]);
         let internal = sigma * st.grad[e] * p.volume[q];
-        let external = (gravity * p.mass[q] + p.load[q] * load_factor(q)) * st.weight[e];
+        let external = applied_force(p, q, gravity, load_factor) * st.weight[e];
         external - internal
     })
+}
+
+/// Force applied to particle q: m_q g + s_q f_q (gravity and its scaled load).
+pub fn applied_force<const D: usize>(
+    p: &Particles<D>,
+    q: usize,
+    gravity: &Vector<D>,
+    load_factor: &impl Fn(usize) -> f64,
+) -> Vector<D> {
+    gravity * p.mass[q] + p.load[q] * load_factor(q)
 }
 
 /// External nodal force Σ_p S_Ip (m_p g + s_p f_p) (2-52), s_p the load factor.
@@ -146,7 +156,7 @@ pub fn external_force<const D: usize>(
     load_factor: &(impl Fn(usize) -> f64 + Sync),
 ) -> Vec<Vector<D>> {
     map.gather(st.stride, Vector::<D>::zeros(), |q, e| {
-        (gravity * p.mass[q] + p.load[q] * load_factor(q)) * st.weight[e]
+        applied_force(p, q, gravity, load_factor) * st.weight[e]
     })
 }
 

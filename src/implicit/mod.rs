@@ -20,10 +20,11 @@ use crate::explicit::{check_state, Divergence};
 use crate::linear::direct::{DirectSolver, Structure};
 use crate::material::Increment;
 use crate::scene::{Integrator, MassMatrix, SolverConfig};
-use crate::setup::Model;
+use crate::setup::{load_factor, Model};
 use crate::shape::{ShapeFunction, Stencils};
 use crate::transfer::{
-    external_force, interpolate, mass_momentum, nodal_force, NodeMap, MIN_PARALLEL_LEN,
+    applied_force, external_force, interpolate, mass_momentum, nodal_force, NodeMap,
+    MIN_PARALLEL_LEN,
 };
 use newmark::Newmark;
 use rayon::prelude::*;
@@ -213,10 +214,7 @@ impl<const D: usize> Implicit<D> {
     fn initial_acceleration(&mut self, m: &Model<D>) {
         let p = &m.particles;
         let (g, scales) = self.load_factors(m, self.t_start);
-        let load = |q: usize| match m.load_ramp_of[q] {
-            u32::MAX => 0.0,
-            r => scales[r as usize],
-        };
+        let load = |q: usize| load_factor(&m.load_ramp_of, q, &scales);
         let force = nodal_force(&self.map, &self.stencils, p, &(m.gravity * g), &load);
         let (mass, _) = mass_momentum(&self.map, &self.stencils, p);
         let a: Vec<Vector<D>> = force
@@ -262,10 +260,7 @@ impl<const D: usize> Implicit<D> {
         let (st, map) = (&self.stencils, &self.map);
         let p = &m.particles;
         let n = map.len();
-        let load_new = |q: usize| match m.load_ramp_of[q] {
-            u32::MAX => 0.0,
-            r => scales_new[r as usize],
-        };
+        let load_new = |q: usize| load_factor(&m.load_ramp_of, q, &scales_new);
 
         // Initial iterate: the predictor, with the prescribed components imposed.
         let mut u = u_tilde.to_vec();
@@ -374,18 +369,15 @@ impl<const D: usize> Implicit<D> {
         // Commit: stresses of the converged iterate (the last residual evaluation),
         // positions, and the Newmark update of velocities and accelerations.
         let (g_old, scales_old) = self.load_factors(m, t);
-        let load_old = |q: usize| match m.load_ramp_of[q] {
-            u32::MAX => 0.0,
-            r => scales_old[r as usize],
-        };
+        let load_old = |q: usize| load_factor(&m.load_ramp_of, q, &scales_old);
         let (map, st) = (&self.map, &self.stencils);
         let p = &mut m.particles;
         self.trial.commit(p);
         let dx: Vec<Vector<D>> = (0..p.len()).map(|q| interpolate(map, st, q, &u)).collect();
         let work: f64 = (0..p.len())
             .map(|q| {
-                let f_old = m.gravity * (p.mass[q] * g_old) + p.load[q] * load_old(q);
-                let f_new = m.gravity * (p.mass[q] * g_new) + p.load[q] * load_new(q);
+                let f_old = applied_force(p, q, &(m.gravity * g_old), &load_old);
+                let f_new = applied_force(p, q, &(m.gravity * g_new), &load_new);
                 (f_old + f_new).dot(&dx[q]) * 0.5
             })
             .sum();
@@ -439,10 +431,7 @@ impl<const D: usize> Implicit<D> {
 
         // External force at the end of the step; inertia terms (Newmark).
         let (g_new, scales_new) = self.load_factors(m, t + dt);
-        let load_new = |q: usize| match m.load_ramp_of[q] {
-            u32::MAX => 0.0,
-            r => scales_new[r as usize],
-        };
+        let load_new = |q: usize| load_factor(&m.load_ramp_of, q, &scales_new);
         let f_ext = external_force(map, st, p, &(m.gravity * g_new), &load_new);
         let (mass, momentum) = mass_momentum(map, st, p);
         let nodal = |w: &[f64], a: usize| if w[a] > 0.0 { 1.0 / w[a] } else { 0.0 };
