@@ -260,7 +260,7 @@ impl<const D: usize> Implicit<D> {
         let (st, map) = (&self.stencils, &self.map);
         let p = &m.particles;
         let n = map.len();
-        let load_new = |q: usize| load_factor(&m.load_ramp_of, q, &scales_new);
+        let load_new = |q: usize| load_factor(&m.load_ramp_of, q, scales_new);
 
         // Initial iterate: the predictor, with the prescribed components imposed.
         let mut u = u_tilde.to_vec();
