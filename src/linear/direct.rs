@@ -94,7 +94,7 @@ enum Numeric {
         fwd: Vec<usize>,
         inv: Vec<usize>,
     },
-    Lu(NumericLu<usize, f64>),
+    Lu(Box<NumericLu<usize, f64>>),
 }
 
 /// Sparse direct solver holding the symbolic factorizations and the pattern they belong to.
@@ -126,7 +126,7 @@ impl DirectSolver {
 
     /// Factorize K given as triplets (duplicates summed); reuses the symbolic factorization
     /// when the pattern (the sorted, deduplicated set of (row, col)) equals the previous one.
-    /// On error the previous factorization is discarded ([`Self::solve`] gives `NotFactorized`).
+    /// Symmetric: LLᵀ, else LBLᵀ, else LU; General: LU. On error no factorization is kept.
     pub fn factorize(
         &mut self,
         n: usize,
@@ -144,7 +144,10 @@ impl DirectSolver {
 
     /// Solve `K x = b` with the last factorization; `b` is left untouched and `x` returned.
     pub fn solve(&self, b: &[f64]) -> Result<Vec<f64>, SolveError> {
-        let n = self.pattern.as_ref().ok_or(SolveError::NotFactorized)?.n;
+        let n = match (&self.pattern, &self.numeric) {
+            (Some(p), Numeric::Llt(_) | Numeric::Lblt { .. } | Numeric::Lu(_)) => p.n,
+            _ => return Err(SolveError::NotFactorized),
+        };
         if b.len() != n {
             let msg = format!("right-hand side has length {}, expected {n}", b.len());
             return Err(SolveError::InvalidInput(msg));
@@ -153,7 +156,6 @@ impl DirectSolver {
         let par = faer::get_global_parallelism();
         let rhs = MatMut::from_column_major_slice_mut(&mut x, n, 1);
         match &self.numeric {
-            Numeric::None => return Err(SolveError::NotFactorized),
             Numeric::Lu(num) => self.solve_lu(num, rhs, par)?,
             chol => self.solve_chol(chol, rhs, par)?,
         }
@@ -288,7 +290,7 @@ impl DirectSolver {
         let stack = MemStack::new(&mut mem);
         sym.factorize_numeric_lu(&mut num, a, par, stack, Default::default())
             .map_err(lu_error)?;
-        self.numeric = Numeric::Lu(num);
+        self.numeric = Numeric::Lu(Box::new(num));
         self.check(a, false)?;
         Ok(Method::Lu)
     }
@@ -417,6 +419,13 @@ fn build_csc(
             "non-finite value {v} at ({r}, {c})"
         )));
     }
+    let upper_only = structure == Structure::Symmetric
+        && triplets.iter().any(|t| t.0 < t.1)
+        && !triplets.iter().any(|t| t.0 > t.1);
+    if upper_only {
+        let msg = "Symmetric structure reads the lower triangle, but only upper entries were given";
+        return Err(SolveError::InvalidInput(msg.into()));
+    }
     let keep = |t: &&(usize, usize, f64)| structure == Structure::General || t.0 >= t.1;
     let entries: Vec<Triplet<usize, usize, f64>> = triplets
         .iter()
@@ -470,5 +479,379 @@ fn lu_error(e: LuError) -> SolveError {
             SolveError::Singular(format!("LU: structurally singular at step {index}"))
         }
         LuError::Generic(e) => backend(e),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::time::Instant;
+
+    type Trip = Vec<(usize, usize, f64)>;
+
+    /// `y = K x` straight from the triplets (full matrix, duplicates add up).
+    fn apply(n: usize, t: &[(usize, usize, f64)], x: &[f64]) -> Vec<f64> {
+        let mut y = vec![0.0; n];
+        for &(i, j, v) in t {
+            y[i] += v * x[j];
+        }
+        y
+    }
+
+    fn norm(a: &[f64]) -> f64 {
+        a.iter().map(|t| t * t).sum::<f64>().sqrt()
+    }
+
+    fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
+        let d: Vec<f64> = a.iter().zip(b).map(|(s, t)| s - t).collect();
+        norm(&d) / norm(b)
+    }
+
+    /// Smooth-ish known solution.
+    fn x_star(n: usize) -> Vec<f64> {
+        (0..n)
+            .map(|i| (0.37 * i as f64).sin() + 0.1 * (i % 5) as f64)
+            .collect()
+    }
+
+    /// Factorize, solve against x*, return (method, relative error, relative residual).
+    fn check_solve(
+        s: &mut DirectSolver,
+        n: usize,
+        t: &[(usize, usize, f64)],
+        st: Structure,
+    ) -> (Method, f64, f64) {
+        let method = s.factorize(n, t, st).expect("factorize");
+        let xs = x_star(n);
+        let b = apply(n, t, &xs);
+        let x = s.solve(&b).expect("solve");
+        let res = rel_diff(&apply(n, t, &x), &b);
+        (method, rel_diff(&x, &xs), res)
+    }
+
+    /// 1D Laplacian assembled from 2x2 element matrices, grounded at both ends (SPD).
+    fn laplace_1d(n: usize, ground: bool) -> Trip {
+        let mut t = Vec::new();
+        for e in 0..n - 1 {
+            let (a, b) = (e, e + 1);
+            t.extend([(a, a, 1.0), (a, b, -1.0), (b, a, -1.0), (b, b, 1.0)]);
+        }
+        if ground {
+            t.extend([(0, 0, 1.0), (n - 1, n - 1, 1.0)]);
+        }
+        t
+    }
+
+    /// 2D 5-point Laplacian (Dirichlet), diagonal `4 * scale - shift`.
+    fn laplace_2d(m: usize, scale: f64, shift: f64) -> Trip {
+        let id = |i: usize, j: usize| i * m + j;
+        let mut t = Vec::new();
+        for i in 0..m {
+            for j in 0..m {
+                t.push((id(i, j), id(i, j), 4.0 * scale - shift));
+                if i > 0 {
+                    t.push((id(i, j), id(i - 1, j), -1.0));
+                }
+                if i + 1 < m {
+                    t.push((id(i, j), id(i + 1, j), -1.0));
+                }
+                if j > 0 {
+                    t.push((id(i, j), id(i, j - 1), -1.0));
+                }
+                if j + 1 < m {
+                    t.push((id(i, j), id(i, j + 1), -1.0));
+                }
+            }
+        }
+        t
+    }
+
+    /// 3D 7-point Laplacian (Dirichlet).
+    fn laplace_3d(m: usize) -> Trip {
+        let id = |i: usize, j: usize, k: usize| (i * m + j) * m + k;
+        let mut t = Vec::new();
+        for i in 0..m {
+            for j in 0..m {
+                for k in 0..m {
+                    let p = id(i, j, k);
+                    t.push((p, p, 6.0));
+                    let nb = [
+                        (i > 0, (i.wrapping_sub(1), j, k)),
+                        (i + 1 < m, (i + 1, j, k)),
+                        (j > 0, (i, j.wrapping_sub(1), k)),
+                        (j + 1 < m, (i, j + 1, k)),
+                        (k > 0, (i, j, k.wrapping_sub(1))),
+                        (k + 1 < m, (i, j, k + 1)),
+                    ];
+                    for (ok, (a, b, c)) in nb {
+                        if ok {
+                            t.push((p, id(a, b, c), -1.0));
+                        }
+                    }
+                }
+            }
+        }
+        t
+    }
+
+    #[test]
+    fn laplace_1d_with_duplicates_uses_llt() {
+        let n = 1000;
+        let t = laplace_1d(n, true);
+        let mut s = DirectSolver::new();
+        let (method, err, res) = check_solve(&mut s, n, &t, Structure::Symmetric);
+        eprintln!(
+            "1D Laplacian n={n}: method {method:?}, rel error {err:.2e}, rel residual {res:.2e}"
+        );
+        assert_eq!(method, Method::Llt);
+        assert!(err < 1e-10, "relative error {err}");
+        assert_eq!(s.symbolic_count(), 1);
+    }
+
+    #[test]
+    fn lower_triangle_only_gives_same_solution() {
+        let n = 200;
+        let full = laplace_1d(n, true);
+        let lower: Trip = full.iter().copied().filter(|t| t.0 >= t.1).collect();
+        let b = apply(n, &full, &x_star(n));
+        let mut s = DirectSolver::new();
+        s.factorize(n, &full, Structure::Symmetric).unwrap();
+        let x_full = s.solve(&b).unwrap();
+        s.factorize(n, &lower, Structure::Symmetric).unwrap();
+        assert_eq!(x_full, s.solve(&b).unwrap());
+        assert_eq!(s.symbolic_count(), 1, "same lower pattern");
+    }
+
+    #[test]
+    fn laplace_2d_symbolic_reuse() {
+        let m = 100;
+        let n = m * m;
+        let mut s = DirectSolver::new();
+        let t = laplace_2d(m, 1.0, 0.0);
+        let t0 = Instant::now();
+        let (method, err, res) = check_solve(&mut s, n, &t, Structure::Symmetric);
+        let first = t0.elapsed();
+        eprintln!("2D Laplacian n={n}: {method:?}, rel error {err:.2e}, rel residual {res:.2e}, first factorize+solve {first:?}");
+        assert_eq!(method, Method::Llt);
+        assert!(err < 1e-10, "relative error {err}");
+        assert_eq!(s.symbolic_count(), 1);
+
+        let t2 = laplace_2d(m, 2.0, 0.0);
+        let t0 = Instant::now();
+        let (method, err, res) = check_solve(&mut s, n, &t2, Structure::Symmetric);
+        let second = t0.elapsed();
+        eprintln!("  values changed: {method:?}, rel error {err:.2e}, rel residual {res:.2e}, refactorize+solve {second:?}");
+        assert_eq!(method, Method::Llt);
+        assert!(err < 1e-10, "relative error {err}");
+        assert_eq!(
+            s.symbolic_count(),
+            1,
+            "symbolic factorization must be reused"
+        );
+
+        let mut t3 = t2.clone();
+        t3.extend([(0, n - 1, -0.5), (n - 1, 0, -0.5)]);
+        let (method, err, _) = check_solve(&mut s, n, &t3, Structure::Symmetric);
+        assert_eq!(method, Method::Llt);
+        assert!(err < 1e-10, "relative error {err}");
+        assert_eq!(s.symbolic_count(), 2, "pattern changed");
+    }
+
+    #[test]
+    fn timing_2d_100x100() {
+        let m = 100;
+        let n = m * m;
+        let t = laplace_2d(m, 1.0, 0.0);
+        let mut s = DirectSolver::new();
+        let t0 = Instant::now();
+        s.factorize(n, &t, Structure::Symmetric).unwrap();
+        let first = t0.elapsed();
+        let mut times = Vec::new();
+        for _ in 0..5 {
+            let t0 = Instant::now();
+            s.factorize(n, &t, Structure::Symmetric).unwrap();
+            times.push(t0.elapsed());
+        }
+        let b = vec![1.0; n];
+        let t0 = Instant::now();
+        let _ = s.solve(&b).unwrap();
+        let solve = t0.elapsed();
+        eprintln!("100x100: first factorize (symbolic+numeric+check) {first:?}, reuse {times:?}, solve {solve:?}");
+        assert_eq!(s.symbolic_count(), 1);
+    }
+
+    #[test]
+    fn laplace_minus_shift_is_indefinite() {
+        let m = 30;
+        let n = m * m;
+        let t = laplace_2d(m, 1.0, 1.2345);
+        let mut s = DirectSolver::new();
+        let (method, err, res) = check_solve(&mut s, n, &t, Structure::Symmetric);
+        eprintln!(
+            "shifted Laplacian n={n}: {method:?}, rel error {err:.2e}, rel residual {res:.2e}"
+        );
+        assert_ne!(method, Method::Llt);
+        assert!(res < 1e-8, "relative residual {res}");
+    }
+
+    #[test]
+    fn saddle_point_is_indefinite() {
+        // [[A, Bᵀ], [B, 0]], A = 1D Laplacian (n_a), B sums pairs of consecutive unknowns.
+        let (na, nb) = (400, 100);
+        let n = na + nb;
+        let mut t = laplace_1d(na, true);
+        for k in 0..nb {
+            for j in [4 * k, 4 * k + 1] {
+                t.extend([(na + k, j, 1.0), (j, na + k, 1.0)]);
+            }
+        }
+        let mut s = DirectSolver::new();
+        let (method, err, res) = check_solve(&mut s, n, &t, Structure::Symmetric);
+        eprintln!("saddle point n={n}: {method:?}, rel error {err:.2e}, rel residual {res:.2e}, symbolic {}", s.symbolic_count());
+        assert_ne!(method, Method::Llt);
+        assert!(res < 1e-8, "relative residual {res}");
+    }
+
+    /// -eps u'' + c u' on a uniform grid, first-order upwinding (c > 0), Dirichlet ends.
+    fn convection_diffusion(n: usize, eps: f64, c: f64) -> Trip {
+        let h = 1.0 / (n + 1) as f64;
+        let (d, lo, up) = (
+            2.0 * eps / (h * h) + c / h,
+            -eps / (h * h) - c / h,
+            -eps / (h * h),
+        );
+        let mut t = Vec::new();
+        for i in 0..n {
+            t.push((i, i, d));
+            if i > 0 {
+                t.push((i, i - 1, lo));
+            }
+            if i + 1 < n {
+                t.push((i, i + 1, up));
+            }
+        }
+        t
+    }
+
+    #[test]
+    fn nonsymmetric_uses_lu_and_reuses_symbolic() {
+        let n = 1000;
+        let t = convection_diffusion(n, 0.01, 1.0);
+        let mut s = DirectSolver::new();
+        let (method, err, res) = check_solve(&mut s, n, &t, Structure::General);
+        eprintln!(
+            "convection-diffusion n={n}: {method:?}, rel error {err:.2e}, rel residual {res:.2e}"
+        );
+        assert_eq!(method, Method::Lu);
+        assert!(err < 1e-10, "relative error {err}");
+        let t2 = convection_diffusion(n, 0.001, 2.0);
+        let (method, err, _) = check_solve(&mut s, n, &t2, Structure::General);
+        assert_eq!(method, Method::Lu);
+        assert!(err < 1e-10, "relative error {err}");
+        assert_eq!(s.symbolic_count(), 1);
+    }
+
+    #[test]
+    fn singular_matrices_give_errors() {
+        let n = 300;
+        let mut s = DirectSolver::new();
+        // General: row k is all zeros (column k keeps its entries).
+        let k = 150;
+        let t: Trip = convection_diffusion(n, 0.01, 1.0)
+            .into_iter()
+            .filter(|e| e.0 != k)
+            .collect();
+        let r = s.factorize(n, &t, Structure::General);
+        eprintln!("zero row (general): {r:?}");
+        assert!(matches!(r, Err(SolveError::Singular(_))));
+        assert!(matches!(
+            s.solve(&vec![1.0; n]),
+            Err(SolveError::NotFactorized)
+        ));
+        // General: row k holds an explicit 0 on the diagonal only.
+        let mut t0 = t.clone();
+        t0.retain(|e| e.1 != k);
+        t0.push((k, k, 0.0));
+        let r = s.factorize(n, &t0, Structure::General);
+        eprintln!("zero row+column with explicit zero diagonal (general): {r:?}");
+        assert!(matches!(r, Err(SolveError::Singular(_))));
+        // Symmetric: zero row and column.
+        let t: Trip = laplace_1d(n, true)
+            .into_iter()
+            .filter(|e| e.0 != k && e.1 != k)
+            .collect();
+        let r = s.factorize(n, &t, Structure::Symmetric);
+        eprintln!("zero row and column (symmetric): {r:?}");
+        assert!(matches!(r, Err(SolveError::Singular(_))));
+        // Symmetric: pure-Neumann Laplacians, 1D and 2D.
+        let r = s.factorize(n, &laplace_1d(n, false), Structure::Symmetric);
+        eprintln!("pure Neumann 1D: {r:?}");
+        assert!(matches!(r, Err(SolveError::Singular(_))));
+        let m = 40;
+        let mut t = laplace_2d(m, 1.0, 0.0);
+        for (i, j, v) in t.iter_mut() {
+            if i == j {
+                let (a, b) = (*i / m, *i % m);
+                *v = [a > 0, a + 1 < m, b > 0, b + 1 < m]
+                    .iter()
+                    .filter(|&&x| x)
+                    .count() as f64;
+            }
+        }
+        let r = s.factorize(m * m, &t, Structure::Symmetric);
+        eprintln!("pure Neumann 2D: {r:?}");
+        assert!(matches!(r, Err(SolveError::Singular(_))));
+    }
+
+    #[test]
+    fn invalid_input_is_reported() {
+        let mut s = DirectSolver::new();
+        assert!(matches!(s.solve(&[1.0]), Err(SolveError::NotFactorized)));
+        let r = s.factorize(3, &[(0, 0, 1.0), (3, 0, 1.0)], Structure::General);
+        assert!(matches!(r, Err(SolveError::InvalidInput(_))));
+        let r = s.factorize(2, &[(0, 0, 1.0), (1, 1, f64::NAN)], Structure::General);
+        assert!(matches!(r, Err(SolveError::InvalidInput(_))));
+        let upper = [(0, 0, 2.0), (0, 1, -1.0), (1, 1, 2.0)];
+        let r = s.factorize(2, &upper, Structure::Symmetric);
+        assert!(matches!(r, Err(SolveError::InvalidInput(_))));
+        s.factorize(2, &[(0, 0, 2.0), (1, 1, 4.0)], Structure::Symmetric)
+            .unwrap();
+        assert!(matches!(s.solve(&[1.0]), Err(SolveError::InvalidInput(_))));
+        let x = s.solve(&[1.0, 1.0]).unwrap();
+        assert!((x[0] - 0.5).abs() < 1e-15 && (x[1] - 0.25).abs() < 1e-15);
+        for st in [Structure::Symmetric, Structure::General] {
+            assert!(s.factorize(0, &[], st).is_ok());
+            assert!(s.solve(&[]).unwrap().is_empty());
+        }
+    }
+
+    #[test]
+    fn deterministic_results() {
+        let cases: Vec<(usize, Trip, Structure)> = vec![
+            (10_000, laplace_2d(100, 1.0, 0.0), Structure::Symmetric),
+            (27_000, laplace_3d(30), Structure::Symmetric),
+            (900, laplace_2d(30, 1.0, 1.2345), Structure::Symmetric),
+            (27_000, laplace_3d(30), Structure::General),
+        ];
+        for (n, t, st) in cases {
+            let b = apply(n, &t, &x_star(n));
+            let mut s1 = DirectSolver::new();
+            let m1 = s1.factorize(n, &t, st).unwrap();
+            let x1 = s1.solve(&b).unwrap();
+            let x1b = s1.solve(&b).unwrap();
+            s1.factorize(n, &t, st).unwrap();
+            let x1c = s1.solve(&b).unwrap();
+            let mut s2 = DirectSolver::new();
+            let m2 = s2.factorize(n, &t, st).unwrap();
+            let x2 = s2.solve(&b).unwrap();
+            eprintln!(
+                "determinism n={n} {st:?}: {m1:?}, rel error {:.2e}",
+                rel_diff(&x1, &x_star(n))
+            );
+            assert_eq!(m1, m2);
+            assert_eq!(x1, x1b);
+            assert_eq!(x1, x1c);
+            assert_eq!(x1, x2);
+        }
     }
 }
