@@ -4,7 +4,7 @@
 //!
 //! Every writer is generic over the dimension `D` (2 or 3). Floating-point numbers in
 //! text files are written with the shortest representation that parses back to the
-//! same `f64` (see [`write_f64`]).
+//! same `f64`: plain notation for moderate magnitudes, scientific (`1e-7`) otherwise.
 
 mod history;
 mod particles_csv;

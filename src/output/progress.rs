@@ -59,15 +59,23 @@ impl Progress {
             return;
         }
         self.last_update.store(now, Ordering::Relaxed);
-        self.bar.set_position(self.ticks(t));
+        // Message first: setting the position may redraw.
         self.bar
             .set_message(format!("t = {t:.4e} / {:.4e}, step {step}", self.end_time));
+        self.bar.set_position(self.ticks(t));
     }
 
-    /// Fill the bar and leave it on screen.
+    /// Fill the bar and leave it on screen, followed by a newline (idempotent).
     pub fn finish(&self) {
+        if self.bar.is_finished() {
+            return;
+        }
         self.bar.set_position(TICKS);
         self.bar.finish();
+        if !self.bar.is_hidden() {
+            // indicatif leaves the cursor at the end of the bar's line.
+            eprintln!();
+        }
     }
 
     fn ticks(&self, t: f64) -> u64 {

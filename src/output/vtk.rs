@@ -65,7 +65,19 @@ impl FrameWriter {
         let name = format!("{}_{:05}.vtu", self.prefix, self.frames.len());
         let vtk = frame_model(p, extra);
         write_atomically(&self.dir.join(&name), |w| {
-            vtk.write_xml(w).map_err(io::Error::other)
+            if n > 0 {
+                return vtk.write_xml(w).map_err(io::Error::other);
+            }
+            // vtkio omits `NumberOfCells` when it is zero, and VTK then refuses the piece.
+            let mut buf = Vec::new();
+            vtk.write_xml(&mut buf).map_err(io::Error::other)?;
+            let xml = String::from_utf8(buf).map_err(io::Error::other)?;
+            let xml = xml.replacen(
+                r#"<Piece NumberOfPoints="0""#,
+                r#"<Piece NumberOfPoints="0" NumberOfCells="0""#,
+                1,
+            );
+            w.write_all(xml.as_bytes())
         })?;
         self.frames.push((t, name));
         self.write_pvd()
@@ -385,8 +397,12 @@ mod tests {
         let mut fw = FrameWriter::new(dir.path(), "e").unwrap();
         fw.write_frame(0.0, &Particles::<2>::default(), &[])
             .unwrap();
-        let piece = read_piece(&dir.path().join("e_00000.vtu"));
+        let path = dir.path().join("e_00000.vtu");
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(text.contains(r#"NumberOfCells="0""#), "{text}");
+        let piece = read_piece(&path);
         assert_eq!(piece.num_points(), 0);
+        assert_eq!(piece.cells.num_cells(), 0);
         let short = [1.0];
         let err = fw
             .write_frame(1.0, &scene_2d(), &[("eps", &short)])
