@@ -98,7 +98,10 @@ fn bench_writes_rows_errors_statuses_and_plots() {
         let error = column_error(&out.join(&run_dir[i]).join("particles_final.csv"));
         let reported = csv.col("error")[i];
         println!("{}: error {reported:.6e}, here {error:.6e}", run_dir[i]);
-        assert!((reported / error - 1.0).abs() < 1e-12, "{reported} vs {error}");
+        assert!(
+            (reported / error - 1.0).abs() < 1e-12,
+            "{reported} vs {error}"
+        );
         assert_eq!(csv.col("load_steps")[i], 4.0);
         assert_eq!(csv.col("dt")[i], 0.25);
         assert_eq!(csv.col("steps")[i], 4.0);
@@ -116,7 +119,10 @@ fn bench_writes_rows_errors_statuses_and_plots() {
     );
     // 1 cell wide, rollers: only y components are free; nodes 0…4 (0…8) up the
     // column, the base fixed in y: 2 × 4 (2 × 8) unknowns.
-    assert_eq!((csv.col("unknowns")[a], csv.col("unknowns")[b]), (8.0, 16.0));
+    assert_eq!(
+        (csv.col("unknowns")[a], csv.col("unknowns")[b]),
+        (8.0, 16.0)
+    );
     assert!(csv.col("error")[b] < csv.col("error")[a]);
 
     // Krylov: skipped with the validator's message until the Newton–Krylov path

@@ -170,7 +170,8 @@ history_interval = 0.1
     for shape in ["linear", "ugimp", "cpdi", "bspline2"] {
         let (result, dir) = run_text(text, &[&format!("grid.shape_function={shape}")]);
         result.unwrap_or_else(|e| panic!("{shape}: {e}"));
-        let ke = *Table::read(&dir.path().join("history.csv")).unwrap()
+        let ke = *Table::read(&dir.path().join("history.csv"))
+            .unwrap()
             .col("kinetic")
             .last()
             .unwrap();

@@ -195,7 +195,8 @@ fn line_search_saves_newton_iterations() {
             ],
         );
         let s = result.unwrap();
-        let y = Table::read(&dir.path().join("particles_final.csv")).unwrap()
+        let y = Table::read(&dir.path().join("particles_final.csv"))
+            .unwrap()
             .col("y")
             .to_vec();
         (

@@ -125,7 +125,9 @@ history_interval = 0.1
     result.unwrap();
     let expected = 1.0e4 * (1.0f64 + 1.0e-3).ln();
     assert_uniform(
-        Table::read(&dir.path().join("particles_final.csv")).unwrap().col("sxx"),
+        Table::read(&dir.path().join("particles_final.csv"))
+            .unwrap()
+            .col("sxx"),
         expected,
         "prescribed velocity",
     );

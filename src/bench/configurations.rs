@@ -32,7 +32,11 @@ impl Configuration {
     /// The overrides as one line for bench.csv: `KEY=VALUE; …; unset KEY; …`.
     pub fn describe(set: &[String], unset: &[String]) -> String {
         let unset = unset.iter().map(|k| format!("unset {k}"));
-        set.iter().cloned().chain(unset).collect::<Vec<_>>().join("; ")
+        set.iter()
+            .cloned()
+            .chain(unset)
+            .collect::<Vec<_>>()
+            .join("; ")
     }
 }
 
@@ -82,7 +86,7 @@ pub fn builtin(
     if name == "explicit" {
         let Some(s) = &base.solver else {
             return Some(Err(
-                "the explicit configuration needs a single [solver] table".into()
+                "the explicit configuration needs a single [solver] table".into(),
             ));
         };
         if s.kind == SolverKind::Implicit {
@@ -196,7 +200,9 @@ max_iterations = 10
                 "solver.preconditioner=\"block_jacobi\""
             ]
         );
-        let d = builtin("direct", &base.config, NEWMARK, 0.01).unwrap().unwrap();
+        let d = builtin("direct", &base.config, NEWMARK, 0.01)
+            .unwrap()
+            .unwrap();
         assert!(d.set.is_empty());
         assert!(builtin("cholesky", &base.config, NEWMARK, 0.01).is_none());
         assert_eq!(builtin_names().len(), 10);

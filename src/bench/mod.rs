@@ -234,10 +234,7 @@ pub fn bench(opts: &BenchOptions) -> Result<BenchReport, BenchError> {
 /// The bench settings: the `--config` file's or the scene's `[bench]` table, then
 /// the command-line options. Also says where configuration names came from (for
 /// error positions).
-fn settings(
-    opts: &BenchOptions,
-    scene: &Scene,
-) -> Result<(BenchConfig, NamesSource), SceneError> {
+fn settings(opts: &BenchOptions, scene: &Scene) -> Result<(BenchConfig, NamesSource), SceneError> {
     let (mut b, mut source) = match &opts.config {
         Some(path) => {
             let file = path.display().to_string();
@@ -387,10 +384,11 @@ fn time_points(s: &SceneConfig, b: &BenchConfig) -> Vec<TimePoint> {
         (SolverKind::Explicit, _) => vec![TimePoint::Scene],
         (SolverKind::Implicit, Integrator::Newmark) => dts(&b.dt),
         (SolverKind::Implicit, Integrator::QuasiStatic) => {
-            let steps = b
-                .load_steps
-                .clone()
-                .or_else(|| b.dt.is_none().then_some(solver.load_steps?).map(|n| vec![n, 2 * n]));
+            let steps = b.load_steps.clone().or_else(|| {
+                b.dt.is_none()
+                    .then_some(solver.load_steps?)
+                    .map(|n| vec![n, 2 * n])
+            });
             match steps {
                 Some(v) => v.into_iter().map(TimePoint::LoadSteps).collect(),
                 None => dts(&b.dt),
@@ -458,8 +456,8 @@ fn run_point(
     std::fs::create_dir_all(&run_dir)?;
     let scene_path = run_dir.join("scene.toml");
     let label = scene_path.display().to_string();
-    let text = overrides::unset(file, base_text, &unset)
-        .and_then(|t| overrides::apply(file, &t, &set))?;
+    let text =
+        overrides::unset(file, base_text, &unset).and_then(|t| overrides::apply(file, &t, &set))?;
     std::fs::write(&scene_path, &text)?;
     let scene = match Scene::parse(&label, &text, &[]) {
         Ok(s) => s,
@@ -538,7 +536,9 @@ fn read_outputs(row: &mut Row, dir: &Path) {
         row.newton_iterations = s["newton_iterations"].as_u64();
         row.cutbacks = s["cutbacks"].as_u64();
         if row.dt.is_none() {
-            row.dt = s["dt"].as_f64();
+            // Explicit runs: the mean step (the last one is cut to the end time).
+            let steps = row.steps.filter(|&n| n > 0);
+            row.dt = steps.and_then(|n| Some(s["end_time"].as_f64()? / n as f64));
         }
     }
     if let Ok(newton) = Table::read(&dir.join("newton.csv")) {

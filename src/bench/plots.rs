@@ -63,22 +63,60 @@ pub fn draw_all(rows: &[Row], out: &Path) -> Result<Vec<PathBuf>, String> {
         r.is_ok().then_some(())?;
         Some((r.wall_seconds?, r.error?))
     });
-    plot(&path, "Error against wall time", "wall time of the run (s)", "error", true, true, &series, "no completed run has an error (does the scene have a [reference]?)")?;
+    plot(
+        &path,
+        "Error against wall time",
+        "wall time of the run (s)",
+        "error",
+        true,
+        true,
+        &series,
+        "no completed run has an error (does the scene have a [reference]?)",
+    )?;
     files.push(path);
 
     let path = out.join("newton_per_step.png");
-    let series = by_configuration_and_time(&ran, |r| Some((r.unknowns? as f64, r.newton_per_step()?)));
-    plot(&path, "Newton iterations per step", "unknowns", "Newton iterations per step", true, false, &series, "no implicit run")?;
+    let series =
+        by_configuration_and_time(&ran, |r| Some((r.unknowns? as f64, r.newton_per_step()?)));
+    plot(
+        &path,
+        "Newton iterations per step",
+        "unknowns",
+        "Newton iterations per step",
+        true,
+        false,
+        &series,
+        "no implicit run",
+    )?;
     files.push(path);
 
     let path = out.join("krylov_per_newton.png");
-    let series = by_configuration_and_time(&ran, |r| Some((r.unknowns? as f64, r.krylov_per_newton()?)));
-    plot(&path, "Krylov iterations per Newton iteration", "unknowns", "Krylov iterations per Newton iteration", true, false, &series, "no run reports Krylov iterations (newton.csv has no krylov column)")?;
+    let series =
+        by_configuration_and_time(&ran, |r| Some((r.unknowns? as f64, r.krylov_per_newton()?)));
+    plot(
+        &path,
+        "Krylov iterations per Newton iteration",
+        "unknowns",
+        "Krylov iterations per Newton iteration",
+        true,
+        false,
+        &series,
+        "no run reports Krylov iterations (newton.csv has no krylov column)",
+    )?;
     files.push(path);
 
     let path = out.join("residual_history.png");
     let series = residual_histories(&ran, out);
-    plot(&path, "Newton residual histories (largest grid, first time point)", "Newton iteration (cumulative over the run)", "normalised residual", false, true, &series, "no implicit run wrote newton.csv")?;
+    plot(
+        &path,
+        "Newton residual histories (largest grid, first time point)",
+        "Newton iteration (cumulative over the run)",
+        "normalised residual",
+        false,
+        true,
+        &series,
+        "no implicit run wrote newton.csv",
+    )?;
     files.push(path);
     Ok(files)
 }
@@ -88,7 +126,11 @@ fn by_configuration_and_time(
     rows: &[&Row],
     point: impl Fn(&Row) -> Option<(f64, f64)>,
 ) -> Vec<Series> {
-    group(rows, |r| format!("{} {}", r.configuration, time_label(r)), point)
+    group(
+        rows,
+        |r| format!("{} {}", r.configuration, time_label(r)),
+        point,
+    )
 }
 
 fn time_label(r: &Row) -> String {
@@ -160,10 +202,14 @@ fn residual_histories(rows: &[&Row], out: &Path) -> Vec<Series> {
 
 /// Axis range over the data, padded; for a log axis only positive values count.
 fn range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
-    let v: Vec<f64> = values.filter(|x| x.is_finite() && (!log || *x > 0.0)).collect();
+    let v: Vec<f64> = values
+        .filter(|x| x.is_finite() && (!log || *x > 0.0))
+        .collect();
     let (lo, hi) = v
         .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+            (a.min(x), b.max(x))
+        });
     if !lo.is_finite() {
         return if log { (0.1, 10.0) } else { (0.0, 1.0) };
     }
@@ -171,8 +217,15 @@ fn range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
         let pad = if hi / lo < 10.0 { 2.0 } else { 1.3 };
         (lo / pad, hi * pad)
     } else {
-        let pad = if hi > lo { 0.08 * (hi - lo) } else { 0.5 * lo.abs().max(1.0) };
-        ((lo - pad).min(if lo >= 0.0 { 0.0 } else { lo - pad }), hi + pad)
+        let pad = if hi > lo {
+            0.08 * (hi - lo)
+        } else {
+            0.5 * lo.abs().max(1.0)
+        };
+        (
+            (lo - pad).min(if lo >= 0.0 { 0.0 } else { lo - pad }),
+            hi + pad,
+        )
     }
 }
 
@@ -193,10 +246,42 @@ fn plot(
     let xr = range(points().map(|p| p.0), log_x);
     let yr = range(points().map(|p| p.1), log_y);
     match (log_x, log_y) {
-        (true, true) => draw(&root, title, x_label, y_label, (xr.0..xr.1).log_scale(), (yr.0..yr.1).log_scale(), series),
-        (true, false) => draw(&root, title, x_label, y_label, (xr.0..xr.1).log_scale(), yr.0..yr.1, series),
-        (false, true) => draw(&root, title, x_label, y_label, xr.0..xr.1, (yr.0..yr.1).log_scale(), series),
-        (false, false) => draw(&root, title, x_label, y_label, xr.0..xr.1, yr.0..yr.1, series),
+        (true, true) => draw(
+            &root,
+            title,
+            x_label,
+            y_label,
+            (xr.0..xr.1).log_scale(),
+            (yr.0..yr.1).log_scale(),
+            series,
+        ),
+        (true, false) => draw(
+            &root,
+            title,
+            x_label,
+            y_label,
+            (xr.0..xr.1).log_scale(),
+            yr.0..yr.1,
+            series,
+        ),
+        (false, true) => draw(
+            &root,
+            title,
+            x_label,
+            y_label,
+            xr.0..xr.1,
+            (yr.0..yr.1).log_scale(),
+            series,
+        ),
+        (false, false) => draw(
+            &root,
+            title,
+            x_label,
+            y_label,
+            xr.0..xr.1,
+            yr.0..yr.1,
+            series,
+        ),
     }?;
     if series.is_empty() {
         root.draw(&Text::new(
@@ -254,7 +339,11 @@ where
         let filled = (i / COLOURS.len()) % 2 == 0;
         chart
             .draw_series(s.points.iter().map(|&p| {
-                let st = if filled { colour.filled() } else { colour.stroke_width(2) };
+                let st = if filled {
+                    colour.filled()
+                } else {
+                    colour.stroke_width(2)
+                };
                 Circle::new(p, 4, st)
             }))
             .map_err(e)?;

@@ -47,7 +47,10 @@ pub fn from_scene(s: &SceneConfig) -> Result<Option<Box<dyn ErrorMeasure>>, KeyE
 /// Corners of body 0, which must be a rectangle or box (the references are about a
 /// prismatic body).
 fn body0_box(s: &SceneConfig) -> Result<(Vec<f64>, Vec<f64>), KeyError> {
-    let b = s.bodies.first().ok_or(("body".to_string(), "no body".to_string()))?;
+    let b = s
+        .bodies
+        .first()
+        .ok_or(("body".to_string(), "no body".to_string()))?;
     match (b.shape, &b.min, &b.max) {
         (Shape::Rectangle | Shape::Box, Some(lo), Some(hi)) => Ok((lo.clone(), hi.clone())),
         _ => Err((
@@ -65,7 +68,10 @@ fn body0_material(s: &SceneConfig) -> Result<(f64, f64, f64), KeyError> {
         .iter()
         .enumerate()
         .find(|(_, m)| &m.name == name)
-        .ok_or(("body.0.material".to_string(), "unknown material".to_string()))?;
+        .ok_or((
+            "body.0.material".to_string(),
+            "unknown material".to_string(),
+        ))?;
     let e = m.youngs_modulus.ok_or((
         format!("material.{i}.youngs_modulus"),
         "the [reference] needs the Young's modulus of body 0's material".to_string(),

@@ -121,7 +121,11 @@ pub fn bench(b: &BenchConfig, prefix: &str) -> Check {
         )?;
     }
     for (i, n) in b.load_steps.iter().flatten().enumerate() {
-        ensure(*n >= 1, key(&format!("load_steps.{i}")), "must be at least 1")?;
+        ensure(
+            *n >= 1,
+            key(&format!("load_steps.{i}")),
+            "must be at least 1",
+        )?;
     }
     ensure(
         b.cells.is_none() || b.refine.is_none(),
