@@ -5,6 +5,7 @@
 //! Cauchy stress) are always stored as 3×3; vectors on the grid and particles have
 //! `D` components.
 
+pub mod bench;
 pub mod boundary;
 pub mod deformation;
 pub mod dim;
@@ -15,6 +16,7 @@ pub mod linear;
 pub mod material;
 pub mod output;
 pub mod particles;
+pub mod reference;
 pub mod run;
 pub mod scene;
 pub mod setup;

@@ -3,12 +3,11 @@
 //! the sides, fixed base. At the material point from height Y the exact Cauchy stress
 //! is σ_yy = −ρ g (l0 − Y): the weight above it over an unchanged cross-section, so
 //! it holds at finite strain too. Error (normalised L2 over the reference volume):
-//! e = √(Σ V0_p (σ_yy,p − σ_a(Y_p))²) / (ρ g l0 √(Σ V0_p)).
+//! e = √(Σ V0_p (σ_yy,p − σ_a(Y_p))²) / (ρ g l0 √(Σ V0_p)) (`mpm::reference::column`).
 
 mod common;
 use common::{run_problem, Table};
-
-const RHO_G_L0: f64 = 80.0 * 10.0 * 50.0;
+use mpm::reference::column::Column;
 
 fn column_error(shape: &str, cells: usize, extra: &[&str]) -> f64 {
     let mut args = vec![
@@ -21,21 +20,21 @@ fn column_error(shape: &str, cells: usize, extra: &[&str]) -> f64 {
     let args: Vec<&str> = args.iter().map(|s| s.as_str()).collect();
     let (result, dir) = run_problem("column_explicit.toml", &args);
     result.unwrap();
-    let h = Table::read(&dir.path().join("history.csv"));
+    let h = Table::read(&dir.path().join("history.csv")).unwrap();
     let ke = *h.col("kinetic").last().unwrap();
     assert!(
         ke < 1e-4,
         "{shape} {cells}: dynamic relaxation not converged, kinetic energy {ke}"
     );
-    let p = Table::read(&dir.path().join("particles_final.csv"));
-    let (y0, syy, v0) = (p.col("Y0"), p.col("syy"), p.col("volume0"));
-    let (mut num, mut vol) = (0.0, 0.0);
-    for i in 0..y0.len() {
-        let exact = -80.0 * 10.0 * (50.0 - y0[i]);
-        num += v0[i] * (syy[i] - exact).powi(2);
-        vol += v0[i];
+    let p = Table::read(&dir.path().join("particles_final.csv")).unwrap();
+    Column {
+        axis: 1,
+        rho_g: 80.0 * 10.0,
+        top: 50.0,
+        height: 50.0,
     }
-    (num / vol).sqrt() / RHO_G_L0
+    .error_of(&p)
+    .unwrap()
 }
 
 const CELLS: [usize; 4] = [8, 16, 32, 64];

@@ -22,7 +22,7 @@ fn disks(scheme: &str) -> Collision {
         &[&format!("solver.scheme={scheme}"), "output.frames=0"],
     );
     result.unwrap();
-    let h = Table::read(&dir.path().join("history.csv"));
+    let h = Table::read(&dir.path().join("history.csv")).unwrap();
     let (k, s) = (h.col("kinetic"), h.col("strain"));
     let total: Vec<f64> = k.iter().zip(s).map(|(a, b)| a + b).collect();
     let e0 = total[0];

@@ -55,7 +55,7 @@ history_interval = 1.0
                 ],
             );
             result.unwrap_or_else(|e| panic!("{shape} {scheme}: {e}"));
-            let p = Table::read(&dir.path().join("particles_final.csv"));
+            let p = Table::read(&dir.path().join("particles_final.csv")).unwrap();
             let n = p.col("id").len();
             for i in 0..n {
                 let moved = (p.col("x")[i] - p.col("X0")[i] - 10.0).abs()
@@ -86,7 +86,7 @@ fn nearly_incompressible_disks() {
             ],
         );
         let s = result.unwrap_or_else(|e| panic!("{model}: {e}"));
-        let h = Table::read(&dir.path().join("history.csv"));
+        let h = Table::read(&dir.path().join("history.csv")).unwrap();
         let e: Vec<f64> = h
             .col("kinetic")
             .iter()
@@ -171,12 +171,13 @@ history_interval = 0.1
         let (result, dir) = run_text(text, &[&format!("grid.shape_function={shape}")]);
         result.unwrap_or_else(|e| panic!("{shape}: {e}"));
         let ke = *Table::read(&dir.path().join("history.csv"))
+            .unwrap()
             .col("kinetic")
             .last()
             .unwrap();
         // Stored energy ≈ 10 J: 1e-5 J is relaxed to 1e-6.
         assert!(ke < 1e-5, "{shape}: not relaxed, kinetic energy {ke}");
-        let p = Table::read(&dir.path().join("particles_final.csv"));
+        let p = Table::read(&dir.path().join("particles_final.csv")).unwrap();
         let errors: Vec<(f64, f64)> = p
             .col("Y0")
             .iter()

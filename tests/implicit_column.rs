@@ -2,10 +2,12 @@
 //! AMPLE set-up): E = 1 MPa, 20 load steps, one cell wide, 2×2 particles per cell,
 //! rollers on the sides and the base. σ_yy = −ρ g (l0 − Y) at the material point
 //! from height Y (exact at finite strain). Error (normalised L2 over the reference
-//! volume) e = √(Σ V0 (σ_yy − σ_a)²) / (ρ g l0 √(Σ V0)).
+//! volume) e = √(Σ V0 (σ_yy − σ_a)²) / (ρ g l0 √(Σ V0)), computed by
+//! `mpm::reference::column` (also the error of `mpm bench` for this scene).
 
 mod common;
 use common::{run_problem, Table};
+use mpm::reference::column::Column;
 
 const RHO_G: f64 = 80.0 * 10.0;
 const L0: f64 = 50.0;
@@ -26,36 +28,23 @@ fn column(shape: &str, cells: usize, extra: &[&str]) -> Run {
     let args: Vec<&str> = args.iter().map(|s| s.as_str()).collect();
     let (result, dir) = run_problem("column.toml", &args);
     result.unwrap_or_else(|e| panic!("{shape} {cells}: {e}"));
-    let particles = Table::read(&dir.path().join("particles_final.csv"));
-    let newton = read_newton(&dir.path().join("newton.csv"));
-    let (y0, syy, v0) = (
-        particles.col("Y0"),
-        particles.col("syy"),
-        particles.col("volume0"),
-    );
-    let (mut num, mut vol) = (0.0, 0.0);
-    for i in 0..y0.len() {
-        num += v0[i] * (syy[i] + RHO_G * (L0 - y0[i])).powi(2);
-        vol += v0[i];
-    }
+    let particles = Table::read(&dir.path().join("particles_final.csv")).unwrap();
+    let newton = Table::read(&dir.path().join("newton.csv")).unwrap();
+    let error = COLUMN.error_of(&particles).unwrap();
     Run {
-        error: (num / vol).sqrt() / (RHO_G * L0),
+        error,
         particles,
         newton,
     }
 }
 
-/// newton.csv has a text column (the factorisation); keep the numeric ones.
-fn read_newton(path: &std::path::Path) -> Table {
-    let text = std::fs::read_to_string(path).unwrap();
-    let cleaned: String = text
-        .lines()
-        .map(|l| l.rsplit_once(',').unwrap().0.to_string() + "\n")
-        .collect();
-    let tmp = tempfile::NamedTempFile::new().unwrap();
-    std::fs::write(tmp.path(), cleaned).unwrap();
-    Table::read(tmp.path())
-}
+/// σ_yy = −ρ g (l0 − Y) (mpm::reference::column, the `[reference]` of column.toml).
+const COLUMN: Column = Column {
+    axis: 1,
+    rho_g: RHO_G,
+    top: L0,
+    height: L0,
+};
 
 const CELLS: [usize; 6] = [4, 8, 16, 32, 64, 128];
 

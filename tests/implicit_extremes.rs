@@ -8,7 +8,7 @@ use common::{run_problem, Table};
 use std::process::Command;
 
 fn syy_errors(dir: &std::path::Path, l0: f64) -> Vec<(f64, f64)> {
-    let p = Table::read(&dir.join("particles_final.csv"));
+    let p = Table::read(&dir.join("particles_final.csv")).unwrap();
     p.col("Y0")
         .iter()
         .zip(p.col("syy"))
@@ -196,6 +196,7 @@ fn line_search_saves_newton_iterations() {
         );
         let s = result.unwrap();
         let y = Table::read(&dir.path().join("particles_final.csv"))
+            .unwrap()
             .col("y")
             .to_vec();
         (

@@ -50,7 +50,7 @@ history_interval = 0.5
 fn end_load_stress(load: &str) -> Vec<f64> {
     let (result, dir) = run_text(&format!("{BAR}{load}"), &[]);
     result.unwrap();
-    let p = Table::read(&dir.path().join("particles_final.csv"));
+    let p = Table::read(&dir.path().join("particles_final.csv")).unwrap();
     p.col("sxx")
         .iter()
         .zip(p.col("X0"))
@@ -125,7 +125,9 @@ history_interval = 0.1
     result.unwrap();
     let expected = 1.0e4 * (1.0f64 + 1.0e-3).ln();
     assert_uniform(
-        Table::read(&dir.path().join("particles_final.csv")).col("sxx"),
+        Table::read(&dir.path().join("particles_final.csv"))
+            .unwrap()
+            .col("sxx"),
         expected,
         "prescribed velocity",
     );
@@ -147,7 +149,7 @@ fn energy_balance_with_gravity() {
         ],
     );
     result.unwrap();
-    let h = Table::read(&dir.path().join("history.csv"));
+    let h = Table::read(&dir.path().join("history.csv")).unwrap();
     let w_max = h.col("external_work").iter().cloned().fold(0.0, f64::max);
     let worst = (0..h.col("t").len())
         .map(|i| (h.col("kinetic")[i] + h.col("strain")[i] - h.col("external_work")[i]).abs())

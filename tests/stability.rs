@@ -91,7 +91,7 @@ fn runs_at_nine_tenths_of_the_critical_step() {
             ],
         );
         assert_eq!(result.unwrap().json["status"], "completed");
-        let h = Table::read(&dir.path().join("history.csv"));
+        let h = Table::read(&dir.path().join("history.csv")).unwrap();
         let e: Vec<f64> = h
             .col("kinetic")
             .iter()
@@ -126,7 +126,7 @@ fn diverges_at_twice_the_critical_step_and_stops_cleanly() {
     assert_eq!(summary["status"], "diverged");
     let step = summary["diverged_step"].as_u64().unwrap();
     assert!(step > 1);
-    let h = Table::read(&dir.path().join("history.csv"));
+    let h = Table::read(&dir.path().join("history.csv")).unwrap();
     assert_eq!(
         h.col("t").len() as u64,
         step,

@@ -27,7 +27,7 @@ fn quasi_static_then_explicit_then_newmark() {
     assert_eq!(stages[0]["integrator"], "quasi_static");
     assert_eq!(stages[2]["integrator"], "newmark");
 
-    let h = Table::read(&dir.path().join("history.csv"));
+    let h = Table::read(&dir.path().join("history.csv")).unwrap();
     let t = h.col("t");
     assert!(
         t.windows(2).all(|w| w[1] > w[0]),
@@ -56,7 +56,7 @@ fn quasi_static_then_explicit_then_newmark() {
     );
 
     // The stress is still the self-weight stress.
-    let p = Table::read(&dir.path().join("particles_final.csv"));
+    let p = Table::read(&dir.path().join("particles_final.csv")).unwrap();
     let worst = p
         .col("Y0")
         .iter()

@@ -45,11 +45,14 @@ frames = 2
     );
     let (result, dir) = run_text(&text, &[]);
     result.unwrap();
-    let h = Table::read(&dir.path().join("history.csv"));
+    let h = Table::read(&dir.path().join("history.csv")).unwrap();
     let zc = zero_crossings(h.col("t"), h.col("body0_vx"));
     let period = 2.0 * (zc[zc.len() - 1] - zc[0]) / (zc.len() - 1) as f64;
     println!("3D {label} {shape_function}: period {period:.5} s");
-    (period, Table::read(&dir.path().join("particles_final.csv")))
+    (
+        period,
+        Table::read(&dir.path().join("particles_final.csv")).unwrap(),
+    )
 }
 
 const LINEAR: &str = "[[material]]\nname = \"bar\"\nmodel = \"linear_elastic\"\ndensity = 1.0\nyoungs_modulus = 100.0\npoisson_ratio = 0.0\n";

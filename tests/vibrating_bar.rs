@@ -28,7 +28,7 @@ fn bar(scheme: &str, shape: &str, cfl: f64) -> Bar {
         ],
     );
     result.unwrap();
-    let h = Table::read(&dir.path().join("history.csv"));
+    let h = Table::read(&dir.path().join("history.csv")).unwrap();
     let (t, v) = (h.col("t"), h.col("body0_vx"));
     let zc = zero_crossings(t, v);
     assert!(
@@ -73,7 +73,7 @@ fn initial_energy_matches_the_mode() {
         &["solver.end_time=0.1", "output.frames=0"],
     );
     result.unwrap();
-    let h = Table::read(&dir.path().join("history.csv"));
+    let h = Table::read(&dir.path().join("history.csv")).unwrap();
     let k0 = h.col("kinetic")[0];
     assert!(
         (k0 / 0.0625 - 1.0).abs() < 2e-3,

@@ -8,6 +8,8 @@ Standard library only. Usage:
     python3 elastica.py runs [SHAPE ...]   # mpm along the load path (4 cells/depth, 3 ppc)
     python3 elastica.py refine [SHAPE ...] # mpm at full load, several resolutions
     python3 elastica.py small [SHAPE ...]  # mpm at P = 100 N against the linear beam
+    python3 elastica.py slender [SHAPE ...] # L/d = 20 (d = 0.5 m) at the same k = 9.6
+    python3 elastica.py support [SHAPE ...] # full load against solver.min_node_support
 
 The mpm binary is taken from $MPM, else ../../target/release/mpm relative to
 this folder, else $CARGO_TARGET_DIR/release/mpm. Runs go to $OUT (default a
@@ -113,9 +115,9 @@ def read_csv(path):
     return rows
 
 
-def run_mpm(shape, cells_per_depth, ppc, p, steps, out):
+def run_mpm(shape, cells_per_depth, ppc, p, steps, out, depth=DEPTH, extra=()):
     """Run problems/cantilever.toml; returns (status, wall seconds, v, u, message)."""
-    h = DEPTH / cells_per_depth
+    h = depth / cells_per_depth
     nx, ny = round(11.0 / h), round(12.0 / h)
     here = os.path.dirname(os.path.abspath(__file__))
     scene = os.path.join(here, "..", "..", "problems", "cantilever.toml")
@@ -126,7 +128,9 @@ def run_mpm(shape, cells_per_depth, ppc, p, steps, out):
             "--set", f"body.0.particles_per_cell={ppc}",
             "--set", f"load.0.region_min=[{x_min!r},0.0]",
             "--set", f"load.0.force=[0.0,{-p!r}]",
-            "--set", f"solver.load_steps={steps}"]
+            "--set", f"body.0.max=[{L!r},{depth!r}]",
+            "--set", f"load.0.region_max=[{L!r},{depth!r}]",
+            "--set", f"solver.load_steps={steps}"] + [x for kv in extra for x in ("--set", kv)]
     proc = subprocess.run(args, capture_output=True, text=True)
     with open(os.path.join(out, "summary.json")) as f:
         summary = json.load(f)
@@ -180,11 +184,11 @@ def cmd_check():
     print(f"largest difference {worst:.1e}")
 
 
-def reissner_reference(p, h, ppc, ei=EI_PLANE_STRAIN):
+def reissner_reference(p, h, ppc, ei=EI_PLANE_STRAIN, depth=DEPTH):
     """As tip_reference, with extension and shear (plane-strain EA, kappa G A)."""
     a = L - 0.5 * h / ppc
-    a_e = p / (E / (1.0 - NU * NU) * DEPTH)
-    a_s = p / (KAPPA * G * DEPTH)
+    a_e = p / (E / (1.0 - NU * NU) * depth)
+    a_s = p / (KAPPA * G * depth)
     v, u, _ = elastica(p * a * a / ei, a_e, a_s)
     return v * a, u * a
 
@@ -194,17 +198,20 @@ HEADER = ("| shape | cells/depth | ppc | P (kN) | k = PL²/EI | elastica v/a | o
           "|---|---|---|---|---|---|---|---|---|---|---|---|---|")
 
 
-def row(shape, cells, ppc, p, out_root):
-    steps = max(1, round(50 * p / P_END))
-    out = os.path.join(out_root, f"{shape}_{cells}_{ppc}_{p / 1e3:.0f}")
+def row(shape, cells, ppc, p, out_root, depth=DEPTH, extra=(), label=None):
+    steps = max(1, round(50 * p / (P_END * (depth / DEPTH) ** 3)))
+    tag = "_".join(e.replace("=", "") for e in extra)
+    out = os.path.join(out_root, f"{shape}_{cells}_{ppc}_{p / 1e3:.1f}_{depth}_{tag}")
     os.makedirs(out, exist_ok=True)
-    status, wall, v, u, msg = run_mpm(shape, cells, ppc, p, steps, out)
-    h = DEPTH / cells
+    status, wall, v, u, msg = run_mpm(shape, cells, ppc, p, steps, out, depth, extra)
+    h = depth / cells
     a = L - 0.5 * h / ppc
-    k = p * L * L / EI_PLANE_STRAIN
-    v_ref, u_ref = tip_reference(p, h, ppc)
-    v_r, u_r = reissner_reference(p, h, ppc)
-    head = f"| {shape} | {cells} | {ppc} | {p / 1e3:.0f} | {k:.2f} | {v_ref / a:.5f} |"
+    ei = EI_PLANE_STRAIN * (depth / DEPTH) ** 3
+    k = p * L * L / ei
+    v_ref, u_ref = tip_reference(p, h, ppc, ei)
+    v_r, u_r = reissner_reference(p, h, ppc, ei, depth)
+    first = label if label is not None else f"{p / 1e3:.1f}"
+    head = f"| {shape} | {cells} | {ppc} | {first} | {k:.2f} | {v_ref / a:.5f} |"
     if status != "completed":
         line = msg.splitlines()[-1] if msg else ""
         print(f"{head} {status} | | {u_ref / a:.5f} | | | | {wall:.2f} |")
@@ -234,6 +241,27 @@ def cmd_refine(shapes):
     for shape in shapes:
         for cells, ppc in [(4, 2), (4, 3), (4, 4), (8, 2), (8, 3)]:
             row(shape, cells, ppc, P_END, out_root)
+
+
+def cmd_slender(shapes):
+    """L/d = 20: d = 0.5 m, P = 12.5 kN (the same k = 9.6), 4 cells through the depth."""
+    shapes = shapes or ["bspline2", "ugimp", "cpdi"]
+    out_root = os.environ.get("OUT") or tempfile.mkdtemp(prefix="cantilever_")
+    print(HEADER)
+    for shape in shapes:
+        for ppc in [2, 3]:
+            row(shape, 4, ppc, P_END / 8.0, out_root, depth=0.5)
+
+
+def cmd_support(shapes):
+    """Full load, 4 cells/depth, 3 ppc, against solver.min_node_support (column P)."""
+    shapes = shapes or ["bspline2", "ugimp", "cpdi"]
+    out_root = os.environ.get("OUT") or tempfile.mkdtemp(prefix="cantilever_")
+    print(HEADER.replace("| P (kN) |", "| min_node_support |"))
+    for shape in shapes:
+        for tol in ["1e-3", "3e-3", "1e-2", "3e-2", "1e-1"]:
+            row(shape, 4, 3, P_END, out_root, extra=(f"solver.min_node_support={tol}",),
+                label=tol)
 
 
 def cmd_small(shapes):
@@ -275,5 +303,9 @@ if __name__ == "__main__":
         cmd_small(sys.argv[2:])
     elif cmd == "refine":
         cmd_refine(sys.argv[2:])
+    elif cmd == "slender":
+        cmd_slender(sys.argv[2:])
+    elif cmd == "support":
+        cmd_support(sys.argv[2:])
     else:
         sys.exit(__doc__)

@@ -1,7 +1,9 @@
-//! The `mpm` command: `mpm run SCENE --out DIR [--set KEY=VALUE]...` and
-//! `mpm check SCENE [--set KEY=VALUE]...`.
+//! The `mpm` command: `mpm run SCENE --out DIR [--set KEY=VALUE]...`,
+//! `mpm check SCENE [--set KEY=VALUE]...` and `mpm bench SCENE --out DIR [...]`
+//! (docs/bench.md).
 
 use clap::{Parser, Subcommand};
+use mpm::bench::{bench, BenchError, BenchOptions};
 use mpm::run::{run, RunError, RunOptions};
 use mpm::scene::Scene;
 use std::path::PathBuf;
@@ -11,7 +13,7 @@ use std::process::ExitCode;
 #[command(
     name = "mpm",
     version,
-    about = "Material point method: explicit MPM in 2D plane strain and 3D"
+    about = "Material point method: explicit and implicit MPM in 2D plane strain and 3D"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -39,10 +41,111 @@ enum Command {
         #[arg(long = "set", value_name = "KEY=VALUE")]
         overrides: Vec<String>,
     },
+    /// Run a scene over solver configurations and sweeps of Δt (or load steps) and
+    /// grid size; write DIR/bench.csv and PNG plots (docs/bench.md).
+    Bench(BenchArgs),
+}
+
+#[derive(clap::Args)]
+struct BenchArgs {
+    scene: PathBuf,
+    /// Output directory (created if missing).
+    #[arg(long)]
+    out: PathBuf,
+    /// Override a scene key in every run (as for `mpm run`).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    overrides: Vec<String>,
+    /// A TOML file with a [bench] table, used instead of the scene's.
+    #[arg(long, value_name = "FILE")]
+    config: Option<PathBuf>,
+    /// Configurations to run, comma-separated (built-in: explicit, direct,
+    /// gmres_P and cg_P for P = none, jacobi, block_jacobi, lagged_direct).
+    #[arg(long, value_delimiter = ',', value_name = "NAMES")]
+    configurations: Option<Vec<String>>,
+    /// Time steps to sweep (Newmark; quasi-static scenes without load steps).
+    #[arg(long, value_delimiter = ',', value_name = "DT")]
+    dt: Option<Vec<f64>>,
+    /// Load-step counts to sweep (quasi-static).
+    #[arg(long = "load-steps", value_delimiter = ',', value_name = "N")]
+    load_steps: Option<Vec<usize>>,
+    /// Grids to sweep, e.g. 1x16,1x32 (cells per direction).
+    #[arg(long, value_delimiter = ',', value_name = "NXxNY")]
+    cells: Option<Vec<String>>,
+    /// Refinement factors of the scene's grid to sweep (default 1,2).
+    #[arg(long, value_delimiter = ',', value_name = "F")]
+    refine: Option<Vec<usize>>,
+    /// Time limit of one run in seconds (default 3600).
+    #[arg(long, value_name = "SECONDS")]
+    timeout: Option<f64>,
+    /// Worker threads of each run (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+}
+
+fn run_bench(a: BenchArgs) -> ExitCode {
+    let cells = match a.cells.map(|v| v.iter().map(|c| parse_cells(c)).collect()) {
+        None => None,
+        Some(Ok(c)) => Some(c),
+        Some(Err(e)) => {
+            eprintln!("error: command line: --cells: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let exe = match std::env::current_exe() {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("error: cannot find the mpm executable to run the configurations: {e}");
+            return ExitCode::from(1);
+        }
+    };
+    let opts = BenchOptions {
+        scene: a.scene,
+        out: a.out,
+        overrides: a.overrides,
+        config: a.config,
+        configurations: a.configurations,
+        dt: a.dt,
+        load_steps: a.load_steps,
+        cells,
+        refine: a.refine,
+        timeout: a.timeout,
+        threads: a.threads,
+        exe,
+    };
+    match bench(&opts) {
+        Ok(report) => {
+            let ok = report.rows.iter().filter(|r| r.is_ok()).count();
+            println!(
+                "{} runs ({ok} ok); {} and {} plots in {}",
+                report.rows.len(),
+                report.csv.display(),
+                report.plots.len(),
+                opts.out.display()
+            );
+            ExitCode::SUCCESS
+        }
+        Err(e @ BenchError::Scene(_)) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// `1x16` → [1, 16].
+fn parse_cells(s: &str) -> Result<Vec<usize>, String> {
+    s.split('x')
+        .map(|n| n.trim().parse::<usize>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("`{s}` is not of the form NXxNY[xNZ] (cells per direction)"))
 }
 
 fn main() -> ExitCode {
     match Cli::parse().command {
+        Command::Bench(args) => run_bench(args),
         Command::Check { scene, overrides } => match Scene::load(&scene, &overrides) {
             Ok(s) => {
                 let c = &s.config;

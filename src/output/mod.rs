@@ -1,6 +1,7 @@
 //! Run outputs: energy/centre-of-mass history (`history.csv`), the final particle
 //! state (`particles_final.csv`), ParaView frames (`.vtu` + `.pvd`), a terminal
-//! progress bar and pretty-printed JSON (`summary.json`).
+//! progress bar and pretty-printed JSON (`summary.json`); [`Table`] reads the CSV
+//! files back by column name.
 //!
 //! Every writer is generic over the dimension `D` (2 or 3). Floating-point numbers in
 //! text files are written with the shortest representation that parses back to the
@@ -9,11 +10,13 @@
 mod history;
 mod particles_csv;
 mod progress;
+mod table;
 mod vtk;
 
 pub use history::{body_centres, HistoryWriter};
 pub use particles_csv::write_particles_csv;
 pub use progress::Progress;
+pub use table::{csv_field, Table};
 pub use vtk::FrameWriter;
 
 use std::fs::File;

@@ -31,6 +31,10 @@ pub struct SceneConfig {
     pub stages: Vec<SolverConfig>,
     #[serde(default)]
     pub output: OutputConfig,
+    /// The analytical reference the scene's error is measured against (`mpm bench`).
+    pub reference: Option<ReferenceConfig>,
+    /// Settings of `mpm bench` for this scene.
+    pub bench: Option<BenchConfig>,
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -354,4 +358,72 @@ impl Default for OutputConfig {
             history_interval: 0.0,
         }
     }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ReferenceKind {
+    /// Column under self-weight: σ along gravity against −ρ g (l0 − Y).
+    Column,
+    /// Fixed-free bar in its first axial mode: period against 4 L / c.
+    VibratingBar,
+    /// Cantilever with an end load: tip deflection against the elastica.
+    Cantilever,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Beam {
+    /// The elastica with extension and shear (the beam model of a 2D continuum).
+    Reissner,
+    /// The classical inextensible elastica.
+    Elastica,
+}
+
+/// The `[reference]` table: which analytical solution the scene has
+/// (`crate::reference`).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReferenceConfig {
+    pub kind: ReferenceKind,
+    /// Cantilever only: the beam model (default `reissner`).
+    pub beam: Option<Beam>,
+}
+
+/// The `[bench]` table (or the same table in a separate file given to
+/// `mpm bench --config`): which solver configurations and sweeps to run.
+/// docs/bench.md documents the keys.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BenchConfig {
+    /// Configurations to run, by name: built-in or `[[bench.configuration]]`.
+    pub configurations: Option<Vec<String>>,
+    /// User-defined configurations.
+    #[serde(default, rename = "configuration")]
+    pub custom: Vec<BenchConfiguration>,
+    /// Time-step sweep (Newmark; quasi-static runs without `load_steps`).
+    pub dt: Option<Vec<f64>>,
+    /// Load-step sweep (quasi-static).
+    pub load_steps: Option<Vec<usize>>,
+    /// Grid sweep: cell counts per direction …
+    pub cells: Option<Vec<Vec<usize>>>,
+    /// … or refinement factors of the scene's cells.
+    pub refine: Option<Vec<usize>>,
+    /// Wall-time limit of one run in seconds.
+    pub timeout: Option<f64>,
+    /// Overrides applied to every run (`--set` syntax).
+    #[serde(default)]
+    pub set: Vec<String>,
+}
+
+/// A named solver configuration: scene overrides in `--set KEY=VALUE` syntax, and
+/// keys to remove.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BenchConfiguration {
+    pub name: String,
+    #[serde(default)]
+    pub set: Vec<String>,
+    #[serde(default)]
+    pub unset: Vec<String>,
 }

@@ -2,6 +2,7 @@
 //! `material.0.youngs_modulus` for the first [[material]]), VALUE is in TOML syntax
 //! (`[64,1]`, `1e6`, `"cpdi"`); a value that is not valid TOML is taken as a string,
 //! so `--set grid.shape_function=cpdi` works too. Arrays are replaced whole.
+//! [`unset`] removes keys (used by `mpm bench` configurations that switch solvers).
 
 use super::SceneError;
 use toml_edit::{DocumentMut, Item, Table, TableLike, Value};
@@ -10,15 +11,7 @@ pub fn apply(file: &str, text: &str, overrides: &[String]) -> Result<String, Sce
     if overrides.is_empty() {
         return Ok(text.to_string());
     }
-    let mut doc: DocumentMut = text.parse().map_err(|e: toml_edit::TomlError| {
-        let position = e.span().map(|s| super::error::line_col(text, s.start));
-        SceneError {
-            file: file.into(),
-            key: None,
-            position,
-            message: e.message().trim().to_string(),
-        }
-    })?;
+    let mut doc = parse(file, text)?;
     for o in overrides {
         let bad = |m: String| SceneError::plain(file, m);
         let (key, value) = o
@@ -35,6 +28,56 @@ pub fn apply(file: &str, text: &str, overrides: &[String]) -> Result<String, Sce
         })?;
     }
     Ok(doc.to_string())
+}
+
+/// Remove the keys at dotted paths (`solver.load_steps`); a missing key is no error.
+pub fn unset(file: &str, text: &str, keys: &[String]) -> Result<String, SceneError> {
+    if keys.is_empty() {
+        return Ok(text.to_string());
+    }
+    let mut doc = parse(file, text)?;
+    for key in keys {
+        remove(doc.as_table_mut(), key.trim());
+    }
+    Ok(doc.to_string())
+}
+
+fn parse(file: &str, text: &str) -> Result<DocumentMut, SceneError> {
+    text.parse().map_err(|e: toml_edit::TomlError| {
+        let position = e.span().map(|s| super::error::line_col(text, s.start));
+        SceneError {
+            file: file.into(),
+            key: None,
+            position,
+            message: e.message().trim().to_string(),
+        }
+    })
+}
+
+/// Remove the value at a dotted path, if it is there.
+fn remove(mut table: &mut dyn TableLike, path: &str) {
+    let segs: Vec<&str> = path.split('.').collect();
+    let Some((last, parents)) = segs.split_last() else {
+        return;
+    };
+    let mut i = 0;
+    while i < parents.len() {
+        let next = match table.get_mut(parents[i]) {
+            Some(Item::ArrayOfTables(a)) => {
+                let Some(t) = parents.get(i + 1).and_then(|s| s.parse().ok()) else {
+                    return;
+                };
+                i += 1;
+                a.get_mut(t).map(|t| t as &mut dyn TableLike)
+            }
+            Some(other) => other.as_table_like_mut(),
+            None => None,
+        };
+        let Some(next) = next else { return };
+        table = next;
+        i += 1;
+    }
+    table.remove(last);
 }
 
 /// Set the value at a dotted path, creating missing tables on the way.
@@ -94,6 +137,25 @@ mod tests {
         let out = apply("s.toml", SCENE, &["grid.shape_function=cpdi".into()]).unwrap();
         let doc: toml::Table = toml::from_str(&out).unwrap();
         assert_eq!(doc["grid"]["shape_function"].as_str(), Some("cpdi"));
+    }
+
+    #[test]
+    fn unset_removes_nested_keys_and_ignores_missing_ones() {
+        let out = unset(
+            "s.toml",
+            SCENE,
+            &[
+                "grid.cells".into(),
+                "material.0.density".into(),
+                "solver.dt".into(),
+                "material.5.name".into(),
+            ],
+        )
+        .unwrap();
+        let doc: toml::Table = toml::from_str(&out).unwrap();
+        assert!(doc["grid"].get("cells").is_none());
+        let m = &doc["material"].as_array().unwrap()[0];
+        assert!(m.get("density").is_none() && m.get("name").is_some());
     }
 
     #[test]

@@ -101,7 +101,86 @@ pub fn validate(s: &SceneConfig) -> Check {
         s.output.history_interval >= 0.0,
         "output.history_interval",
         "must be ≥ 0",
-    )
+    )?;
+    crate::reference::from_scene(s)?;
+    if let Some(b) = &s.bench {
+        bench(b, "bench")?;
+    }
+    Ok(())
+}
+
+/// The `[bench]` table (also used for a separate bench file, `prefix` = "bench").
+/// Configuration names are resolved by `mpm bench`, which knows the built-in ones.
+pub fn bench(b: &BenchConfig, prefix: &str) -> Check {
+    let key = |k: &str| format!("{prefix}.{k}");
+    for (i, dt) in b.dt.iter().flatten().enumerate() {
+        ensure(
+            *dt > 0.0 && dt.is_finite(),
+            key(&format!("dt.{i}")),
+            "must be a positive number",
+        )?;
+    }
+    for (i, n) in b.load_steps.iter().flatten().enumerate() {
+        ensure(
+            *n >= 1,
+            key(&format!("load_steps.{i}")),
+            "must be at least 1",
+        )?;
+    }
+    ensure(
+        b.cells.is_none() || b.refine.is_none(),
+        key("refine"),
+        "give either cells or refine, not both",
+    )?;
+    for (i, c) in b.cells.iter().flatten().enumerate() {
+        ensure(
+            !c.is_empty() && c.iter().all(|&n| n >= 1),
+            key(&format!("cells.{i}")),
+            "every entry needs at least one cell per direction",
+        )?;
+    }
+    for (i, f) in b.refine.iter().flatten().enumerate() {
+        ensure(*f >= 1, key(&format!("refine.{i}")), "must be at least 1")?;
+    }
+    if let Some(t) = b.timeout {
+        ensure(
+            t > 0.0 && t.is_finite(),
+            key("timeout"),
+            "must be a positive number of seconds",
+        )?;
+    }
+    for (i, c) in b.custom.iter().enumerate() {
+        let dup = b.custom[..i].iter().any(|o| o.name == c.name);
+        ensure(
+            !dup,
+            key(&format!("configuration.{i}.name")),
+            format!("configuration `{}` is defined twice", c.name),
+        )?;
+        let ok = !c.name.is_empty()
+            && c.name
+                .chars()
+                .all(|ch| ch.is_ascii_alphanumeric() || ch == '_' || ch == '-');
+        ensure(
+            ok,
+            key(&format!("configuration.{i}.name")),
+            "use letters, digits, `_` and `-` only (it names the run directories)",
+        )?;
+        for (j, o) in c.set.iter().enumerate() {
+            ensure(
+                o.contains('='),
+                key(&format!("configuration.{i}.set.{j}")),
+                format!("`{o}` is not of the form KEY=VALUE"),
+            )?;
+        }
+    }
+    for (j, o) in b.set.iter().enumerate() {
+        ensure(
+            o.contains('='),
+            key(&format!("set.{j}")),
+            format!("`{o}` is not of the form KEY=VALUE"),
+        )?;
+    }
+    Ok(())
 }
 
 fn grid(g: &GridConfig, dim: usize) -> Check {

@@ -4,7 +4,6 @@
 
 use mpm::run::{run, RunError, RunOptions, RunSummary};
 use mpm::scene::Scene;
-use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 pub fn problem(name: &str) -> PathBuf {
@@ -25,47 +24,12 @@ pub fn run_problem(
     (result, dir)
 }
 
-/// A CSV file as columns keyed by header name.
-pub struct Table {
-    pub columns: HashMap<String, Vec<f64>>,
-    pub header: Vec<String>,
-}
-
-impl Table {
-    pub fn read(path: &Path) -> Table {
-        let text =
-            std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        let mut lines = text.lines();
-        let header: Vec<String> = lines
-            .next()
-            .unwrap()
-            .split(',')
-            .map(|s| s.trim().to_string())
-            .collect();
-        let mut columns: HashMap<String, Vec<f64>> =
-            header.iter().map(|h| (h.clone(), Vec::new())).collect();
-        for line in lines.filter(|l| !l.trim().is_empty()) {
-            for (h, v) in header.iter().zip(line.split(',')) {
-                columns.get_mut(h).unwrap().push(v.trim().parse().unwrap());
-            }
-        }
-        Table { columns, header }
-    }
-
-    pub fn col(&self, name: &str) -> &[f64] {
-        self.columns
-            .get(name)
-            .unwrap_or_else(|| panic!("no column {name} in {:?}", self.header))
-    }
-}
-
-/// Times at which a sampled signal crosses zero downwards/upwards (linear interpolation).
-pub fn zero_crossings(t: &[f64], y: &[f64]) -> Vec<f64> {
-    (1..t.len())
-        .filter(|&i| (y[i - 1] > 0.0) != (y[i] > 0.0))
-        .map(|i| t[i - 1] + (t[i] - t[i - 1]) * y[i - 1] / (y[i - 1] - y[i]))
-        .collect()
-}
+/// CSV outputs by column name, and the zero crossings of a sampled signal: the
+/// library's own (used by the error measures of `mpm bench`).
+#[allow(unused_imports)]
+pub use mpm::output::Table;
+#[allow(unused_imports)]
+pub use mpm::reference::bar::zero_crossings;
 
 /// Run scene text (named `scene.toml` in errors) with overrides.
 pub fn run_text(
