@@ -13,6 +13,7 @@
 pub mod newmark;
 pub mod tangent;
 
+use crate::absorbing::AbsorbingStep;
 use crate::boundary::{node_constraint, Constraint};
 use crate::deformation::Trial;
 use crate::dim::Vector;
@@ -115,6 +116,8 @@ pub struct Implicit<const D: usize> {
     solver: DirectSolver,
     /// Particle accelerations (Newmark only; empty otherwise).
     accel: Vec<Vector<D>>,
+    /// Absorbing faces within the current step (empty when the scene has none).
+    absorbing: AbsorbingStep<D>,
     /// Newton iterations since the last `take_log`.
     log: Vec<NewtonRow>,
     pub newton_iterations: usize,
@@ -144,6 +147,7 @@ impl<const D: usize> Implicit<D> {
             trial: Trial::default(),
             solver: DirectSolver::new(),
             accel: Vec::new(),
+            absorbing: AbsorbingStep::default(),
             log: Vec::new(),
             newton_iterations: 0,
             cutbacks: 0,
@@ -215,8 +219,13 @@ impl<const D: usize> Implicit<D> {
         let p = &m.particles;
         let (g, scales) = self.load_factors(m, self.t_start);
         let load = |q: usize| load_factor(&m.load_ramp_of, q, &scales);
-        let force = nodal_force(&self.map, &self.stencils, p, &(m.gravity * g), &load);
-        let (mass, _) = mass_momentum(&self.map, &self.stencils, p);
+        let mut force = nodal_force(&self.map, &self.stencils, p, &(m.gravity * g), &load);
+        let (mass, momentum) = mass_momentum(&self.map, &self.stencils, p);
+        let v: Vec<Vector<D>> = (0..mass.len())
+            .map(|a| if mass[a] > 0.0 { momentum[a] / mass[a] } else { momentum[a] })
+            .collect();
+        m.absorbing
+            .add_force(&m.grid, p, &self.map, &self.stencils, &v, &mut force);
         let a: Vec<Vector<D>> = force
             .iter()
             .zip(&mass)
@@ -239,6 +248,7 @@ impl<const D: usize> Implicit<D> {
         let started = Instant::now();
         let dynamic = self.integrator == Integrator::Newmark;
         let sys = self.prepare(m, t, dt);
+        self.prepare_absorbing(m, &sys, dt);
         let StepSystem {
             constraint,
             dofs,
@@ -474,6 +484,20 @@ impl<const D: usize> Implicit<D> {
         }
     }
 
+    /// The absorbing faces of this step: layer particles at the step start, and
+    /// their velocity as a function of u through Newmark (none when quasi-static).
+    fn prepare_absorbing(&mut self, m: &Model<D>, sys: &StepSystem<D>, dt: f64) {
+        let newmark = (self.integrator == Integrator::Newmark).then_some((&self.newmark, dt));
+        self.absorbing = AbsorbingStep::new(
+            &m.absorbing,
+            &m.grid,
+            &m.particles,
+            &sys.a_n,
+            &sys.u_tilde,
+            newmark,
+        );
+    }
+
     /// M (u − ũ) / (βΔt²) at the active nodes (lumped or consistent M).
     fn inertial_force(
         &self,
@@ -527,9 +551,13 @@ impl<const D: usize> Implicit<D> {
         let f_int = internal_force(&self.map, &self.stencils, &p.volume, &pk1);
         let w: Vec<Vector<D>> = u.iter().zip(u_tilde).map(|(a, b)| a - b).collect();
         let f_inertia = self.inertial_force(&self.map, &self.stencils, p, mass, &w, inertia);
-        Ok((0..u.len())
+        let mut r: Vec<Vector<D>> = (0..u.len())
             .map(|a| f_inertia[a] + f_int[a] - f_ext[a])
-            .collect())
+            .collect();
+        // Absorbing faces: − f_boundary(u), dashpots through v_{n+1}(u) (2-63).
+        self.absorbing
+            .add_residual(&self.map, &self.stencils, p, u, &mut r);
+        Ok(r)
     }
 
     /// Consistent tangent triplets over the free unknowns, and whether it is symmetric.
@@ -570,6 +598,9 @@ impl<const D: usize> Implicit<D> {
         let a: Vec<Pk1Derivative> = a.into_iter().map(|x| x.unwrap()).collect();
         let (mut triplets, symmetric) =
             stiffness_triplets(&self.map, &self.stencils, dofs, &p.volume, &a);
+        // Absorbing faces: Σ S_I S_J (γ/(βΔt) C + K), symmetric.
+        self.absorbing
+            .add_tangent(&self.map, &self.stencils, dofs, &mut triplets);
         if inertia > 0.0 {
             match self.mass_matrix {
                 MassMatrix::Lumped => {
