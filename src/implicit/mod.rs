@@ -736,25 +736,35 @@ dt = 0.01
         out
     }
 
-    /// The assembled tangent (material + geometric + inertia, 2-40…2-42) against
-    /// central differences of the residual (2-37), column by column, at a
-    /// non-trivial iterate, for every material, several shape functions and both
-    /// mass matrices.
+    /// Absorbing faces for the tangent check: dashpots and springs (thesis 2-63).
+    const ABSORBING: &str = "[[boundary]]\nface = \"xmin\"\ncondition = \"absorbing\"\nspring_distance = 2.0\n[[boundary]]\nface = \"ymin\"\ncondition = \"absorbing\"\nspring_stiffness = [4.0e4, 1.0e4]\n";
+
+    /// The assembled tangent (material + geometric + inertia, 2-40…2-42, and the
+    /// dashpots and springs of absorbing faces) against central differences of the
+    /// residual (2-37), column by column, at a non-trivial iterate, for every
+    /// material, several shape functions and both mass matrices.
     #[test]
     fn global_tangent_matches_finite_differences_of_the_residual() {
-        for (model, shape, mass) in [
-            ("hencky", "linear", "lumped"),
-            ("hencky", "cpdi", "consistent"),
-            ("neo_hookean", "bspline2", "lumped"),
-            ("linear_elastic", "ugimp", "lumped"),
-            ("neo_hookean", "cpgimp", "consistent"),
+        for (model, shape, mass, absorbing) in [
+            ("hencky", "linear", "lumped", false),
+            ("hencky", "cpdi", "consistent", false),
+            ("neo_hookean", "bspline2", "lumped", false),
+            ("linear_elastic", "ugimp", "lumped", false),
+            ("neo_hookean", "cpgimp", "consistent", false),
+            ("hencky", "linear", "lumped", true),
+            ("linear_elastic", "bspline2", "consistent", true),
         ] {
             let overrides = vec![
                 format!("material.0.model={model}"),
                 format!("grid.shape_function={shape}"),
                 format!("solver.mass={mass}"),
             ];
-            let scene = Scene::parse("block.toml", BLOCK, &overrides).unwrap();
+            let text = if absorbing {
+                BLOCK.replace("[solver]", &format!("{ABSORBING}[solver]"))
+            } else {
+                BLOCK.to_string()
+            };
+            let scene = Scene::parse("block.toml", &text, &overrides).unwrap();
             let m = Model::<2>::build(&scene).unwrap();
             let mut solver = Implicit::<2>::new(
                 scene.config.grid.shape_function,
@@ -762,6 +772,8 @@ dt = 0.01
                 0.0,
             );
             let sys = solver.prepare(&m, 0.0, 0.01);
+            solver.prepare_absorbing(&m, &sys, 0.01);
+            assert_eq!(solver.absorbing.is_empty(), !absorbing);
             // A smooth, finite-strain iterate (strains of a few per cent).
             let nodes: Vec<usize> = solver.map.active.iter().map(|&g| g as usize).collect();
             let u: Vec<Vector<2>> = nodes
@@ -818,7 +830,7 @@ dt = 0.01
                 }
             }
             println!(
-                "{model} {shape} {mass}: {n} unknowns, max |K − K_fd| / max|K| = {:.2e}",
+                "{model} {shape} {mass} absorbing={absorbing}: {n} unknowns, max |K − K_fd| / max|K| = {:.2e}",
                 worst / kmax
             );
             assert!(
