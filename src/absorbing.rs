@@ -179,11 +179,7 @@ impl<const D: usize> Absorbing<D> {
 
     /// Every absorbing face needs material in its outermost cell layer: its
     /// impedance comes from there. Returns the offending `[[boundary]]` index.
-    pub fn check_adjacent(
-        &self,
-        grid: &Grid<D>,
-        p: &Particles<D>,
-    ) -> Result<(), (usize, String)> {
+    pub fn check_adjacent(&self, grid: &Grid<D>, p: &Particles<D>) -> Result<(), (usize, String)> {
         for f in &self.faces {
             if !p.x.iter().any(|x| Self::in_layer(grid, f.face, x)) {
                 return Err((
@@ -213,10 +209,7 @@ impl<const D: usize> Absorbing<D> {
         let along = |normal: f64, tangential: f64| {
             Vector::<D>::from_fn(|d, _| if d == f.face.axis { normal } else { tangential })
         };
-        (
-            along(w.normal_impedance, w.shear_impedance),
-            along(kn, ks),
-        )
+        (along(w.normal_impedance, w.shear_impedance), along(kn, ks))
     }
 
     /// The particles in the outermost layer of any absorbing face now, in particle
@@ -385,7 +378,10 @@ mod tests {
             (Box::new(LinearElastic::new(2000.0, e, nu)), g),
             (Box::new(Hencky::new(2000.0, e, nu)), g),
             (Box::new(NeoHookean::new(2000.0, e, nu)), g),
-            (Box::new(MooneyRivlin::from_thesis(2000.0, 3.0e6, 1.0e6, nu)), 8.0e6),
+            (
+                Box::new(MooneyRivlin::from_thesis(2000.0, 3.0e6, 1.0e6, nu)),
+                8.0e6,
+            ),
         ];
         for (m, expected) in models {
             let got = shear_modulus(m.as_ref());
@@ -395,7 +391,9 @@ mod tests {
                 m.model()
             );
             let w = Waves::of(m.as_ref());
-            assert!((w.shear_impedance - (2000.0 * expected).sqrt()).abs() < 1e-6 * w.shear_impedance);
+            assert!(
+                (w.shear_impedance - (2000.0 * expected).sqrt()).abs() < 1e-6 * w.shear_impedance
+            );
             assert!(w.normal_impedance > w.shear_impedance);
         }
     }
@@ -452,7 +450,10 @@ end_time = 1.0
     /// Springs from the source distance: α G / R with the 2D factors.
     #[test]
     fn spring_from_distance() {
-        let text = LAYER.replace("spring_stiffness = [3.0e6, 1.0e6]", "spring_distance = 10.0");
+        let text = LAYER.replace(
+            "spring_stiffness = [3.0e6, 1.0e6]",
+            "spring_distance = 10.0",
+        );
         let scene = Scene::parse("layer.toml", &text, &[]).unwrap();
         let m = Model::<2>::build(&scene).unwrap();
         let layer = m.absorbing.layer(&m.grid, &m.particles);

@@ -205,7 +205,7 @@ fn local_damping<const D: usize>(f: &Vector<D>, v: &Vector<D>, alpha: f64) -> Ve
 }
 
 /// v_I = p_I / m_I (2-25); zero on a node whose mass is exactly zero.
-fn mass_average<const D: usize>(mass: &[f64], momentum: &[Vector<D>]) -> Vec<Vector<D>> {
+pub(crate) fn mass_average<const D: usize>(mass: &[f64], momentum: &[Vector<D>]) -> Vec<Vector<D>> {
     (0..mass.len())
         .map(|a| {
             if mass[a] > 0.0 {

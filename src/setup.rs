@@ -33,7 +33,8 @@ impl<const D: usize> Model<D> {
     pub fn build(scene: &Scene) -> Result<Model<D>, SceneError> {
         let c = &scene.config;
         assert_eq!(c.dimension, D, "caller dispatches on the scene dimension");
-        let err = |key: String, msg: String| SceneError::at_key(&scene.file, &scene.text, &key, msg);
+        let err =
+            |key: String, msg: String| SceneError::at_key(&scene.file, &scene.text, &key, msg);
         let vec = |v: &[f64]| Vector::<D>::from_fn(|d, _| v[d]);
         let cells = std::array::from_fn(|d| c.grid.cells[d]);
         let grid = Grid::new(
@@ -102,7 +103,11 @@ impl<const D: usize> Model<D> {
                 });
             for &p in &selected {
                 if load_ramp_of[p] != u32::MAX && load_ramp_of[p] != ramp as u32 {
-                    let key = if l.pulse_duration.is_some() { "pulse_duration" } else { "ramp_time" };
+                    let key = if l.pulse_duration.is_some() {
+                        "pulse_duration"
+                    } else {
+                        "ramp_time"
+                    };
                     return Err(err(
                         format!("load.{i}.{key}"),
                         format!("particle {p} already carries a load with another time history (ramp_time or pulse_duration)"),
@@ -165,7 +170,9 @@ impl LoadTime {
         match *self {
             LoadTime::Ramp(r) if r > 0.0 => (t / r).min(1.0),
             LoadTime::Ramp(_) => 1.0,
-            LoadTime::Pulse(d) if t >= 0.0 && t <= d => (std::f64::consts::PI * t / d).sin().powi(2),
+            LoadTime::Pulse(d) if t >= 0.0 && t <= d => {
+                (std::f64::consts::PI * t / d).sin().powi(2)
+            }
             LoadTime::Pulse(_) => 0.0,
         }
     }

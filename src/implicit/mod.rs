@@ -221,9 +221,7 @@ impl<const D: usize> Implicit<D> {
         let load = |q: usize| load_factor(&m.load_ramp_of, q, &scales);
         let mut force = nodal_force(&self.map, &self.stencils, p, &(m.gravity * g), &load);
         let (mass, momentum) = mass_momentum(&self.map, &self.stencils, p);
-        let v: Vec<Vector<D>> = (0..mass.len())
-            .map(|a| if mass[a] > 0.0 { momentum[a] / mass[a] } else { momentum[a] })
-            .collect();
+        let v = crate::explicit::mass_average(&mass, &momentum);
         m.absorbing
             .add_force(&m.grid, p, &self.map, &self.stencils, &v, &mut force);
         let a: Vec<Vector<D>> = force

@@ -90,7 +90,8 @@ mod tests {
             if x > 0.0 && x_new <= 0.0 {
                 crossings.push(n as f64 * dt + dt * x / (x - x_new));
             }
-            let v_end = nm.end_velocity(dt, &Vector1::new(u), &Vector1::new(ut), &Vector1::new(a))[0];
+            let v_end =
+                nm.end_velocity(dt, &Vector1::new(u), &Vector1::new(ut), &Vector1::new(a))[0];
             v += nm.velocity_increment(dt, &Vector1::new(a), &Vector1::new(a_new))[0];
             assert!((v_end - v).abs() < 1e-12, "end velocity {v_end} vs {v}");
             (x, a) = (x_new, a_new);
