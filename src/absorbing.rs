@@ -29,7 +29,7 @@
 use crate::dim::Vector;
 use crate::grid::{Face, Grid};
 use crate::implicit::newmark::Newmark;
-use crate::implicit::tangent::{Dofs, Triplets};
+use crate::implicit::tangent::{push_terms, Dofs, Triplets};
 use crate::material::{Increment, Material};
 use crate::particles::Particles;
 use crate::scene::{BoundaryConfig, Condition};
@@ -341,7 +341,8 @@ impl<const D: usize> AbsorbingStep<D> {
     }
 
     /// Tangent of `add_residual`: Σ_p S_Ip S_Jp (rate C_p + K_p), diagonal in the
-    /// components, over the free unknowns (symmetric, positive semi-definite).
+    /// components, onto the unknowns (tied nodes through their masters; symmetric,
+    /// positive semi-definite).
     pub fn add_tangent(&self, map: &NodeMap, st: &Stencils<D>, dofs: &Dofs, t: &mut Triplets) {
         for lp in &self.layer {
             let coefficient = lp.damping * self.rate + lp.stiffness;
@@ -351,9 +352,8 @@ impl<const D: usize> AbsorbingStep<D> {
                     let n2 = map.local[st.node[e2] as usize] as usize;
                     let w = st.weight[e1] * st.weight[e2];
                     for d in 0..D {
-                        if let (Some(i), Some(j)) = (dofs.of(n1, d, D), dofs.of(n2, d, D)) {
-                            t.push((i, j, w * coefficient[d]));
-                        }
+                        let (rows, cols) = (dofs.terms(n1, d, D), dofs.terms(n2, d, D));
+                        push_terms(t, &rows, &cols, w * coefficient[d]);
                     }
                 }
             }

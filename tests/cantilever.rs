@@ -29,17 +29,26 @@ const P_END: f64 = 100.0e3;
 
 /// Plane-strain bending stiffness E/(1 − ν²) · d³/12 (unit thickness).
 fn ei() -> f64 {
-    E / (1.0 - NU * NU) * DEPTH.powi(3) / 12.0
+    ei_of(DEPTH)
+}
+fn ei_of(depth: f64) -> f64 {
+    E / (1.0 - NU * NU) * depth.powi(3) / 12.0
 }
 
 /// Plane-strain axial stiffness E/(1 − ν²) · d.
 fn ea() -> f64 {
-    E / (1.0 - NU * NU) * DEPTH
+    ea_of(DEPTH)
+}
+fn ea_of(depth: f64) -> f64 {
+    E / (1.0 - NU * NU) * depth
 }
 
 /// Shear stiffness κ G A with κ = 5/6 (rectangle), G = E / (2 (1 + ν)).
 fn kga() -> f64 {
-    5.0 / 6.0 * E / (2.0 * (1.0 + NU)) * DEPTH
+    kga_of(DEPTH)
+}
+fn kga_of(depth: f64) -> f64 {
+    5.0 / 6.0 * E / (2.0 * (1.0 + NU)) * depth
 }
 
 /// Integrate θ'' = −k x'(θ) over s ∈ [0, 1] (lengths in units of the beam length)
@@ -145,24 +154,37 @@ fn cantilever(
     force: f64,
     steps: usize,
 ) -> Result<Run, String> {
-    let h = DEPTH / cells_per_depth as f64;
+    beam(DEPTH, shape, cells_per_depth, ppc, force, steps)
+}
+
+/// The same scene with beam depth `depth` (L = 10 m; the grid keeps its extent
+/// and `cells_per_depth` cells through the depth).
+fn beam(
+    depth: f64,
+    shape: &str,
+    cells_per_depth: usize,
+    ppc: usize,
+    force: f64,
+    steps: usize,
+) -> Result<Run, String> {
+    let h = depth / cells_per_depth as f64;
     let x_load = L - h / ppc as f64;
+    let per_metre = (cells_per_depth as f64 / depth).round() as usize;
     let args = [
         format!("grid.shape_function={shape}"),
-        format!(
-            "grid.cells=[{},{}]",
-            11 * cells_per_depth,
-            12 * cells_per_depth
-        ),
+        format!("grid.cells=[{},{}]", 11 * per_metre, 12 * per_metre),
+        format!("body.0.max=[{L:?},{depth:?}]"),
         format!("body.0.particles_per_cell={ppc}"),
         format!("load.0.region_min=[{x_load:?},0.0]"),
+        format!("load.0.region_max=[{L:?},{depth:?}]"),
         format!("load.0.force=[0.0,{:?}]", -force),
         format!("solver.load_steps={steps}"),
         "output.frames=0".into(),
     ];
     let args: Vec<&str> = args.iter().map(|s| s.as_str()).collect();
     let (result, dir) = run_problem("cantilever.toml", &args);
-    let summary = result.map_err(|e| format!("{shape} {cells_per_depth}x{ppc}: {e}"))?;
+    let summary =
+        result.map_err(|e| format!("{shape} d = {depth} {cells_per_depth}x{ppc}: {e}"))?;
     Ok(Run {
         particles: Table::read(&dir.path().join("particles_final.csv")),
         wall: summary.wall_seconds,
@@ -243,19 +265,18 @@ fn small_load_clamp_and_plane_strain_stiffness() {
 }
 
 /// Full load (k = 9.6), 50 load steps: the tip of the loaded column against the
-/// elastica. Required (issue): within 2 %. Asserted against Reissner's beam
-/// (elastica with extension and shear), which is the beam model of a 2D continuum;
-/// against the classical inextensible elastica within 3 % (the gap is the
-/// O((d/L)²) continuum effect described at the top of the file).
+/// elastica. Required (issue): within 2 %. The 2D continuum with L/d = 10 is not
+/// the inextensible, shear-rigid classical elastica: it is asserted within 2 % of
+/// Reissner's beam (the elastica with extension and shear, the beam model of a 2D
+/// continuum) and within 3 % of the classical elastica. The slender beam below
+/// shows the classical 2 % where the classical elastica applies.
 ///
-/// With a local experimental patch of the implicit solver that drops nodes of
-/// particle support below 1e-2 cell volume and renormalises the remaining shape
-/// functions (not in src/), all three shape functions complete, within 4–5 s each:
-/// v +2.47 % (B-spline), +2.28 % (CPDI), +2.24 % (uGIMP) against the classical
-/// elastica and about +1 % against Reissner's beam; 8 cells/depth gives +2.4 %.
+/// Measured (4 cells/depth, 3 ppc, min_node_support 1e-2): v +2.50 % (B-spline),
+/// +2.31 % (uGIMP), +2.31 % (CPDI) against the classical elastica, +1.08 / +0.89 /
+/// +0.89 % against Reissner's beam; u +1.82 / +1.58 / +1.47 % (classical).
+/// The gap to the classical elastica does not shrink with h (8 cells/depth: +2.4 %)
+/// and scales as (d/L)² (next test): it is the continuum, not the discretisation.
 #[test]
-#[ignore = "the quasi-static tangent becomes singular when particles cross into new \
-            cells (nodes of near-zero support); see papers/cantilever_elastica/README.md"]
 fn full_load_tip_matches_the_elastica() {
     let mut failures = Vec::new();
     for shape in ["bspline2", "ugimp", "cpdi"] {
@@ -297,4 +318,39 @@ fn full_load_tip_matches_the_elastica() {
         }
     }
     assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// A slender beam, L/d = 20 (d = 0.5 m) at the same k = 9.6 (P = 12.5 kN): the
+/// continuum effects (extension, shear, finite fibre strains) are four times
+/// smaller, and the tip is within 2 % of the classical elastica (measured: CPDI
+/// 2 ppc, 25 load steps: v +0.71 %, u +0.84 %, and +0.36 % / +0.75 % against
+/// Reissner's beam; 50 load steps give the same v to 1e-5 m).
+#[test]
+fn slender_beam_tip_matches_the_classical_elastica() {
+    let depth: f64 = 0.5;
+    let force = P_END * depth.powi(3);
+    let run = beam(depth, "cpdi", 4, 2, force, 25).unwrap_or_else(|e| panic!("{e}"));
+    let a = run.a;
+    let k = force * a * a / ei_of(depth);
+    let (v_c, u_c, _) = elastica(k, 0.0, 0.0);
+    let (v_r, u_r, _) = elastica(k, force / ea_of(depth), force / kga_of(depth));
+    let (v, u) = run.tip();
+    let (ev, eu) = (v / (v_c * a) - 1.0, u / (u_c * a) - 1.0);
+    println!(
+        "L/d = 20, k = {k:.3}: v {v:.4} m, u {u:.4} m; elastica v {:.4} ({:+.2} %), u {:.4} ({:+.2} %); \
+         Reissner v {:+.2} %, u {:+.2} %; {:.2} s",
+        v_c * a,
+        100.0 * ev,
+        u_c * a,
+        100.0 * eu,
+        100.0 * (v / (v_r * a) - 1.0),
+        100.0 * (u / (u_r * a) - 1.0),
+        run.wall
+    );
+    assert!(
+        ev.abs() < 0.02 && eu.abs() < 0.02,
+        "v {:+.2} %, u {:+.2} % against the classical elastica",
+        100.0 * ev,
+        100.0 * eu
+    );
 }

@@ -11,6 +11,7 @@
 //! iteration fails is halved and retried, up to `max_cutbacks` times.
 
 pub mod newmark;
+pub mod support;
 pub mod tangent;
 
 use crate::absorbing::AbsorbingStep;
@@ -30,8 +31,10 @@ use crate::transfer::{
 use newmark::Newmark;
 use rayon::prelude::*;
 use std::time::Instant;
+use support::{nodal_support, ties};
 use tangent::{
-    internal_force, pk1_derivative, relative_pk1, stiffness_triplets, Dofs, Pk1Derivative,
+    internal_force, pk1_derivative, push_terms, relative_pk1, stiffness_triplets, Dofs,
+    Pk1Derivative,
 };
 
 /// One Newton iteration, as written to newton.csv.
@@ -110,6 +113,8 @@ pub struct Implicit<const D: usize> {
     max_iterations: usize,
     line_search: bool,
     max_cutbacks: usize,
+    /// Nodes with less particle support (cells) are tied to their neighbours.
+    min_node_support: f64,
     stencils: Stencils<D>,
     map: NodeMap,
     trial: Trial,
@@ -142,6 +147,7 @@ impl<const D: usize> Implicit<D> {
             max_iterations: s.max_iterations(),
             line_search: s.line_search(),
             max_cutbacks: s.max_cutbacks(),
+            min_node_support: s.min_node_support(),
             stencils: Stencils::default(),
             map: NodeMap::default(),
             trial: Trial::default(),
@@ -277,21 +283,11 @@ impl<const D: usize> Implicit<D> {
                 u[a][d] = constraint[a].value[d] * dt;
             }
         }
-        let free = |r: &[Vector<D>]| -> Vec<f64> {
-            let mut out = vec![0.0; dofs.free];
-            for (a, ra) in r.iter().enumerate() {
-                for d in 0..D {
-                    if let Some(i) = dofs.of(a, d, D) {
-                        out[i] = ra[d];
-                    }
-                }
-            }
-            out
-        };
+        dofs.follow_ties(&mut u);
         let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
-        let reference = norm(&free(f_ext)).max(norm(&free(
-            &self.inertial_force(map, st, p, mass, u_tilde, inertia),
-        )));
+        let reference = norm(&dofs.reduce(f_ext)).max(norm(
+            &dofs.reduce(&self.inertial_force(map, st, p, mass, u_tilde, inertia)),
+        ));
         let mut method = "none";
         let mut converged = false;
         let mut last_increment = f64::NAN;
@@ -299,11 +295,11 @@ impl<const D: usize> Implicit<D> {
         for iteration in 0..=self.max_iterations {
             // Residual at the current iterate, from the step-start state.
             let r = self.residual(m, &u, u_tilde, mass, f_ext, inertia, dt)?;
-            let r_free = free(&r);
+            let r_free = dofs.reduce(&r);
             let r_norm = norm(&r_free);
             let scale = reference.max(f64::MIN_POSITIVE);
             let residual_ok = r_norm <= self.residual_tolerance * scale || r_norm == 0.0;
-            let u_norm = norm(&free(&u));
+            let u_norm = norm(&dofs.values(&u));
             // Near rest (e.g. settled on absorbing faces) ‖u‖ → 0 and ‖δu‖/‖u‖ stalls
             // at round-off: a converged residual that a correction no longer halves
             // is at the round-off floor and accepted.
@@ -362,9 +358,9 @@ impl<const D: usize> Implicit<D> {
                 step_length =
                     self.line_search(m, &u, &du, dofs, u_tilde, mass, f_ext, inertia, dt, r_norm)?;
             }
-            apply_correction(&mut u, &du, dofs, step_length);
+            dofs.apply_correction(&mut u, &du, step_length);
             last_increment =
-                step_length * norm(&du) / norm(&free(&u)).max(u_norm).max(f64::MIN_POSITIVE);
+                step_length * norm(&du) / norm(&dofs.values(&u)).max(u_norm).max(f64::MIN_POSITIVE);
             row.increment = last_increment;
             row.linear_solver = method;
             row.wall_seconds = started.elapsed().as_secs_f64();
@@ -441,7 +437,9 @@ impl<const D: usize> Implicit<D> {
             .with_min_len(MIN_PARALLEL_LEN)
             .map(|&g| node_constraint(&m.grid, &m.faces, g as usize))
             .collect();
-        let dofs = Dofs::new(constraint.iter().map(|c| c.fixed));
+        let support = nodal_support(map, st, &p.volume, m.grid.cell_volume());
+        let ties = ties(&m.grid, map, &support, &constraint, self.min_node_support);
+        let dofs = Dofs::with_ties(constraint.iter().map(|c| c.fixed), ties);
         let n = map.len();
 
         // External force at the end of the step; inertia terms (Newmark).
@@ -611,9 +609,8 @@ impl<const D: usize> Implicit<D> {
                 MassMatrix::Lumped => {
                     for (node, m_i) in mass.iter().enumerate() {
                         for d in 0..D {
-                            if let Some(i) = dofs.of(node, d, D) {
-                                triplets.push((i, i, m_i * inertia));
-                            }
+                            let t = dofs.terms(node, d, D);
+                            push_terms(&mut triplets, &t, &t, m_i * inertia);
                         }
                     }
                 }
@@ -628,11 +625,8 @@ impl<const D: usize> Implicit<D> {
                                 );
                                 let v = p.mass[q] * st.weight[e1] * st.weight[e2] * inertia;
                                 for d in 0..D {
-                                    if let (Some(i), Some(j)) =
-                                        (dofs.of(n1, d, D), dofs.of(n2, d, D))
-                                    {
-                                        triplets.push((i, j, v));
-                                    }
+                                    let (rows, cols) = (dofs.terms(n1, d, D), dofs.terms(n2, d, D));
+                                    push_terms(&mut triplets, &rows, &cols, v);
                                 }
                             }
                         }
@@ -662,14 +656,10 @@ impl<const D: usize> Implicit<D> {
         let mut length = 1.0;
         for _ in 0..6 {
             let mut trial_u = u.to_vec();
-            apply_correction(&mut trial_u, du, dofs, length);
+            dofs.apply_correction(&mut trial_u, du, length);
             let r = self.residual(m, &trial_u, u_tilde, mass, f_ext, inertia, dt);
             if let Ok(r) = r {
-                let n: f64 = (0..r.len())
-                    .flat_map(|a| (0..D).filter_map(move |d| dofs.of(a, d, D).map(|_| (a, d))))
-                    .map(|(a, d)| r[a][d] * r[a][d])
-                    .sum::<f64>()
-                    .sqrt();
+                let n: f64 = dofs.reduce(&r).iter().map(|x| x * x).sum::<f64>().sqrt();
                 if n < r_norm {
                     return Ok(length);
                 }
@@ -677,17 +667,6 @@ impl<const D: usize> Implicit<D> {
             length *= 0.5;
         }
         Ok(length)
-    }
-}
-
-/// u_free += length · du.
-fn apply_correction<const D: usize>(u: &mut [Vector<D>], du: &[f64], dofs: &Dofs, length: f64) {
-    for (a, ua) in u.iter_mut().enumerate() {
-        for d in 0..D {
-            if let Some(i) = dofs.of(a, d, D) {
-                ua[d] += length * du[i];
-            }
-        }
     }
 }
 
@@ -729,40 +708,34 @@ end_time = 1.0
 dt = 0.01
 "#;
 
-    fn free(r: &[Vector<2>], dofs: &Dofs) -> Vec<f64> {
-        let mut out = vec![0.0; dofs.free];
-        for (a, ra) in r.iter().enumerate() {
-            for d in 0..2 {
-                if let Some(i) = dofs.of(a, d, 2) {
-                    out[i] = ra[d];
-                }
-            }
-        }
-        out
-    }
-
     /// Absorbing faces for the tangent check: dashpots and springs (thesis 2-63).
     const ABSORBING: &str = "[[boundary]]\nface = \"xmin\"\ncondition = \"absorbing\"\nspring_distance = 2.0\n[[boundary]]\nface = \"ymin\"\ncondition = \"absorbing\"\nspring_stiffness = [4.0e4, 1.0e4]\n";
 
     /// The assembled tangent (material + geometric + inertia, 2-40…2-42, and the
     /// dashpots and springs of absorbing faces) against central differences of the
     /// residual (2-37), column by column, at a non-trivial iterate, for every
-    /// material, several shape functions and both mass matrices.
+    /// material, several shape functions and both mass matrices. Two cases tie many
+    /// weakly supported nodes (a large `min_node_support`), so the tangent is
+    /// checked through the ties too; three have absorbing faces.
     #[test]
     fn global_tangent_matches_finite_differences_of_the_residual() {
-        for (model, shape, mass, absorbing) in [
-            ("hencky", "linear", "lumped", false),
-            ("hencky", "cpdi", "consistent", false),
-            ("neo_hookean", "bspline2", "lumped", false),
-            ("linear_elastic", "ugimp", "lumped", false),
-            ("neo_hookean", "cpgimp", "consistent", false),
-            ("hencky", "linear", "lumped", true),
-            ("linear_elastic", "bspline2", "consistent", true),
+        for (model, shape, mass, support, absorbing) in [
+            ("hencky", "linear", "lumped", 0.0, false),
+            ("hencky", "cpdi", "consistent", 0.01, false),
+            ("neo_hookean", "bspline2", "lumped", 0.01, false),
+            ("linear_elastic", "ugimp", "lumped", 0.01, false),
+            ("neo_hookean", "cpgimp", "consistent", 0.01, false),
+            ("hencky", "bspline2", "consistent", 0.3, false),
+            ("hencky", "ugimp", "lumped", 0.3, false),
+            ("hencky", "linear", "lumped", 0.0, true),
+            ("linear_elastic", "bspline2", "consistent", 0.01, true),
+            ("hencky", "ugimp", "lumped", 0.3, true),
         ] {
             let overrides = vec![
                 format!("material.0.model={model}"),
                 format!("grid.shape_function={shape}"),
                 format!("solver.mass={mass}"),
+                format!("solver.min_node_support={support}"),
             ];
             let text = if absorbing {
                 BLOCK.replace("[solver]", &format!("{ABSORBING}[solver]"))
@@ -798,12 +771,15 @@ dt = 0.01
                     v
                 })
                 .collect();
+            let mut u = u;
+            sys.dofs.follow_ties(&mut u);
+            let tied = sys.dofs.ties.iter().filter(|t| t.is_some()).count();
             let dt = 0.01;
             let res = |solver: &mut Implicit<2>, u: &[Vector<2>]| {
                 let r = solver
                     .residual(&m, u, &sys.u_tilde, &sys.mass, &sys.f_ext, sys.inertia, dt)
                     .unwrap();
-                free(&r, &sys.dofs)
+                sys.dofs.reduce(&r)
             };
             res(&mut solver, &u);
             let (triplets, _) = solver
@@ -819,15 +795,10 @@ dt = 0.01
             let mut worst: f64 = 0.0;
             for col in 0..n {
                 let (mut up, mut um) = (u.clone(), u.clone());
-                'find: for (a, (p, q)) in up.iter_mut().zip(um.iter_mut()).enumerate() {
-                    for d in 0..2 {
-                        if sys.dofs.of(a, d, 2) == Some(col) {
-                            p[d] += h;
-                            q[d] -= h;
-                            break 'find;
-                        }
-                    }
-                }
+                let mut e = vec![0.0; n];
+                e[col] = 1.0;
+                sys.dofs.apply_correction(&mut up, &e, h);
+                sys.dofs.apply_correction(&mut um, &e, -h);
                 let (rp, rm) = (res(&mut solver, &up), res(&mut solver, &um));
                 for row in 0..n {
                     let fd = (rp[row] - rm[row]) / (2.0 * h);
@@ -835,7 +806,8 @@ dt = 0.01
                 }
             }
             println!(
-                "{model} {shape} {mass} absorbing={absorbing}: {n} unknowns, max |K − K_fd| / max|K| = {:.2e}",
+                "{model} {shape} {mass} absorbing={absorbing}: {n} unknowns, {tied} tied nodes, \
+                 max |K − K_fd| / max|K| = {:.2e}",
                 worst / kmax
             );
             assert!(
@@ -843,6 +815,95 @@ dt = 0.01
                 "{model} {shape} {mass}: tangent off by {:.2e} of its largest entry",
                 worst / kmax
             );
+        }
+    }
+}
+
+#[cfg(test)]
+mod tie_tests {
+    use super::*;
+    use crate::dim::Tensor;
+    use crate::scene::Scene;
+    use crate::transfer::gradient;
+
+    /// A rotated, sheared block whose edges cut the cells anywhere: many nodes
+    /// are weakly supported at a large `min_node_support`.
+    const BLOCK: &str = r#"dimension = 2
+[grid]
+min = [0.0, 0.0]
+max = [5.0, 5.0]
+cells = [10, 10]
+shape_function = "linear"
+[[material]]
+name = "m"
+model = "hencky"
+density = 1000.0
+youngs_modulus = 1.0e5
+poisson_ratio = 0.3
+[[body]]
+material = "m"
+shape = "rectangle"
+min = [0.61, 0.77]
+max = [3.93, 2.38]
+particles_per_cell = 2
+[solver]
+kind = "implicit"
+integrator = "quasi_static"
+end_time = 1.0
+load_steps = 1
+"#;
+
+    /// Tied nodes follow a linear field exactly, so every particle's gradient of
+    /// a linear nodal field is exact (linear consistency survives the ties), and
+    /// masters are never tied themselves.
+    #[test]
+    fn ties_keep_linear_fields_exact() {
+        for shape in ["linear", "ugimp", "cpdi", "bspline2", "bspline3"] {
+            let overrides = vec![
+                format!("grid.shape_function={shape}"),
+                "solver.min_node_support=0.2".to_string(),
+            ];
+            let scene = Scene::parse("block.toml", BLOCK, &overrides).unwrap();
+            let m = Model::<2>::build(&scene).unwrap();
+            let mut solver = Implicit::<2>::new(
+                scene.config.grid.shape_function,
+                scene.config.stages()[0],
+                0.0,
+            );
+            let sys = solver.prepare(&m, 0.0, 1.0);
+            let ties = &sys.dofs.ties;
+            let tied = ties.iter().filter(|t| t.is_some()).count();
+            assert!(tied > 0, "{shape}: no tied node at min_node_support 0.2");
+            for t in ties.iter().flatten() {
+                assert!(ties[t.master[0]].is_none() && ties[t.master[1]].is_none());
+            }
+            let a = Tensor::<2>::new(0.013, -0.021, 0.008, 0.017);
+            let b = Vector::<2>::new(0.3, -0.1);
+            let linear = |g: u32| {
+                let x = m.grid.node_position(m.grid.node_ijk(g as usize));
+                a * x + b
+            };
+            let mut u: Vec<Vector<2>> = solver.map.active.iter().map(|&g| linear(g)).collect();
+            let exact = u.clone();
+            for (ua, t) in u.iter_mut().zip(ties) {
+                if t.is_some() {
+                    *ua = Vector::<2>::new(9.0, 9.0); // overwritten by the tie
+                }
+            }
+            sys.dofs.follow_ties(&mut u);
+            let node_error = u
+                .iter()
+                .zip(&exact)
+                .map(|(x, y)| (x - y).norm())
+                .fold(0.0, f64::max);
+            let grad_error = (0..m.particles.len())
+                .map(|q| (gradient(&solver.map, &solver.stencils, q, &u) - a).amax())
+                .fold(0.0, f64::max);
+            println!(
+                "{shape}: {tied} of {} nodes tied; node error {node_error:.1e}, gradient error {grad_error:.1e}",
+                u.len()
+            );
+            assert!(node_error < 1e-14 && grad_error < 1e-12, "{shape}");
         }
     }
 }

@@ -17,7 +17,9 @@ use faer::sparse::linalg::lu::{
     factorize_symbolic_lu, LuRef, LuSymbolicParams, NumericLu, SymbolicLu,
 };
 use faer::sparse::linalg::LuError;
-use faer::sparse::{CreationError, SparseColMat, SparseColMatRef, Triplet};
+use faer::sparse::{
+    Argsort, CreationError, Pair, SparseColMat, SparseColMatRef, SymbolicSparseColMat, Triplet,
+};
 use faer::{Conj, MatMut, Par, Side};
 
 /// Largest accepted normwise backward error `‖K y − b‖ / (‖|K||y|‖ + ‖b‖)` of the probe solve.
@@ -83,6 +85,17 @@ struct Pattern {
     row_idx: Vec<usize>,
 }
 
+/// The (row, col) sequence of the last triplet list with its CSC pattern and value
+/// order: a list with the same sequence (every Newton iteration of a step) is
+/// scattered into CSC without sorting again.
+struct ValueOrder {
+    n: usize,
+    structure: Structure,
+    indices: Vec<(usize, usize)>,
+    symbolic: SymbolicSparseColMat<usize>,
+    order: Argsort<usize>,
+}
+
 /// Numeric factors of the last successful factorization.
 #[allow(clippy::large_enum_variant)] // one instance per solver: size is irrelevant
 enum Numeric {
@@ -99,6 +112,7 @@ enum Numeric {
 
 /// Sparse direct solver holding the symbolic factorizations and the pattern they belong to.
 pub struct DirectSolver {
+    value_order: Option<ValueOrder>,
     pattern: Option<Pattern>,
     chol: Option<SymbolicCholesky<usize>>,
     lu: Option<SymbolicLu<usize>>,
@@ -116,6 +130,7 @@ impl DirectSolver {
     /// Empty solver: no pattern, no factorization.
     pub fn new() -> Self {
         Self {
+            value_order: None,
             pattern: None,
             chol: None,
             lu: None,
@@ -134,7 +149,7 @@ impl DirectSolver {
         structure: Structure,
     ) -> Result<Method, SolveError> {
         self.numeric = Numeric::None;
-        let a = build_csc(n, triplets, structure)?;
+        let a = self.build_csc(n, triplets, structure)?;
         self.update_pattern(n, structure, a.as_ref());
         match structure {
             Structure::General => self.factor_lu(a.as_ref()),
@@ -408,31 +423,67 @@ fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).fold(0.0, |m, (s, t)| m.max((s - t).abs()))
 }
 
-/// Build the CSC matrix (duplicates summed by faer); lower triangle only for `Symmetric`.
-fn build_csc(
-    n: usize,
-    triplets: &[(usize, usize, f64)],
-    structure: Structure,
-) -> Result<SparseColMat<usize, f64>, SolveError> {
-    if let Some(&(r, c, v)) = triplets.iter().find(|t| !t.2.is_finite()) {
-        return Err(SolveError::InvalidInput(format!(
-            "non-finite value {v} at ({r}, {c})"
-        )));
+impl DirectSolver {
+    /// Build the CSC matrix (duplicates summed); lower triangle only for
+    /// `Symmetric`. The sort into CSC order is skipped when the (row, col)
+    /// sequence repeats the previous call's.
+    fn build_csc(
+        &mut self,
+        n: usize,
+        triplets: &[(usize, usize, f64)],
+        structure: Structure,
+    ) -> Result<SparseColMat<usize, f64>, SolveError> {
+        if let Some(&(r, c, v)) = triplets.iter().find(|t| !t.2.is_finite()) {
+            return Err(SolveError::InvalidInput(format!(
+                "non-finite value {v} at ({r}, {c})"
+            )));
+        }
+        let upper_only = structure == Structure::Symmetric
+            && triplets.iter().any(|t| t.0 < t.1)
+            && !triplets.iter().any(|t| t.0 > t.1);
+        if upper_only {
+            let msg =
+                "Symmetric structure reads the lower triangle, but only upper entries were given";
+            return Err(SolveError::InvalidInput(msg.into()));
+        }
+        let keep = |t: &&(usize, usize, f64)| structure == Structure::General || t.0 >= t.1;
+        let same = self.value_order.as_ref().is_some_and(|o| {
+            o.n == n
+                && o.structure == structure
+                && triplets
+                    .iter()
+                    .filter(keep)
+                    .map(|t| (t.0, t.1))
+                    .eq(o.indices.iter().copied())
+        });
+        if !same {
+            self.value_order = None;
+            if let Some(&(r, c, _)) = triplets.iter().find(|t| t.0 >= n || t.1 >= n) {
+                return Err(creation_error(CreationError::OutOfBounds {
+                    row: r,
+                    col: c,
+                }));
+            }
+            let indices: Vec<(usize, usize)> =
+                triplets.iter().filter(keep).map(|t| (t.0, t.1)).collect();
+            let pairs: Vec<Pair<usize, usize>> = indices
+                .iter()
+                .map(|&(row, col)| Pair { row, col })
+                .collect();
+            let (symbolic, order) =
+                SymbolicSparseColMat::try_new_from_indices(n, n, &pairs).map_err(creation_error)?;
+            self.value_order = Some(ValueOrder {
+                n,
+                structure,
+                indices,
+                symbolic,
+                order,
+            });
+        }
+        let o = self.value_order.as_ref().expect("value order just set");
+        let values: Vec<f64> = triplets.iter().filter(keep).map(|t| t.2).collect();
+        SparseColMat::new_from_argsort(o.symbolic.clone(), &o.order, &values).map_err(backend)
     }
-    let upper_only = structure == Structure::Symmetric
-        && triplets.iter().any(|t| t.0 < t.1)
-        && !triplets.iter().any(|t| t.0 > t.1);
-    if upper_only {
-        let msg = "Symmetric structure reads the lower triangle, but only upper entries were given";
-        return Err(SolveError::InvalidInput(msg.into()));
-    }
-    let keep = |t: &&(usize, usize, f64)| structure == Structure::General || t.0 >= t.1;
-    let entries: Vec<Triplet<usize, usize, f64>> = triplets
-        .iter()
-        .filter(keep)
-        .map(|&(r, c, v)| Triplet::new(r, c, v))
-        .collect();
-    SparseColMat::try_new_from_triplets(n, n, &entries).map_err(creation_error)
 }
 
 /// Full symmetric matrix from its lower triangle (for the LU fallback).

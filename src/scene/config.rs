@@ -262,6 +262,7 @@ pub struct SolverConfig {
     pub max_iterations: Option<usize>,
     pub line_search: Option<bool>,
     pub max_cutbacks: Option<usize>,
+    pub min_node_support: Option<f64>,
 }
 
 impl SceneConfig {
@@ -333,6 +334,12 @@ impl SolverConfig {
     /// Times a failing step may be halved before the run stops (default 5).
     pub fn max_cutbacks(&self) -> usize {
         self.max_cutbacks.unwrap_or(5)
+    }
+    /// Nodes whose particle support Σ_p V_p S_Ip is below this fraction of a cell
+    /// volume are tied to two neighbours by linear extrapolation (default 1e-2;
+    /// 0 turns it off). See `implicit::support`.
+    pub fn min_node_support(&self) -> f64 {
+        self.min_node_support.unwrap_or(1e-2)
     }
 }
 

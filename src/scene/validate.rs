@@ -461,6 +461,11 @@ fn explicit(s: &SolverConfig, prefix: &str) -> Check {
     forbidden(&s.max_iterations, format!("{prefix}.max_iterations"), what)?;
     forbidden(&s.line_search, format!("{prefix}.line_search"), what)?;
     forbidden(&s.max_cutbacks, format!("{prefix}.max_cutbacks"), what)?;
+    forbidden(
+        &s.min_node_support,
+        format!("{prefix}.min_node_support"),
+        what,
+    )?;
     let cfl = s.cfl();
     ensure(
         cfl > 0.0 && cfl <= 1.0,
@@ -540,6 +545,12 @@ fn implicit(s: &SolverConfig, prefix: &str) -> Check {
             "must lie in (0, 1)",
         )?;
     }
+    let support = s.min_node_support();
+    ensure(
+        (0.0..0.5).contains(&support),
+        format!("{prefix}.min_node_support"),
+        format!("must lie in [0, 0.5) (a fraction of one cell volume); got {support}"),
+    )?;
     ensure(
         s.max_iterations() >= 1,
         format!("{prefix}.max_iterations"),

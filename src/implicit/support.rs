@@ -1,0 +1,152 @@
+//! Weakly supported nodes of the implicit system.
+//!
+//! A particle that has just entered a cell touches the far nodes of its new
+//! stencil with weights ~ξ² and gradients ~ξ (ξ its penetration in cells). Such a
+//! node is seen by few quadrature points with tiny weights: its stiffness rows are
+//! nearly (often exactly, up to round-off) zero-energy modes, and a quasi-static
+//! tangent has no mass term to lift them. The remedy here follows the extended
+//! B-splines of the implicit MPM literature: a node whose particle support
+//! Σ_p V_p S_Ip is below a fraction of a cell volume is no unknown of its own; its
+//! displacement is linearly extrapolated from two well-supported nodes on a grid
+//! line through it, u_a = c₀ u_J + c₁ u_K. Every particle's shape functions
+//! stay a partition of unity and keep reproducing linear fields exactly, and the
+//! tangent stays the exact derivative of the (constrained) residual.
+
+use super::tangent::Tie;
+use crate::boundary::Constraint;
+use crate::dim::Vector;
+use crate::grid::Grid;
+use crate::shape::Stencils;
+use crate::transfer::NodeMap;
+
+/// Σ_p V_p S_Ip / (cell volume) at every active node.
+pub fn nodal_support<const D: usize>(
+    map: &NodeMap,
+    st: &Stencils<D>,
+    volume: &[f64],
+    cell_volume: f64,
+) -> Vec<f64> {
+    map.gather(st.stride, 0.0, |q, e| {
+        volume[q] * st.weight[e] / cell_volume
+    })
+}
+
+/// Ties for the free active nodes whose support is below `threshold` (cells).
+/// Masters: the pair J = a + s, K = a + 2s (s a grid direction, axes first, then
+/// diagonals) with the largest smaller support, both at or above the threshold.
+/// A weak node with no such pair, or with a prescribed component, stays an
+/// unknown. Returns no ties at all when none are needed.
+pub fn ties<const D: usize>(
+    grid: &Grid<D>,
+    map: &NodeMap,
+    support: &[f64],
+    constraint: &[Constraint<D>],
+    threshold: f64,
+) -> Vec<Option<Tie>> {
+    let weak = |a: usize| support[a] < threshold;
+    if threshold <= 0.0 || !(0..map.len()).any(|a| weak(a) && constraint[a].is_free()) {
+        return Vec::new();
+    }
+    let directions = directions::<D>();
+    let position = |b: usize| grid.node_position(grid.node_ijk(map.active[b] as usize));
+    (0..map.len())
+        .map(|a| {
+            if !weak(a) || !constraint[a].is_free() {
+                return None;
+            }
+            let ijk = grid.node_ijk(map.active[a] as usize);
+            let mut best: Option<(usize, f64, usize, usize)> = None; // (|s|², score, J, K)
+            for s in &directions {
+                let order = s.iter().map(|c| (c * c) as usize).sum::<usize>();
+                if best.is_some_and(|b| b.0 < order) {
+                    break; // a shorter direction already works
+                }
+                let (Some(j), Some(k)) = (
+                    neighbour(grid, map, ijk, s, 1),
+                    neighbour(grid, map, ijk, s, 2),
+                ) else {
+                    continue;
+                };
+                let score = support[j].min(support[k]);
+                if weak(j) || weak(k) || best.is_some_and(|b| b.1 >= score) {
+                    continue;
+                }
+                // B-spline control points (Greville abscissae) are not evenly
+                // spaced next to the grid boundary: a diagonal may bend.
+                if !collinear(&position(a), &position(j), &position(k), grid.h_min()) {
+                    continue;
+                }
+                best = Some((order, score, j, k));
+            }
+            let (_, _, j, k) = best?;
+            Some(extrapolation(
+                &position(a),
+                j,
+                &position(j),
+                k,
+                &position(k),
+            ))
+        })
+        .collect()
+}
+
+/// Linear extrapolation along the line through x_J and x_K:
+/// u(x) = t u_J + (1 − t) u_K with t = (x − x_K)·(x_J − x_K)/|x_J − x_K|².
+fn extrapolation<const D: usize>(
+    x: &Vector<D>,
+    j: usize,
+    xj: &Vector<D>,
+    k: usize,
+    xk: &Vector<D>,
+) -> Tie {
+    let line = xj - xk;
+    let t = (x - xk).dot(&line) / line.norm_squared();
+    Tie {
+        master: [j, k],
+        coef: [t, 1.0 - t],
+    }
+}
+
+/// Is x on the line through x_J and x_K (to round-off, relative to h)?
+fn collinear<const D: usize>(x: &Vector<D>, xj: &Vector<D>, xk: &Vector<D>, h: f64) -> bool {
+    let tie = extrapolation(x, 0, xj, 1, xk);
+    (xj * tie.coef[0] + xk * tie.coef[1] - x).norm() <= 1e-12 * h
+}
+
+/// Grid directions {−1, 0, 1}^D without 0, ordered by length (axes first).
+fn directions<const D: usize>() -> Vec<[i64; D]> {
+    let mut out: Vec<[i64; D]> = (0..3usize.pow(D as u32))
+        .map(|mut code| {
+            std::array::from_fn(|_| {
+                let c = (code % 3) as i64 - 1;
+                code /= 3;
+                c
+            })
+        })
+        .filter(|s: &[i64; D]| s.iter().any(|&c| c != 0))
+        .collect();
+    out.sort_by_key(|s| s.iter().map(|c| c * c).sum::<i64>());
+    out
+}
+
+/// Active index of node ijk + m·s, if it is on the grid and active.
+fn neighbour<const D: usize>(
+    grid: &Grid<D>,
+    map: &NodeMap,
+    ijk: [usize; D],
+    s: &[i64; D],
+    m: i64,
+) -> Option<usize> {
+    let mut target = [0usize; D];
+    for d in 0..D {
+        let i = ijk[d] as i64 + m * s[d];
+        if i < 0 || i >= grid.nodes[d] as i64 {
+            return None;
+        }
+        target[d] = i as usize;
+    }
+    match map.local[grid.node_index(target)] {
+        NodeMap::NONE => None,
+        a => Some(a as usize),
+    }
+}
