@@ -129,7 +129,10 @@ impl<const D: usize> Explicit<D> {
         // Nodal forces, damping, acceleration and updated velocity (2-23, 2-29).
         let scales = m.load_scales(t);
         let load_factor = |q: usize| load_factor(&m.load_ramp_of, q, &scales);
-        let force = nodal_force(map, st, p, &m.gravity, &load_factor);
+        let mut force = nodal_force(map, st, p, &m.gravity, &load_factor);
+        // Absorbing faces: dashpot (and spring) forces on the outer cell layer (2-63).
+        m.absorbing
+            .add_force(&m.grid, p, map, st, &velocity, &mut force);
         let accel: Vec<Vector<D>> = (0..map.len())
             .into_par_iter()
             .with_min_len(MIN_PARALLEL_LEN)
@@ -202,7 +205,7 @@ fn local_damping<const D: usize>(f: &Vector<D>, v: &Vector<D>, alpha: f64) -> Ve
 }
 
 /// v_I = p_I / m_I (2-25); zero on a node whose mass is exactly zero.
-fn mass_average<const D: usize>(mass: &[f64], momentum: &[Vector<D>]) -> Vec<Vector<D>> {
+pub(crate) fn mass_average<const D: usize>(mass: &[f64], momentum: &[Vector<D>]) -> Vec<Vector<D>> {
     (0..mass.len())
         .map(|a| {
             if mass[a] > 0.0 {

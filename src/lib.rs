@@ -5,6 +5,7 @@
 //! Cauchy stress) are always stored as 3×3; vectors on the grid and particles have
 //! `D` components.
 
+pub mod absorbing;
 pub mod bench;
 pub mod boundary;
 pub mod deformation;

@@ -1,6 +1,7 @@
 //! From a validated scene to the objects a solver works on: grid, particles,
 //! materials, boundary conditions and loads.
 
+use crate::absorbing::Absorbing;
 use crate::boundary::{Constraint, FaceCondition};
 use crate::dim::Vector;
 use crate::grid::{Face, Grid};
@@ -18,10 +19,12 @@ pub struct Model<const D: usize> {
     pub particles: Particles<D>,
     pub materials: Vec<Box<dyn Material>>,
     pub faces: Vec<FaceCondition<D>>,
+    /// Non-reflecting faces (Lysmer–Kuhlemeyer dashpots, optional springs).
+    pub absorbing: Absorbing<D>,
     pub gravity: Vector<D>,
-    /// Per load: selected particles, ramp time (the force is stored on the particles
-    /// grouped by ramp, see `load_scale`).
-    pub load_ramps: Vec<f64>,
+    /// The distinct time histories of the loads (the force is stored on the
+    /// particles grouped by history, see `load_scales`).
+    pub load_ramps: Vec<LoadTime>,
     /// For each particle, the index into `load_ramps` of its load (u32::MAX: none).
     pub load_ramp_of: Vec<u32>,
 }
@@ -30,12 +33,8 @@ impl<const D: usize> Model<D> {
     pub fn build(scene: &Scene) -> Result<Model<D>, SceneError> {
         let c = &scene.config;
         assert_eq!(c.dimension, D, "caller dispatches on the scene dimension");
-        let err = |key: String, msg: String| SceneError {
-            file: scene.file.clone(),
-            key: Some(key),
-            position: None,
-            message: msg,
-        };
+        let err =
+            |key: String, msg: String| SceneError::at_key(&scene.file, &scene.text, &key, msg);
         let vec = |v: &[f64]| Vector::<D>::from_fn(|d, _| v[d]);
         let cells = std::array::from_fn(|d| c.grid.cells[d]);
         let grid = Grid::new(
@@ -61,8 +60,13 @@ impl<const D: usize> Model<D> {
         let faces = c
             .boundaries
             .iter()
+            .filter(|b| b.condition != Condition::Absorbing)
             .map(|b| face_condition(b, D, &vec))
             .collect();
+        let absorbing = Absorbing::new(&c.boundaries, &materials);
+        absorbing
+            .check_adjacent(&grid, &particles)
+            .map_err(|(i, msg)| err(format!("boundary.{i}.face"), msg))?;
         let gravity = c.gravity.as_deref().map_or(Vector::<D>::zeros(), vec);
         let mut load_ramp_of = vec![u32::MAX; particles.len()];
         let mut load_ramps = Vec::new();
@@ -86,18 +90,27 @@ impl<const D: usize> Model<D> {
                     "the load region selects no particle".into(),
                 ));
             }
+            let time = match l.pulse_duration {
+                Some(t) => LoadTime::Pulse(t),
+                None => LoadTime::Ramp(l.ramp_time),
+            };
             let ramp = load_ramps
                 .iter()
-                .position(|&r| r == l.ramp_time)
+                .position(|&r| r == time)
                 .unwrap_or_else(|| {
-                    load_ramps.push(l.ramp_time);
+                    load_ramps.push(time);
                     load_ramps.len() - 1
                 });
             for &p in &selected {
                 if load_ramp_of[p] != u32::MAX && load_ramp_of[p] != ramp as u32 {
+                    let key = if l.pulse_duration.is_some() {
+                        "pulse_duration"
+                    } else {
+                        "ramp_time"
+                    };
                     return Err(err(
-                        format!("load.{i}.ramp_time"),
-                        format!("particle {p} already carries a load with another ramp_time"),
+                        format!("load.{i}.{key}"),
+                        format!("particle {p} already carries a load with another time history (ramp_time or pulse_duration)"),
                     ));
                 }
                 load_ramp_of[p] = ramp as u32;
@@ -120,18 +133,16 @@ impl<const D: usize> Model<D> {
             particles,
             materials,
             faces,
+            absorbing,
             gravity,
             load_ramps,
             load_ramp_of,
         })
     }
 
-    /// Load factor of each ramp at time t: min(t / ramp_time, 1).
+    /// Load factor of each load time history at time t.
     pub fn load_scales(&self, t: f64) -> Vec<f64> {
-        self.load_ramps
-            .iter()
-            .map(|&r| if r > 0.0 { (t / r).min(1.0) } else { 1.0 })
-            .collect()
+        self.load_ramps.iter().map(|r| r.factor(t)).collect()
     }
 
     /// Number of bodies (for per-body outputs).
@@ -142,6 +153,28 @@ impl<const D: usize> Model<D> {
             .map(|&b| b as usize + 1)
             .max()
             .unwrap_or(0)
+    }
+}
+
+/// How a load varies in time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LoadTime {
+    /// min(t / ramp_time, 1); at once when the ramp time is 0.
+    Ramp(f64),
+    /// A smooth pulse of duration T: sin²(π t / T) for t ≤ T, then 0.
+    Pulse(f64),
+}
+
+impl LoadTime {
+    pub fn factor(&self, t: f64) -> f64 {
+        match *self {
+            LoadTime::Ramp(r) if r > 0.0 => (t / r).min(1.0),
+            LoadTime::Ramp(_) => 1.0,
+            LoadTime::Pulse(d) if t >= 0.0 && t <= d => {
+                (std::f64::consts::PI * t / d).sin().powi(2)
+            }
+            LoadTime::Pulse(_) => 0.0,
+        }
     }
 }
 
@@ -183,6 +216,7 @@ fn face_condition<const D: usize>(
     match b.condition {
         Condition::Fixed => (0..D).for_each(|d| constraint.set(d, 0.0)),
         Condition::Roller => constraint.set(face.axis, 0.0),
+        Condition::Absorbing => unreachable!("absorbing faces are not velocity conditions"),
         Condition::Velocity => {
             let v = vec(b.velocity.as_ref().unwrap());
             let comps: Vec<usize> = match &b.components {

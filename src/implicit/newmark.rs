@@ -35,6 +35,25 @@ impl Newmark {
         (a * (1.0 - self.gamma) + a_new * self.gamma) * dt
     }
 
+    /// End-of-step velocity as a function of the increment u:
+    /// v_{n+1} = v_n + Δt ((1 − γ) a_n + γ a_{n+1}) with v_n = (ũ − (½ − β) Δt² a_n)/Δt
+    /// recovered from the predictor (2-33…2-36).
+    pub fn end_velocity<const D: usize>(
+        &self,
+        dt: f64,
+        u: &Vector<D>,
+        u_tilde: &Vector<D>,
+        a: &Vector<D>,
+    ) -> Vector<D> {
+        let v = (u_tilde - a * ((0.5 - self.beta) * dt * dt)) / dt;
+        v + self.velocity_increment(dt, a, &self.acceleration(dt, u, u_tilde))
+    }
+
+    /// ∂v_{n+1}/∂u = γ / (β Δt), the damping coefficient of the tangent.
+    pub fn velocity_rate(&self, dt: f64) -> f64 {
+        self.gamma / (self.beta * dt)
+    }
+
     /// Inertia coefficient of the tangent, 1 / (β Δt²) (2-40).
     pub fn inertia(&self, dt: f64) -> f64 {
         1.0 / (self.beta * dt * dt)
@@ -71,7 +90,10 @@ mod tests {
             if x > 0.0 && x_new <= 0.0 {
                 crossings.push(n as f64 * dt + dt * x / (x - x_new));
             }
+            let v_end =
+                nm.end_velocity(dt, &Vector1::new(u), &Vector1::new(ut), &Vector1::new(a))[0];
             v += nm.velocity_increment(dt, &Vector1::new(a), &Vector1::new(a_new))[0];
+            assert!((v_end - v).abs() < 1e-12, "end velocity {v_end} vs {v}");
             (x, a) = (x_new, a_new);
             let energy = 0.5 * v * v + 0.5 * omega * omega * x * x;
             assert!((energy - 0.5).abs() < 1e-12, "energy {energy} at step {n}");

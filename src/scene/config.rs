@@ -144,6 +144,9 @@ pub enum Condition {
     Roller,
     /// Prescribed `velocity` on the listed `components` (default all).
     Velocity,
+    /// Non-reflecting: Lysmer–Kuhlemeyer dashpots (thesis 2-59…2-63), optionally
+    /// with springs in parallel (`spring_distance` or `spring_stiffness`).
+    Absorbing,
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -155,6 +158,12 @@ pub struct BoundaryConfig {
     pub velocity: Option<Vec<f64>>,
     /// Components the velocity condition acts on ("x", "y", "z"); default all.
     pub components: Option<Vec<String>>,
+    /// Absorbing: springs in parallel with k_n = α_N G/R, k_s = α_T G/R, where R is
+    /// this distance from the wave source to the face.
+    pub spring_distance: Option<f64>,
+    /// Absorbing: springs in parallel with these stiffnesses per unit area,
+    /// [normal, tangential].
+    pub spring_stiffness: Option<Vec<f64>>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
@@ -182,6 +191,8 @@ pub struct LoadConfig {
     /// Linear ramp from zero over this time (0: applied at once).
     #[serde(default)]
     pub ramp_time: f64,
+    /// A pulse instead of a ramp: the load times sin²(π t / T) for t ≤ T, then zero.
+    pub pulse_duration: Option<f64>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]

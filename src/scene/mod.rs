@@ -21,6 +21,8 @@ use std::path::Path;
 pub struct Scene {
     pub file: String,
     pub config: SceneConfig,
+    /// The text after overrides (to locate keys in errors found after parsing).
+    pub text: String,
 }
 
 impl Scene {
@@ -42,6 +44,7 @@ impl Scene {
         Ok(Scene {
             file: file.to_string(),
             config,
+            text,
         })
     }
 }

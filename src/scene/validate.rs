@@ -385,6 +385,11 @@ fn boundary(b: &BoundaryConfig, i: usize, dim: usize) -> Check {
         key("face"),
         format!("must be one of {face_names}"),
     )?;
+    if b.condition != Condition::Absorbing {
+        let what = "a fixed, roller or velocity condition (only to absorbing)";
+        forbidden(&b.spring_distance, key("spring_distance"), what)?;
+        forbidden(&b.spring_stiffness, key("spring_stiffness"), what)?;
+    }
     match b.condition {
         Condition::Fixed | Condition::Roller => {
             forbidden(&b.velocity, key("velocity"), "fixed or roller conditions")?;
@@ -394,6 +399,7 @@ fn boundary(b: &BoundaryConfig, i: usize, dim: usize) -> Check {
                 "fixed or roller conditions",
             )
         }
+        Condition::Absorbing => absorbing(b, i),
         Condition::Velocity => {
             required(&b.velocity, key("velocity"), "a velocity condition")?;
             vector(b.velocity.as_ref().unwrap(), dim, &key("velocity"))?;
@@ -408,6 +414,39 @@ fn boundary(b: &BoundaryConfig, i: usize, dim: usize) -> Check {
             Ok(())
         }
     }
+}
+
+/// Keys of an absorbing face: no velocity, at most one way of giving springs.
+fn absorbing(b: &BoundaryConfig, i: usize) -> Check {
+    let key = |k: &str| format!("boundary.{i}.{k}");
+    let what = "an absorbing condition";
+    forbidden(&b.velocity, key("velocity"), what)?;
+    forbidden(&b.components, key("components"), what)?;
+    if let Some(r) = b.spring_distance {
+        ensure(
+            r > 0.0 && r.is_finite(),
+            key("spring_distance"),
+            format!("must be a positive distance (from the wave source to the face); got {r}"),
+        )?;
+        forbidden(
+            &b.spring_stiffness,
+            key("spring_stiffness"),
+            "a face that sets spring_distance (give one of the two)",
+        )?;
+    }
+    if let Some(k) = &b.spring_stiffness {
+        ensure(
+            k.len() == 2,
+            key("spring_stiffness"),
+            format!("needs 2 entries [normal, tangential], has {}", k.len()),
+        )?;
+        ensure(
+            k.iter().all(|k| *k >= 0.0 && k.is_finite()),
+            key("spring_stiffness"),
+            "stiffnesses per unit area must be finite and ≥ 0",
+        )?;
+    }
+    Ok(())
 }
 
 pub fn axis(name: &str) -> Option<usize> {
@@ -428,6 +467,18 @@ fn load(l: &LoadConfig, i: usize, s: &SceneConfig) -> Check {
         key("ramp_time"),
         "must be ≥ 0",
     )?;
+    if let Some(t) = l.pulse_duration {
+        ensure(
+            t > 0.0 && t.is_finite(),
+            key("pulse_duration"),
+            "must be a positive number",
+        )?;
+        ensure(
+            l.ramp_time == 0.0,
+            key("pulse_duration"),
+            "a load is either ramped (ramp_time) or a pulse (pulse_duration), not both",
+        )?;
+    }
     match l.kind {
         LoadKind::Point => {
             required(&l.force, key("force"), "a point load")?;
