@@ -11,6 +11,7 @@ pub mod dim;
 pub mod explicit;
 pub mod grid;
 pub mod implicit;
+pub mod limit_analysis;
 pub mod linear;
 pub mod material;
 pub mod output;

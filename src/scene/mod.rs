@@ -8,7 +8,7 @@
 mod config;
 mod error;
 pub mod expr;
-mod overrides;
+pub(crate) mod overrides;
 pub mod validate;
 
 pub use config::*;
