@@ -125,6 +125,14 @@ impl ConicProgram {
             .push(([stress, stress + 1, stress + 2], strength));
     }
 
+    /// Residual of every equality row (as scaled) at a point x.
+    pub fn equality_residuals(&self, x: &[f64]) -> Vec<f64> {
+        self.equalities
+            .iter()
+            .map(|(row, rhs)| row.iter().map(|&(j, a)| a * x[j]).sum::<f64>() - rhs)
+            .collect()
+    }
+
     pub fn equalities(&self) -> usize {
         self.equalities.len()
     }

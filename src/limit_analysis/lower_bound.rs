@@ -147,3 +147,119 @@ pub fn lower_bound(model: &Model) -> Result<Bound, SolverFailure> {
             .collect(),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::limit_analysis::cone::MohrCoulomb;
+    use crate::limit_analysis::model::{MeshSize, SlopeGeometry};
+
+    fn slope_patch() -> Model {
+        let strength = MohrCoulomb {
+            cohesion: 1.0,
+            friction_angle: 0.3,
+        };
+        let geometry = SlopeGeometry {
+            height: 1.0,
+            gradient: 1.5,
+            crest: 1.0,
+            toe: 0.5,
+            foundation_depth: 0.5,
+        };
+        let size = MeshSize {
+            fine: 0.25,
+            growth: 1.5,
+            max: 0.5,
+            refinements: 0,
+        };
+        Model::slope(strength, 1.0, geometry, size)
+    }
+
+    /// A field that is linear over the whole domain and in equilibrium with
+    /// gravity α γ (γ = 1 in the model's units), put at every element node,
+    /// satisfies every equilibrium and every continuity row exactly (only
+    /// boundary rows may fail: the field ignores the boundary conditions); a
+    /// change at one node of one triangle breaks its rows and no others.
+    #[test]
+    fn equilibrium_and_continuity_rows_hold_for_a_global_equilibrated_field() {
+        let model = slope_patch();
+        let p = program(&model);
+        let ne = model.mesh.triangles.len();
+        // σx = 0.3x − 0.2y + 1, σy = 0.6y + 0.5x, τ = 0.1x − 0.3y:
+        // ∂σx/∂x + ∂τ/∂y = 0 and ∂τ/∂x + ∂σy/∂y = 0.7 = α γ.
+        let field = |[x, y]: [f64; 2]| {
+            [
+                0.3 * x - 0.2 * y + 1.0,
+                0.6 * y + 0.5 * x,
+                0.1 * x - 0.3 * y,
+            ]
+        };
+        let mut x = vec![0.0; p.variables];
+        for (e, t) in model.mesh.triangles.iter().enumerate() {
+            for k in 0..3 {
+                let s = field(model.mesh.nodes[t[k]]);
+                x[stress(e, k)..stress(e, k) + 3].copy_from_slice(&s);
+            }
+        }
+        x[9 * ne] = 0.7;
+        let r = p.equality_residuals(&x);
+        assert!(r[..2 * ne].iter().all(|v| v.abs() < 1e-12), "equilibrium");
+        let boundary_rows: usize = model
+            .boundary
+            .iter()
+            .flatten()
+            .map(|k| match k {
+                BoundaryKind::Free => 4,
+                BoundaryKind::Smooth | BoundaryKind::Footing => 2,
+                BoundaryKind::Rigid => 0,
+            })
+            .sum();
+        let violated = r.iter().filter(|v| v.abs() > 1e-12).count();
+        assert!(
+            violated > 0 && violated <= boundary_rows,
+            "{violated} > {boundary_rows}"
+        );
+        // The wrong multiplier breaks every y-equilibrium row.
+        let mut w = x.clone();
+        w[9 * ne] = 0.8;
+        let bad = p.equality_residuals(&w)[..2 * ne]
+            .iter()
+            .filter(|v| v.abs() > 1e-12)
+            .count();
+        assert_eq!(bad, ne);
+        // Perturb σx at node 0 of a triangle with only interior edges: its
+        // x-equilibrium row and the traction rows of its two edges through
+        // that node change (σn and τ on each, where the normal makes them
+        // depend on σx), nothing else.
+        let e = (0..ne)
+            .find(|&e| {
+                model
+                    .edges
+                    .iter()
+                    .filter(|ed| ed.sides.iter().any(|s| s.0 == e))
+                    .all(|ed| ed.sides.len() == 2)
+            })
+            .unwrap();
+        let mut y = x.clone();
+        y[stress(e, 0)] += 1.0;
+        let r2 = p.equality_residuals(&y);
+        let changed = r
+            .iter()
+            .zip(&r2)
+            .filter(|(a, b)| (*a - *b).abs() > 1e-12)
+            .count();
+        assert!((3..=5).contains(&changed), "{changed}");
+    }
+
+    /// The traction of a stress on a plane is the projection of σ·n.
+    #[test]
+    fn traction_rows_project_the_stress_vector() {
+        let n = [0.6, 0.8];
+        let s = [3.0, -2.0, 1.5];
+        let (sn, tau) = traction(0, n);
+        let eval = |row: &Row| row.iter().map(|&(j, a)| a * s[j]).sum::<f64>();
+        let t = [s[0] * n[0] + s[2] * n[1], s[2] * n[0] + s[1] * n[1]];
+        assert!((eval(&sn) - (t[0] * n[0] + t[1] * n[1])).abs() < 1e-14);
+        assert!((eval(&tau) - (-t[0] * n[1] + t[1] * n[0])).abs() < 1e-14);
+    }
+}

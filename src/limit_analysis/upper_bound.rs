@@ -238,3 +238,82 @@ pub fn upper_bound(model: &Model) -> Result<Bound, SolverFailure> {
         field: velocity,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::limit_analysis::cone::MohrCoulomb;
+    use crate::limit_analysis::model::MeshSize;
+
+    /// The quadratic shape functions reproduce linear and quadratic fields:
+    /// Σ ∇N_a x_a = (1, 0), Σ ∇N_a = 0, and ∇(x²) at a vertex is (2x, 0).
+    #[test]
+    fn shape_gradients_reproduce_quadratic_fields() {
+        let p = [[0.2, 0.1], [1.3, 0.4], [0.5, 1.1]];
+        let mid = |i: usize, j: usize| [0.5 * (p[i][0] + p[j][0]), 0.5 * (p[i][1] + p[j][1])];
+        let x = [p[0], p[1], p[2], mid(0, 1), mid(1, 2), mid(2, 0)];
+        for q in 0..3 {
+            let g = shape_gradients(p, q);
+            for d in 0..2 {
+                let sum: f64 = g.iter().map(|v| v[d]).sum();
+                let lin: f64 = g.iter().zip(&x).map(|(v, xa)| v[d] * xa[0]).sum();
+                let quad: f64 = g.iter().zip(&x).map(|(v, xa)| v[d] * xa[0] * xa[1]).sum();
+                assert!(sum.abs() < 1e-12);
+                assert!((lin - if d == 0 { 1.0 } else { 0.0 }).abs() < 1e-12);
+                // ∇(xy) = (y, x) at vertex q.
+                let exact = if d == 0 { p[q][1] } else { p[q][0] };
+                assert!((quad - exact).abs() < 1e-12);
+            }
+        }
+    }
+
+    /// Patch test of the weak equilibrium: a constant stress gives zero
+    /// internal force at every node away from the boundary, and the footing
+    /// equation alone carries the load (the footing's width).
+    #[test]
+    fn constant_stress_is_in_weak_equilibrium_and_only_the_footing_is_loaded() {
+        let strength = MohrCoulomb {
+            cohesion: 1.0,
+            friction_angle: 0.0,
+        };
+        let size = MeshSize {
+            fine: 0.3,
+            growth: 1.4,
+            max: 0.6,
+            refinements: 0,
+        };
+        let model = Model::footing(strength, 1.0, 2.5, 1.5, size);
+        let (p, map, load) = program(&model);
+        let ne = model.mesh.triangles.len();
+        let mut x = vec![0.0; p.variables];
+        for e in 0..ne {
+            for k in 0..3 {
+                x[stress(e, k)..stress(e, k) + 3].copy_from_slice(&[-1.3, 0.4, 0.7]);
+            }
+        }
+        let r = p.equality_residuals(&x);
+        // Rows of nodes with no boundary edge: internal force zero.
+        let nv = model.mesh.nodes.len();
+        let mut on_boundary = vec![false; nv + model.edges.len()];
+        for (i, (e, k)) in model.edges.iter().zip(&model.boundary).enumerate() {
+            if k.is_some() {
+                on_boundary[e.nodes[0]] = true;
+                on_boundary[e.nodes[1]] = true;
+                on_boundary[nv + i] = true;
+            }
+        }
+        let mut checked = 0;
+        for (node, m) in map.iter().enumerate() {
+            for &(row, _) in m.iter().flatten() {
+                if !on_boundary[node] {
+                    assert!(r[row].abs() < 1e-12, "node {node}: {}", r[row]);
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 50);
+        // The footing row carries the load (its width); nothing else does.
+        assert_eq!(load.iter().filter(|f| **f != 0.0).count(), 1);
+        assert!((load.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+    }
+}
