@@ -115,11 +115,11 @@ fn dof_map(model: &Model, nnodes: usize) -> (Vec<[Dof; 2]>, usize, Option<usize>
         .iter()
         .map(|b| {
             let mut d = [Dof::Fixed; 2];
-            for c in 0..2 {
-                if b.fix[c] {
+            for (c, (dof, &fixed)) in d.iter_mut().zip(&b.fix).enumerate() {
+                if fixed {
                     continue;
                 }
-                d[c] = if c == 1 && b.footing {
+                *dof = if c == 1 && b.footing {
                     Dof::Footing
                 } else {
                     rows += 1;
