@@ -13,6 +13,7 @@ pub mod dim;
 pub mod explicit;
 pub mod grid;
 pub mod implicit;
+pub mod limit_analysis;
 pub mod linear;
 pub mod material;
 pub mod output;

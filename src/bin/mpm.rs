@@ -44,6 +44,14 @@ enum Command {
     /// Run a scene over solver configurations and sweeps of Δt (or load steps) and
     /// grid size; write DIR/bench.csv and PNG plots (docs/bench.md).
     Bench(BenchArgs),
+    /// Lower and upper limit-analysis bounds (footing, slope) into DIR: see docs/limit_analysis.md.
+    Limit {
+        scene: PathBuf,
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        overrides: Vec<String>,
+    },
 }
 
 #[derive(clap::Args)]
@@ -146,6 +154,11 @@ fn parse_cells(s: &str) -> Result<Vec<usize>, String> {
 fn main() -> ExitCode {
     match Cli::parse().command {
         Command::Bench(args) => run_bench(args),
+        Command::Limit {
+            scene,
+            out,
+            overrides,
+        } => limit(&scene, &out, &overrides),
         Command::Check { scene, overrides } => match Scene::load(&scene, &overrides) {
             Ok(s) => {
                 let c = &s.config;
@@ -216,6 +229,34 @@ fn main() -> ExitCode {
                     ExitCode::from(1)
                 }
             }
+        }
+    }
+}
+
+fn limit(scene: &std::path::Path, out: &std::path::Path, overrides: &[String]) -> ExitCode {
+    use mpm::limit_analysis::{config::LimitScene, run::run_limit};
+    let scene = match LimitScene::load(scene, overrides) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    match run_limit(&scene, out, true) {
+        Ok(s) => {
+            println!(
+                "{}: {} between {:.5} and {:.5}; outputs in {}",
+                scene.file,
+                s["quantity"].as_str().unwrap_or(""),
+                s["lower_bound"].as_f64().unwrap_or(f64::NAN),
+                s["upper_bound"].as_f64().unwrap_or(f64::NAN),
+                out.display()
+            );
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(1)
         }
     }
 }

@@ -1,0 +1,131 @@
+//! Factor of safety in the strength-reduction sense from a bound on the collapse
+//! multiplier α on gravity: for a trial F the strength is c/F, atan(tan φ/F);
+//! the factor of safety is the F at which α(F) = 1.
+//!
+//! α(F) decreases with F. A lower bound α_LB(F) ≤ α(F) therefore gives
+//! F_LB ≤ F, and an upper bound gives F_UB ≥ F. The root is bracketed and
+//! narrowed by the Illinois variant of regula falsi on ln α(F) (nearly linear in
+//! F), which keeps a bracket at every step.
+
+use super::cone::SolverFailure;
+use super::model::Model;
+use super::Bound;
+
+/// One evaluation α(F).
+#[derive(Clone, Debug)]
+pub struct Trial {
+    pub factor: f64,
+    pub multiplier: f64,
+    pub seconds: f64,
+}
+
+/// The factor of safety with its bracket: α(low) ≥ 1 ≥ α(high).
+#[derive(Clone, Debug)]
+pub struct FactorOfSafety {
+    pub factor: f64,
+    pub bracket: [f64; 2],
+    pub trials: Vec<Trial>,
+}
+
+#[derive(Debug)]
+pub enum ReductionError {
+    Solver(f64, SolverFailure),
+    /// α(F) − 1 has the same sign at both ends of the search interval.
+    NotBracketed {
+        low: Trial,
+        high: Trial,
+    },
+}
+
+impl std::fmt::Display for ReductionError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ReductionError::Solver(factor, e) => write!(f, "at F = {factor}: {e}"),
+            ReductionError::NotBracketed { low, high } => write!(
+                f,
+                "the factor of safety is not inside the search interval: α({}) = {:.4}, α({}) = {:.4} (both on the same side of 1)",
+                low.factor, low.multiplier, high.factor, high.multiplier
+            ),
+        }
+    }
+}
+
+impl std::error::Error for ReductionError {}
+
+/// Find F with α(F) = 1 in [low, high] to a bracket narrower than `tolerance`.
+pub fn factor_of_safety(
+    model: &Model,
+    bound: fn(&Model) -> Result<Bound, SolverFailure>,
+    interval: [f64; 2],
+    tolerance: f64,
+) -> Result<FactorOfSafety, ReductionError> {
+    let base = model.strength;
+    let mut trials = Vec::new();
+    let mut eval = |factor: f64| -> Result<Trial, ReductionError> {
+        let b = bound(&model.with_strength(base.reduced(factor)))
+            .map_err(|e| ReductionError::Solver(factor, e))?;
+        let t = Trial {
+            factor,
+            multiplier: b.multiplier,
+            seconds: b.seconds,
+        };
+        trials.push(t.clone());
+        Ok(t)
+    };
+    let g = |t: &Trial| t.multiplier.max(1e-300).ln();
+    // Move the interval (up to four times) until it brackets the root: halve
+    // the low end if α(low) < 1, step the high end up if α(high) > 1.
+    let width = interval[1] - interval[0];
+    let mut a = eval(interval[0])?;
+    let mut b = eval(interval[1])?;
+    for _ in 0..4 {
+        if g(&a) < 0.0 {
+            b = a;
+            a = eval(0.5 * b.factor)?;
+        } else if g(&b) > 0.0 {
+            a = b;
+            b = eval(a.factor + 2.0 * width)?;
+        } else {
+            break;
+        }
+    }
+    if g(&a) < 0.0 || g(&b) > 0.0 {
+        return Err(ReductionError::NotBracketed { low: a, high: b });
+    }
+    let (mut ga, mut gb) = (g(&a), g(&b));
+    let mut side = 0;
+    while b.factor - a.factor > tolerance && ga != 0.0 && gb != 0.0 {
+        let mut f = (a.factor * gb - b.factor * ga) / (gb - ga);
+        // Never step closer than a tenth of the tolerance to an end.
+        let margin = 0.1 * tolerance;
+        f = f.clamp(a.factor + margin, b.factor - margin);
+        let t = eval(f)?;
+        let gt = g(&t);
+        if gt >= 0.0 {
+            a = t;
+            ga = gt;
+            if side == 1 {
+                gb *= 0.5;
+            }
+            side = 1;
+        } else {
+            b = t;
+            gb = gt;
+            if side == -1 {
+                ga *= 0.5;
+            }
+            side = -1;
+        }
+    }
+    let (ga, gb) = (g(&a), g(&b));
+    let factor = if ga == gb {
+        a.factor
+    } else {
+        (a.factor * gb - b.factor * ga) / (gb - ga)
+    };
+    Ok(FactorOfSafety {
+        factor,
+        bracket: [a.factor, b.factor],
+        trials,
+    })
+}
