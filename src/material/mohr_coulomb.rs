@@ -24,7 +24,8 @@
 //! by Newton's method in (Δγ, κ) (one step without softening). The sets are
 //! tried in order — the main plane {1–3}; the edges {1–3, 1–2} (τ_2 = τ_3,
 //! triaxial extension) and {1–3, 2–3} (τ_1 = τ_2, triaxial compression); with a
-//! cut-off, {T}, {T_1, T_2}, {1–3, T}, {1–3, 1–2, T}, {1–3, 2–3, T},
+//! cut-off, {T}, {T_1, T_2}, {1–3, T}, {1–3, T_1, T_2}, {1–3, 1–2, T},
+//! {1–3, 2–3, T},
 //! {T_1, T_2, T_3} — and the first one with Δγ ≥ 0 whose stress keeps the
 //! principal order and satisfies f ≤ 0 and τ_1 ≤ T is taken. The apex
 //! τ = c cot φ I is the last resort (trial beyond it): there the stress is
@@ -105,10 +106,11 @@ const EXTENSION: Surface = Plane(0, 1);
 const COMPRESSION: Surface = Plane(1, 2);
 
 const PYRAMID_SETS: [&[Surface]; 3] = [&[MAIN], &[MAIN, EXTENSION], &[MAIN, COMPRESSION]];
-const CUT_OFF_SETS: [&[Surface]; 6] = [
+const CUT_OFF_SETS: [&[Surface]; 7] = [
     &[Tension(0)],
     &[Tension(0), Tension(1)],
     &[MAIN, Tension(0)],
+    &[MAIN, Tension(0), Tension(1)],
     &[MAIN, EXTENSION, Tension(0)],
     &[MAIN, COMPRESSION, Tension(0)],
     &[Tension(0), Tension(1), Tension(2)],
@@ -473,5 +475,251 @@ impl Material for MohrCoulomb {
 
     fn stress_derivative(&self, inc: &Increment) -> Option<StressDerivative> {
         principal::stress_derivative(self, inc)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::driver;
+    use nalgebra::Vector3;
+    use std::collections::BTreeSet;
+
+    const C: f64 = 1.0e4;
+
+    fn strength(c: f64, phi_deg: f64, psi_deg: f64) -> Strength {
+        Strength {
+            cohesion: c,
+            friction_angle: phi_deg.to_radians(),
+            dilation_angle: psi_deg.to_radians(),
+        }
+    }
+
+    fn model(phi_deg: f64, psi_deg: f64) -> MohrCoulomb {
+        MohrCoulomb {
+            density: 2000.0,
+            youngs_modulus: 2.0e7,
+            poisson_ratio: 0.3,
+            peak: strength(C, phi_deg, psi_deg),
+            softening: None,
+            tensile_strength: None,
+        }
+    }
+
+    fn softening() -> Softening {
+        Softening {
+            residual_cohesion: 0.2 * C,
+            residual_friction_angle: 25f64.to_radians(),
+            residual_dilation_angle: 0.0,
+            start: 0.0,
+            end: 0.05,
+        }
+    }
+
+    fn rotated(d: [f64; 3]) -> Mat3 {
+        let axis = nalgebra::Unit::new_normalize(Vector3::new(0.3, -0.5, 0.8));
+        let r = *nalgebra::Rotation3::from_axis_angle(&axis, 0.3).matrix();
+        r * Mat3::from_diagonal(&Vector3::from(d))
+    }
+
+    fn start(confinement: f64) -> (Mat3, Mat3) {
+        let f_old = driver::rotation_z(0.4)
+            * Mat3::new(1.01, 0.002, 0.0, 0.0, 0.995, 0.001, 0.0, 0.0, 0.998);
+        let dev = Mat3::new(-0.1, 0.05, 0.01, 0.05, 0.1, -0.02, 0.01, -0.02, 0.0);
+        (f_old, (Mat3::identity() + dev * 0.3) * -confinement)
+    }
+
+    /// Where the return ended: elastic, or the active parts (plane, the edges
+    /// τ1 = τ2 and τ2 = τ3, the apex, the cut-off T).
+    fn state(m: &MohrCoulomb, i: &Increment) -> String {
+        let mut h = [0.0];
+        let s = m.update(i, &mut h) * (i.df * i.f_old).determinant();
+        if h[0] == i.history_old[0] {
+            return "elastic".into();
+        }
+        let mut t = nalgebra::SymmetricEigen::new(s).eigenvalues;
+        t.as_mut_slice().sort_by(|a, b| b.total_cmp(a));
+        let tol = 1e-8 * (C + t.amax());
+        let mut parts = Vec::new();
+        if (t[0] - t[2]).abs() < tol {
+            parts.push("apex");
+        } else {
+            if m.yield_function(&t, h[0]).abs() < tol {
+                parts.push("plane");
+            }
+            if (t[0] - t[1]).abs() < tol {
+                parts.push("edge 1=2");
+            }
+            if (t[1] - t[2]).abs() < tol {
+                parts.push("edge 2=3");
+            }
+        }
+        if m.tensile_strength.is_some_and(|cut| (t[0] - cut).abs() < tol) {
+            parts.push("cut-off");
+        }
+        assert!(m.yield_function(&t, h[0]) < tol, "inside the pyramid after the return");
+        parts.join(" + ")
+    }
+
+    /// Tangent against central differences for a set of increments; returns the
+    /// states visited.
+    fn check(m: &MohrCoulomb, name: &str, kappa: f64, confinement: f64, trials: &[[f64; 3]]) -> BTreeSet<String> {
+        let (f_old, s_old) = start(confinement);
+        let history = [kappa];
+        let mut seen = BTreeSet::new();
+        for d in trials {
+            let i = Increment {
+                f_old,
+                df: rotated(*d),
+                dt: 0.0,
+                stress_old: s_old,
+                history_old: &history,
+            };
+            let st = state(m, &i);
+            let e = driver::tangent_error(m, &i, 1e-7);
+            eprintln!("MC {name:<28} {st:<22}: tangent vs FD {e:.2e}");
+            assert!(e < 1e-6, "{name}, {st}, ΔF = {d:?}: tangent vs central FD {e:e} < 1e-6");
+            seen.insert(st);
+        }
+        seen
+    }
+
+    const PYRAMID_TRIALS: [[f64; 3]; 6] = [
+        [1.0 + 2e-5, 1.0 - 1e-5, 1.0],
+        [1.02, 1.0, 0.98],
+        [1.01, 1.01, 0.98],
+        [1.02, 0.99, 0.99],
+        [1.025, 1.0, 0.99],
+        [1.03, 1.02, 1.025],
+    ];
+
+    fn expect(seen: &BTreeSet<String>, wanted: &[&str], name: &str) {
+        for w in wanted {
+            assert!(seen.contains(*w), "{name}: state `{w}` not reached (saw {seen:?})");
+        }
+    }
+
+    #[test]
+    fn tangent_matches_finite_differences_on_plane_edges_and_apex() {
+        let all = ["elastic", "plane", "plane + edge 1=2", "plane + edge 2=3", "apex"];
+        for (phi, psi) in [(30.0, 30.0), (30.0, 10.0), (30.0, 0.0)] {
+            let name = format!("φ = {phi}, ψ = {psi}");
+            let seen = check(&model(phi, psi), &name, 0.0, 1e5, &PYRAMID_TRIALS);
+            expect(&seen, &all, &name);
+        }
+        // Tresca: no apex; the hydrostatic trial stays elastic.
+        let seen = check(&model(0.0, 0.0), "Tresca", 0.0, 1e5, &PYRAMID_TRIALS);
+        expect(&seen, &all[..4], "Tresca");
+    }
+
+    #[test]
+    fn tangent_matches_finite_differences_while_softening() {
+        let mut m = model(30.0, 10.0);
+        m.softening = Some(softening());
+        let all = ["plane", "plane + edge 1=2", "plane + edge 2=3", "apex"];
+        // From the peak (κ = 0, softening starts at once) and mid-way (κ = 0.01).
+        for kappa in [0.0, 0.01] {
+            let name = format!("softening from κ = {kappa}");
+            let seen = check(&m, &name, kappa, 1e5, &PYRAMID_TRIALS);
+            expect(&seen, &all, &name);
+        }
+        // Past the residual strain: the residual strength, constant.
+        let seen = check(&m, "residual", 0.2, 1e5, &PYRAMID_TRIALS);
+        expect(&seen, &all, "residual");
+    }
+
+    #[test]
+    fn tangent_matches_finite_differences_with_tension_cut_off() {
+        let mut m = model(30.0, 10.0);
+        m.tensile_strength = Some(0.5 * C);
+        let trials = [
+            [1.001, 1.0002, 0.9999],
+            [1.001, 1.0009, 0.9999],
+            [1.002, 0.9996, 0.9994],
+            [1.003, 1.003, 0.9985],
+            [1.003, 0.999, 0.999],
+            [1.03, 1.02, 1.025],
+        ];
+        let mut seen = check(&m, "cut-off T = c/2", 0.0, 1e4, &trials);
+        let confined = [[1.01, 1.0, 0.998], [1.01, 1.002, 1.0], [1.01, 1.0, 1.0]];
+        seen.extend(check(&m, "cut-off T = c/2, confined", 0.0, 1e5, &confined));
+        for w in [
+            "cut-off",
+            "edge 1=2 + cut-off",
+            "plane + cut-off",
+            "plane + edge 1=2 + cut-off",
+            "plane + edge 2=3 + cut-off",
+            "apex + cut-off",
+        ] {
+            assert!(seen.contains(w), "cut-off state `{w}` not reached (saw {seen:?})");
+        }
+        m.softening = Some(softening());
+        check(&m, "cut-off with softening", 0.01, 1e4, &trials);
+        check(&m, "cut-off with softening, confined", 0.01, 1e5, &confined);
+    }
+
+    #[test]
+    fn plane_return_closed_form_without_softening() {
+        // De Souza Neto et al. (8.2): Δγ = f^tr / a with
+        // a = 4G(1 + sin φ sin ψ/3) + 4K sin φ sin ψ (our own derivation, same result).
+        let m = model(30.0, 10.0);
+        let el = m.elastic();
+        let eps = Vector3::new(0.004, 0.0005, -0.005);
+        let mut h = [0.0];
+        let ret = m.return_map(&eps, &[0.0], &mut h);
+        let tau_tr = el.stress(&eps);
+        let (sp, sq) = (m.peak.friction_angle.sin(), m.peak.dilation_angle.sin());
+        let a = 4.0 * el.mu * (1.0 + sp * sq / 3.0) + 4.0 * el.bulk() * sp * sq;
+        let dg = m.yield_function(&tau_tr, 0.0) / a;
+        let n = Vector3::new(1.0 + sq, 0.0, -(1.0 - sq));
+        let expect = tau_tr - el.stiffness() * n * dg;
+        assert!((ret.tau - expect).norm() < 1e-9 * expect.norm(), "plane return in closed form");
+        let dev = n - Principal::repeat(n.sum() / 3.0);
+        let dk = dg * (2.0 / 3.0 * dev.norm_squared()).sqrt();
+        assert!((h[0] - dk).abs() < 1e-15, "Δε̄p = √(2/3)|dev Δεp|");
+    }
+
+    /// Trial strains over all of principal space (deterministic pseudo-random
+    /// sample, volumetric and deviatoric parts up to 5 %): every return must end
+    /// inside the pyramid and below the cut-off, in the principal order of the
+    /// trial.
+    #[test]
+    fn every_return_is_admissible() {
+        let mut seed: u64 = 0x2545_f491_4f6c_dd1d;
+        let mut uniform = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let mut variants = vec![model(30.0, 10.0), model(30.0, 0.0), model(0.0, 0.0), model(40.0, 40.0)];
+        let mut soft = model(30.0, 10.0);
+        soft.softening = Some(softening());
+        variants.push(soft);
+        for mut m in variants.clone() {
+            m.tensile_strength = Some(0.3 * C);
+            variants.push(m);
+        }
+        let el = variants[0].elastic();
+        let mut count = 0;
+        for m in &variants {
+            for _ in 0..2000 {
+                let eps = Vector3::new(uniform(), uniform(), uniform()) * 0.05;
+                let kappa = 0.03 * (uniform() + 1.0);
+                let mut h = [0.0];
+                let ret = m.return_map(&eps, &[kappa], &mut h);
+                let mut order = [0, 1, 2];
+                order.sort_by(|&a, &b| eps[b].total_cmp(&eps[a]));
+                let t = Vector3::from_fn(|i, _| ret.tau[order[i]]);
+                let scale = el.stress(&eps).amax() + C;
+                let tol = 1e-9 * scale;
+                assert!(t[0] >= t[1] - tol && t[1] >= t[2] - tol, "principal order kept");
+                assert!(m.yield_function(&t, h[0]) <= tol, "f ≤ 0 after the return: {m:?} ε = {eps:?}");
+                assert!(m.tensile_strength.is_none_or(|cut| t[0] <= cut + tol), "τ1 ≤ T after the return");
+                assert!(h[0] >= kappa, "ε̄p never decreases");
+                count += 1;
+            }
+        }
+        eprintln!("{count} sampled returns admissible");
     }
 }
