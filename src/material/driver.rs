@@ -69,6 +69,10 @@ pub struct StressControl {
     pub target: f64,
     /// The component (k, l) of ΔF that is solved for.
     pub free: (usize, usize),
+    /// Another component of ΔF kept equal to the free one (axisymmetry: ΔF_yy =
+    /// ΔF_xx in a triaxial test, where two separate controls would be singular on
+    /// the Mohr–Coulomb edge σ_xx = σ_yy).
+    pub mirror: Option<(usize, usize)>,
 }
 
 /// A mixed-control run: the response and, per increment, the scaled residual
@@ -135,14 +139,17 @@ pub fn run_mixed<M: Material + ?Sized>(
                 .unwrap_or_else(|| numerical_stress_derivative(material, &inc, 1e-7));
             let jac = nalgebra::DMatrix::from_fn(n, n, |m, j| {
                 let (a, b) = controls[m].stress;
-                let (c, e) = controls[j].free;
-                d[(3 * a + b, 3 * c + e)]
+                let column = |(c, e): (usize, usize)| d[(3 * a + b, 3 * c + e)];
+                column(controls[j].free) + controls[j].mirror.map_or(0.0, column)
             });
             let Some(dx) = jac.lu().solve(&(-r)) else {
                 break None;
             };
             for (c, x) in controls.iter().zip(dx.iter()) {
                 df[c.free] += x;
+                if let Some(m) = c.mirror {
+                    df[m] += x;
+                }
             }
         };
         let Some(s) = converged else {
