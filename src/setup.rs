@@ -194,7 +194,9 @@ fn material(m: &MaterialConfig) -> Box<dyn Material> {
         MaterialModel::MohrCoulomb => {
             let peak = peak_strength(m);
             let softening = m.softening_start.map(|start| {
-                let phi_r = m.residual_friction_angle.unwrap_or(m.friction_angle.unwrap());
+                let phi_r = m
+                    .residual_friction_angle
+                    .unwrap_or(m.friction_angle.unwrap());
                 Softening {
                     residual_cohesion: m.residual_cohesion.unwrap_or(peak.cohesion),
                     residual_friction_angle: phi_r.to_radians(),

@@ -11,8 +11,8 @@
 //! printed "small-strain" values are the formulas with J = 1.
 
 use mpm::dim::Mat3;
-use mpm::material::drucker_prager::{Cone, MohrCoulombFit};
 use mpm::material::driver::{run_mixed, MixedResponse, StressControl};
+use mpm::material::drucker_prager::{Cone, MohrCoulombFit};
 use mpm::material::mohr_coulomb::{Softening, Strength};
 use mpm::material::principal::Elasticity;
 use mpm::material::{DruckerPrager, Material, MohrCoulomb};
@@ -134,7 +134,12 @@ fn plastic_increment(resp: &MixedResponse, n: usize) -> [f64; 3] {
 
 #[test]
 fn mohr_coulomb_triaxial_compression_and_extension() {
-    for (c, phi_deg, psi_deg) in [(C, 30.0, 10.0), (0.0, 35.0, 35.0), (C, 0.0, 0.0), (C, 20.0, 0.0)] {
+    for (c, phi_deg, psi_deg) in [
+        (C, 30.0, 10.0),
+        (0.0, 35.0, 35.0),
+        (C, 0.0, 0.0),
+        (C, 20.0, 0.0),
+    ] {
         let m = mc(c, phi_deg, psi_deg);
         let (phi, psi) = (f64::to_radians(phi_deg), f64::to_radians(psi_deg));
         let resp = triaxial(&m, -0.06, 60);
@@ -166,7 +171,10 @@ fn mohr_coulomb_triaxial_compression_and_extension() {
         let d = plastic_increment(&resp, 10);
         let ratio = (d[0] + d[1] + d[2]) / d[2];
         let expect = 2.0 * psi.sin() / (1.0 + psi.sin());
-        assert!((ratio - expect).abs() < 1e-8, "extension dilatancy {ratio} vs {expect}");
+        assert!(
+            (ratio - expect).abs() < 1e-8,
+            "extension dilatancy {ratio} vs {expect}"
+        );
     }
 }
 
@@ -174,7 +182,11 @@ fn mohr_coulomb_triaxial_compression_and_extension() {
 fn drucker_prager_triaxial_limits_match_the_fitted_vertices() {
     for (phi_deg, psi_deg) in [(30.0, 10.0), (25.0, 25.0), (30.0, 0.0)] {
         let (phi, psi) = (f64::to_radians(phi_deg), f64::to_radians(psi_deg));
-        for fit in [MohrCoulombFit::Outer, MohrCoulombFit::Inner, MohrCoulombFit::PlaneStrain] {
+        for fit in [
+            MohrCoulombFit::Outer,
+            MohrCoulombFit::Inner,
+            MohrCoulombFit::PlaneStrain,
+        ] {
             let m = dp(fit, phi_deg, psi_deg);
             let cone = Cone::fit(fit, C, phi, psi);
             let resp = triaxial(&m, -0.06, 60);
@@ -182,7 +194,8 @@ fn drucker_prager_triaxial_limits_match_the_fitted_vertices() {
             let j = resp.response.f.last().unwrap().determinant();
             let q = s[(0, 0)] - s[(2, 2)];
             // q + 3α σ_m = σ_Y with σ_m = −σ_c − q/3 (Kirchhoff: × J).
-            let expect = (cone.yield_stress / j + 3.0 * cone.alpha * CONFINING) / (1.0 - cone.alpha);
+            let expect =
+                (cone.yield_stress / j + 3.0 * cone.alpha * CONFINING) / (1.0 - cone.alpha);
             let e = rel(q, expect);
             eprintln!("DP {fit:?} compression φ = {phi_deg} ψ = {psi_deg}: q = {q:.6e}, closed form {expect:.6e}, rel. error {e:.1e}");
             assert!(e < 1e-9, "DP triaxial compression limit to 1e-9");
@@ -194,12 +207,16 @@ fn drucker_prager_triaxial_limits_match_the_fitted_vertices() {
             let d = plastic_increment(&resp, 10);
             let ratio = (d[0] + d[1] + d[2]) / d[2];
             let expect = -3.0 * cone.beta / (1.0 - cone.beta);
-            assert!((ratio - expect).abs() < 1e-8, "DP dilatancy {ratio} vs {expect}");
+            assert!(
+                (ratio - expect).abs() < 1e-8,
+                "DP dilatancy {ratio} vs {expect}"
+            );
             let resp = triaxial(&m, 0.06, 60);
             let s = resp.response.stress.last().unwrap();
             let j = resp.response.f.last().unwrap().determinant();
             let q = s[(2, 2)] - s[(0, 0)];
-            let expect = (cone.yield_stress / j + 3.0 * cone.alpha * CONFINING) / (1.0 + cone.alpha);
+            let expect =
+                (cone.yield_stress / j + 3.0 * cone.alpha * CONFINING) / (1.0 + cone.alpha);
             let e = rel(q, expect);
             eprintln!("DP {fit:?} extension   φ = {phi_deg} ψ = {psi_deg}: q = {q:.6e}, closed form {expect:.6e}, rel. error {e:.1e}");
             assert!(e < 1e-9, "DP triaxial extension limit to 1e-9");
@@ -224,7 +241,10 @@ fn simple_shear_limits_for_associated_and_non_dilatant_flow() {
         let psi = f64::to_radians(psi_deg);
         let models: [(&str, Box<dyn Material>); 2] = [
             ("MC", Box::new(mc(C, phi_deg, psi_deg))),
-            ("DP plane strain", Box::new(dp(MohrCoulombFit::PlaneStrain, phi_deg, psi_deg))),
+            (
+                "DP plane strain",
+                Box::new(dp(MohrCoulombFit::PlaneStrain, phi_deg, psi_deg)),
+            ),
         ];
         for (name, m) in models {
             let resp = simple_shear(m.as_ref(), 0.05, 100);
@@ -232,7 +252,8 @@ fn simple_shear_limits_for_associated_and_non_dilatant_flow() {
             let j = f.determinant();
             let tau = resp.response.stress.last().unwrap() * j;
             let normal = -CONFINING * j;
-            let expect = psi.cos() * (C * phi.cos() - normal * phi.sin()) / (1.0 - phi.sin() * psi.sin());
+            let expect =
+                psi.cos() * (C * phi.cos() - normal * phi.sin()) / (1.0 - phi.sin() * psi.sin());
             let e = rel(tau[(0, 1)], expect);
             eprintln!(
                 "{name} simple shear φ = {phi_deg} ψ = {psi_deg}: τ_xy = {:.6e}, Davis limit {expect:.6e}, rel. error {e:.1e} (J = {j:.5}, max Newton residual history {:?})",
@@ -244,12 +265,18 @@ fn simple_shear_limits_for_associated_and_non_dilatant_flow() {
             // shear strain at the limit (observed: the error falls from 1.7e-3 to
             // 2.8e-4 when E is raised tenfold, ψ = 0).
             let gamma_e = expect / Elasticity::new(E, NU).mu;
-            assert!(e < gamma_e, "{name} ψ = {psi_deg}: simple-shear limit to γ_e = {gamma_e:.1e}, got {e:e}");
+            assert!(
+                e < gamma_e,
+                "{name} ψ = {psi_deg}: simple-shear limit to γ_e = {gamma_e:.1e}, got {e:e}"
+            );
             limits.push(tau[(0, 1)]);
         }
     }
     let (assoc, nondil) = (limits[0], limits[2]);
-    assert!(assoc > 1.1 * nondil, "ψ = φ carries more shear than ψ = 0 ({assoc:e} vs {nondil:e})");
+    assert!(
+        assoc > 1.1 * nondil,
+        "ψ = φ carries more shear than ψ = 0 ({assoc:e} vs {nondil:e})"
+    );
 }
 
 /// Softening path: c, φ, ψ fall from peak to residual with ε̄p; the deviator
@@ -276,7 +303,10 @@ fn mohr_coulomb_softening_triaxial_ends_at_the_residual_strength() {
         if kappa > r.history[k - 1][0] {
             let (st, _) = m.strength(kappa);
             let expect = mc_compression(st.cohesion, st.friction_angle, j);
-            assert!(rel(q, expect) < 1e-9, "on the current yield surface at ε̄p = {kappa}");
+            assert!(
+                rel(q, expect) < 1e-9,
+                "on the current yield surface at ε̄p = {kappa}"
+            );
         }
     }
     let kappa = r.history.last().unwrap()[0];
@@ -291,8 +321,14 @@ fn mohr_coulomb_softening_triaxial_ends_at_the_residual_strength() {
         "MC softening: peak q = {peak:.6e} (closed form {peak_form:.6e}), final q = {q:.6e} at ε̄p = {kappa:.4}, residual closed form {residual:.6e}"
     );
     assert!(kappa > 0.04, "the path passes the residual strain");
-    assert!(rel(q, residual) < 1e-9, "ends at the residual strength to 1e-9");
-    assert!(rel(peak, peak_form) < 5e-3, "peak within 0.5 % of the closed form");
+    assert!(
+        rel(q, residual) < 1e-9,
+        "ends at the residual strength to 1e-9"
+    );
+    assert!(
+        rel(peak, peak_form) < 5e-3,
+        "peak within 0.5 % of the closed form"
+    );
     let iterations: usize = resp.residuals.iter().map(|r| r.len() - 1).max().unwrap();
     assert!(iterations <= 6, "mixed-control Newton with the consistent tangent: ≤ 6 iterations per increment, got {iterations}");
 }

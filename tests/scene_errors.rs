@@ -252,17 +252,62 @@ fn the_geomaterial_scene_is_valid() {
 #[test]
 fn geomaterial_parameters_out_of_range() {
     let cases = [
-        ("friction_angle = 30.0", "friction_angle = 95.0", "scene.toml:15:18", "material.0.friction_angle", "[0, 90)"),
-        ("dilation_angle = 10.0", "dilation_angle = 35.0", "scene.toml:16:18", "material.0.dilation_angle", "friction_angle = 30"),
-        ("cohesion = 1.0e4\nfriction_angle = 30.0\ndilation", "cohesion = -1.0\nfriction_angle = 30.0\ndilation", "scene.toml:14:12", "material.0.cohesion", "negative cohesion"),
-        ("residual_cohesion = 2.0e3", "residual_cohesion = 2.0e4", "scene.toml:17:21", "material.0.residual_cohesion", "residual no larger than peak"),
-        ("residual_friction_angle = 25.0", "residual_friction_angle = 31.0", "scene.toml:18:27", "material.0.residual_friction_angle", "residual no larger than peak"),
-        ("softening_end = 0.05", "softening_end = 0.0", "scene.toml:20:17", "material.0.softening_end", "must exceed softening_start"),
-        ("tensile_strength = 1.0e3", "tensile_strength = -1.0", "scene.toml:21:20", "material.0.tensile_strength", "≥ 0"),
+        (
+            "friction_angle = 30.0",
+            "friction_angle = 95.0",
+            "scene.toml:15:18",
+            "material.0.friction_angle",
+            "[0, 90)",
+        ),
+        (
+            "dilation_angle = 10.0",
+            "dilation_angle = 35.0",
+            "scene.toml:16:18",
+            "material.0.dilation_angle",
+            "friction_angle = 30",
+        ),
+        (
+            "cohesion = 1.0e4\nfriction_angle = 30.0\ndilation",
+            "cohesion = -1.0\nfriction_angle = 30.0\ndilation",
+            "scene.toml:14:12",
+            "material.0.cohesion",
+            "negative cohesion",
+        ),
+        (
+            "residual_cohesion = 2.0e3",
+            "residual_cohesion = 2.0e4",
+            "scene.toml:17:21",
+            "material.0.residual_cohesion",
+            "residual no larger than peak",
+        ),
+        (
+            "residual_friction_angle = 25.0",
+            "residual_friction_angle = 31.0",
+            "scene.toml:18:27",
+            "material.0.residual_friction_angle",
+            "residual no larger than peak",
+        ),
+        (
+            "softening_end = 0.05",
+            "softening_end = 0.0",
+            "scene.toml:20:17",
+            "material.0.softening_end",
+            "must exceed softening_start",
+        ),
+        (
+            "tensile_strength = 1.0e3",
+            "tensile_strength = -1.0",
+            "scene.toml:21:20",
+            "material.0.tensile_strength",
+            "≥ 0",
+        ),
     ];
     for (from, to, at, key, msg) in cases {
         let e = err(&GEO.replacen(from, to, 1));
-        assert!(e.contains(at) && e.contains(&format!("key `{key}`")) && e.contains(msg), "{e}");
+        assert!(
+            e.contains(at) && e.contains(&format!("key `{key}`")) && e.contains(msg),
+            "{e}"
+        );
     }
 }
 
@@ -293,6 +338,9 @@ fn geomaterial_keys_of_the_other_model_and_missing_keys() {
         e.contains("key `material.0.softening_start`") && e.contains("strain softening"),
         "{e}"
     );
-    let e = err(&GEO.replace("cohesion = 1.0e4\nfriction_angle = 30.0\ndilation_angle = 10.0", "cohesion = 0.0\nfriction_angle = 0.0\ndilation_angle = 0.0"));
+    let e = err(&GEO.replace(
+        "cohesion = 1.0e4\nfriction_angle = 30.0\ndilation_angle = 10.0",
+        "cohesion = 0.0\nfriction_angle = 0.0\ndilation_angle = 0.0",
+    ));
     assert!(e.contains("no strength"), "{e}");
 }

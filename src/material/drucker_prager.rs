@@ -166,11 +166,12 @@ impl ReturnMapping for DruckerPrager {
         let ratio = q / q_trial;
         let sm = sm_trial - 3.0 * beta * k * dl; // (3-55)
         let tau = s_trial * ratio + one * sm; // (3-57)
-        // Tangent: differentiate Δλ, q/q* and σ_m with respect to ε^tr.
+                                              // Tangent: differentiate Δλ, q/q* and σ_m with respect to ε^tr.
         let dq_trial = s_trial * (3.0 * g / q_trial);
         let d_dl = (dq_trial + one * (3.0 * alpha * k)) / denominator;
         let d_ratio = d_dl * (-3.0 * g / q_trial) + dq_trial * (3.0 * g * dl / (q_trial * q_trial));
-        let deviatoric_projector = PrincipalTangent::identity() - PrincipalTangent::repeat(1.0 / 3.0);
+        let deviatoric_projector =
+            PrincipalTangent::identity() - PrincipalTangent::repeat(1.0 / 3.0);
         let d_sm = one * k - d_dl * (3.0 * beta * k);
         let tangent = s_trial * d_ratio.transpose()
             + deviatoric_projector * (2.0 * g * ratio)
@@ -259,8 +260,14 @@ mod tests {
                 let inner = model(MohrCoulombFit::Inner, phi_deg, 0.0);
                 let fo = yield_value(&outer, &comp) / C;
                 let fi = yield_value(&inner, &ext) / C;
-                assert!(fo.abs() < 1e-12, "outer cone through the compression vertex (φ = {phi_deg}°): {fo:e}");
-                assert!(fi.abs() < 1e-12, "inner cone through the extension vertex (φ = {phi_deg}°): {fi:e}");
+                assert!(
+                    fo.abs() < 1e-12,
+                    "outer cone through the compression vertex (φ = {phi_deg}°): {fo:e}"
+                );
+                assert!(
+                    fi.abs() < 1e-12,
+                    "inner cone through the extension vertex (φ = {phi_deg}°): {fi:e}"
+                );
                 // The outer cone contains the extension vertex, the inner one lies inside the compression vertex.
                 if phi_deg > 0.0 {
                     assert!(yield_value(&outer, &ext) < 0.0 && yield_value(&inner, &comp) > 0.0);
@@ -292,12 +299,20 @@ mod tests {
     fn start() -> (Mat3, Mat3) {
         let r = driver::rotation_z(0.4);
         let f_old = r * Mat3::new(1.01, 0.002, 0.0, 0.0, 0.995, 0.001, 0.0, 0.0, 0.998);
-        let s = Mat3::new(-1.2e5, 8.0e3, 1.0e3, 8.0e3, -0.9e5, -2.0e3, 1.0e3, -2.0e3, -1.0e5);
+        let s = Mat3::new(
+            -1.2e5, 8.0e3, 1.0e3, 8.0e3, -0.9e5, -2.0e3, 1.0e3, -2.0e3, -1.0e5,
+        );
         (f_old, s)
     }
 
     fn inc<'a>(f_old: Mat3, stress_old: Mat3, df: Mat3, history: &'a [f64]) -> Increment<'a> {
-        Increment { f_old, df, dt: 0.0, stress_old, history_old: history }
+        Increment {
+            f_old,
+            df,
+            dt: 0.0,
+            stress_old,
+            history_old: history,
+        }
     }
 
     fn rotated(d: [f64; 3]) -> Mat3 {
@@ -316,7 +331,10 @@ mod tests {
         } else if (eig.max() - eig.min()).abs() < 1e-9 * eig.amax() {
             "apex"
         } else {
-            assert!(yield_value(m, &eig).abs() < 1e-8 * C, "on the cone after the return");
+            assert!(
+                yield_value(m, &eig).abs() < 1e-8 * C,
+                "on the cone after the return"
+            );
             "cone"
         }
     }
@@ -331,7 +349,11 @@ mod tests {
             ("apex", [1.03, 1.02, 1.025]),
         ];
         let history = [0.01];
-        for fit in [MohrCoulombFit::Outer, MohrCoulombFit::Inner, MohrCoulombFit::PlaneStrain] {
+        for fit in [
+            MohrCoulombFit::Outer,
+            MohrCoulombFit::Inner,
+            MohrCoulombFit::PlaneStrain,
+        ] {
             for (phi, psi) in [(30.0, 30.0), (30.0, 0.0), (25.0, 10.0), (0.0, 0.0)] {
                 let mut m = model(fit, phi, psi);
                 if phi == 0.0 {
@@ -346,8 +368,13 @@ mod tests {
                         assert_eq!(got, expect, "{fit:?} φ = {phi}, ψ = {psi}, ΔF = {d:?}");
                     }
                     let e = driver::tangent_error(&m, &i, 1e-7);
-                    eprintln!("DP {fit:?} φ = {phi:>4} ψ = {psi:>4} {got:>7}: tangent vs FD {e:.2e}");
-                    assert!(e < 1e-6, "{fit:?} φ = {phi} ψ = {psi} {got}: tangent vs central FD {e:e} < 1e-6");
+                    eprintln!(
+                        "DP {fit:?} φ = {phi:>4} ψ = {psi:>4} {got:>7}: tangent vs FD {e:.2e}"
+                    );
+                    assert!(
+                        e < 1e-6,
+                        "{fit:?} φ = {phi} ψ = {psi} {got}: tangent vs central FD {e:e} < 1e-6"
+                    );
                 }
             }
         }
@@ -367,10 +394,18 @@ mod tests {
         let sm_t = k * eps.sum();
         let s_t = (eps - Principal::repeat(eps.sum() / 3.0)) * 2.0 * g;
         let q_t = equivalent(&s_t);
-        let dl = (q_t + 3.0 * cone.alpha * sm_t - cone.yield_stress) / (3.0 * g + 9.0 * cone.alpha * cone.beta * k);
-        let expect = s_t * ((q_t - 3.0 * g * dl) / q_t) + Principal::repeat(sm_t - 3.0 * cone.beta * k * dl);
-        assert!((ret.tau - expect).norm() < 1e-9 * expect.norm(), "τ from (3-55)…(3-59)");
+        let dl = (q_t + 3.0 * cone.alpha * sm_t - cone.yield_stress)
+            / (3.0 * g + 9.0 * cone.alpha * cone.beta * k);
+        let expect =
+            s_t * ((q_t - 3.0 * g * dl) / q_t) + Principal::repeat(sm_t - 3.0 * cone.beta * k * dl);
+        assert!(
+            (ret.tau - expect).norm() < 1e-9 * expect.norm(),
+            "τ from (3-55)…(3-59)"
+        );
         assert!((h[0] - dl).abs() < 1e-15, "Δε̄p = Δλ (3-60)");
-        assert!(yield_value(&m, &ret.tau).abs() < 1e-8 * C, "f = 0 after the return");
+        assert!(
+            yield_value(&m, &ret.tau).abs() < 1e-8 * C,
+            "f = 0 after the return"
+        );
     }
 }

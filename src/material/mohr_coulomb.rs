@@ -554,16 +554,27 @@ mod tests {
                 parts.push("edge 2=3");
             }
         }
-        if m.tensile_strength.is_some_and(|cut| (t[0] - cut).abs() < tol) {
+        if m.tensile_strength
+            .is_some_and(|cut| (t[0] - cut).abs() < tol)
+        {
             parts.push("cut-off");
         }
-        assert!(m.yield_function(&t, h[0]) < tol, "inside the pyramid after the return");
+        assert!(
+            m.yield_function(&t, h[0]) < tol,
+            "inside the pyramid after the return"
+        );
         parts.join(" + ")
     }
 
     /// Tangent against central differences for a set of increments; returns the
     /// states visited.
-    fn check(m: &MohrCoulomb, name: &str, kappa: f64, confinement: f64, trials: &[[f64; 3]]) -> BTreeSet<String> {
+    fn check(
+        m: &MohrCoulomb,
+        name: &str,
+        kappa: f64,
+        confinement: f64,
+        trials: &[[f64; 3]],
+    ) -> BTreeSet<String> {
         let (f_old, s_old) = start(confinement);
         let history = [kappa];
         let mut seen = BTreeSet::new();
@@ -578,7 +589,10 @@ mod tests {
             let st = state(m, &i);
             let e = driver::tangent_error(m, &i, 1e-7);
             eprintln!("MC {name:<28} {st:<22}: tangent vs FD {e:.2e}");
-            assert!(e < 1e-6, "{name}, {st}, ΔF = {d:?}: tangent vs central FD {e:e} < 1e-6");
+            assert!(
+                e < 1e-6,
+                "{name}, {st}, ΔF = {d:?}: tangent vs central FD {e:e} < 1e-6"
+            );
             seen.insert(st);
         }
         seen
@@ -595,13 +609,22 @@ mod tests {
 
     fn expect(seen: &BTreeSet<String>, wanted: &[&str], name: &str) {
         for w in wanted {
-            assert!(seen.contains(*w), "{name}: state `{w}` not reached (saw {seen:?})");
+            assert!(
+                seen.contains(*w),
+                "{name}: state `{w}` not reached (saw {seen:?})"
+            );
         }
     }
 
     #[test]
     fn tangent_matches_finite_differences_on_plane_edges_and_apex() {
-        let all = ["elastic", "plane", "plane + edge 1=2", "plane + edge 2=3", "apex"];
+        let all = [
+            "elastic",
+            "plane",
+            "plane + edge 1=2",
+            "plane + edge 2=3",
+            "apex",
+        ];
         for (phi, psi) in [(30.0, 30.0), (30.0, 10.0), (30.0, 0.0)] {
             let name = format!("φ = {phi}, ψ = {psi}");
             let seen = check(&model(phi, psi), &name, 0.0, 1e5, &PYRAMID_TRIALS);
@@ -651,7 +674,10 @@ mod tests {
             "plane + edge 2=3 + cut-off",
             "apex + cut-off",
         ] {
-            assert!(seen.contains(w), "cut-off state `{w}` not reached (saw {seen:?})");
+            assert!(
+                seen.contains(w),
+                "cut-off state `{w}` not reached (saw {seen:?})"
+            );
         }
         m.softening = Some(softening());
         check(&m, "cut-off with softening", 0.01, 1e4, &trials);
@@ -673,7 +699,10 @@ mod tests {
         let dg = m.yield_function(&tau_tr, 0.0) / a;
         let n = Vector3::new(1.0 + sq, 0.0, -(1.0 - sq));
         let expect = tau_tr - el.stiffness() * n * dg;
-        assert!((ret.tau - expect).norm() < 1e-9 * expect.norm(), "plane return in closed form");
+        assert!(
+            (ret.tau - expect).norm() < 1e-9 * expect.norm(),
+            "plane return in closed form"
+        );
         let dev = n - Principal::repeat(n.sum() / 3.0);
         let dk = dg * (2.0 / 3.0 * dev.norm_squared()).sqrt();
         assert!((h[0] - dk).abs() < 1e-15, "Δε̄p = √(2/3)|dev Δεp|");
@@ -692,7 +721,12 @@ mod tests {
             seed ^= seed << 17;
             (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
         };
-        let mut variants = vec![model(30.0, 10.0), model(30.0, 0.0), model(0.0, 0.0), model(40.0, 40.0)];
+        let mut variants = vec![
+            model(30.0, 10.0),
+            model(30.0, 0.0),
+            model(0.0, 0.0),
+            model(40.0, 40.0),
+        ];
         let mut soft = model(30.0, 10.0);
         soft.softening = Some(softening());
         variants.push(soft);
@@ -713,9 +747,18 @@ mod tests {
                 let t = Vector3::from_fn(|i, _| ret.tau[order[i]]);
                 let scale = el.stress(&eps).amax() + C;
                 let tol = 1e-9 * scale;
-                assert!(t[0] >= t[1] - tol && t[1] >= t[2] - tol, "principal order kept");
-                assert!(m.yield_function(&t, h[0]) <= tol, "f ≤ 0 after the return: {m:?} ε = {eps:?}");
-                assert!(m.tensile_strength.is_none_or(|cut| t[0] <= cut + tol), "τ1 ≤ T after the return");
+                assert!(
+                    t[0] >= t[1] - tol && t[1] >= t[2] - tol,
+                    "principal order kept"
+                );
+                assert!(
+                    m.yield_function(&t, h[0]) <= tol,
+                    "f ≤ 0 after the return: {m:?} ε = {eps:?}"
+                );
+                assert!(
+                    m.tensile_strength.is_none_or(|cut| t[0] <= cut + tol),
+                    "τ1 ≤ T after the return"
+                );
                 assert!(h[0] >= kappa, "ε̄p never decreases");
                 count += 1;
             }

@@ -89,8 +89,12 @@ pub trait ReturnMapping {
 
     /// Principal Kirchhoff stresses for the trial principal elastic strains
     /// `eps_trial` (any order), with ∂τ_a/∂ε_b; writes the new history.
-    fn return_map(&self, eps_trial: &Principal, history_old: &[f64], history_new: &mut [f64])
-        -> Return;
+    fn return_map(
+        &self,
+        eps_trial: &Principal,
+        history_old: &[f64],
+        history_new: &mut [f64],
+    ) -> Return;
 }
 
 /// The trial elastic state of an increment.
@@ -113,14 +117,13 @@ impl Trial {
         // b_e,old − I = exp(2 ε_e,old) − I, exact at zero stress.
         let eps_old = SymmetricEigen::new(el.strain_of_stress(&(inc.stress_old * j_old)));
         let v = eps_old.eigenvectors;
-        let be_old_minus_i =
-            v * Mat3::from_diagonal(&eps_old.eigenvalues.map(|e| (2.0 * e).exp_m1())) * v.transpose();
+        let be_old_minus_i = v
+            * Mat3::from_diagonal(&eps_old.eigenvalues.map(|e| (2.0 * e).exp_m1()))
+            * v.transpose();
         // b_e^tr − I = ΔF (b_e,old − I) ΔFᵀ + (ΔF ΔFᵀ − I), without cancellation.
         let h = inc.df - Mat3::identity();
-        let btr_minus_i = inc.df * be_old_minus_i * inc.df.transpose()
-            + h
-            + h.transpose()
-            + h * h.transpose();
+        let btr_minus_i =
+            inc.df * be_old_minus_i * inc.df.transpose() + h + h.transpose() + h * h.transpose();
         let eig = SymmetricEigen::new(btr_minus_i);
         let m = eig.eigenvalues;
         Trial {
@@ -262,19 +265,35 @@ mod tests {
         let m = elastic();
         let path = driver::from_fn(30, |t| {
             driver::rotation_z(0.7 * t)
-                * Mat3::new(1.0 + 0.3 * t, 0.2 * t, 0.0, -0.1 * t, 1.0 - 0.2 * t, 0.05 * t, 0.0, 0.0, 1.0 + 0.1 * t)
+                * Mat3::new(
+                    1.0 + 0.3 * t,
+                    0.2 * t,
+                    0.0,
+                    -0.1 * t,
+                    1.0 - 0.2 * t,
+                    0.05 * t,
+                    0.0,
+                    0.0,
+                    1.0 + 0.1 * t,
+                )
         });
         let resp = driver::run(&m, &path, 0.0);
         for (f, s) in resp.f.iter().zip(&resp.stress) {
             let h = m.1.cauchy(f);
             let e = (s - h).norm() / h.norm().max(1.0);
-            assert!(e < 1e-10, "stress from the carried elastic state = Hencky σ(F) to 1e-10: {e:e}");
+            assert!(
+                e < 1e-10,
+                "stress from the carried elastic state = Hencky σ(F) to 1e-10: {e:e}"
+            );
         }
         let f = resp.f.last().unwrap();
         let s = resp.stress.last().unwrap();
         let e_plastic = m.strain_energy_density(f, s, &[]);
         let e_hencky = m.1.strain_energy_density(f, s, &[]);
-        assert!((e_plastic - e_hencky).abs() < 1e-10 * e_hencky, "stored energy = Hencky W/J");
+        assert!(
+            (e_plastic - e_hencky).abs() < 1e-10 * e_hencky,
+            "stored energy = Hencky W/J"
+        );
     }
 
     #[test]
@@ -284,10 +303,25 @@ mod tests {
         let s_old = m.1.cauchy(&f_old);
         let r = driver::rotation_z(0.2);
         let cases = [
-            ("generic", f_old, s_old, r * Mat3::new(1.02, 0.03, 0.01, -0.01, 0.99, 0.02, 0.0, 0.01, 1.01)),
+            (
+                "generic",
+                f_old,
+                s_old,
+                r * Mat3::new(1.02, 0.03, 0.01, -0.01, 0.99, 0.02, 0.0, 0.01, 1.01),
+            ),
             ("ΔF = I", f_old, s_old, Mat3::identity()),
-            ("unstressed, ΔF = I", Mat3::identity(), Mat3::zeros(), Mat3::identity()),
-            ("hydrostatic", Mat3::identity() * 1.1, m.1.cauchy(&(Mat3::identity() * 1.1)), Mat3::identity() * 0.95),
+            (
+                "unstressed, ΔF = I",
+                Mat3::identity(),
+                Mat3::zeros(),
+                Mat3::identity(),
+            ),
+            (
+                "hydrostatic",
+                Mat3::identity() * 1.1,
+                m.1.cauchy(&(Mat3::identity() * 1.1)),
+                Mat3::identity() * 0.95,
+            ),
         ];
         for (name, f, s, df) in cases {
             let i = inc(f, s, df);
@@ -298,7 +332,10 @@ mod tests {
             let e_fd = (exact - fd).norm() / exact.norm();
             eprintln!("elastic return tangent, {name}: vs Hencky {e_h:e}, vs FD {e_fd:e}");
             assert!(e_h < 1e-9, "{name}: tangent = Hencky's to 1e-9 ({e_h:e})");
-            assert!(e_fd < 1e-6, "{name}: tangent vs central FD to 1e-6 ({e_fd:e})");
+            assert!(
+                e_fd < 1e-6,
+                "{name}: tangent vs central FD to 1e-6 ({e_fd:e})"
+            );
         }
     }
 }

@@ -196,8 +196,14 @@ fn optional_keys(m: &MaterialConfig) -> [(&'static str, bool); 13] {
         ("dilation_angle", m.dilation_angle.is_some()),
         ("mohr_coulomb_fit", m.mohr_coulomb_fit.is_some()),
         ("residual_cohesion", m.residual_cohesion.is_some()),
-        ("residual_friction_angle", m.residual_friction_angle.is_some()),
-        ("residual_dilation_angle", m.residual_dilation_angle.is_some()),
+        (
+            "residual_friction_angle",
+            m.residual_friction_angle.is_some(),
+        ),
+        (
+            "residual_dilation_angle",
+            m.residual_dilation_angle.is_some(),
+        ),
         ("softening_start", m.softening_start.is_some()),
         ("softening_end", m.softening_end.is_some()),
         ("tensile_strength", m.tensile_strength.is_some()),
