@@ -413,7 +413,11 @@ impl MohrCoulomb {
             return self.apex(eps, kappa_old);
         }
         // Not reached for a Tresca prism (φ = 0) without cut-off: the main plane or
-        // an edge always applies. Keep the trial rather than fail.
+        // an edge always applies (`every_return_is_admissible` samples this).
+        debug_assert!(
+            false,
+            "no admissible Mohr–Coulomb return for τ^tr = {tau_trial:?}"
+        );
         Solution {
             tau: tau_trial,
             tangent: el.stiffness(),
