@@ -5,11 +5,16 @@ use crate::absorbing::Absorbing;
 use crate::boundary::{Constraint, FaceCondition};
 use crate::dim::Vector;
 use crate::grid::{Face, Grid};
-use crate::material::{Hencky, LinearElastic, Material, MooneyRivlin, NeoHookean};
+use crate::material::mohr_coulomb::{Softening, Strength};
+use crate::material::{
+    drucker_prager, DruckerPrager, Hencky, LinearElastic, Material, MohrCoulomb, MooneyRivlin,
+    NeoHookean,
+};
 use crate::particles::Particles;
 use crate::scene::validate::{axis, body_bounds};
 use crate::scene::{
-    expr, BodyConfig, Condition, LoadKind, MaterialConfig, MaterialModel, Scene, SceneError, Shape,
+    expr, BodyConfig, Condition, LoadKind, MaterialConfig, MaterialModel, MohrCoulombFit, Scene,
+    SceneError, Shape,
 };
 
 /// Everything a solver needs, in dimension D.
@@ -203,6 +208,57 @@ fn material(m: &MaterialConfig) -> Box<dyn Material> {
             m.b.unwrap(),
             nu,
         )),
+        MaterialModel::DruckerPrager => {
+            let peak = peak_strength(m);
+            Box::new(DruckerPrager {
+                density: m.density,
+                youngs_modulus: m.youngs_modulus.unwrap(),
+                poisson_ratio: nu,
+                cohesion: peak.cohesion,
+                friction_angle: peak.friction_angle,
+                dilation_angle: peak.dilation_angle,
+                fit: match m.mohr_coulomb_fit.unwrap() {
+                    MohrCoulombFit::Outer => drucker_prager::MohrCoulombFit::Outer,
+                    MohrCoulombFit::Inner => drucker_prager::MohrCoulombFit::Inner,
+                    MohrCoulombFit::PlaneStrain => drucker_prager::MohrCoulombFit::PlaneStrain,
+                },
+            })
+        }
+        MaterialModel::MohrCoulomb => {
+            let peak = peak_strength(m);
+            let softening = m.softening_start.map(|start| {
+                let phi_r = m
+                    .residual_friction_angle
+                    .unwrap_or(m.friction_angle.unwrap());
+                Softening {
+                    residual_cohesion: m.residual_cohesion.unwrap_or(peak.cohesion),
+                    residual_friction_angle: phi_r.to_radians(),
+                    residual_dilation_angle: m
+                        .residual_dilation_angle
+                        .unwrap_or(m.dilation_angle.unwrap_or(0.0).min(phi_r))
+                        .to_radians(),
+                    start,
+                    end: m.softening_end.unwrap(),
+                }
+            });
+            Box::new(MohrCoulomb {
+                density: m.density,
+                youngs_modulus: m.youngs_modulus.unwrap(),
+                poisson_ratio: nu,
+                peak,
+                softening,
+                tensile_strength: m.tensile_strength,
+            })
+        }
+    }
+}
+
+/// Peak cohesion, friction and dilation (degrees in the scene, radians here).
+fn peak_strength(m: &MaterialConfig) -> Strength {
+    Strength {
+        cohesion: m.cohesion.unwrap(),
+        friction_angle: m.friction_angle.unwrap().to_radians(),
+        dilation_angle: m.dilation_angle.unwrap_or(0.0).to_radians(),
     }
 }
 

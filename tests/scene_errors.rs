@@ -199,3 +199,148 @@ fn cli_exits_non_zero_without_panicking() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("cannot read"));
 }
+
+const GEO: &str = r#"dimension = 2
+
+[grid]
+min = [0.0, 0.0]
+max = [4.0, 1.0]
+cells = [4, 1]
+
+[[material]]
+name = "soil"
+model = "mohr_coulomb"
+density = 2000.0
+youngs_modulus = 1.0e7
+poisson_ratio = 0.3
+cohesion = 1.0e4
+friction_angle = 30.0
+dilation_angle = 10.0
+residual_cohesion = 2.0e3
+residual_friction_angle = 25.0
+softening_start = 0.0
+softening_end = 0.05
+tensile_strength = 1.0e3
+
+[[material]]
+name = "cone"
+model = "drucker_prager"
+density = 2000.0
+youngs_modulus = 1.0e7
+poisson_ratio = 0.3
+cohesion = 1.0e4
+friction_angle = 30.0
+mohr_coulomb_fit = "plane_strain"
+
+[[body]]
+material = "soil"
+shape = "rectangle"
+min = [0.0, 0.0]
+max = [2.0, 1.0]
+
+[solver]
+kind = "explicit"
+end_time = 1.0
+"#;
+
+#[test]
+fn the_geomaterial_scene_is_valid() {
+    let s = Scene::parse("scene.toml", GEO, &[]).unwrap();
+    assert_eq!(s.config.materials.len(), 2);
+}
+
+#[test]
+fn geomaterial_parameters_out_of_range() {
+    let cases = [
+        (
+            "friction_angle = 30.0",
+            "friction_angle = 95.0",
+            "scene.toml:15:18",
+            "material.0.friction_angle",
+            "[0, 90)",
+        ),
+        (
+            "dilation_angle = 10.0",
+            "dilation_angle = 35.0",
+            "scene.toml:16:18",
+            "material.0.dilation_angle",
+            "friction_angle = 30",
+        ),
+        (
+            "cohesion = 1.0e4\nfriction_angle = 30.0\ndilation",
+            "cohesion = -1.0\nfriction_angle = 30.0\ndilation",
+            "scene.toml:14:12",
+            "material.0.cohesion",
+            "negative cohesion",
+        ),
+        (
+            "residual_cohesion = 2.0e3",
+            "residual_cohesion = 2.0e4",
+            "scene.toml:17:21",
+            "material.0.residual_cohesion",
+            "residual no larger than peak",
+        ),
+        (
+            "residual_friction_angle = 25.0",
+            "residual_friction_angle = 31.0",
+            "scene.toml:18:27",
+            "material.0.residual_friction_angle",
+            "residual no larger than peak",
+        ),
+        (
+            "softening_end = 0.05",
+            "softening_end = 0.0",
+            "scene.toml:20:17",
+            "material.0.softening_end",
+            "must exceed softening_start",
+        ),
+        (
+            "tensile_strength = 1.0e3",
+            "tensile_strength = -1.0",
+            "scene.toml:21:20",
+            "material.0.tensile_strength",
+            "≥ 0",
+        ),
+    ];
+    for (from, to, at, key, msg) in cases {
+        let e = err(&GEO.replacen(from, to, 1));
+        assert!(
+            e.contains(at) && e.contains(&format!("key `{key}`")) && e.contains(msg),
+            "{e}"
+        );
+    }
+}
+
+#[test]
+fn geomaterial_keys_of_the_other_model_and_missing_keys() {
+    let e = err(&GEO.replace(
+        "mohr_coulomb_fit = \"plane_strain\"",
+        "mohr_coulomb_fit = \"plane_strain\"\ntensile_strength = 0.0",
+    ));
+    assert!(
+        e.contains("scene.toml:32:20")
+            && e.contains("key `material.1.tensile_strength`")
+            && e.contains("does not apply to model `drucker_prager`"),
+        "{e}"
+    );
+    let e = err(&GEO.replace("mohr_coulomb_fit = \"plane_strain\"\n", ""));
+    assert!(
+        e.contains("key `material.1.mohr_coulomb_fit`") && e.contains("is required"),
+        "{e}"
+    );
+    let e = err(&GEO.replace("\"plane_strain\"", "\"planestrain\""));
+    assert!(
+        e.contains("scene.toml:31:20") && e.contains("unknown variant `planestrain`"),
+        "{e}"
+    );
+    let e = err(&GEO.replace("softening_start = 0.0\n", ""));
+    assert!(
+        e.contains("key `material.0.softening_start`") && e.contains("strain softening"),
+        "{e}"
+    );
+    let e = err(&GEO.replace(
+        "cohesion = 1.0e4\nfriction_angle = 30.0\ndilation_angle = 10.0",
+        "cohesion = 0.0\nfriction_angle = 0.0\ndilation_angle = 0.0",
+    ));
+    assert!(e.contains("no strength"), "{e}");
+}

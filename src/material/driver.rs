@@ -60,6 +60,115 @@ pub fn run_from<M: Material + ?Sized>(
     }
 }
 
+/// A Cauchy stress component held at a target value by solving for one component
+/// of ΔF (mixed control, e.g. a constant confining pressure).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StressControl {
+    /// The controlled stress component (i, j).
+    pub stress: (usize, usize),
+    pub target: f64,
+    /// The component (k, l) of ΔF that is solved for.
+    pub free: (usize, usize),
+    /// Another component of ΔF kept equal to the free one (axisymmetry: ΔF_yy =
+    /// ΔF_xx in a triaxial test, where two separate controls would be singular on
+    /// the Mohr–Coulomb edge σ_xx = σ_yy).
+    pub mirror: Option<(usize, usize)>,
+}
+
+/// A mixed-control run: the response and, per increment, the scaled residual
+/// max_m |σ_m − target_m| / scale of each Newton iterate.
+#[derive(Clone, Debug)]
+pub struct MixedResponse {
+    pub response: Response,
+    pub residuals: Vec<Vec<f64>>,
+}
+
+/// Drive `material` by the increments ΔF_k, except that the `free` components of
+/// each ΔF are found by Newton's method (Jacobian from
+/// [`Material::stress_derivative`], or central differences if it has none) so
+/// that the controlled stress components equal their targets to `tolerance`
+/// relative to max(|targets|, |σ|). Starts from `stress0`, `history0` at F = I.
+/// Fails with a message naming the increment if Newton does not converge in 30
+/// iterations.
+pub fn run_mixed<M: Material + ?Sized>(
+    material: &M,
+    increments: &[Mat3],
+    controls: &[StressControl],
+    dt: f64,
+    stress0: Mat3,
+    history0: Vec<f64>,
+    tolerance: f64,
+) -> Result<MixedResponse, String> {
+    assert_eq!(history0.len(), material.n_history(), "history length");
+    let n = controls.len();
+    let mut f = vec![Mat3::identity()];
+    let mut stress = vec![stress0];
+    let mut history = vec![history0];
+    let mut residuals = Vec::new();
+    for (k, increment) in increments.iter().enumerate() {
+        let mut df = *increment;
+        let mut h_new = vec![0.0; material.n_history()];
+        let mut log = Vec::new();
+        let converged = loop {
+            let inc = Increment {
+                f_old: f[k],
+                df,
+                dt,
+                stress_old: stress[k],
+                history_old: &history[k],
+            };
+            let s = material.update(&inc, &mut h_new);
+            let scale = controls
+                .iter()
+                .map(|c| c.target.abs())
+                .fold(s.amax(), f64::max)
+                .max(f64::MIN_POSITIVE);
+            let r = nalgebra::DVector::from_fn(n, |m, _| {
+                let c = controls[m];
+                s[c.stress] - c.target
+            });
+            log.push(r.amax() / scale);
+            if r.amax() <= tolerance * scale {
+                break Some(s);
+            }
+            if log.len() > 30 {
+                break None;
+            }
+            let d = material
+                .stress_derivative(&inc)
+                .unwrap_or_else(|| numerical_stress_derivative(material, &inc, 1e-7));
+            let jac = nalgebra::DMatrix::from_fn(n, n, |m, j| {
+                let (a, b) = controls[m].stress;
+                let column = |(c, e): (usize, usize)| d[(3 * a + b, 3 * c + e)];
+                column(controls[j].free) + controls[j].mirror.map_or(0.0, column)
+            });
+            let Some(dx) = jac.lu().solve(&(-r)) else {
+                break None;
+            };
+            for (c, x) in controls.iter().zip(dx.iter()) {
+                df[c.free] += x;
+                if let Some(m) = c.mirror {
+                    df[m] += x;
+                }
+            }
+        };
+        let Some(s) = converged else {
+            return Err(format!(
+                "mixed control did not converge in increment {} (residuals {log:?})",
+                k + 1
+            ));
+        };
+        f.push(df * f[k]);
+        stress.push(s);
+        history.push(h_new);
+        residuals.push(log);
+    }
+    Ok(MixedResponse {
+        response: Response { f, stress, history },
+        residuals,
+    })
+}
+
 /// Path F_k = f(k/steps), k = 0…steps; `f(0)` should be the identity.
 pub fn from_fn(steps: usize, f: impl Fn(f64) -> Mat3) -> Vec<Mat3> {
     assert!(steps > 0, "a path needs at least one step");
@@ -128,6 +237,16 @@ pub fn numerical_stress_derivative<M: Material + ?Sized>(
         }
     }
     d
+}
+
+/// Relative (Frobenius) difference between `material`'s exact stress derivative and
+/// central differences of its update with step `h`.
+pub fn tangent_error<M: Material + ?Sized>(material: &M, inc: &Increment, h: f64) -> f64 {
+    let exact = material
+        .stress_derivative(inc)
+        .expect("the material has an exact stress derivative");
+    let fd = numerical_stress_derivative(material, inc, h);
+    (exact - fd).norm() / exact.norm().max(fd.norm())
 }
 
 #[cfg(test)]

@@ -97,7 +97,7 @@ fn ln_1p_over_r_series(r: f64) -> f64 {
 
 /// (ln(1 + x) − ln(1 + y)) / (x − y), with the limit 1/(1 + x) at x = y; x, y > −1 are
 /// eigenvalues of b − I. See the module documentation for the evaluation.
-fn log_divided_difference(x: f64, y: f64) -> f64 {
+pub(crate) fn log_divided_difference(x: f64, y: f64) -> f64 {
     let (hi, lo) = if x >= y { (x, y) } else { (y, x) };
     let d = hi - lo;
     let beta_lo = 1.0 + lo;

@@ -8,13 +8,18 @@
 //! tangent of the update).
 
 pub mod driver;
+pub mod drucker_prager;
 pub mod hencky;
 pub mod linear_elastic;
+pub mod mohr_coulomb;
 pub mod mooney_rivlin;
 pub mod neo_hookean;
+pub mod principal;
 
+pub use drucker_prager::DruckerPrager;
 pub use hencky::Hencky;
 pub use linear_elastic::LinearElastic;
+pub use mohr_coulomb::MohrCoulomb;
 pub use mooney_rivlin::MooneyRivlin;
 pub use neo_hookean::NeoHookean;
 

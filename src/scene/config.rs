@@ -62,6 +62,26 @@ pub enum MaterialModel {
     Hencky,
     /// Mooney-Rivlin (thesis 3-2): a, b, poisson_ratio; c and d follow (3-8, 3-17).
     MooneyRivlin,
+    /// Drucker-Prager elastoplasticity (thesis 3-36…3-62) at finite strain:
+    /// youngs_modulus, poisson_ratio, cohesion, friction_angle, dilation_angle,
+    /// mohr_coulomb_fit.
+    DruckerPrager,
+    /// Mohr-Coulomb elastoplasticity (3-34, 3-35) at finite strain: youngs_modulus,
+    /// poisson_ratio, cohesion, friction_angle, dilation_angle; optional softening
+    /// (residual_*, softening_start, softening_end) and tensile_strength.
+    MohrCoulomb,
+}
+
+/// How a Drucker-Prager cone is fitted to the Mohr-Coulomb parameters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MohrCoulombFit {
+    /// Through the triaxial-compression vertices (thesis 3-37, 3-38).
+    Outer,
+    /// Through the triaxial-extension vertices (3-39, 3-40).
+    Inner,
+    /// Same plane-strain limit state as Mohr-Coulomb.
+    PlaneStrain,
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -74,6 +94,17 @@ pub struct MaterialConfig {
     pub poisson_ratio: Option<f64>,
     pub a: Option<f64>,
     pub b: Option<f64>,
+    // Plasticity (drucker_prager, mohr_coulomb); angles in degrees.
+    pub cohesion: Option<f64>,
+    pub friction_angle: Option<f64>,
+    pub dilation_angle: Option<f64>,
+    pub mohr_coulomb_fit: Option<MohrCoulombFit>,
+    pub residual_cohesion: Option<f64>,
+    pub residual_friction_angle: Option<f64>,
+    pub residual_dilation_angle: Option<f64>,
+    pub softening_start: Option<f64>,
+    pub softening_end: Option<f64>,
+    pub tensile_strength: Option<f64>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]

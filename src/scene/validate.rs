@@ -208,27 +208,31 @@ fn material(m: &MaterialConfig, i: usize) -> Check {
         "must be a positive number",
     )?;
     let what = format!("model `{}`", model_name(m.model));
+    for (k, present) in optional_keys(m) {
+        ensure(
+            !present || model_keys(m.model).contains(&k),
+            key(k),
+            format!("does not apply to {what}"),
+        )?;
+    }
     match m.model {
-        MaterialModel::LinearElastic | MaterialModel::NeoHookean | MaterialModel::Hencky => {
-            required(&m.youngs_modulus, key("youngs_modulus"), &what)?;
-            forbidden(&m.a, key("a"), &what)?;
-            forbidden(&m.b, key("b"), &what)?;
-            let e = m.youngs_modulus.unwrap_or(0.0);
-            ensure(
-                e > 0.0 && e.is_finite(),
-                key("youngs_modulus"),
-                "must be a positive number",
-            )?;
-        }
         MaterialModel::MooneyRivlin => {
             required(&m.a, key("a"), &what)?;
             required(&m.b, key("b"), &what)?;
-            forbidden(&m.youngs_modulus, key("youngs_modulus"), &what)?;
             let g = 2.0 * (m.a.unwrap_or(0.0) + m.b.unwrap_or(0.0));
             ensure(
                 g > 0.0 && g.is_finite(),
                 key("a"),
                 "a + b (= G/2, thesis 3-16) must be positive",
+            )?;
+        }
+        _ => {
+            required(&m.youngs_modulus, key("youngs_modulus"), &what)?;
+            let e = m.youngs_modulus.unwrap_or(0.0);
+            ensure(
+                e > 0.0 && e.is_finite(),
+                key("youngs_modulus"),
+                "must be a positive number",
             )?;
         }
     }
@@ -238,6 +242,167 @@ fn material(m: &MaterialConfig, i: usize) -> Check {
         nu > -1.0 && nu < 0.5,
         key("poisson_ratio"),
         format!("must lie in (-1, 0.5) for the compressible {what}; got {nu}"),
+    )?;
+    match m.model {
+        MaterialModel::DruckerPrager => {
+            strength(m, i, &what)?;
+            required(&m.mohr_coulomb_fit, key("mohr_coulomb_fit"), &what)
+        }
+        MaterialModel::MohrCoulomb => {
+            strength(m, i, &what)?;
+            softening(m, i)?;
+            if let Some(t) = m.tensile_strength {
+                ensure(
+                    t >= 0.0 && t.is_finite(),
+                    key("tensile_strength"),
+                    format!("must be a number ≥ 0; got {t}"),
+                )?;
+            }
+            Ok(())
+        }
+        _ => Ok(()),
+    }
+}
+
+/// The model-specific optional keys and whether each is given.
+fn optional_keys(m: &MaterialConfig) -> [(&'static str, bool); 13] {
+    [
+        ("youngs_modulus", m.youngs_modulus.is_some()),
+        ("a", m.a.is_some()),
+        ("b", m.b.is_some()),
+        ("cohesion", m.cohesion.is_some()),
+        ("friction_angle", m.friction_angle.is_some()),
+        ("dilation_angle", m.dilation_angle.is_some()),
+        ("mohr_coulomb_fit", m.mohr_coulomb_fit.is_some()),
+        ("residual_cohesion", m.residual_cohesion.is_some()),
+        (
+            "residual_friction_angle",
+            m.residual_friction_angle.is_some(),
+        ),
+        (
+            "residual_dilation_angle",
+            m.residual_dilation_angle.is_some(),
+        ),
+        ("softening_start", m.softening_start.is_some()),
+        ("softening_end", m.softening_end.is_some()),
+        ("tensile_strength", m.tensile_strength.is_some()),
+    ]
+}
+
+/// The optional keys a model accepts.
+fn model_keys(model: MaterialModel) -> &'static [&'static str] {
+    match model {
+        MaterialModel::LinearElastic | MaterialModel::NeoHookean | MaterialModel::Hencky => {
+            &["youngs_modulus"]
+        }
+        MaterialModel::MooneyRivlin => &["a", "b"],
+        MaterialModel::DruckerPrager => &[
+            "youngs_modulus",
+            "cohesion",
+            "friction_angle",
+            "dilation_angle",
+            "mohr_coulomb_fit",
+        ],
+        MaterialModel::MohrCoulomb => &[
+            "youngs_modulus",
+            "cohesion",
+            "friction_angle",
+            "dilation_angle",
+            "residual_cohesion",
+            "residual_friction_angle",
+            "residual_dilation_angle",
+            "softening_start",
+            "softening_end",
+            "tensile_strength",
+        ],
+    }
+}
+
+/// Cohesion c ≥ 0, friction angle 0 ≤ φ < 90°, dilation angle 0 ≤ ψ ≤ φ (degrees),
+/// and some strength (c > 0 or φ > 0).
+fn strength(m: &MaterialConfig, i: usize, what: &str) -> Check {
+    let key = |k: &str| format!("material.{i}.{k}");
+    required(&m.cohesion, key("cohesion"), what)?;
+    required(&m.friction_angle, key("friction_angle"), what)?;
+    let (c, phi) = (m.cohesion.unwrap(), m.friction_angle.unwrap());
+    let psi = m.dilation_angle.unwrap_or(0.0);
+    ensure(
+        c >= 0.0 && c.is_finite(),
+        key("cohesion"),
+        format!("must be a number ≥ 0 (no negative cohesion); got {c}"),
+    )?;
+    ensure(
+        (0.0..90.0).contains(&phi),
+        key("friction_angle"),
+        format!("must lie in [0, 90) degrees; got {phi}"),
+    )?;
+    ensure(
+        psi >= 0.0 && psi <= phi,
+        key("dilation_angle"),
+        format!("must lie in [0, friction_angle = {phi}] degrees; got {psi}"),
+    )?;
+    ensure(
+        c > 0.0 || phi > 0.0,
+        key("cohesion"),
+        "cohesion and friction_angle are both zero: the material has no strength",
+    )
+}
+
+/// Softening keys (mohr_coulomb): residual values no larger than the peak ones,
+/// 0 ≤ softening_start < softening_end, both given when any softening key is.
+fn softening(m: &MaterialConfig, i: usize) -> Check {
+    let key = |k: &str| format!("material.{i}.{k}");
+    let any = m.residual_cohesion.is_some()
+        || m.residual_friction_angle.is_some()
+        || m.residual_dilation_angle.is_some()
+        || m.softening_start.is_some()
+        || m.softening_end.is_some();
+    if !any {
+        return Ok(());
+    }
+    let what = "strain softening";
+    required(&m.softening_start, key("softening_start"), what)?;
+    required(&m.softening_end, key("softening_end"), what)?;
+    let (start, end) = (m.softening_start.unwrap(), m.softening_end.unwrap());
+    ensure(
+        start >= 0.0 && start.is_finite(),
+        key("softening_start"),
+        format!("must be a plastic strain ≥ 0; got {start}"),
+    )?;
+    ensure(
+        end > start && end.is_finite(),
+        key("softening_end"),
+        format!("must exceed softening_start = {start}; got {end}"),
+    )?;
+    let (c, phi) = (m.cohesion.unwrap(), m.friction_angle.unwrap());
+    let psi = m.dilation_angle.unwrap_or(0.0);
+    let c_r = m.residual_cohesion.unwrap_or(c);
+    let phi_r = m.residual_friction_angle.unwrap_or(phi);
+    let psi_r = m.residual_dilation_angle.unwrap_or(psi.min(phi_r));
+    ensure(
+        c_r >= 0.0 && c_r <= c,
+        key("residual_cohesion"),
+        format!("must lie in [0, cohesion = {c}] (residual no larger than peak); got {c_r}"),
+    )?;
+    ensure(
+        phi_r >= 0.0 && phi_r <= phi,
+        key("residual_friction_angle"),
+        format!("must lie in [0, friction_angle = {phi}] degrees (residual no larger than peak); got {phi_r}"),
+    )?;
+    ensure(
+        phi_r > 0.0 || phi == 0.0,
+        key("residual_friction_angle"),
+        "must be positive when friction_angle is (the pyramid keeps its apex)",
+    )?;
+    ensure(
+        psi_r >= 0.0 && psi_r <= phi_r,
+        key("residual_dilation_angle"),
+        format!("must lie in [0, residual_friction_angle = {phi_r}] degrees; got {psi_r}"),
+    )?;
+    ensure(
+        c_r > 0.0 || phi_r > 0.0,
+        key("residual_cohesion"),
+        "residual cohesion and friction are both zero: no residual strength",
     )
 }
 
@@ -247,6 +412,8 @@ pub fn model_name(m: MaterialModel) -> &'static str {
         MaterialModel::NeoHookean => "neo_hookean",
         MaterialModel::Hencky => "hencky",
         MaterialModel::MooneyRivlin => "mooney_rivlin",
+        MaterialModel::DruckerPrager => "drucker_prager",
+        MaterialModel::MohrCoulomb => "mohr_coulomb",
     }
 }
 

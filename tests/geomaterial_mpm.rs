@@ -1,0 +1,185 @@
+//! Drucker–Prager and Mohr–Coulomb inside the MPM solvers: plane-strain
+//! unconfined compression of a block by a smooth rigid platen
+//! (`problems/unconfined_compression.toml`) in the explicit, implicit
+//! quasi-static and implicit Newmark paths. The stress stays homogeneous with
+//! σ_xx = 0, and σ_yy must reach the plane-strain unconfined strength
+//! −2c cos φ/(1 − sin φ) (Mohr–Coulomb, and Drucker–Prager fitted to it in plane
+//! strain) once the block has been compressed three times its yield strain.
+//! The quasi-static runs also check the Newton iterations of the plastic steps.
+
+mod common;
+use common::{problem, run_text, Table};
+
+const C: f64 = 1.0e4;
+
+/// The strength at volume ratio J: the yield function acts on τ = Jσ, so the
+/// Cauchy limit carries c/J (J − 1 is the plastic dilation, below 1 %).
+fn strength(j: f64) -> f64 {
+    let phi = 30f64.to_radians();
+    -2.0 * C * phi.cos() / (j * (1.0 - phi.sin()))
+}
+
+/// newton.csv without its text column.
+fn read_newton(path: &std::path::Path) -> Table {
+    let text = std::fs::read_to_string(path).unwrap();
+    let cleaned: String = text
+        .lines()
+        .map(|l| l.rsplit_once(',').unwrap().0.to_string() + "\n")
+        .collect();
+    let tmp = tempfile::NamedTempFile::new().unwrap();
+    std::fs::write(tmp.path(), cleaned).unwrap();
+    Table::read(tmp.path())
+}
+
+/// Drucker–Prager fitted in plane strain. Its limit needs steady plastic flow
+/// (σ_zz settles at s_zz = −2βq/3), so the platen goes four times further
+/// (2 % strain) than for Mohr–Coulomb.
+const DP: [&str; 3] = [
+    "material.0.model=drucker_prager",
+    "material.0.mohr_coulomb_fit=plane_strain",
+    "boundary.2.velocity=[0.0,-0.02]",
+];
+
+/// The problem with its `[solver]` table replaced by `solver` (None: as shipped).
+fn scene(solver: Option<&str>) -> String {
+    let text = std::fs::read_to_string(problem("unconfined_compression.toml")).unwrap();
+    match solver {
+        None => text,
+        Some(s) => {
+            let (head, tail) = text.split_once("[solver]").unwrap();
+            let (_, output) = tail.split_once("[output]").unwrap();
+            format!("{head}{s}\n[output]{output}")
+        }
+    }
+}
+
+/// Mean stresses of a run.
+struct Result {
+    syy: f64,
+    /// Mean |σ_xx|.
+    sxx: f64,
+    /// Largest deviation of σ_yy from its mean.
+    spread: f64,
+    /// Mean volume ratio V/V0.
+    j: f64,
+}
+
+/// Run and return the mean stresses and the output directory.
+fn run(text: &str, overrides: &[&str]) -> (Result, tempfile::TempDir) {
+    let (result, dir) = run_text(text, overrides);
+    let summary = result.unwrap_or_else(|e| panic!("{overrides:?}: {e}"));
+    assert_eq!(summary.json["status"], "completed");
+    let p = Table::read(&dir.path().join("particles_final.csv"));
+    let n = p.col("syy").len() as f64;
+    let syy = p.col("syy").iter().sum::<f64>() / n;
+    let sxx = p.col("sxx").iter().map(|s| s.abs()).sum::<f64>() / n;
+    let spread = p
+        .col("syy")
+        .iter()
+        .map(|s| (s - syy).abs())
+        .fold(0.0, f64::max);
+    let j = p
+        .col("volume")
+        .iter()
+        .zip(p.col("volume0"))
+        .map(|(v, v0)| v / v0)
+        .sum::<f64>()
+        / n;
+    (
+        Result {
+            syy,
+            sxx,
+            spread,
+            j,
+        },
+        dir,
+    )
+}
+
+fn check(name: &str, r: &Result, tol: f64) {
+    let limit = strength(r.j);
+    let e = (r.syy - limit).abs() / limit.abs();
+    eprintln!(
+        "{name}: σ_yy = {:.5e} (plane-strain unconfined strength {limit:.5e} at J = {:.5}; {:.5e} at J = 1), rel. error {e:.1e}; mean |σ_xx| = {:.1e}, spread of σ_yy = {:.1e}",
+        r.syy, r.j, strength(1.0), r.sxx, r.spread
+    );
+    assert!(e < tol, "{name}: limit stress to {tol:e}, got {e:e}");
+    assert!(
+        r.sxx < tol * limit.abs(),
+        "{name}: σ_xx = 0 at the free side"
+    );
+}
+
+/// Orders p_k = ln(r_{k+1}/r_k) / ln(r_k/r_{k−1}) of the residuals of one step,
+/// over the iterations whose residuals lie well above the round-off floor (the
+/// last residual of the step); the best of them, and the number of iterations.
+fn newton_order(r: &[f64]) -> (f64, usize) {
+    let floor = *r.last().unwrap();
+    let informative = |x: f64| x > 1e3 * floor;
+    let best = (1..r.len() - 1)
+        .filter(|&k| informative(r[k - 1]) && informative(r[k]))
+        .map(|k| (r[k + 1] / r[k]).ln() / (r[k] / r[k - 1]).ln())
+        .fold(f64::NAN, f64::max);
+    (best, r.len() - 1)
+}
+
+#[test]
+fn quasi_static_reaches_the_limit_with_quadratic_newton() {
+    let text = scene(None);
+    // Yield at a strain of 1.7e-3: Mohr–Coulomb in 3 steps of 1.67e-3 (steps 2 and
+    // 3 plastic), Drucker–Prager in 6 steps of 3.3e-3 (all plastic).
+    let mc = ["solver.load_steps=3"];
+    let dp = ["solver.load_steps=6", DP[0], DP[1], DP[2]];
+    for (name, overrides, tol) in [
+        ("MC ψ = 10°", mc.to_vec(), 1e-3),
+        ("MC ψ = 0", vec![mc[0], "material.0.dilation_angle=0"], 1e-3),
+        ("DP plane strain ψ = 10°", dp.to_vec(), 1e-2),
+    ] {
+        let (r, dir) = run(&text, &overrides);
+        check(&format!("quasi-static {name}"), &r, tol);
+        let newton = read_newton(&dir.path().join("newton.csv"));
+        let (step, res) = (newton.col("step"), newton.col("residual"));
+        for s in [2.0, 3.0] {
+            let r: Vec<f64> = (0..step.len())
+                .filter(|&i| step[i] == s)
+                .map(|i| res[i])
+                .collect();
+            let (order, iterations) = newton_order(&r);
+            eprintln!("   step {s}: residuals {r:?}: order {order:.2}, {iterations} iterations");
+            assert!(
+                iterations <= 8,
+                "{name} step {s}: at most 8 Newton iterations"
+            );
+            assert!(
+                order > 1.8,
+                "{name} step {s}: quadratic convergence (order {order:.2} > 1.8)"
+            );
+        }
+    }
+}
+
+/// Explicit and Newmark: a dense block (ρ = 2000 kg/m³, no gravity) starting with
+/// the velocity field of the platen, v_y = −v y / (1 m) (no impact wave).
+#[test]
+fn explicit_and_newmark_reach_the_limit() {
+    let base = ["material.0.density=2000.0", "gravity=[0.0,0.0]"];
+    let start = |v: &str| format!("body.0.velocity_expr=[\"0\",\"-{v}*y\"]");
+    let explicit = scene(Some("[solver]\nkind = \"explicit\"\nend_time = 1.0\n"));
+    let newmark = scene(Some(
+        "[solver]\nkind = \"implicit\"\nintegrator = \"newmark\"\nend_time = 1.0\ndt = 0.05\n",
+    ));
+    for (solver, text) in [("explicit", &explicit), ("Newmark", &newmark)] {
+        let (mc_start, dp_start) = (start("0.005"), start("0.02"));
+        for (name, mut extra) in [
+            ("MC", vec![mc_start.as_str()]),
+            ("DP plane strain", vec![dp_start.as_str()]),
+        ] {
+            if name.starts_with("DP") {
+                extra.extend(DP);
+            }
+            let overrides: Vec<&str> = base.iter().copied().chain(extra).collect();
+            let (r, _dir) = run(text, &overrides);
+            check(&format!("{solver} {name}"), &r, 1e-2);
+        }
+    }
+}
