@@ -221,6 +221,52 @@ pub enum MassMatrix {
     Consistent,
 }
 
+/// How the implicit solver solves each Newton correction (thesis 2-38).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LinearSolver {
+    /// Assembled consistent tangent, sparse Cholesky / LU (needs an analytic tangent).
+    Direct,
+    /// Matrix-free restarted GMRES with finite-difference products (2-39).
+    Gmres,
+    /// Matrix-free conjugate gradients (symmetric positive definite tangents).
+    Cg,
+}
+
+impl LinearSolver {
+    pub fn name(&self) -> &'static str {
+        match self {
+            LinearSolver::Direct => "direct",
+            LinearSolver::Gmres => "gmres",
+            LinearSolver::Cg => "cg",
+        }
+    }
+}
+
+/// Preconditioner of the Krylov solvers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PreconditionerKind {
+    None,
+    /// Inverse of the tangent's diagonal, built particle by particle.
+    Jacobi,
+    /// Inverse of each node's D×D diagonal block, built particle by particle.
+    BlockJacobi,
+    /// The assembled tangent of an earlier iteration, factorized once and reused.
+    LaggedDirect,
+}
+
+impl PreconditionerKind {
+    pub fn name(&self) -> &'static str {
+        match self {
+            PreconditionerKind::None => "none",
+            PreconditionerKind::Jacobi => "jacobi",
+            PreconditionerKind::BlockJacobi => "block_jacobi",
+            PreconditionerKind::LaggedDirect => "lagged_direct",
+        }
+    }
+}
+
 /// The `[solver]` table. Keys that belong to the other kind are rejected by
 /// `validate`; the accessors give the documented defaults.
 #[derive(Clone, Debug, Deserialize)]
@@ -251,6 +297,12 @@ pub struct SolverConfig {
     pub max_iterations: Option<usize>,
     pub line_search: Option<bool>,
     pub max_cutbacks: Option<usize>,
+    // Linear solver of the Newton corrections (implicit).
+    pub linear_solver: Option<LinearSolver>,
+    pub preconditioner: Option<PreconditionerKind>,
+    pub krylov_tolerance: Option<f64>,
+    pub krylov_restart: Option<usize>,
+    pub krylov_max_iterations: Option<usize>,
 }
 
 impl SceneConfig {
@@ -322,6 +374,23 @@ impl SolverConfig {
     /// Times a failing step may be halved before the run stops (default 5).
     pub fn max_cutbacks(&self) -> usize {
         self.max_cutbacks.unwrap_or(5)
+    }
+    /// Linear solver of the Newton corrections (default direct).
+    pub fn linear_solver(&self) -> LinearSolver {
+        self.linear_solver.unwrap_or(LinearSolver::Direct)
+    }
+    /// Krylov preconditioner (default block_jacobi).
+    pub fn preconditioner(&self) -> PreconditionerKind {
+        self.preconditioner
+            .unwrap_or(PreconditionerKind::BlockJacobi)
+    }
+    /// GMRES restart length (default 30).
+    pub fn krylov_restart(&self) -> usize {
+        self.krylov_restart.unwrap_or(30)
+    }
+    /// Krylov iterations allowed per Newton correction (default 1000).
+    pub fn krylov_max_iterations(&self) -> usize {
+        self.krylov_max_iterations.unwrap_or(1000)
     }
 }
 

@@ -410,6 +410,19 @@ fn explicit(s: &SolverConfig, prefix: &str) -> Check {
     forbidden(&s.max_iterations, format!("{prefix}.max_iterations"), what)?;
     forbidden(&s.line_search, format!("{prefix}.line_search"), what)?;
     forbidden(&s.max_cutbacks, format!("{prefix}.max_cutbacks"), what)?;
+    forbidden(&s.linear_solver, format!("{prefix}.linear_solver"), what)?;
+    forbidden(&s.preconditioner, format!("{prefix}.preconditioner"), what)?;
+    forbidden(
+        &s.krylov_tolerance,
+        format!("{prefix}.krylov_tolerance"),
+        what,
+    )?;
+    forbidden(&s.krylov_restart, format!("{prefix}.krylov_restart"), what)?;
+    forbidden(
+        &s.krylov_max_iterations,
+        format!("{prefix}.krylov_max_iterations"),
+        what,
+    )?;
     let cfl = s.cfl();
     ensure(
         cfl > 0.0 && cfl <= 1.0,
@@ -492,6 +505,44 @@ fn implicit(s: &SolverConfig, prefix: &str) -> Check {
     ensure(
         s.max_iterations() >= 1,
         format!("{prefix}.max_iterations"),
+        "must be at least 1",
+    )?;
+    linear_solver(s, prefix)
+}
+
+/// Keys of the linear solver: Krylov keys only with a Krylov solver, the restart
+/// only with GMRES.
+fn linear_solver(s: &SolverConfig, prefix: &str) -> Check {
+    let key = |k: &str| format!("{prefix}.{k}");
+    match s.linear_solver() {
+        LinearSolver::Direct => {
+            let what = "linear_solver = \"direct\" (set \"gmres\" or \"cg\")";
+            forbidden(&s.preconditioner, key("preconditioner"), what)?;
+            forbidden(&s.krylov_tolerance, key("krylov_tolerance"), what)?;
+            forbidden(&s.krylov_restart, key("krylov_restart"), what)?;
+            return forbidden(&s.krylov_max_iterations, key("krylov_max_iterations"), what);
+        }
+        LinearSolver::Cg => forbidden(
+            &s.krylov_restart,
+            key("krylov_restart"),
+            "linear_solver = \"cg\" (it is the GMRES restart length)",
+        )?,
+        LinearSolver::Gmres => ensure(
+            s.krylov_restart() >= 1,
+            key("krylov_restart"),
+            "must be at least 1",
+        )?,
+    }
+    if let Some(eta) = s.krylov_tolerance {
+        ensure(
+            eta > 0.0 && eta < 1.0,
+            key("krylov_tolerance"),
+            format!("must lie in (0, 1) (a relative residual of the linear solve); got {eta}"),
+        )?;
+    }
+    ensure(
+        s.krylov_max_iterations() >= 1,
+        key("krylov_max_iterations"),
         "must be at least 1",
     )
 }
