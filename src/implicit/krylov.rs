@@ -282,17 +282,10 @@ impl<const D: usize> Implicit<D> {
                     return Ok(());
                 }
                 let eps = difference_step(h, u_max, v_max);
-                let mut up = u.to_vec();
-                apply_correction(&mut up, v, dofs, eps);
-                let r = self
-                    .residual(m, &up, u_tilde, mass, f_ext, inertia, dt)
-                    .map_err(|f| Failure {
-                        particle: f.particle,
-                        message: format!("{} (in a finite-difference product, 2-39)", f.message),
-                    })?;
-                for (o, (rp, r0)) in out.iter_mut().zip(free_part(&r, dofs).iter().zip(r_free)) {
-                    *o = (rp - r0) / eps;
-                }
+                let jv = self.difference_product(
+                    m, dofs, u, r_free, v, eps, u_tilde, mass, f_ext, inertia, dt,
+                )?;
+                out.copy_from_slice(&jv);
                 Ok(())
             };
             let factors = Factorized(&solver);
@@ -341,6 +334,37 @@ impl<const D: usize> Implicit<D> {
             krylov_iterations: outcome.iterations,
             forcing: eta,
         })
+    }
+
+    /// (r(u + ε v) − r(u)) / ε over the free unknowns (2-39); `r_free` is r(u).
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn difference_product(
+        &mut self,
+        m: &Model<D>,
+        dofs: &Dofs,
+        u: &[Vector<D>],
+        r_free: &[f64],
+        v: &[f64],
+        eps: f64,
+        u_tilde: &[Vector<D>],
+        mass: &[f64],
+        f_ext: &[Vector<D>],
+        inertia: f64,
+        dt: f64,
+    ) -> Result<Vec<f64>, Failure> {
+        let mut up = u.to_vec();
+        apply_correction(&mut up, v, dofs, eps);
+        let r = self
+            .residual(m, &up, u_tilde, mass, f_ext, inertia, dt)
+            .map_err(|f| Failure {
+                particle: f.particle,
+                message: format!("{} (in a finite-difference product, 2-39)", f.message),
+            })?;
+        Ok(free_part(&r, dofs)
+            .iter()
+            .zip(r_free)
+            .map(|(rp, r0)| (rp - r0) / eps)
+            .collect())
     }
 
     /// The preconditioner at the current iterate (the trial state).
@@ -453,4 +477,206 @@ fn max_norm_free<const D: usize>(u: &[Vector<D>], dofs: &Dofs) -> f64 {
     free_part(u, dofs)
         .iter()
         .fold(0.0f64, |a, x| a.max(x.abs()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Scene;
+
+    /// A 4×4-cell block with cell size h = `length`, Hencky,
+    /// fixed base, gravity and a corner load, quasi-static, uGIMP.
+    fn block(length: f64) -> String {
+        format!(
+            r#"dimension = 2
+gravity = [0.0, -10.0]
+[grid]
+min = [0.0, 0.0]
+max = [{g}, {g}]
+cells = [4, 4]
+shape_function = "ugimp"
+[[material]]
+name = "m"
+model = "hencky"
+density = 1000.0
+youngs_modulus = 1.0e5
+poisson_ratio = 0.3
+[[body]]
+material = "m"
+shape = "rectangle"
+min = [{b0}, 0.0]
+max = [{b1}, {b2}]
+[[boundary]]
+face = "ymin"
+condition = "fixed"
+[[load]]
+kind = "point"
+region_min = [{b2}, {b1x}]
+region_max = [{b1}, {b2}]
+force = [3.0e3, -1.0e3]
+[solver]
+kind = "implicit"
+integrator = "quasi_static"
+end_time = 1.0
+load_steps = 1
+"#,
+            g = 4.0 * length,
+            b0 = 0.5 * length,
+            b1 = 3.0 * length,
+            b2 = 2.5 * length,
+            b1x = 2.0 * length,
+        )
+    }
+
+    /// Relative error ‖J_fd v − K v‖ / ‖K v‖ of the difference product against the
+    /// assembled tangent at a finite-strain iterate, for each step in `steps`, and
+    /// the step the documented rule chooses.
+    fn product_errors(length: f64, steps: &[f64]) -> (Vec<f64>, f64) {
+        let scene = Scene::parse("block.toml", &block(length), &[]).unwrap();
+        let m = Model::<2>::build(&scene).unwrap();
+        let mut solver =
+            Implicit::<2>::new(scene.config.grid.shape_function, scene.config.stages()[0], 0.0);
+        let sys = solver.prepare(&m, 0.0, 1.0);
+        let nodes: Vec<usize> = solver.map.active.iter().map(|&g| g as usize).collect();
+        // Strains of a few per cent: displacements scale with the length.
+        let u: Vec<Vector<2>> = nodes
+            .iter()
+            .zip(&sys.constraint)
+            .map(|(&g, c)| {
+                let x = m.grid.node_position(m.grid.node_ijk(g)) / length;
+                let mut v = Vector::<2>::new(
+                    0.03 * (0.7 * x[1]).sin() + 0.01 * x[0],
+                    -0.02 * x[0] * x[1] / 4.0,
+                ) * length;
+                for d in 0..2 {
+                    if c.fixed[d] {
+                        v[d] = 0.0;
+                    }
+                }
+                v
+            })
+            .collect();
+        let dofs = &sys.dofs;
+        let res = |s: &mut Implicit<2>, u: &[Vector<2>]| {
+            let r = s
+                .residual(&m, u, &sys.u_tilde, &sys.mass, &sys.f_ext, sys.inertia, 1.0)
+                .unwrap();
+            free_part(&r, dofs)
+        };
+        let r0 = res(&mut solver, &u);
+        let (triplets, _) = solver.tangent(&m, dofs, &sys.mass, sys.inertia).unwrap();
+        // A smooth direction with ‖v‖_∞ = 1.
+        let n = dofs.free;
+        let v: Vec<f64> = (0..n).map(|i| (0.37 * i as f64).sin()).collect();
+        let v_max = v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let v: Vec<f64> = v.iter().map(|x| x / v_max).collect();
+        let mut kv = vec![0.0; n];
+        for (r, c, val) in triplets {
+            kv[r] += val * v[c];
+        }
+        let kv_norm = crate::linear::iterative::norm(&kv);
+        let errors = steps
+            .iter()
+            .map(|&eps| {
+                let jv = solver
+                    .difference_product(
+                        &m,
+                        dofs,
+                        &u,
+                        &r0,
+                        &v,
+                        eps,
+                        &sys.u_tilde,
+                        &sys.mass,
+                        &sys.f_ext,
+                        sys.inertia,
+                        1.0,
+                    )
+                    .unwrap();
+                let diff: Vec<f64> = jv.iter().zip(&kv).map(|(a, b)| a - b).collect();
+                crate::linear::iterative::norm(&diff) / kv_norm
+            })
+            .collect();
+        let chosen = difference_step(m.grid.h_min(), max_norm_free(&u, dofs), 1.0);
+        (errors, chosen)
+    }
+
+    /// The difference product against the assembled tangent (thesis 2-39 vs 2-40)
+    /// over ε = 1e-1 … 1e-13 · length: the error falls ∝ ε (truncation) for large ε
+    /// and grows ∝ 1/ε (round-off) for small ε; the minimum lies within a decade of
+    /// the documented ε = √ε_mach (h + ‖u‖_∞)/‖v‖_∞, where the error is below 1e-6
+    /// (the balance predicts a few √ε_mach ≈ 1.5e-8). The same problem in units a
+    /// hundred times larger moves the whole curve, and the chosen ε, by 100.
+    #[test]
+    fn difference_product_error_against_step() {
+        for length in [1.0, 100.0] {
+            let exponents: Vec<i32> = (1..=13).collect();
+            let steps: Vec<f64> = exponents
+                .iter()
+                .map(|&k| length * 10f64.powi(-k))
+                .collect();
+            let (errors, chosen) = product_errors(length, &steps);
+            let (_, at_chosen) = {
+                let (e, _) = product_errors(length, &[chosen]);
+                (chosen, e[0])
+            };
+            println!("length scale {length}: ε, relative error of J v");
+            for (s, e) in steps.iter().zip(&errors) {
+                println!("  {s:9.1e}  {e:9.2e}");
+            }
+            println!("  chosen ε = {chosen:.2e}: {at_chosen:.2e}");
+            // Truncation: one decade of ε is one decade of error (slope 1) at ε ≥ 1e-4 L.
+            for k in 1..3 {
+                let slope = (errors[k - 1] / errors[k]).log10();
+                assert!(
+                    (0.8..1.2).contains(&slope),
+                    "truncation slope {slope:.2} at ε = {:.0e}",
+                    steps[k]
+                );
+            }
+            // Round-off: the error grows as ε shrinks below 1e-10 L, about 1/ε
+            // (noisy: the slope over two decades lies in 0.6 … 1.4).
+            let slope = (errors[12] / errors[10]).log10() / 2.0;
+            assert!(
+                (0.6..1.4).contains(&slope),
+                "round-off slope {slope:.2} between ε = 1e-11 L and 1e-13 L"
+            );
+            let best = (0..errors.len())
+                .min_by(|&a, &b| errors[a].total_cmp(&errors[b]))
+                .unwrap();
+            let decades = (steps[best] / chosen).log10().abs();
+            assert!(
+                decades <= 1.0,
+                "minimum at ε = {:.1e}, {decades:.1} decades from the chosen {chosen:.1e}",
+                steps[best]
+            );
+            assert!(
+                at_chosen < 1e-6 && at_chosen < 3.0 * errors[best],
+                "error {at_chosen:.2e} at the chosen ε (best {:.2e})",
+                errors[best]
+            );
+        }
+    }
+
+    /// Choice 2 of Eisenstat–Walker with its safeguards.
+    #[test]
+    fn forcing_terms() {
+        let mut f = Forcing::new(None);
+        let stop = 1e-12;
+        assert_eq!(f.next(1.0, stop), Forcing::ETA_0);
+        // Quadratic-like decrease: η = 0.9 (0.1)² = 9e-3, safeguard 0.9·0.5² = 0.225 > 0.1 wins.
+        assert!((f.next(0.1, stop) - 0.225).abs() < 1e-15);
+        // Next: 0.9 (1e-3 / 0.1)² = 9e-5; safeguard 0.9·0.225² = 0.0456 < 0.1 is off.
+        assert!((f.next(1e-3, stop) - 9e-5).abs() < 1e-18);
+        // A poor step (residual grows) is capped at η_max.
+        assert_eq!(f.next(1.0, stop), Forcing::ETA_MAX);
+        // Near the Newton tolerance η ≥ ½ τ / ‖r‖.
+        f.reset();
+        f.next(1.0, 0.5);
+        assert!((f.next(2e-1, 0.5) - 0.9f64.min(0.5 * 0.5 / 0.2)).abs() < 1e-15);
+        // A fixed tolerance stays fixed.
+        let mut c = Forcing::new(Some(1e-4));
+        assert_eq!(c.next(1.0, 0.0), 1e-4);
+        assert_eq!(c.next(1e-3, 0.0), 1e-4);
+    }
 }
