@@ -4,7 +4,7 @@
 use crate::boundary::{Constraint, FaceCondition};
 use crate::dim::Vector;
 use crate::grid::{Face, Grid};
-use crate::material::{Hencky, LinearElastic, Material, MooneyRivlin, NeoHookean};
+use crate::material::{Hencky, LinearElastic, Material, MooneyRivlin, NeoHookean, Ogden};
 use crate::particles::Particles;
 use crate::scene::validate::{axis, body_bounds};
 use crate::scene::{
@@ -168,6 +168,12 @@ fn material(m: &MaterialConfig) -> Box<dyn Material> {
             m.density,
             m.a.unwrap(),
             m.b.unwrap(),
+            nu,
+        )),
+        MaterialModel::Ogden => Box::new(Ogden::new(
+            m.density,
+            m.mu.clone().unwrap(),
+            m.alpha.clone().unwrap(),
             nu,
         )),
     }

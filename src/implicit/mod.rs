@@ -59,12 +59,12 @@ pub struct NewtonRow {
 }
 
 pub const NEWTON_CSV_HEADER: &str =
-    "step,time,dt,cutback,iteration,residual,increment,wall_seconds,linear_solver,krylov_iterations,forcing";
+    "step,time,dt,cutback,iteration,residual,increment,wall_seconds,krylov_iterations,forcing,linear_solver";
 
 impl NewtonRow {
     pub fn csv(&self) -> String {
         format!(
-            "{},{},{},{},{},{:e},{:e},{:e},{},{},{:e}",
+            "{},{},{},{},{},{:e},{:e},{:e},{},{:e},{}",
             self.step,
             self.time,
             self.dt,
@@ -73,9 +73,9 @@ impl NewtonRow {
             self.residual,
             self.increment,
             self.wall_seconds,
-            self.linear_solver,
             self.krylov_iterations,
-            self.forcing
+            self.forcing,
+            self.linear_solver
         )
     }
 }

@@ -12,11 +12,13 @@ pub mod hencky;
 pub mod linear_elastic;
 pub mod mooney_rivlin;
 pub mod neo_hookean;
+pub mod ogden;
 
 pub use hencky::Hencky;
 pub use linear_elastic::LinearElastic;
 pub use mooney_rivlin::MooneyRivlin;
 pub use neo_hookean::NeoHookean;
+pub use ogden::Ogden;
 
 use crate::dim::Mat3;
 use nalgebra::SMatrix;

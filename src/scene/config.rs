@@ -58,6 +58,17 @@ pub enum MaterialModel {
     Hencky,
     /// Mooney-Rivlin (thesis 3-2): a, b, poisson_ratio; c and d follow (3-8, 3-17).
     MooneyRivlin,
+    /// Compressible Ogden: mu, alpha (one entry per term), poisson_ratio. No
+    /// analytic tangent: implicit runs need a Krylov linear solver.
+    Ogden,
+}
+
+impl MaterialModel {
+    /// Whether the model supplies the exact derivative of its stress update (the
+    /// direct implicit solver needs it; the Krylov solvers do not).
+    pub fn has_analytic_tangent(&self) -> bool {
+        !matches!(self, MaterialModel::Ogden)
+    }
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -70,6 +81,9 @@ pub struct MaterialConfig {
     pub poisson_ratio: Option<f64>,
     pub a: Option<f64>,
     pub b: Option<f64>,
+    /// Ogden μ_p and α_p, one entry per term.
+    pub mu: Option<Vec<f64>>,
+    pub alpha: Option<Vec<f64>>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]

@@ -77,6 +77,7 @@ pub fn validate(s: &SceneConfig) -> Check {
     for (i, l) in s.loads.iter().enumerate() {
         load(l, i, s)?;
     }
+    needs_krylov(s)?;
     match (&s.solver, s.stages.is_empty()) {
         (Some(solver_config), true) => solver(solver_config, "solver")?,
         (None, false) => {
@@ -102,6 +103,39 @@ pub fn validate(s: &SceneConfig) -> Check {
         "output.history_interval",
         "must be ≥ 0",
     )
+}
+
+/// A material without an analytic tangent cannot run on an implicit stage with
+/// the direct solver.
+fn needs_krylov(s: &SceneConfig) -> Check {
+    let Some(m) = s.materials.iter().find(|m| !m.model.has_analytic_tangent()) else {
+        return Ok(());
+    };
+    let stages: Vec<(String, &SolverConfig)> = match &s.solver {
+        Some(solver) => vec![("solver".into(), solver)],
+        None => (s.stages.iter().enumerate())
+            .map(|(k, st)| (format!("stage.{k}"), st))
+            .collect(),
+    };
+    for (prefix, st) in stages {
+        let direct = st.kind == SolverKind::Implicit && st.linear_solver() == LinearSolver::Direct;
+        let key = match st.linear_solver {
+            Some(_) => format!("{prefix}.linear_solver"),
+            None => format!("{prefix}.kind"),
+        };
+        ensure(
+            !direct,
+            key,
+            format!(
+                "material `{}` (model `{}`) has no analytic tangent, which the direct \
+                 implicit solver needs: set linear_solver = \"gmres\" (or \"cg\" for \
+                 symmetric problems) in this table",
+                m.name,
+                model_name(m.model)
+            ),
+        )?;
+    }
+    Ok(())
 }
 
 fn grid(g: &GridConfig, dim: usize) -> Check {
@@ -134,6 +168,8 @@ fn material(m: &MaterialConfig, i: usize) -> Check {
             required(&m.youngs_modulus, key("youngs_modulus"), &what)?;
             forbidden(&m.a, key("a"), &what)?;
             forbidden(&m.b, key("b"), &what)?;
+            forbidden(&m.mu, key("mu"), &what)?;
+            forbidden(&m.alpha, key("alpha"), &what)?;
             let e = m.youngs_modulus.unwrap_or(0.0);
             ensure(
                 e > 0.0 && e.is_finite(),
@@ -145,11 +181,36 @@ fn material(m: &MaterialConfig, i: usize) -> Check {
             required(&m.a, key("a"), &what)?;
             required(&m.b, key("b"), &what)?;
             forbidden(&m.youngs_modulus, key("youngs_modulus"), &what)?;
+            forbidden(&m.mu, key("mu"), &what)?;
+            forbidden(&m.alpha, key("alpha"), &what)?;
             let g = 2.0 * (m.a.unwrap_or(0.0) + m.b.unwrap_or(0.0));
             ensure(
                 g > 0.0 && g.is_finite(),
                 key("a"),
                 "a + b (= G/2, thesis 3-16) must be positive",
+            )?;
+        }
+        MaterialModel::Ogden => {
+            required(&m.mu, key("mu"), &what)?;
+            required(&m.alpha, key("alpha"), &what)?;
+            forbidden(&m.youngs_modulus, key("youngs_modulus"), &what)?;
+            forbidden(&m.a, key("a"), &what)?;
+            forbidden(&m.b, key("b"), &what)?;
+            let (mu, alpha) = (m.mu.as_ref().unwrap(), m.alpha.as_ref().unwrap());
+            ensure(
+                (1..=6).contains(&mu.len()),
+                key("mu"),
+                "needs 1 to 6 terms",
+            )?;
+            ensure(
+                alpha.len() == mu.len(),
+                key("alpha"),
+                format!("needs one entry per term of mu ({})", mu.len()),
+            )?;
+            ensure(
+                mu.iter().zip(alpha).all(|(m, a)| m * a > 0.0 && (m * a).is_finite()),
+                key("alpha"),
+                "every term needs mu_p * alpha_p > 0 (a positive shear modulus)",
             )?;
         }
     }
@@ -164,6 +225,7 @@ fn material(m: &MaterialConfig, i: usize) -> Check {
 
 pub fn model_name(m: MaterialModel) -> &'static str {
     match m {
+        MaterialModel::Ogden => "ogden",
         MaterialModel::LinearElastic => "linear_elastic",
         MaterialModel::NeoHookean => "neo_hookean",
         MaterialModel::Hencky => "hencky",
