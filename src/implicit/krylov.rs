@@ -104,7 +104,9 @@ impl Forcing {
                 eta.min(Self::ETA_MAX)
             }
         };
-        let eta = eta.max(0.5 * stop / r_norm).min(self.fixed.unwrap_or(Self::ETA_MAX));
+        let eta = eta
+            .max(0.5 * stop / r_norm)
+            .min(self.fixed.unwrap_or(Self::ETA_MAX));
         self.previous = Some((eta, r_norm));
         eta
     }
@@ -315,7 +317,9 @@ impl<const D: usize> Implicit<D> {
             let why = outcome
                 .breakdown
                 .map(|b| format!("stopped: {b}"))
-                .unwrap_or_else(|| format!("hit krylov_max_iterations = {}", config.max_iterations));
+                .unwrap_or_else(|| {
+                    format!("hit krylov_max_iterations = {}", config.max_iterations)
+                });
             return Err(Failure {
                 particle: None,
                 message: format!(
@@ -534,8 +538,11 @@ load_steps = 1
     fn product_errors(length: f64, steps: &[f64]) -> (Vec<f64>, f64) {
         let scene = Scene::parse("block.toml", &block(length), &[]).unwrap();
         let m = Model::<2>::build(&scene).unwrap();
-        let mut solver =
-            Implicit::<2>::new(scene.config.grid.shape_function, scene.config.stages()[0], 0.0);
+        let mut solver = Implicit::<2>::new(
+            scene.config.grid.shape_function,
+            scene.config.stages()[0],
+            0.0,
+        );
         let sys = solver.prepare(&m, 0.0, 1.0);
         let nodes: Vec<usize> = solver.map.active.iter().map(|&g| g as usize).collect();
         // Strains of a few per cent: displacements scale with the length.
@@ -611,10 +618,7 @@ load_steps = 1
     fn difference_product_error_against_step() {
         for length in [1.0, 100.0] {
             let exponents: Vec<i32> = (1..=13).collect();
-            let steps: Vec<f64> = exponents
-                .iter()
-                .map(|&k| length * 10f64.powi(-k))
-                .collect();
+            let steps: Vec<f64> = exponents.iter().map(|&k| length * 10f64.powi(-k)).collect();
             let (errors, chosen) = product_errors(length, &steps);
             let (_, at_chosen) = {
                 let (e, _) = product_errors(length, &[chosen]);

@@ -331,6 +331,7 @@ impl<const D: usize> Implicit<D> {
                 break;
             }
             // Correction: direct, or matrix-free Krylov to the forcing term.
+            let krylov_before = self.krylov_iterations;
             let correction = if self.krylov.is_some() {
                 let stop = self.residual_tolerance * scale;
                 self.krylov_correction(
@@ -344,6 +345,7 @@ impl<const D: usize> Implicit<D> {
                 Err(f) => {
                     // Keep the failing iteration in newton.csv.
                     row.wall_seconds = started.elapsed().as_secs_f64();
+                    row.krylov_iterations = self.krylov_iterations - krylov_before;
                     self.log.push(row);
                     return Err(f);
                 }

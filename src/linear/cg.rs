@@ -58,7 +58,8 @@ pub fn cg<E>(
         let curvature = dot(&p, &q);
         if !(curvature > 0.0) {
             outcome.converged = false;
-            outcome.breakdown = Some("a search direction with pᵀA p ≤ 0: A is not positive definite");
+            outcome.breakdown =
+                Some("a search direction with pᵀA p ≤ 0: A is not positive definite");
             return Ok(outcome);
         }
         let alpha = rz / curvature;
@@ -129,9 +130,7 @@ mod tests {
         let d: Vec<f64> = (0..n)
             .map(|i| 10f64.powf(2.0 * i as f64 / n as f64))
             .collect();
-        let a: Vec<f64> = (0..n * n)
-            .map(|k| d[k / n] * base[k] * d[k % n])
-            .collect();
+        let a: Vec<f64> = (0..n * n).map(|k| d[k / n] * base[k] * d[k % n]).collect();
         let b = rhs(n);
         let (_, reference) = solve(&base, n, &b, &Identity, 10 * n);
         let (_, plain) = solve(&a, n, &b, &Identity, 10 * n);

@@ -273,7 +273,10 @@ mod tests {
             );
             let res = relative_residual(&a, n, &x, &b);
             assert!(!out.converged && out.iterations == 8 * cycles, "{out:?}");
-            assert!(res <= last * (1.0 + 1e-12), "cycle {cycles}: {res} > {last}");
+            assert!(
+                res <= last * (1.0 + 1e-12),
+                "cycle {cycles}: {res} > {last}"
+            );
             assert!((res - out.relative_residual).abs() < 1e-8);
             last = res;
         }

@@ -82,7 +82,11 @@ impl BlockJacobi {
                     let mut d = DMatrix::<f64>::zeros(k, k);
                     for i in 0..k {
                         let v = block[(i, i)];
-                        d[(i, i)] = if v != 0.0 && v.is_finite() { 1.0 / v } else { 1.0 };
+                        d[(i, i)] = if v != 0.0 && v.is_finite() {
+                            1.0 / v
+                        } else {
+                            1.0
+                        };
                     }
                     d
                 });

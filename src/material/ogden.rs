@@ -44,7 +44,13 @@ impl Ogden {
 
     /// (λ, μ): small-strain Lamé constants.
     pub fn lame(&self) -> (f64, f64) {
-        let mu = 0.5 * self.mu.iter().zip(&self.alpha).map(|(m, a)| m * a).sum::<f64>();
+        let mu = 0.5
+            * self
+                .mu
+                .iter()
+                .zip(&self.alpha)
+                .map(|(m, a)| m * a)
+                .sum::<f64>();
         let nu = self.poisson_ratio;
         (2.0 * mu * nu / (1.0 - 2.0 * nu), mu)
     }
@@ -128,7 +134,11 @@ mod tests {
         let mu = e / (2.0 * (1.0 + nu));
         let ogden = Ogden::new(1000.0, vec![mu], vec![2.0], nu);
         let neo = NeoHookean::new(1000.0, e, nu);
-        for f in [general_f(), driver::rotation_z(0.7) * general_f(), Mat3::identity()] {
+        for f in [
+            general_f(),
+            driver::rotation_z(0.7) * general_f(),
+            Mat3::identity(),
+        ] {
             let (a, b) = (ogden.cauchy(&f), neo.cauchy(&f));
             assert!((a - b).norm() <= 1e-9 * b.norm().max(1.0), "{a} vs {b}");
             let (wa, wb) = (
@@ -144,7 +154,12 @@ mod tests {
     /// dW (central differences, three terms), and σ(I) = 0.
     #[test]
     fn stress_is_the_derivative_of_the_energy() {
-        let m = Ogden::new(1000.0, vec![6.3e5, 1.2e3, -1.0e4], vec![1.3, 5.0, -2.0], 0.3);
+        let m = Ogden::new(
+            1000.0,
+            vec![6.3e5, 1.2e3, -1.0e4],
+            vec![1.3, 5.0, -2.0],
+            0.3,
+        );
         assert!(m.cauchy(&Mat3::identity()).norm() < 1e-9);
         let f = general_f();
         let sigma = m.cauchy(&f);
@@ -155,7 +170,8 @@ mod tests {
                 let mut df = Mat3::zeros();
                 df[(k, l)] = 1.0;
                 let dw = (w(&(f + df * h)) - w(&(f - df * h))) / (2.0 * h);
-                let power = f.determinant() * (sigma.component_mul(&(df * f.try_inverse().unwrap()))).sum();
+                let power =
+                    f.determinant() * (sigma.component_mul(&(df * f.try_inverse().unwrap()))).sum();
                 assert!(
                     (dw - power).abs() < 1e-6 * sigma.norm(),
                     "({k},{l}): dW = {dw}, J σ : dF F⁻¹ = {power}"

@@ -197,18 +197,16 @@ fn material(m: &MaterialConfig, i: usize) -> Check {
             forbidden(&m.a, key("a"), &what)?;
             forbidden(&m.b, key("b"), &what)?;
             let (mu, alpha) = (m.mu.as_ref().unwrap(), m.alpha.as_ref().unwrap());
-            ensure(
-                (1..=6).contains(&mu.len()),
-                key("mu"),
-                "needs 1 to 6 terms",
-            )?;
+            ensure((1..=6).contains(&mu.len()), key("mu"), "needs 1 to 6 terms")?;
             ensure(
                 alpha.len() == mu.len(),
                 key("alpha"),
                 format!("needs one entry per term of mu ({})", mu.len()),
             )?;
             ensure(
-                mu.iter().zip(alpha).all(|(m, a)| m * a > 0.0 && (m * a).is_finite()),
+                mu.iter()
+                    .zip(alpha)
+                    .all(|(m, a)| m * a > 0.0 && (m * a).is_finite()),
                 key("alpha"),
                 "every term needs mu_p * alpha_p > 0 (a positive shear modulus)",
             )?;

@@ -33,23 +33,7 @@ pub struct Table {
 
 impl Table {
     pub fn read(path: &Path) -> Table {
-        let text =
-            std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        let mut lines = text.lines();
-        let header: Vec<String> = lines
-            .next()
-            .unwrap()
-            .split(',')
-            .map(|s| s.trim().to_string())
-            .collect();
-        let mut columns: HashMap<String, Vec<f64>> =
-            header.iter().map(|h| (h.clone(), Vec::new())).collect();
-        for line in lines.filter(|l| !l.trim().is_empty()) {
-            for (h, v) in header.iter().zip(line.split(',')) {
-                columns.get_mut(h).unwrap().push(v.trim().parse().unwrap());
-            }
-        }
-        Table { columns, header }
+        Table::read_columns(path, |_| true)
     }
 
     pub fn col(&self, name: &str) -> &[f64] {
@@ -77,4 +61,39 @@ pub fn run_text(
     let scene = Scene::parse("scene.toml", text, &overrides).expect("scene parses");
     let result = run(&scene, dir.path(), &RunOptions::default());
     (result, dir)
+}
+
+/// newton.csv without its text column (`linear_solver`).
+pub fn read_newton(path: &Path) -> Table {
+    let mut t = Table::read_columns(path, |h| h != "linear_solver");
+    t.header.retain(|h| h != "linear_solver");
+    t
+}
+
+impl Table {
+    /// Only the columns whose header passes `keep` (the others may hold text).
+    pub fn read_columns(path: &Path, keep: impl Fn(&str) -> bool) -> Table {
+        let text =
+            std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let mut lines = text.lines();
+        let header: Vec<String> = lines
+            .next()
+            .unwrap()
+            .split(',')
+            .map(|s| s.trim().to_string())
+            .collect();
+        let mut columns: HashMap<String, Vec<f64>> = header
+            .iter()
+            .filter(|h| keep(h))
+            .map(|h| (h.clone(), Vec::new()))
+            .collect();
+        for line in lines.filter(|l| !l.trim().is_empty()) {
+            for (h, v) in header.iter().zip(line.split(',')) {
+                if let Some(c) = columns.get_mut(h) {
+                    c.push(v.trim().parse().unwrap());
+                }
+            }
+        }
+        Table { columns, header }
+    }
 }
