@@ -48,7 +48,8 @@ pub fn cg<E>(
             outcome.converged = false;
             return Ok(outcome);
         }
-        if !(rz > 0.0) {
+        // Written so that NaN also stops the iteration.
+        if rz.is_nan() || rz <= 0.0 {
             outcome.converged = false;
             outcome.breakdown = Some("the preconditioner is not positive definite");
             return Ok(outcome);
@@ -56,7 +57,7 @@ pub fn cg<E>(
         apply(&p, &mut q)?;
         outcome.iterations += 1;
         let curvature = dot(&p, &q);
-        if !(curvature > 0.0) {
+        if curvature.is_nan() || curvature <= 0.0 {
             outcome.converged = false;
             outcome.breakdown =
                 Some("a search direction with pᵀA p ≤ 0: A is not positive definite");
