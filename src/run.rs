@@ -143,6 +143,7 @@ impl<const D: usize> Stepper<D> {
                 summary["krylov_iterations"] = json!(i.krylov_iterations);
                 if s.linear_solver() != LinearSolver::Direct {
                     summary["preconditioner"] = json!(s.preconditioner().name());
+                    summary["lagged_factorizations"] = json!(i.lagged_factorizations());
                 }
                 if s.integrator() == Integrator::Newmark {
                     summary["beta"] = json!(s.beta());

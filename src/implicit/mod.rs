@@ -175,6 +175,11 @@ impl<const D: usize> Implicit<D> {
         self.map.len()
     }
 
+    /// Factorizations of the lagged_direct preconditioner so far (0 otherwise).
+    pub fn lagged_factorizations(&self) -> usize {
+        self.krylov.as_ref().map_or(0, |k| k.factorizations)
+    }
+
     /// Advance from t to t + dt, halving the step on Newton failure. Returns the
     /// work of gravity and applied loads.
     pub fn advance(
