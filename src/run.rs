@@ -8,7 +8,7 @@ use crate::implicit::{Implicit, NEWTON_CSV_HEADER};
 use crate::output::{
     body_centres, write_json, write_particles_csv, FrameWriter, HistoryWriter, Progress,
 };
-use crate::scene::{Integrator, SolverConfig, SolverKind};
+use crate::scene::{Integrator, LinearSolver, SolverConfig, SolverKind};
 use crate::scene::{Scene, SceneError};
 use crate::setup::Model;
 use crate::transfer::deterministic_sum;
@@ -139,6 +139,12 @@ impl<const D: usize> Stepper<D> {
                 });
                 summary["newton_iterations"] = json!(i.newton_iterations);
                 summary["cutbacks"] = json!(i.cutbacks);
+                summary["linear_solver"] = json!(s.linear_solver().name());
+                summary["krylov_iterations"] = json!(i.krylov_iterations);
+                if s.linear_solver() != LinearSolver::Direct {
+                    summary["preconditioner"] = json!(s.preconditioner().name());
+                    summary["lagged_factorizations"] = json!(i.lagged_factorizations());
+                }
                 if s.integrator() == Integrator::Newmark {
                     summary["beta"] = json!(s.beta());
                     summary["gamma"] = json!(s.gamma());
@@ -207,7 +213,7 @@ fn run_dim<const D: usize>(
     let mut stage_summaries = Vec::new();
     let mut outcome: Result<(), Divergence> = Ok(());
     let mut summary = json!({});
-    let (mut newton_total, mut cutbacks_total) = (0u64, 0u64);
+    let (mut newton_total, mut cutbacks_total, mut krylov_total) = (0u64, 0u64, 0u64);
     for (k, sc) in stages.iter().enumerate() {
         let mut stepper = Stepper::<D>::new(cfg.grid.shape_function, sc, t);
         let (stage_start, stage_end) = (t, t + sc.end_time);
@@ -243,6 +249,7 @@ fn run_dim<const D: usize>(
         stepper.describe(sc, &mut stage);
         newton_total += stage["newton_iterations"].as_u64().unwrap_or(0);
         cutbacks_total += stage["cutbacks"].as_u64().unwrap_or(0);
+        krylov_total += stage["krylov_iterations"].as_u64().unwrap_or(0);
         // The top level carries the solver fields of the last stage that ran.
         stepper.describe(sc, &mut summary);
         summary["dt"] = json!(last_dt);
@@ -278,6 +285,7 @@ fn run_dim<const D: usize>(
     if newton_log.is_some() {
         summary["newton_iterations"] = json!(newton_total);
         summary["cutbacks"] = json!(cutbacks_total);
+        summary["krylov_iterations"] = json!(krylov_total);
     }
     if let Err(d) = outcome {
         summary["status"] = json!("diverged");

@@ -8,7 +8,7 @@ use crate::grid::{Face, Grid};
 use crate::material::mohr_coulomb::{Softening, Strength};
 use crate::material::{
     drucker_prager, DruckerPrager, Hencky, LinearElastic, Material, MohrCoulomb, MooneyRivlin,
-    NeoHookean,
+    NeoHookean, Ogden,
 };
 use crate::particles::Particles;
 use crate::scene::validate::{axis, body_bounds};
@@ -206,6 +206,12 @@ fn material(m: &MaterialConfig) -> Box<dyn Material> {
             m.density,
             m.a.unwrap(),
             m.b.unwrap(),
+            nu,
+        )),
+        MaterialModel::Ogden => Box::new(Ogden::new(
+            m.density,
+            m.mu.clone().unwrap(),
+            m.alpha.clone().unwrap(),
             nu,
         )),
         MaterialModel::DruckerPrager => {

@@ -169,6 +169,88 @@ fn overrides_are_checked_like_the_file() {
     assert_eq!(s.config.grid.cells, vec![8, 2]);
 }
 
+/// The implicit reference scene with extra [solver] lines from line 25 on.
+fn implicit(extra: &str) -> String {
+    GOOD.replace(
+        "kind = \"explicit\"\nend_time = 1.0\ncfl = 0.5",
+        &format!("kind = \"implicit\"\nend_time = 1.0\ndt = 0.1\n{extra}"),
+    )
+}
+
+#[test]
+fn linear_solver_keys_are_checked() {
+    Scene::parse(
+        "scene.toml",
+        &implicit("linear_solver = \"gmres\"\npreconditioner = \"lagged_direct\"\nkrylov_restart = 50\nkrylov_tolerance = 1e-3"),
+        &[],
+    )
+    .unwrap();
+    let e = err(&implicit("preconditioner = \"jacobi\""));
+    assert!(
+        e.contains("scene.toml:25:18")
+            && e.contains("key `solver.preconditioner`")
+            && e.contains("linear_solver = \"direct\""),
+        "{e}"
+    );
+    let e = err(&implicit("linear_solver = \"cg\"\nkrylov_restart = 10"));
+    assert!(
+        e.contains("scene.toml:26:18") && e.contains("key `solver.krylov_restart`"),
+        "{e}"
+    );
+    let e = err(&implicit(
+        "linear_solver = \"gmres\"\nkrylov_tolerance = 1.5",
+    ));
+    assert!(
+        e.contains("scene.toml:26:20") && e.contains("must lie in (0, 1)"),
+        "{e}"
+    );
+    let e = err(&implicit(
+        "linear_solver = \"gmres\"\nkrylov_max_iterations = 0",
+    ));
+    assert!(e.contains("key `solver.krylov_max_iterations`"), "{e}");
+    let e = err(&implicit("linear_solver = \"bicgstab\""));
+    assert!(
+        e.contains("scene.toml:25:17") && e.contains("unknown variant `bicgstab`"),
+        "{e}"
+    );
+    let e = err(&GOOD.replace("cfl = 0.5", "cfl = 0.5\nlinear_solver = \"gmres\""));
+    assert!(
+        e.contains("key `solver.linear_solver`") && e.contains("explicit"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_model_without_tangent_needs_a_krylov_solver() {
+    let ogden = |solver: &str| {
+        implicit(solver).replace(
+            "model = \"linear_elastic\"\ndensity = 1.0\nyoungs_modulus = 100.0",
+            "model = \"ogden\"\ndensity = 1.0\nmu = [30.0, -5.0]\nalpha = [2.0, -1.0]",
+        )
+    };
+    Scene::parse("scene.toml", &ogden("linear_solver = \"cg\""), &[]).unwrap();
+    let e = err(&ogden("linear_solver = \"direct\""));
+    assert!(
+        e.contains("scene.toml:26:17")
+            && e.contains("material `m` (model `ogden`) has no analytic tangent")
+            && e.contains("gmres"),
+        "{e}"
+    );
+    let e = err(&ogden(""));
+    assert!(
+        e.contains("key `solver.kind`") && e.contains("no analytic tangent"),
+        "{e}"
+    );
+    let e = err(&ogden("linear_solver = \"cg\"").replace("alpha = [2.0, -1.0]", "alpha = [2.0]"));
+    assert!(
+        e.contains("key `material.0.alpha`") && e.contains("one entry per term"),
+        "{e}"
+    );
+    let e =
+        err(&ogden("linear_solver = \"cg\"").replace("alpha = [2.0, -1.0]", "alpha = [2.0, 1.0]"));
+    assert!(e.contains("mu_p * alpha_p > 0"), "{e}");
+}
+
 /// The binary reports the error on stderr with exit code 2 and never panics.
 #[test]
 fn cli_exits_non_zero_without_panicking() {

@@ -6,10 +6,12 @@
 //! displacement increments u of the free components; residual (2-37)
 //! r(u) = M (u − ũ)/(βΔt²) + f_int(u) − f_ext (no inertia when quasi-static);
 //! Newton (2-38) with the assembled consistent tangent (2-40), Dirichlet
-//! components eliminated, sparse direct solves. Every iterate's stresses are
+//! components eliminated, sparse direct solves, or matrix-free GMRES / CG on
+//! finite-difference products (2-39, `krylov`). Every iterate's stresses are
 //! recomputed from the step-start state (`deformation::Trial`). A step whose Newton
 //! iteration fails is halved and retried, up to `max_cutbacks` times.
 
+pub mod krylov;
 pub mod newmark;
 pub mod support;
 pub mod tangent;
@@ -20,6 +22,7 @@ use crate::deformation::Trial;
 use crate::dim::Vector;
 use crate::explicit::{check_state, Divergence};
 use crate::linear::direct::{DirectSolver, Structure};
+use crate::material::driver::numerical_stress_derivative;
 use crate::material::Increment;
 use crate::scene::{Integrator, MassMatrix, SolverConfig};
 use crate::setup::{load_factor, Model};
@@ -52,15 +55,20 @@ pub struct NewtonRow {
     pub increment: f64,
     pub wall_seconds: f64,
     pub linear_solver: &'static str,
+    /// Krylov iterations of the correction that follows (0: direct solver or
+    /// converged row).
+    pub krylov_iterations: usize,
+    /// Forcing term η of that correction (NaN: direct solver or converged row).
+    pub forcing: f64,
 }
 
 pub const NEWTON_CSV_HEADER: &str =
-    "step,time,dt,cutback,iteration,residual,increment,wall_seconds,linear_solver";
+    "step,time,dt,cutback,iteration,residual,increment,wall_seconds,krylov_iterations,forcing,linear_solver";
 
 impl NewtonRow {
     pub fn csv(&self) -> String {
         format!(
-            "{},{},{},{},{},{:e},{:e},{:e},{}",
+            "{},{},{},{},{},{:e},{:e},{:e},{},{:e},{}",
             self.step,
             self.time,
             self.dt,
@@ -69,6 +77,8 @@ impl NewtonRow {
             self.residual,
             self.increment,
             self.wall_seconds,
+            self.krylov_iterations,
+            self.forcing,
             self.linear_solver
         )
     }
@@ -119,6 +129,8 @@ pub struct Implicit<const D: usize> {
     map: NodeMap,
     trial: Trial,
     solver: DirectSolver,
+    /// Matrix-free Krylov solver (None: direct solves).
+    krylov: Option<krylov::KrylovState>,
     /// Particle accelerations (Newmark only; empty otherwise).
     accel: Vec<Vector<D>>,
     /// Absorbing faces within the current step (empty when the scene has none).
@@ -127,6 +139,8 @@ pub struct Implicit<const D: usize> {
     log: Vec<NewtonRow>,
     pub newton_iterations: usize,
     pub cutbacks: usize,
+    /// Krylov iterations over all Newton corrections (0 with the direct solver).
+    pub krylov_iterations: usize,
 }
 
 impl<const D: usize> Implicit<D> {
@@ -152,11 +166,13 @@ impl<const D: usize> Implicit<D> {
             map: NodeMap::default(),
             trial: Trial::default(),
             solver: DirectSolver::new(),
+            krylov: krylov::KrylovConfig::of(s).map(krylov::KrylovState::new),
             accel: Vec::new(),
             absorbing: AbsorbingStep::default(),
             log: Vec::new(),
             newton_iterations: 0,
             cutbacks: 0,
+            krylov_iterations: 0,
         }
     }
 
@@ -167,6 +183,11 @@ impl<const D: usize> Implicit<D> {
 
     pub fn active_nodes(&self) -> usize {
         self.map.len()
+    }
+
+    /// Factorizations of the lagged_direct preconditioner so far (0 otherwise).
+    pub fn lagged_factorizations(&self) -> usize {
+        self.krylov.as_ref().map_or(0, |k| k.factorizations)
     }
 
     /// Advance from t to t + dt, halving the step on Newton failure. Returns the
@@ -323,6 +344,8 @@ impl<const D: usize> Implicit<D> {
                 increment: f64::NAN,
                 wall_seconds: started.elapsed().as_secs_f64(),
                 linear_solver: method,
+                krylov_iterations: 0,
+                forcing: f64::NAN,
             };
             if residual_ok && increment_ok {
                 self.log.push(row);
@@ -333,26 +356,30 @@ impl<const D: usize> Implicit<D> {
                 self.log.push(row);
                 break;
             }
-            // Tangent and correction.
-            let (triplets, symmetric) = self.tangent(m, dofs, mass, inertia)?;
-            let structure = if symmetric {
-                Structure::Symmetric
+            // Correction: direct, or matrix-free Krylov to the forcing term.
+            let krylov_before = self.krylov_iterations;
+            let correction = if self.krylov.is_some() {
+                let stop = self.residual_tolerance * scale;
+                self.krylov_correction(
+                    m, dofs, &u, &r_free, stop, iteration, u_tilde, mass, f_ext, inertia, dt,
+                )
             } else {
-                Structure::General
+                self.direct_correction(m, dofs, &r_free, mass, inertia)
             };
-            let used = self
-                .solver
-                .factorize(dofs.free, &triplets, structure)
-                .map_err(|e| Failure {
-                    particle: None,
-                    message: format!("linear solve failed: {e}"),
-                })?;
-            method = used.name();
-            let rhs: Vec<f64> = r_free.iter().map(|x| -x).collect();
-            let du = self.solver.solve(&rhs).map_err(|e| Failure {
-                particle: None,
-                message: format!("linear solve failed: {e}"),
-            })?;
+            let correction = match correction {
+                Ok(c) => c,
+                Err(f) => {
+                    // Keep the failing iteration in newton.csv.
+                    row.wall_seconds = started.elapsed().as_secs_f64();
+                    row.krylov_iterations = self.krylov_iterations - krylov_before;
+                    self.log.push(row);
+                    return Err(f);
+                }
+            };
+            let du = correction.du;
+            method = correction.method;
+            row.krylov_iterations = correction.krylov_iterations;
+            row.forcing = correction.forcing;
             let mut step_length = 1.0;
             if self.line_search {
                 step_length =
@@ -563,14 +590,49 @@ impl<const D: usize> Implicit<D> {
         Ok(r)
     }
 
-    /// Consistent tangent triplets over the free unknowns, and whether it is symmetric.
-    fn tangent(
-        &self,
+    /// δu = −K⁻¹ r with the assembled tangent, factorized by the direct solver.
+    fn direct_correction(
+        &mut self,
         m: &Model<D>,
         dofs: &Dofs,
+        r_free: &[f64],
         mass: &[f64],
         inertia: f64,
-    ) -> Result<(tangent::Triplets, bool), Failure> {
+    ) -> Result<krylov::Correction, Failure> {
+        let (triplets, symmetric) = self.tangent(m, dofs, mass, inertia)?;
+        let structure = if symmetric {
+            Structure::Symmetric
+        } else {
+            Structure::General
+        };
+        let used = self
+            .solver
+            .factorize(dofs.free, &triplets, structure)
+            .map_err(|e| Failure {
+                particle: None,
+                message: format!("linear solve failed: {e}"),
+            })?;
+        let rhs: Vec<f64> = r_free.iter().map(|x| -x).collect();
+        let du = self.solver.solve(&rhs).map_err(|e| Failure {
+            particle: None,
+            message: format!("linear solve failed: {e}"),
+        })?;
+        Ok(krylov::Correction {
+            du,
+            method: used.name(),
+            krylov_iterations: 0,
+            forcing: f64::NAN,
+        })
+    }
+
+    /// A_p = ∂P/∂ΔF of every particle at the trial state: from the material's
+    /// exact stress derivative, or, when `numerical` (Krylov preconditioners
+    /// only), from central differences of its stress update if it has none.
+    fn particle_tangents(
+        &self,
+        m: &Model<D>,
+        numerical: bool,
+    ) -> Result<Vec<Pk1Derivative>, Failure> {
         let p = &m.particles;
         let history_old = p.history.slots(&p.history.data);
         let a: Vec<Option<Pk1Derivative>> = (0..p.len())
@@ -584,8 +646,11 @@ impl<const D: usize> Implicit<D> {
                     stress_old: p.stress[q],
                     history_old: history_old[q],
                 };
-                let mat = &m.materials[p.material[q] as usize];
+                let mat = m.materials[p.material[q] as usize].as_ref();
                 mat.stress_derivative(&inc)
+                    .or_else(|| {
+                        numerical.then(|| numerical_stress_derivative(mat, &inc, NUMERICAL_STEP))
+                    })
                     .map(|ds| pk1_derivative(&self.trial.df[q], &self.trial.stress[q], &ds))
             })
             .collect();
@@ -594,11 +659,26 @@ impl<const D: usize> Implicit<D> {
             return Err(Failure {
                 particle: Some(q),
                 message: format!(
-                    "material model `{model}` has no analytic tangent for the direct solver"
+                    "material model `{model}` has no analytic tangent, which the direct solver \
+                     needs; choose a matrix-free solver: linear_solver = \"gmres\" (or \"cg\" \
+                     for symmetric problems) in [solver] or the [[stage]]"
                 ),
             });
         }
-        let a: Vec<Pk1Derivative> = a.into_iter().map(|x| x.unwrap()).collect();
+        Ok(a.into_iter().map(|x| x.unwrap()).collect())
+    }
+
+    /// Consistent tangent triplets over the free unknowns, and whether it is symmetric.
+    fn tangent(
+        &self,
+        m: &Model<D>,
+        dofs: &Dofs,
+        mass: &[f64],
+        inertia: f64,
+    ) -> Result<(tangent::Triplets, bool), Failure> {
+        let p = &m.particles;
+        // The Krylov path's lagged preconditioner accepts a numerical tangent.
+        let a = self.particle_tangents(m, self.krylov.is_some())?;
         let (mut triplets, symmetric) =
             stiffness_triplets(&self.map, &self.stencils, dofs, &p.volume, &a);
         // Absorbing faces: Σ S_I S_J (γ/(βΔt) C + K), symmetric.
@@ -669,6 +749,10 @@ impl<const D: usize> Implicit<D> {
         Ok(length)
     }
 }
+
+/// Central-difference step of the numerical stress derivative (preconditioners
+/// of materials without an analytic tangent).
+const NUMERICAL_STEP: f64 = 1e-6;
 
 #[cfg(test)]
 mod tests {

@@ -54,13 +54,13 @@ pub struct Hencky {
 
 /// Spectral decomposition of b = F Fᵀ: eigenvectors (columns of `n`) and the
 /// eigenvalues of b − I (`m`, so β_a = 1 + m_a).
-struct Spectral {
-    n: Mat3,
-    m: Vector3<f64>,
+pub(crate) struct Spectral {
+    pub(crate) n: Mat3,
+    pub(crate) m: Vector3<f64>,
 }
 
 impl Spectral {
-    fn of(f: &Mat3) -> Self {
+    pub(crate) fn of(f: &Mat3) -> Self {
         let h = f - Mat3::identity();
         let b_minus_i = h + h.transpose() + h * h.transpose();
         let eig = SymmetricEigen::new(b_minus_i);
@@ -77,7 +77,7 @@ impl Spectral {
     }
 
     /// Principal Hencky strains ln λ_a = ½ ln β_a.
-    fn principal_log_stretches(&self) -> Vector3<f64> {
+    pub(crate) fn principal_log_stretches(&self) -> Vector3<f64> {
         self.m.map(|m| 0.5 * m.ln_1p())
     }
 

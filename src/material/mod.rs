@@ -14,6 +14,7 @@ pub mod linear_elastic;
 pub mod mohr_coulomb;
 pub mod mooney_rivlin;
 pub mod neo_hookean;
+pub mod ogden;
 pub mod principal;
 
 pub use drucker_prager::DruckerPrager;
@@ -22,6 +23,7 @@ pub use linear_elastic::LinearElastic;
 pub use mohr_coulomb::MohrCoulomb;
 pub use mooney_rivlin::MooneyRivlin;
 pub use neo_hookean::NeoHookean;
+pub use ogden::Ogden;
 
 use crate::dim::Mat3;
 use nalgebra::SMatrix;

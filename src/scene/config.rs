@@ -70,6 +70,17 @@ pub enum MaterialModel {
     /// poisson_ratio, cohesion, friction_angle, dilation_angle; optional softening
     /// (residual_*, softening_start, softening_end) and tensile_strength.
     MohrCoulomb,
+    /// Compressible Ogden: mu, alpha (one entry per term), poisson_ratio. No
+    /// analytic tangent: implicit runs need a Krylov linear solver.
+    Ogden,
+}
+
+impl MaterialModel {
+    /// Whether the model supplies the exact derivative of its stress update (the
+    /// direct implicit solver needs it; the Krylov solvers do not).
+    pub fn has_analytic_tangent(&self) -> bool {
+        !matches!(self, MaterialModel::Ogden)
+    }
 }
 
 /// How a Drucker-Prager cone is fitted to the Mohr-Coulomb parameters.
@@ -105,6 +116,9 @@ pub struct MaterialConfig {
     pub softening_start: Option<f64>,
     pub softening_end: Option<f64>,
     pub tensile_strength: Option<f64>,
+    /// Ogden μ_p and α_p, one entry per term.
+    pub mu: Option<Vec<f64>>,
+    pub alpha: Option<Vec<f64>>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
@@ -267,6 +281,52 @@ pub enum MassMatrix {
     Consistent,
 }
 
+/// How the implicit solver solves each Newton correction (thesis 2-38).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LinearSolver {
+    /// Assembled consistent tangent, sparse Cholesky / LU (needs an analytic tangent).
+    Direct,
+    /// Matrix-free restarted GMRES with finite-difference products (2-39).
+    Gmres,
+    /// Matrix-free conjugate gradients (symmetric positive definite tangents).
+    Cg,
+}
+
+impl LinearSolver {
+    pub fn name(&self) -> &'static str {
+        match self {
+            LinearSolver::Direct => "direct",
+            LinearSolver::Gmres => "gmres",
+            LinearSolver::Cg => "cg",
+        }
+    }
+}
+
+/// Preconditioner of the Krylov solvers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PreconditionerKind {
+    None,
+    /// Inverse of the tangent's diagonal, built particle by particle.
+    Jacobi,
+    /// Inverse of each node's D×D diagonal block, built particle by particle.
+    BlockJacobi,
+    /// The assembled tangent of an earlier iteration, factorized once and reused.
+    LaggedDirect,
+}
+
+impl PreconditionerKind {
+    pub fn name(&self) -> &'static str {
+        match self {
+            PreconditionerKind::None => "none",
+            PreconditionerKind::Jacobi => "jacobi",
+            PreconditionerKind::BlockJacobi => "block_jacobi",
+            PreconditionerKind::LaggedDirect => "lagged_direct",
+        }
+    }
+}
+
 /// The `[solver]` table. Keys that belong to the other kind are rejected by
 /// `validate`; the accessors give the documented defaults.
 #[derive(Clone, Debug, Deserialize)]
@@ -298,6 +358,12 @@ pub struct SolverConfig {
     pub line_search: Option<bool>,
     pub max_cutbacks: Option<usize>,
     pub min_node_support: Option<f64>,
+    // Linear solver of the Newton corrections (implicit).
+    pub linear_solver: Option<LinearSolver>,
+    pub preconditioner: Option<PreconditionerKind>,
+    pub krylov_tolerance: Option<f64>,
+    pub krylov_restart: Option<usize>,
+    pub krylov_max_iterations: Option<usize>,
 }
 
 impl SceneConfig {
@@ -375,6 +441,23 @@ impl SolverConfig {
     /// 0 turns it off). See `implicit::support`.
     pub fn min_node_support(&self) -> f64 {
         self.min_node_support.unwrap_or(1e-2)
+    }
+    /// Linear solver of the Newton corrections (default direct).
+    pub fn linear_solver(&self) -> LinearSolver {
+        self.linear_solver.unwrap_or(LinearSolver::Direct)
+    }
+    /// Krylov preconditioner (default block_jacobi).
+    pub fn preconditioner(&self) -> PreconditionerKind {
+        self.preconditioner
+            .unwrap_or(PreconditionerKind::BlockJacobi)
+    }
+    /// GMRES restart length (default 30).
+    pub fn krylov_restart(&self) -> usize {
+        self.krylov_restart.unwrap_or(30)
+    }
+    /// Krylov iterations allowed per Newton correction (default 1000).
+    pub fn krylov_max_iterations(&self) -> usize {
+        self.krylov_max_iterations.unwrap_or(1000)
     }
 }
 

@@ -77,6 +77,7 @@ pub fn validate(s: &SceneConfig) -> Check {
     for (i, l) in s.loads.iter().enumerate() {
         load(l, i, s)?;
     }
+    needs_krylov(s)?;
     match (&s.solver, s.stages.is_empty()) {
         (Some(solver_config), true) => solver(solver_config, "solver")?,
         (None, false) => {
@@ -183,6 +184,39 @@ pub fn bench(b: &BenchConfig, prefix: &str) -> Check {
     Ok(())
 }
 
+/// A material without an analytic tangent cannot run on an implicit stage with
+/// the direct solver.
+fn needs_krylov(s: &SceneConfig) -> Check {
+    let Some(m) = s.materials.iter().find(|m| !m.model.has_analytic_tangent()) else {
+        return Ok(());
+    };
+    let stages: Vec<(String, &SolverConfig)> = match &s.solver {
+        Some(solver) => vec![("solver".into(), solver)],
+        None => (s.stages.iter().enumerate())
+            .map(|(k, st)| (format!("stage.{k}"), st))
+            .collect(),
+    };
+    for (prefix, st) in stages {
+        let direct = st.kind == SolverKind::Implicit && st.linear_solver() == LinearSolver::Direct;
+        let key = match st.linear_solver {
+            Some(_) => format!("{prefix}.linear_solver"),
+            None => format!("{prefix}.kind"),
+        };
+        ensure(
+            !direct,
+            key,
+            format!(
+                "material `{}` (model `{}`) has no analytic tangent, which the direct \
+                 implicit solver needs: set linear_solver = \"gmres\" (or \"cg\" for \
+                 symmetric problems) in this table",
+                m.name,
+                model_name(m.model)
+            ),
+        )?;
+    }
+    Ok(())
+}
+
 fn grid(g: &GridConfig, dim: usize) -> Check {
     vector(&g.min, dim, "grid.min")?;
     vector(&g.max, dim, "grid.max")?;
@@ -226,6 +260,27 @@ fn material(m: &MaterialConfig, i: usize) -> Check {
                 "a + b (= G/2, thesis 3-16) must be positive",
             )?;
         }
+        MaterialModel::Ogden => {
+            required(&m.mu, key("mu"), &what)?;
+            required(&m.alpha, key("alpha"), &what)?;
+            forbidden(&m.youngs_modulus, key("youngs_modulus"), &what)?;
+            forbidden(&m.a, key("a"), &what)?;
+            forbidden(&m.b, key("b"), &what)?;
+            let (mu, alpha) = (m.mu.as_ref().unwrap(), m.alpha.as_ref().unwrap());
+            ensure((1..=6).contains(&mu.len()), key("mu"), "needs 1 to 6 terms")?;
+            ensure(
+                alpha.len() == mu.len(),
+                key("alpha"),
+                format!("needs one entry per term of mu ({})", mu.len()),
+            )?;
+            ensure(
+                mu.iter()
+                    .zip(alpha)
+                    .all(|(m, a)| m * a > 0.0 && (m * a).is_finite()),
+                key("alpha"),
+                "every term needs mu_p * alpha_p > 0 (a positive shear modulus)",
+            )?;
+        }
         _ => {
             required(&m.youngs_modulus, key("youngs_modulus"), &what)?;
             let e = m.youngs_modulus.unwrap_or(0.0);
@@ -265,11 +320,13 @@ fn material(m: &MaterialConfig, i: usize) -> Check {
 }
 
 /// The model-specific optional keys and whether each is given.
-fn optional_keys(m: &MaterialConfig) -> [(&'static str, bool); 13] {
+fn optional_keys(m: &MaterialConfig) -> [(&'static str, bool); 15] {
     [
         ("youngs_modulus", m.youngs_modulus.is_some()),
         ("a", m.a.is_some()),
         ("b", m.b.is_some()),
+        ("mu", m.mu.is_some()),
+        ("alpha", m.alpha.is_some()),
         ("cohesion", m.cohesion.is_some()),
         ("friction_angle", m.friction_angle.is_some()),
         ("dilation_angle", m.dilation_angle.is_some()),
@@ -296,6 +353,7 @@ fn model_keys(model: MaterialModel) -> &'static [&'static str] {
             &["youngs_modulus"]
         }
         MaterialModel::MooneyRivlin => &["a", "b"],
+        MaterialModel::Ogden => &["mu", "alpha"],
         MaterialModel::DruckerPrager => &[
             "youngs_modulus",
             "cohesion",
@@ -408,6 +466,7 @@ fn softening(m: &MaterialConfig, i: usize) -> Check {
 
 pub fn model_name(m: MaterialModel) -> &'static str {
     match m {
+        MaterialModel::Ogden => "ogden",
         MaterialModel::LinearElastic => "linear_elastic",
         MaterialModel::NeoHookean => "neo_hookean",
         MaterialModel::Hencky => "hencky",
@@ -712,6 +771,19 @@ fn explicit(s: &SolverConfig, prefix: &str) -> Check {
         format!("{prefix}.min_node_support"),
         what,
     )?;
+    forbidden(&s.linear_solver, format!("{prefix}.linear_solver"), what)?;
+    forbidden(&s.preconditioner, format!("{prefix}.preconditioner"), what)?;
+    forbidden(
+        &s.krylov_tolerance,
+        format!("{prefix}.krylov_tolerance"),
+        what,
+    )?;
+    forbidden(&s.krylov_restart, format!("{prefix}.krylov_restart"), what)?;
+    forbidden(
+        &s.krylov_max_iterations,
+        format!("{prefix}.krylov_max_iterations"),
+        what,
+    )?;
     let cfl = s.cfl();
     ensure(
         cfl > 0.0 && cfl <= 1.0,
@@ -800,6 +872,44 @@ fn implicit(s: &SolverConfig, prefix: &str) -> Check {
     ensure(
         s.max_iterations() >= 1,
         format!("{prefix}.max_iterations"),
+        "must be at least 1",
+    )?;
+    linear_solver(s, prefix)
+}
+
+/// Keys of the linear solver: Krylov keys only with a Krylov solver, the restart
+/// only with GMRES.
+fn linear_solver(s: &SolverConfig, prefix: &str) -> Check {
+    let key = |k: &str| format!("{prefix}.{k}");
+    match s.linear_solver() {
+        LinearSolver::Direct => {
+            let what = "linear_solver = \"direct\" (set \"gmres\" or \"cg\")";
+            forbidden(&s.preconditioner, key("preconditioner"), what)?;
+            forbidden(&s.krylov_tolerance, key("krylov_tolerance"), what)?;
+            forbidden(&s.krylov_restart, key("krylov_restart"), what)?;
+            return forbidden(&s.krylov_max_iterations, key("krylov_max_iterations"), what);
+        }
+        LinearSolver::Cg => forbidden(
+            &s.krylov_restart,
+            key("krylov_restart"),
+            "linear_solver = \"cg\" (it is the GMRES restart length)",
+        )?,
+        LinearSolver::Gmres => ensure(
+            s.krylov_restart() >= 1,
+            key("krylov_restart"),
+            "must be at least 1",
+        )?,
+    }
+    if let Some(eta) = s.krylov_tolerance {
+        ensure(
+            eta > 0.0 && eta < 1.0,
+            key("krylov_tolerance"),
+            format!("must lie in (0, 1) (a relative residual of the linear solve); got {eta}"),
+        )?;
+    }
+    ensure(
+        s.krylov_max_iterations() >= 1,
+        key("krylov_max_iterations"),
         "must be at least 1",
     )
 }

@@ -42,3 +42,8 @@ pub fn run_text(
     let result = run(&scene, dir.path(), &RunOptions::default());
     (result, dir)
 }
+
+/// newton.csv (the library's Table also reads its text column, `linear_solver`).
+pub fn read_newton(path: &Path) -> Table {
+    Table::read(path).unwrap_or_else(|e| panic!("{e}"))
+}

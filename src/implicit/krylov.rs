@@ -1,0 +1,685 @@
+//! Matrix-free Newton–Krylov corrections (thesis §2.2.2, first method).
+//!
+//! The Newton correction (2-38) J δu = −r is solved by GMRES or CG, which only
+//! need products J v. Each is a one-sided difference of the residual (2-39),
+//!
+//!   J v ≈ (r(u + ε v) − r(u)) / ε,
+//!
+//! so no tangent is assembled and materials without an analytic tangent run
+//! implicitly. The linear solve is inexact: it stops when
+//! ‖r + J δu‖ ≤ η ‖r‖, with the forcing term η of Eisenstat & Walker (1996),
+//! choice 2 (see [`Forcing`]).
+//!
+//! Choice of ε ([`difference_step`]). The residual depends on u through the
+//! incremental deformation gradient ΔF = I + Σ u ⊗ ∇S, i.e. on u / h at cell size
+//! h. Forming ΔF in floating point perturbs it by about ε_mach, which acts like a
+//! displacement error ε_mach·h, or ε_mach·|u| once |u| exceeds h; the round-off
+//! of the difference quotient relative to J v is therefore about
+//! ε_mach (h + ‖u‖_∞) / (ε ‖v‖_∞). Its truncation error, ½ ε ‖v‖² |r''| relative to
+//! ‖J v‖, is about ε ‖v‖_∞ / h (the residual bends on the scale of unit strain).
+//! The two balance at
+//!
+//!   ε = √ε_mach (h + ‖u‖_∞) / ‖v‖_∞,
+//!
+//! where both errors are about √ε_mach ≈ 1.5e-8 of J v. Maximum norms make the
+//! rule independent of the number of unknowns: the largest nodal perturbation is
+//! √ε_mach (h + ‖u‖_∞). `tests::difference_product_error_against_step` checks the
+//! error curve against the assembled tangent.
+//!
+//! Preconditioners are built from the particle tangents A_p = ∂P/∂ΔF at the
+//! current iterate (the material's analytic derivative, or central differences
+//! of its stress update when it has none): the diagonal or the nodal D×D
+//! diagonal blocks of K summed particle by particle ([`diagonal_blocks`]), never
+//! forming K; or K itself assembled and factorized with the direct solver and
+//! kept while it works (lagged, see [`LAGGED_REFRESH_ITERATIONS`]).
+
+use super::tangent::{Dofs, Pk1Derivative};
+use super::{Failure, Implicit};
+use crate::dim::Vector;
+use crate::linear::cg::cg;
+use crate::linear::direct::Structure;
+use crate::linear::gmres::gmres;
+use crate::linear::iterative::{Identity, Outcome, Preconditioner, Settings};
+use crate::linear::preconditioner::{BlockJacobi, Factorized, Jacobi};
+use crate::scene::{LinearSolver, MassMatrix, PreconditionerKind, SolverConfig};
+use crate::setup::Model;
+use crate::shape::Stencils;
+use crate::transfer::NodeMap;
+use nalgebra::SMatrix;
+
+/// The lagged factorization is refreshed when a linear solve with it needed more
+/// than this many iterations (or failed), and whenever the unknowns change.
+pub const LAGGED_REFRESH_ITERATIONS: usize = 20;
+
+/// ε = √ε_mach (h + ‖u‖_∞) / ‖v‖_∞ for the difference product (2-39); see the
+/// module documentation.
+pub fn difference_step(h: f64, u_max: f64, v_max: f64) -> f64 {
+    f64::EPSILON.sqrt() * (h + u_max) / v_max
+}
+
+/// Eisenstat–Walker forcing terms, choice 2 (Eisenstat & Walker 1996, SIAM J.
+/// Sci. Comput. 17:16–32): η_k = γ (‖r_k‖ / ‖r_{k−1}‖)^α with γ = 0.9, α = 2,
+/// η_0 = 0.5. Safeguards: η_k ≥ γ η_{k−1}^α whenever γ η_{k−1}^α > 0.1 (a sudden
+/// small η after a poor step would oversolve); η_k ≤ η_max = 0.9; and
+/// η_k ≥ ½ τ / ‖r_k‖ with τ the Newton tolerance on ‖r‖ (a linear residual far
+/// below what Newton will accept is wasted, Kelley 1995 §6.3). With a fixed
+/// `krylov_tolerance` η is that constant (still subject to the last safeguard).
+#[derive(Clone, Debug)]
+pub struct Forcing {
+    fixed: Option<f64>,
+    /// (η, ‖r‖) of the previous Newton iteration of this step.
+    previous: Option<(f64, f64)>,
+}
+
+impl Forcing {
+    pub const GAMMA: f64 = 0.9;
+    pub const ALPHA: f64 = 2.0;
+    pub const ETA_0: f64 = 0.5;
+    pub const ETA_MAX: f64 = 0.9;
+
+    pub fn new(fixed: Option<f64>) -> Forcing {
+        Forcing {
+            fixed,
+            previous: None,
+        }
+    }
+
+    /// Forget the previous iteration (a new step or attempt).
+    pub fn reset(&mut self) {
+        self.previous = None;
+    }
+
+    /// η for the iteration with residual norm `r_norm`; `stop` is the Newton
+    /// tolerance on the same norm.
+    pub fn next(&mut self, r_norm: f64, stop: f64) -> f64 {
+        let eta = match (self.fixed, self.previous) {
+            (Some(eta), _) => eta,
+            (None, None) => Self::ETA_0,
+            (None, Some((eta_prev, r_prev))) => {
+                let mut eta = Self::GAMMA * (r_norm / r_prev).powf(Self::ALPHA);
+                let safeguard = Self::GAMMA * eta_prev.powf(Self::ALPHA);
+                if safeguard > 0.1 {
+                    eta = eta.max(safeguard);
+                }
+                eta.min(Self::ETA_MAX)
+            }
+        };
+        let eta = eta
+            .max(0.5 * stop / r_norm)
+            .min(self.fixed.unwrap_or(Self::ETA_MAX));
+        self.previous = Some((eta, r_norm));
+        eta
+    }
+}
+
+/// The Krylov settings of a stage.
+#[derive(Clone, Copy, Debug)]
+pub struct KrylovConfig {
+    pub method: LinearSolver,
+    pub preconditioner: PreconditionerKind,
+    pub fixed_tolerance: Option<f64>,
+    pub restart: usize,
+    pub max_iterations: usize,
+}
+
+impl KrylovConfig {
+    /// None for the direct solver.
+    pub fn of(s: &SolverConfig) -> Option<KrylovConfig> {
+        (s.linear_solver() != LinearSolver::Direct).then(|| KrylovConfig {
+            method: s.linear_solver(),
+            preconditioner: s.preconditioner(),
+            fixed_tolerance: s.krylov_tolerance,
+            restart: s.krylov_restart(),
+            max_iterations: s.krylov_max_iterations(),
+        })
+    }
+
+    /// "gmres/jacobi" and so on, for newton.csv.
+    pub fn name(&self) -> &'static str {
+        use LinearSolver::*;
+        use PreconditionerKind::*;
+        match (self.method, self.preconditioner) {
+            (Cg, None) => "cg/none",
+            (Cg, Jacobi) => "cg/jacobi",
+            (Cg, BlockJacobi) => "cg/block_jacobi",
+            (Cg, LaggedDirect) => "cg/lagged_direct",
+            (_, None) => "gmres/none",
+            (_, Jacobi) => "gmres/jacobi",
+            (_, BlockJacobi) => "gmres/block_jacobi",
+            (_, LaggedDirect) => "gmres/lagged_direct",
+        }
+    }
+}
+
+/// The Krylov solver's state across Newton iterations and steps.
+#[derive(Clone, Debug)]
+pub struct KrylovState {
+    pub config: KrylovConfig,
+    forcing: Forcing,
+    /// Active nodes and unknown numbering the lagged factorization belongs to.
+    lagged_for: Option<(Vec<u32>, Vec<u32>)>,
+    refresh: bool,
+    /// Lagged factorizations computed so far.
+    pub factorizations: usize,
+}
+
+impl KrylovState {
+    pub fn new(config: KrylovConfig) -> KrylovState {
+        KrylovState {
+            config,
+            forcing: Forcing::new(config.fixed_tolerance),
+            lagged_for: None,
+            refresh: true,
+            factorizations: 0,
+        }
+    }
+}
+
+/// One Newton correction and how it was obtained.
+#[derive(Clone, Debug)]
+pub struct Correction {
+    pub du: Vec<f64>,
+    pub method: &'static str,
+    pub krylov_iterations: usize,
+    /// η of an inexact solve (NaN for the direct solver).
+    pub forcing: f64,
+}
+
+/// The D×D diagonal blocks of the tangent at every active node, summed particle
+/// by particle: K_(Ii)(Ik) = Σ_p V_p ∂S_Ip/∂X_j A_p,ijkl ∂S_Ip/∂X_l (2-41, 2-42)
+/// plus the inertia M_II/(βΔt²) (2-40; lumped, or Σ_p m_p S_Ip² for the consistent
+/// mass). Deterministic (a gather). Components are not yet restricted to the
+/// free unknowns.
+#[allow(clippy::too_many_arguments)]
+pub fn diagonal_blocks<const D: usize>(
+    map: &NodeMap,
+    st: &Stencils<D>,
+    volume: &[f64],
+    particle_mass: &[f64],
+    a: &[Pk1Derivative],
+    lumped_mass: &[f64],
+    mass_matrix: MassMatrix,
+    inertia: f64,
+) -> Vec<SMatrix<f64, D, D>> {
+    let consistent = mass_matrix == MassMatrix::Consistent;
+    let mut blocks = map.gather(st.stride, SMatrix::<f64, D, D>::zeros(), |q, e| {
+        let g = &st.grad[e];
+        let mut b = SMatrix::<f64, D, D>::from_fn(|i, k| {
+            let mut v = 0.0;
+            for j in 0..D {
+                for l in 0..D {
+                    v += g[j] * a[q][(3 * i + j, 3 * k + l)] * g[l];
+                }
+            }
+            v * volume[q]
+        });
+        if consistent {
+            let w = st.weight[e];
+            b += SMatrix::<f64, D, D>::identity() * (particle_mass[q] * w * w * inertia);
+        }
+        b
+    });
+    if !consistent {
+        for (b, m) in blocks.iter_mut().zip(lumped_mass) {
+            *b += SMatrix::<f64, D, D>::identity() * (m * inertia);
+        }
+    }
+    blocks
+}
+
+/// The preconditioner of one linear solve.
+enum Built {
+    Identity,
+    Jacobi(Jacobi),
+    Blocks(BlockJacobi),
+    /// Use the direct solver's current factors.
+    Lagged,
+}
+
+impl<const D: usize> Implicit<D> {
+    /// δu with ‖r + J δu‖ ≤ η ‖r‖ by GMRES or CG on difference products at the
+    /// iterate `u` (whose residual `r_free` the trial state holds). `stop` is the
+    /// Newton tolerance on ‖r‖; `iteration` 0 starts a new forcing sequence.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn krylov_correction(
+        &mut self,
+        m: &Model<D>,
+        dofs: &Dofs,
+        u: &[Vector<D>],
+        r_free: &[f64],
+        stop: f64,
+        iteration: usize,
+        u_tilde: &[Vector<D>],
+        mass: &[f64],
+        f_ext: &[Vector<D>],
+        inertia: f64,
+        dt: f64,
+    ) -> Result<Correction, Failure> {
+        let state = self.krylov.as_mut().expect("a Krylov solver is configured");
+        let config = state.config;
+        if iteration == 0 {
+            state.forcing.reset();
+        }
+        let r_norm = crate::linear::iterative::norm(r_free);
+        let eta = state.forcing.next(r_norm, stop);
+        let built = self.build_preconditioner(m, dofs, mass, inertia)?;
+
+        let h = m.grid.h_min();
+        let u_max = max_norm_free(u, dofs);
+        let b: Vec<f64> = r_free.iter().map(|x| -x).collect();
+        let mut du = vec![0.0; dofs.free];
+        let settings = Settings {
+            tolerance: eta,
+            max_iterations: config.max_iterations,
+            restart: config.restart,
+        };
+        // The direct solver leaves `self` for the solve: the difference products
+        // need `self` mutably (trial states), the lagged preconditioner its factors.
+        let solver = std::mem::take(&mut self.solver);
+        let outcome = {
+            let mut product = |v: &[f64], out: &mut [f64]| -> Result<(), Failure> {
+                let v_max = v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+                if v_max == 0.0 {
+                    out.iter_mut().for_each(|o| *o = 0.0);
+                    return Ok(());
+                }
+                let eps = difference_step(h, u_max, v_max);
+                let jv = self.difference_product(
+                    m, dofs, u, r_free, v, eps, u_tilde, mass, f_ext, inertia, dt,
+                )?;
+                out.copy_from_slice(&jv);
+                Ok(())
+            };
+            let factors = Factorized(&solver);
+            let pre: &dyn Preconditioner = match &built {
+                Built::Identity => &Identity,
+                Built::Jacobi(j) => j,
+                Built::Blocks(b) => b,
+                Built::Lagged => &factors,
+            };
+            match config.method {
+                LinearSolver::Cg => cg(&mut product, pre, &b, &mut du, &settings),
+                _ => gmres(&mut product, pre, &b, &mut du, &settings),
+            }
+        };
+        self.solver = solver;
+        let outcome: Outcome = outcome?;
+        self.krylov_iterations += outcome.iterations;
+        let state = self.krylov.as_mut().unwrap();
+        if !outcome.converged || outcome.iterations > LAGGED_REFRESH_ITERATIONS {
+            state.refresh = true;
+        }
+        if !outcome.converged {
+            let name = match config.method {
+                LinearSolver::Cg => "CG",
+                _ => "GMRES",
+            };
+            let why = outcome
+                .breakdown
+                .map(|b| format!("stopped: {b}"))
+                .unwrap_or_else(|| {
+                    format!("hit krylov_max_iterations = {}", config.max_iterations)
+                });
+            return Err(Failure {
+                particle: None,
+                message: format!(
+                    "{name} ({} preconditioner) did not reach the forcing tolerance η = {eta:.2e} \
+                     in Newton iteration {iteration}: relative linear residual {:.2e} after {} \
+                     iterations, {why}",
+                    config.preconditioner.name(),
+                    outcome.relative_residual,
+                    outcome.iterations
+                ),
+            });
+        }
+        Ok(Correction {
+            du,
+            method: config.name(),
+            krylov_iterations: outcome.iterations,
+            forcing: eta,
+        })
+    }
+
+    /// (r(u + ε v) − r(u)) / ε over the free unknowns (2-39); `r_free` is r(u).
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn difference_product(
+        &mut self,
+        m: &Model<D>,
+        dofs: &Dofs,
+        u: &[Vector<D>],
+        r_free: &[f64],
+        v: &[f64],
+        eps: f64,
+        u_tilde: &[Vector<D>],
+        mass: &[f64],
+        f_ext: &[Vector<D>],
+        inertia: f64,
+        dt: f64,
+    ) -> Result<Vec<f64>, Failure> {
+        let mut up = u.to_vec();
+        dofs.apply_correction(&mut up, v, eps);
+        let r = self
+            .residual(m, &up, u_tilde, mass, f_ext, inertia, dt)
+            .map_err(|f| Failure {
+                particle: f.particle,
+                message: format!("{} (in a finite-difference product, 2-39)", f.message),
+            })?;
+        Ok(dofs
+            .reduce(&r)
+            .iter()
+            .zip(r_free)
+            .map(|(rp, r0)| (rp - r0) / eps)
+            .collect())
+    }
+
+    /// The preconditioner at the current iterate (the trial state).
+    fn build_preconditioner(
+        &mut self,
+        m: &Model<D>,
+        dofs: &Dofs,
+        mass: &[f64],
+        inertia: f64,
+    ) -> Result<Built, Failure> {
+        let kind = self.krylov.as_ref().unwrap().config.preconditioner;
+        let blocks = |this: &Self| -> Result<Vec<SMatrix<f64, D, D>>, Failure> {
+            let a = this.particle_tangents(m, true)?;
+            let p = &m.particles;
+            Ok(diagonal_blocks(
+                &this.map,
+                &this.stencils,
+                &p.volume,
+                &p.mass,
+                &a,
+                mass,
+                this.mass_matrix,
+                inertia,
+            ))
+        };
+        Ok(match kind {
+            PreconditionerKind::None => Built::Identity,
+            PreconditionerKind::Jacobi => {
+                let blocks = blocks(self)?;
+                let mut diagonal = vec![0.0; dofs.free];
+                for (a, block) in blocks.iter().enumerate() {
+                    for d in 0..D {
+                        if let Some(i) = dofs.of(a, d, D) {
+                            diagonal[i] = block[(d, d)];
+                        }
+                    }
+                }
+                Built::Jacobi(Jacobi::new(diagonal))
+            }
+            PreconditionerKind::BlockJacobi => {
+                let blocks = blocks(self)?;
+                let mut unknowns: Vec<Vec<usize>> = Vec::with_capacity(blocks.len());
+                let mut values: Vec<Vec<f64>> = Vec::with_capacity(blocks.len());
+                for (a, block) in blocks.iter().enumerate() {
+                    let free: Vec<(usize, usize)> = (0..D)
+                        .filter_map(|d| dofs.of(a, d, D).map(|i| (d, i)))
+                        .collect();
+                    values.push(
+                        free.iter()
+                            .flat_map(|&(d, _)| free.iter().map(move |&(e, _)| block[(d, e)]))
+                            .collect(),
+                    );
+                    unknowns.push(free.iter().map(|&(_, i)| i).collect());
+                }
+                Built::Blocks(BlockJacobi::new(
+                    unknowns
+                        .iter()
+                        .zip(&values)
+                        .map(|(u, v)| (u.as_slice(), v.as_slice())),
+                ))
+            }
+            PreconditionerKind::LaggedDirect => {
+                self.refresh_lagged(m, dofs, mass, inertia)?;
+                Built::Lagged
+            }
+        })
+    }
+
+    /// Assemble and factorize the tangent at the current iterate if the kept
+    /// factorization is missing, belongs to other unknowns, or has stopped
+    /// working (see [`LAGGED_REFRESH_ITERATIONS`]).
+    fn refresh_lagged(
+        &mut self,
+        m: &Model<D>,
+        dofs: &Dofs,
+        mass: &[f64],
+        inertia: f64,
+    ) -> Result<(), Failure> {
+        let state = self.krylov.as_ref().unwrap();
+        let same_unknowns = state
+            .lagged_for
+            .as_ref()
+            .is_some_and(|(active, index)| *active == self.map.active && *index == dofs.index);
+        if same_unknowns && !state.refresh {
+            return Ok(());
+        }
+        let (triplets, symmetric) = self.tangent(m, dofs, mass, inertia)?;
+        let structure = if symmetric {
+            Structure::Symmetric
+        } else {
+            Structure::General
+        };
+        self.solver
+            .factorize(dofs.free, &triplets, structure)
+            .map_err(|e| Failure {
+                particle: None,
+                message: format!("lagged_direct preconditioner: factorization failed: {e}"),
+            })?;
+        let active = self.map.active.clone();
+        let state = self.krylov.as_mut().unwrap();
+        state.lagged_for = Some((active, dofs.index.clone()));
+        state.refresh = false;
+        state.factorizations += 1;
+        Ok(())
+    }
+}
+
+/// max |u_i| over the free components.
+fn max_norm_free<const D: usize>(u: &[Vector<D>], dofs: &Dofs) -> f64 {
+    dofs.values(u).iter().fold(0.0f64, |a, x| a.max(x.abs()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Scene;
+
+    /// A 4×4-cell block with cell size h = `length`, Hencky,
+    /// fixed base, gravity and a corner load, quasi-static, uGIMP.
+    fn block(length: f64) -> String {
+        format!(
+            r#"dimension = 2
+gravity = [0.0, -10.0]
+[grid]
+min = [0.0, 0.0]
+max = [{g}, {g}]
+cells = [4, 4]
+shape_function = "ugimp"
+[[material]]
+name = "m"
+model = "hencky"
+density = 1000.0
+youngs_modulus = 1.0e5
+poisson_ratio = 0.3
+[[body]]
+material = "m"
+shape = "rectangle"
+min = [{b0}, 0.0]
+max = [{b1}, {b2}]
+[[boundary]]
+face = "ymin"
+condition = "fixed"
+[[load]]
+kind = "point"
+region_min = [{b2}, {b1x}]
+region_max = [{b1}, {b2}]
+force = [3.0e3, -1.0e3]
+[solver]
+kind = "implicit"
+integrator = "quasi_static"
+end_time = 1.0
+load_steps = 1
+"#,
+            g = 4.0 * length,
+            b0 = 0.5 * length,
+            b1 = 3.0 * length,
+            b2 = 2.5 * length,
+            b1x = 2.0 * length,
+        )
+    }
+
+    /// Relative error ‖J_fd v − K v‖ / ‖K v‖ of the difference product against the
+    /// assembled tangent at a finite-strain iterate, for each step in `steps`, and
+    /// the step the documented rule chooses.
+    fn product_errors(length: f64, steps: &[f64]) -> (Vec<f64>, f64) {
+        let scene = Scene::parse("block.toml", &block(length), &[]).unwrap();
+        let m = Model::<2>::build(&scene).unwrap();
+        let mut solver = Implicit::<2>::new(
+            scene.config.grid.shape_function,
+            scene.config.stages()[0],
+            0.0,
+        );
+        let sys = solver.prepare(&m, 0.0, 1.0);
+        let nodes: Vec<usize> = solver.map.active.iter().map(|&g| g as usize).collect();
+        // Strains of a few per cent: displacements scale with the length.
+        let u: Vec<Vector<2>> = nodes
+            .iter()
+            .zip(&sys.constraint)
+            .map(|(&g, c)| {
+                let x = m.grid.node_position(m.grid.node_ijk(g)) / length;
+                let mut v = Vector::<2>::new(
+                    0.03 * (0.7 * x[1]).sin() + 0.01 * x[0],
+                    -0.02 * x[0] * x[1] / 4.0,
+                ) * length;
+                for d in 0..2 {
+                    if c.fixed[d] {
+                        v[d] = 0.0;
+                    }
+                }
+                v
+            })
+            .collect();
+        let dofs = &sys.dofs;
+        let res = |s: &mut Implicit<2>, u: &[Vector<2>]| {
+            let r = s
+                .residual(&m, u, &sys.u_tilde, &sys.mass, &sys.f_ext, sys.inertia, 1.0)
+                .unwrap();
+            dofs.reduce(&r)
+        };
+        let r0 = res(&mut solver, &u);
+        let (triplets, _) = solver.tangent(&m, dofs, &sys.mass, sys.inertia).unwrap();
+        // A smooth direction with ‖v‖_∞ = 1.
+        let n = dofs.free;
+        let v: Vec<f64> = (0..n).map(|i| (0.37 * i as f64).sin()).collect();
+        let v_max = v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let v: Vec<f64> = v.iter().map(|x| x / v_max).collect();
+        let mut kv = vec![0.0; n];
+        for (r, c, val) in triplets {
+            kv[r] += val * v[c];
+        }
+        let kv_norm = crate::linear::iterative::norm(&kv);
+        let errors = steps
+            .iter()
+            .map(|&eps| {
+                let jv = solver
+                    .difference_product(
+                        &m,
+                        dofs,
+                        &u,
+                        &r0,
+                        &v,
+                        eps,
+                        &sys.u_tilde,
+                        &sys.mass,
+                        &sys.f_ext,
+                        sys.inertia,
+                        1.0,
+                    )
+                    .unwrap();
+                let diff: Vec<f64> = jv.iter().zip(&kv).map(|(a, b)| a - b).collect();
+                crate::linear::iterative::norm(&diff) / kv_norm
+            })
+            .collect();
+        let chosen = difference_step(m.grid.h_min(), max_norm_free(&u, dofs), 1.0);
+        (errors, chosen)
+    }
+
+    /// The difference product against the assembled tangent (thesis 2-39 vs 2-40)
+    /// over ε = 1e-1 … 1e-13 · length: the error falls ∝ ε (truncation) for large ε
+    /// and grows ∝ 1/ε (round-off) for small ε; the minimum lies within a decade of
+    /// the documented ε = √ε_mach (h + ‖u‖_∞)/‖v‖_∞, where the error is below 1e-6
+    /// (the balance predicts a few √ε_mach ≈ 1.5e-8). The same problem in units a
+    /// hundred times larger moves the whole curve, and the chosen ε, by 100.
+    #[test]
+    fn difference_product_error_against_step() {
+        for length in [1.0, 100.0] {
+            let exponents: Vec<i32> = (1..=13).collect();
+            let steps: Vec<f64> = exponents.iter().map(|&k| length * 10f64.powi(-k)).collect();
+            let (errors, chosen) = product_errors(length, &steps);
+            let (_, at_chosen) = {
+                let (e, _) = product_errors(length, &[chosen]);
+                (chosen, e[0])
+            };
+            println!("length scale {length}: ε, relative error of J v");
+            for (s, e) in steps.iter().zip(&errors) {
+                println!("  {s:9.1e}  {e:9.2e}");
+            }
+            println!("  chosen ε = {chosen:.2e}: {at_chosen:.2e}");
+            // Truncation: one decade of ε is one decade of error (slope 1) at ε ≥ 1e-4 L.
+            for k in 1..3 {
+                let slope = (errors[k - 1] / errors[k]).log10();
+                assert!(
+                    (0.8..1.2).contains(&slope),
+                    "truncation slope {slope:.2} at ε = {:.0e}",
+                    steps[k]
+                );
+            }
+            // Round-off: the error grows as ε shrinks below 1e-10 L, about 1/ε
+            // (noisy: the slope over two decades lies in 0.6 … 1.4).
+            let slope = (errors[12] / errors[10]).log10() / 2.0;
+            assert!(
+                (0.6..1.4).contains(&slope),
+                "round-off slope {slope:.2} between ε = 1e-11 L and 1e-13 L"
+            );
+            let best = (0..errors.len())
+                .min_by(|&a, &b| errors[a].total_cmp(&errors[b]))
+                .unwrap();
+            let decades = (steps[best] / chosen).log10().abs();
+            assert!(
+                decades <= 1.0,
+                "minimum at ε = {:.1e}, {decades:.1} decades from the chosen {chosen:.1e}",
+                steps[best]
+            );
+            assert!(
+                at_chosen < 1e-6 && at_chosen < 3.0 * errors[best],
+                "error {at_chosen:.2e} at the chosen ε (best {:.2e})",
+                errors[best]
+            );
+        }
+    }
+
+    /// Choice 2 of Eisenstat–Walker with its safeguards.
+    #[test]
+    fn forcing_terms() {
+        let mut f = Forcing::new(None);
+        let stop = 1e-12;
+        assert_eq!(f.next(1.0, stop), Forcing::ETA_0);
+        // Quadratic-like decrease: η = 0.9 (0.1)² = 9e-3, safeguard 0.9·0.5² = 0.225 > 0.1 wins.
+        assert!((f.next(0.1, stop) - 0.225).abs() < 1e-15);
+        // Next: 0.9 (1e-3 / 0.1)² = 9e-5; safeguard 0.9·0.225² = 0.0456 < 0.1 is off.
+        assert!((f.next(1e-3, stop) - 9e-5).abs() < 1e-18);
+        // A poor step (residual grows) is capped at η_max.
+        assert_eq!(f.next(1.0, stop), Forcing::ETA_MAX);
+        // Near the Newton tolerance η ≥ ½ τ / ‖r‖.
+        f.reset();
+        f.next(1.0, 0.5);
+        assert!((f.next(2e-1, 0.5) - 0.9f64.min(0.5 * 0.5 / 0.2)).abs() < 1e-15);
+        // A fixed tolerance stays fixed.
+        let mut c = Forcing::new(Some(1e-4));
+        assert_eq!(c.next(1.0, 0.0), 1e-4);
+        assert_eq!(c.next(1e-3, 0.0), 1e-4);
+    }
+}
