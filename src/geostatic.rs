@@ -34,9 +34,8 @@ pub fn initialise<const D: usize>(model: &mut Model<D>, c: &SceneConfig) {
             .iter()
             .find(|m| m.name == body.material)
             .expect("validated");
-        let k0 = g
-            .k0
-            .unwrap_or_else(|| 1.0 - material.friction_angle.unwrap().to_radians().sin());
+        let k0 =
+            g.k0.unwrap_or_else(|| 1.0 - material.friction_angle.unwrap().to_radians().sin());
         let mut x = [0.0; 3];
         (0..D).for_each(|d| x[d] = p.x0[q][d]);
         let depth = (top(body, &x[..D], v, up) - up * x[v]).max(0.0);

@@ -166,8 +166,7 @@ impl<const D: usize> Model<D> {
         let p = &self.particles;
         let values: Vec<Option<f64>> = (0..p.len())
             .map(|q| {
-                self.materials[p.material[q] as usize]
-                    .equivalent_plastic_strain(p.history.get(q))
+                self.materials[p.material[q] as usize].equivalent_plastic_strain(p.history.get(q))
             })
             .collect();
         values

@@ -66,7 +66,8 @@ impl Trial {
             self.steps,
             self.newton_iterations,
             self.cutbacks,
-            self.monitor_displacement.map_or(String::new(), |d| d.to_string()),
+            self.monitor_displacement
+                .map_or(String::new(), |d| d.to_string()),
             self.wall_seconds,
             self.dir.file_name().unwrap().to_string_lossy()
         )
@@ -117,9 +118,8 @@ pub fn trial(scene: &Scene, dir: &Path, factor: f64) -> Result<Trial, RunError> 
 pub fn search(scene: &Scene, out: &Path, opts: &RunOptions) -> Result<RunSummary, RunError> {
     let cfg = scene.config.strength_reduction.as_ref().expect("caller");
     let started = Instant::now();
-    let mut csv = std::io::BufWriter::new(std::fs::File::create(
-        out.join("strength_reduction.csv"),
-    )?);
+    let mut csv =
+        std::io::BufWriter::new(std::fs::File::create(out.join("strength_reduction.csv"))?);
     writeln!(csv, "{CSV_HEADER}")?;
     let mut trials: Vec<Trial> = Vec::new();
     let mut run_trial = |factor: f64, trials: &mut Vec<Trial>| -> Result<bool, RunError> {
@@ -180,7 +180,13 @@ pub fn search(scene: &Scene, out: &Path, opts: &RunOptions) -> Result<RunSummary
     let wall = started.elapsed().as_secs_f64();
     let newton: u64 = trials.iter().map(|t| t.newton_iterations).sum();
     let steps: u64 = trials.iter().map(|t| t.steps).sum();
-    let rel = |t: &Trial| t.dir.strip_prefix(out).unwrap_or(&t.dir).display().to_string();
+    let rel = |t: &Trial| {
+        t.dir
+            .strip_prefix(out)
+            .unwrap_or(&t.dir)
+            .display()
+            .to_string()
+    };
     let find = |f: Option<f64>| {
         f.and_then(|f| trials.iter().find(|t| t.factor == f))
             .map(rel)

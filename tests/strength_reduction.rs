@@ -80,7 +80,10 @@ fn k0_state_of_level_ground_is_in_equilibrium() {
     // stress: ρ g H² / (2M) at the top, M = E(1 − ν)/((1 + ν)(1 − 2ν)).
     let m = 1.0e4 * 0.75 / (1.25 * 0.5);
     let settlement = 2.0 * 10.0 * 16.0 / (2.0 * m);
-    let (without, dir0) = run_text(&LEVEL.replace("[geostatic]\nk0 = 0.3333333333333333", ""), &[]);
+    let (without, dir0) = run_text(
+        &LEVEL.replace("[geostatic]\nk0 = 0.3333333333333333", ""),
+        &[],
+    );
     without.unwrap();
     let u0 = max_displacement(&Table::read(&dir0.path().join("particles_final.csv")).unwrap());
     let (with, dir) = run_text(LEVEL, &[]);
@@ -88,14 +91,29 @@ fn k0_state_of_level_ground_is_in_equilibrium() {
     let p = Table::read(&dir.path().join("particles_final.csv")).unwrap();
     let u = max_displacement(&p);
     eprintln!("gravity on zero stress: top settlement {u0:.4e} (1D theory {settlement:.4e}); on the K0 state: largest displacement {u:.3e}");
-    assert!((u0 - settlement).abs() < 0.1 * settlement, "gravity switch-on settles the layer");
-    assert!(u < 1e-3 * settlement, "the K0 state with K0 = ν/(1 − ν) stays put");
+    assert!(
+        (u0 - settlement).abs() < 0.1 * settlement,
+        "gravity switch-on settles the layer"
+    );
+    assert!(
+        u < 1e-3 * settlement,
+        "the K0 state with K0 = ν/(1 − ν) stays put"
+    );
     // The stresses are the geostatic ones: σ_yy = −ρ g (4 − Y), σ_xx = σ_zz = K0 σ_yy.
     for i in 0..p.col("Y0").len() {
         let sv = -20.0 * (4.0 - p.col("Y0")[i]);
-        assert!((p.col("syy")[i] - sv).abs() < 1e-3 * 80.0, "σ_yy at particle {i}");
-        assert!((p.col("sxx")[i] - sv / 3.0).abs() < 1e-3 * 80.0, "σ_xx at particle {i}");
-        assert!((p.col("szz")[i] - sv / 3.0).abs() < 1e-3 * 80.0, "σ_zz at particle {i}");
+        assert!(
+            (p.col("syy")[i] - sv).abs() < 1e-3 * 80.0,
+            "σ_yy at particle {i}"
+        );
+        assert!(
+            (p.col("sxx")[i] - sv / 3.0).abs() < 1e-3 * 80.0,
+            "σ_xx at particle {i}"
+        );
+        assert!(
+            (p.col("szz")[i] - sv / 3.0).abs() < 1e-3 * 80.0,
+            "σ_zz at particle {i}"
+        );
     }
 }
 
@@ -130,7 +148,10 @@ fn griffiths_lane_slope_factor_of_safety_coarse() {
         .map(|v| v.as_f64().unwrap())
         .collect();
     eprintln!("coarse Griffiths & Lane slope: F = {fos:.4} in {bracket:?}");
-    assert!(bracket[1] - bracket[0] <= 0.01 + 1e-12, "bracket within the tolerance");
+    assert!(
+        bracket[1] - bracket[0] <= 0.01 + 1e-12,
+        "bracket within the tolerance"
+    );
     assert!((fos - 0.5 * (bracket[0] + bracket[1])).abs() < 1e-12);
     assert!(
         fos > 1.393 && fos < 1.30 * 1.40,
@@ -151,13 +172,19 @@ fn griffiths_lane_slope_factor_of_safety_coarse() {
     // The crest runs away as F approaches the bracket: its displacement at the
     // last stable F is many times the one at the lowest.
     let crest = |f: f64| {
-        trials.iter().find(|t| t["factor"].as_f64() == Some(f)).unwrap()["monitor_displacement"]
+        trials
+            .iter()
+            .find(|t| t["factor"].as_f64() == Some(f))
+            .unwrap()["monitor_displacement"]
             .as_f64()
             .unwrap()
     };
     let lowest = stable.iter().cloned().fold(f64::INFINITY, f64::min);
     let (u_low, u_high) = (crest(lowest), crest(bracket[0]));
-    eprintln!("crest displacement: {u_low:.3e} at F = {lowest}, {u_high:.3e} at F = {}", bracket[0]);
+    eprintln!(
+        "crest displacement: {u_low:.3e} at F = {lowest}, {u_high:.3e} at F = {}",
+        bracket[0]
+    );
     assert!(u_high > 20.0 * u_low, "runaway of the crest near failure");
     // The mechanism: in the last stable trial the plastic strain concentrates in a
     // band that runs out at the toe (x ≈ 35, y ≈ 0), not at the back or the base
@@ -185,20 +212,41 @@ fn bad_strength_reduction_and_geostatic_keys_are_named() {
     let text = std::fs::read_to_string(problem("slope_griffiths_lane.toml")).unwrap();
     let err = |overrides: &[&str]| {
         let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-        Scene::parse("slope.toml", &text, &o).unwrap_err().to_string()
+        Scene::parse("slope.toml", &text, &o)
+            .unwrap_err()
+            .to_string()
     };
     let e = err(&["strength_reduction.search=[1.5,1.2]"]);
-    assert!(e.contains("slope.toml:") && e.contains("strength_reduction.search"), "{e}");
-    let e = err(&["strength_reduction.max_displacement=0.5", "strength_reduction.monitor=[1.0]"]);
-    assert!(e.contains("strength_reduction.monitor") && e.contains("2 components"), "{e}");
+    assert!(
+        e.contains("slope.toml:") && e.contains("strength_reduction.search"),
+        "{e}"
+    );
+    let e = err(&[
+        "strength_reduction.max_displacement=0.5",
+        "strength_reduction.monitor=[1.0]",
+    ]);
+    assert!(
+        e.contains("strength_reduction.monitor") && e.contains("2 components"),
+        "{e}"
+    );
     let e = err(&["geostatic.k0=-1.0"]);
     assert!(e.contains("geostatic.k0") && e.contains("positive"), "{e}");
-    let e = Scene::parse("level.toml", &LEVEL.replace("linear_elastic", "hencky"), &[])
-        .unwrap_err()
-        .to_string();
-    assert!(e.contains("level.toml:") && e.contains("body.0.material") && e.contains("[geostatic]"), "{e}");
+    let e = Scene::parse(
+        "level.toml",
+        &LEVEL.replace("linear_elastic", "hencky"),
+        &[],
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("level.toml:") && e.contains("body.0.material") && e.contains("[geostatic]"),
+        "{e}"
+    );
     let e = err(&["gravity=[0.0,0.0]"]);
     assert!(e.contains("geostatic") && e.contains("gravity"), "{e}");
     let e = err(&["solver.integrator=\"newmark\"", "solver.dt=0.1"]);
-    assert!(e.contains("solver.gravity_ramp") && e.contains("Newmark"), "{e}");
+    assert!(
+        e.contains("solver.gravity_ramp") && e.contains("Newmark"),
+        "{e}"
+    );
 }
