@@ -18,6 +18,7 @@ import json, sys, pathlib
 out = pathlib.Path(sys.argv[1])
 print("| h (m) | particles | F (bracket) | F / 1.40 | F at crest displacement > 0.1 m | trials | wall s | Newton it. per converged trial |")
 print("|---|---|---|---|---|---|---|---|")
+rows = []
 for d in sorted(out.glob("cells_*"), key=lambda p: int(p.name.split("_")[1].split("x")[0])):
     s = json.loads((d / "summary.json").read_text())
     nx = int(d.name.split("_")[1].split("x")[0])
@@ -31,4 +32,22 @@ for d in sorted(out.glob("cells_*"), key=lambda p: int(p.name.split("_")[1].spli
     disp = f"{max(below):.4f}–{min(over + failed):.4f}" if below else "n/a"
     conv = [t["newton_iterations"] for t in s["trials"] if t["status"] == "stable"]
     print(f"| {40/nx:.3f} | {s['particles']} | {f:.4f} [{lo:.4f}, {hi:.4f}] | {f/1.40:.3f} | {disp} | {len(s['trials'])} | {s['wall_seconds']:.0f} | {min(conv)}–{max(conv)} |")
+    rows.append((40 / nx, f))
+# F = F0 + a h^p through the three finest grids (p by bisection on the ratio of differences).
+if len(rows) >= 3:
+    (h1, f1), (h2, f2), (h3, f3) = sorted(rows, reverse=True)[-3:]
+    ratio = (f1 - f2) / (f2 - f3)
+    g = lambda p: (h1**p - h2**p) / (h2**p - h3**p) - ratio
+    lo_p, hi_p = 0.1, 6.0
+    if g(lo_p) * g(hi_p) < 0:
+        for _ in range(100):
+            mid = 0.5 * (lo_p + hi_p)
+            lo_p, hi_p = (mid, hi_p) if g(lo_p) * g(mid) > 0 else (lo_p, mid)
+        p = 0.5 * (lo_p + hi_p)
+        a = (f2 - f3) / (h2**p - h3**p)
+        print(f"\nextrapolated from h = {h1:.3f}, {h2:.3f}, {h3:.3f}: F0 = {f3 - a * h3**p:.4f} (F = F0 + {a:.3f} h^{p:.2f})")
+    else:
+        print("\nno monotone refinement trend to extrapolate")
 PY
+# The mechanism of the finest grid (last stable trial).
+python3 "$(dirname "$0")/mechanism.py" "$OUT/cells_160x48" "$(dirname "$0")/mechanism.svg"
