@@ -8,8 +8,8 @@ MPM=${MPM:-mpm}
 OUT=${1:-out/slope_griffiths_lane}
 SCENE=problems/slope_griffiths_lane.toml
 mkdir -p "$OUT"
-# cells (40 m × 12 m grid) → h = 1, 1/2, 1/3, 1/4 m
-for cells in 40,12 80,24 120,36 160,48; do
+# cells (40 m × 12 m grid) → h = 1, 1/2, 1/3, 1/4, 1/5 m
+for cells in 40,12 80,24 120,36 160,48 200,60; do
   dir="$OUT/cells_${cells/,/x}"
   "$MPM" run "$SCENE" --out "$dir" --set "grid.cells=[$cells]" > "$dir.log" 2>&1 || true
 done
