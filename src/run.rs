@@ -6,7 +6,7 @@
 use crate::explicit::{check_state, Divergence, Explicit};
 use crate::implicit::{Implicit, NEWTON_CSV_HEADER};
 use crate::output::{
-    body_centres, write_json, write_particles_csv, FrameWriter, HistoryWriter, Progress,
+    body_centres, write_json, write_particles_csv_with, FrameWriter, HistoryWriter, Progress,
 };
 use crate::scene::{Integrator, LinearSolver, SolverConfig, SolverKind};
 use crate::scene::{Scene, SceneError};
@@ -42,11 +42,21 @@ pub struct RunSummary {
 pub struct RunOptions {
     /// Show a progress bar (only drawn when stderr is a terminal).
     pub progress: bool,
+    /// Run with the strengths reduced by this factor (one trial of a strength
+    /// reduction search; `None`: as given, or the search itself when the scene
+    /// has `[strength_reduction]`).
+    pub strength_factor: Option<f64>,
+    /// Report the displacement of the particle nearest to this point
+    /// (summary.json `monitor_displacement`).
+    pub monitor: Option<Vec<f64>>,
 }
 
 /// Run a scene, writing its outputs into `out`.
 pub fn run(scene: &Scene, out: &Path, opts: &RunOptions) -> Result<RunSummary, RunError> {
     std::fs::create_dir_all(out)?;
+    if scene.config.strength_reduction.is_some() && opts.strength_factor.is_none() {
+        return crate::strength_reduction::search(scene, out, opts);
+    }
     match scene.config.dimension {
         2 => run_dim::<2>(scene, out, opts),
         3 => run_dim::<3>(scene, out, opts),
@@ -161,6 +171,16 @@ fn run_dim<const D: usize>(
 ) -> Result<RunSummary, RunError> {
     let cfg = &scene.config;
     let mut model = Model::<D>::build(scene)?;
+    if let Some(factor) = opts.strength_factor {
+        model.reduce_strength(factor);
+    }
+    if cfg.geostatic.is_some() {
+        crate::geostatic::initialise(&mut model, cfg);
+    }
+    let monitor = opts
+        .monitor
+        .as_deref()
+        .and_then(|x| model.nearest_particle(x));
     let stages = cfg.stages();
     let end_time = cfg.total_time();
     let n_bodies = model.n_bodies();
@@ -201,7 +221,10 @@ fn run_dim<const D: usize>(
             if let Some(interval) = frame_interval {
                 if (force || t >= next_frame - 1e-12 * end_time) && t != last_frame {
                     last_frame = t;
-                    frames.write_frame(t, &model.particles, &[])?;
+                    let eps_p = model.plastic_strain();
+                    let extra: Vec<(&str, &[f64])> =
+                        eps_p.iter().map(|e| ("eps_p", e.as_slice())).collect();
+                    frames.write_frame(t, &model.particles, &extra)?;
                     while next_frame <= t + 1e-12 * end_time {
                         next_frame += interval;
                     }
@@ -287,6 +310,14 @@ fn run_dim<const D: usize>(
         summary["cutbacks"] = json!(cutbacks_total);
         summary["krylov_iterations"] = json!(krylov_total);
     }
+    if let Some(q) = monitor {
+        let p = &model.particles;
+        summary["monitor_particle"] = json!(q);
+        summary["monitor_displacement"] = json!((p.x[q] - p.x0[q]).norm());
+    }
+    if let Some(f) = opts.strength_factor {
+        summary["strength_factor"] = json!(f);
+    }
     if let Err(d) = outcome {
         summary["status"] = json!("diverged");
         summary["message"] = json!(d.to_string());
@@ -300,7 +331,9 @@ fn run_dim<const D: usize>(
         )));
     }
     record(&model, t, external_work, true)?;
-    write_particles_csv(&out.join("particles_final.csv"), &model.particles)?;
+    let eps_p = model.plastic_strain();
+    let extra: Vec<(&str, &[f64])> = eps_p.iter().map(|e| ("eps_p", e.as_slice())).collect();
+    write_particles_csv_with(&out.join("particles_final.csv"), &model.particles, &extra)?;
     write_json(&out.join("summary.json"), &summary)?;
     Ok(RunSummary {
         steps: step,

@@ -150,6 +150,38 @@ impl<const D: usize> Model<D> {
         self.load_ramps.iter().map(|r| r.factor(t)).collect()
     }
 
+    /// Replace every material that has a frictional strength by the same material
+    /// with c/F, tan φ/F, tan ψ/F (strength reduction).
+    pub fn reduce_strength(&mut self, factor: f64) {
+        for m in &mut self.materials {
+            if let Some(reduced) = m.with_reduced_strength(factor) {
+                *m = reduced;
+            }
+        }
+    }
+
+    /// Equivalent plastic strain of every particle (0 where the material has
+    /// none), or `None` when no material of the scene has one.
+    pub fn plastic_strain(&self) -> Option<Vec<f64>> {
+        let p = &self.particles;
+        let values: Vec<Option<f64>> = (0..p.len())
+            .map(|q| {
+                self.materials[p.material[q] as usize].equivalent_plastic_strain(p.history.get(q))
+            })
+            .collect();
+        values
+            .iter()
+            .any(Option::is_some)
+            .then(|| values.iter().map(|v| v.unwrap_or(0.0)).collect())
+    }
+
+    /// Index of the particle whose reference position is nearest to `x`.
+    pub fn nearest_particle(&self, x: &[f64]) -> Option<usize> {
+        let p = &self.particles;
+        let d2 = |q: usize| (0..D).map(|d| (p.x0[q][d] - x[d]).powi(2)).sum::<f64>();
+        (0..p.len()).min_by(|&a, &b| d2(a).total_cmp(&d2(b)))
+    }
+
     /// Number of bodies (for per-body outputs).
     pub fn n_bodies(&self) -> usize {
         self.particles

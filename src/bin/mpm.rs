@@ -207,7 +207,14 @@ fn main() -> ExitCode {
                     return ExitCode::from(2);
                 }
             };
-            match run(&scene, &out, &RunOptions { progress: true }) {
+            match run(
+                &scene,
+                &out,
+                &RunOptions {
+                    progress: true,
+                    ..Default::default()
+                },
+            ) {
                 Ok(s) => {
                     println!(
                         "{}: {} steps to t = {:.6e}, {} particles, {:.2} s wall; outputs in {}",

@@ -118,6 +118,8 @@ pub struct Implicit<const D: usize> {
     /// Start and duration of the run or stage (quasi-static load factor).
     t_start: f64,
     end_time: f64,
+    /// Quasi-static: gravity ramps with the load factor (else it is in full).
+    gravity_ramp: bool,
     residual_tolerance: f64,
     displacement_tolerance: f64,
     max_iterations: usize,
@@ -156,6 +158,7 @@ impl<const D: usize> Implicit<D> {
             },
             mass_matrix: s.mass(),
             end_time: s.end_time,
+            gravity_ramp: s.gravity_ramp(),
             residual_tolerance: s.residual_tolerance(),
             displacement_tolerance: s.displacement_tolerance(),
             max_iterations: s.max_iterations(),
@@ -235,7 +238,8 @@ impl<const D: usize> Implicit<D> {
         match self.integrator {
             Integrator::QuasiStatic => {
                 let lambda = ((t - self.t_start) / self.end_time).clamp(0.0, 1.0);
-                (lambda, vec![lambda; m.load_ramps.len()])
+                let g = if self.gravity_ramp { lambda } else { 1.0 };
+                (g, vec![lambda; m.load_ramps.len()])
             }
             Integrator::Newmark => (1.0, m.load_scales(t)),
         }

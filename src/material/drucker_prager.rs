@@ -193,6 +193,19 @@ impl Material for DruckerPrager {
         1
     }
 
+    fn with_reduced_strength(&self, factor: f64) -> Option<Box<dyn Material>> {
+        Some(Box::new(DruckerPrager {
+            cohesion: self.cohesion / factor,
+            friction_angle: super::reduced_angle(self.friction_angle, factor),
+            dilation_angle: super::reduced_angle(self.dilation_angle, factor),
+            ..*self
+        }))
+    }
+
+    fn equivalent_plastic_strain(&self, history: &[f64]) -> Option<f64> {
+        history.first().copied()
+    }
+
     fn update(&self, inc: &Increment, history_new: &mut [f64]) -> Mat3 {
         principal::update(self, inc, history_new)
     }

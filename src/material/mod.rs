@@ -74,6 +74,18 @@ pub trait Material: Send + Sync + std::fmt::Debug {
         None
     }
 
+    /// The same model with its shear strength reduced by the factor F (strength
+    /// reduction, Griffiths & Lane 1999): c/F, tan φ/F and tan ψ/F, residual values
+    /// included. `None`: the model has no frictional strength to reduce.
+    fn with_reduced_strength(&self, _factor: f64) -> Option<Box<dyn Material>> {
+        None
+    }
+
+    /// The equivalent plastic strain held in `history` (`None`: the model has none).
+    fn equivalent_plastic_strain(&self, _history: &[f64]) -> Option<f64> {
+        None
+    }
+
     /// Wave speed c = √(M/ρ) at the current Jacobian J (ρ = ρ0/J).
     fn wave_speed(&self, j: f64) -> f64 {
         (self.p_wave_modulus() * j / self.density()).sqrt()
@@ -98,6 +110,12 @@ pub(crate) fn debug_check_elastic(density: f64, youngs_modulus: f64, poisson_rat
         poisson_ratio > -1.0 && poisson_ratio < 0.5,
         "Poisson's ratio must lie in (-1, 0.5)"
     );
+}
+
+/// A friction (or dilation) angle whose tangent is divided by `factor`:
+/// atan(tan θ / F) (strength reduction).
+pub fn reduced_angle(theta: f64, factor: f64) -> f64 {
+    (theta.tan() / factor).atan()
 }
 
 /// Lamé constants from Young's modulus and Poisson's ratio.

@@ -464,6 +464,37 @@ impl Material for MohrCoulomb {
         1
     }
 
+    /// Peak and residual strengths are reduced alike; the tension cut-off is kept.
+    fn with_reduced_strength(&self, factor: f64) -> Option<Box<dyn Material>> {
+        let reduce = |s: Strength| Strength {
+            cohesion: s.cohesion / factor,
+            friction_angle: super::reduced_angle(s.friction_angle, factor),
+            dilation_angle: super::reduced_angle(s.dilation_angle, factor),
+        };
+        let softening = self.softening.map(|s| {
+            let residual = reduce(Strength {
+                cohesion: s.residual_cohesion,
+                friction_angle: s.residual_friction_angle,
+                dilation_angle: s.residual_dilation_angle,
+            });
+            Softening {
+                residual_cohesion: residual.cohesion,
+                residual_friction_angle: residual.friction_angle,
+                residual_dilation_angle: residual.dilation_angle,
+                ..s
+            }
+        });
+        Some(Box::new(MohrCoulomb {
+            peak: reduce(self.peak),
+            softening,
+            ..*self
+        }))
+    }
+
+    fn equivalent_plastic_strain(&self, history: &[f64]) -> Option<f64> {
+        history.first().copied()
+    }
+
     fn update(&self, inc: &Increment, history_new: &mut [f64]) -> Mat3 {
         principal::update(self, inc, history_new)
     }

@@ -14,7 +14,7 @@ mod table;
 mod vtk;
 
 pub use history::{body_centres, HistoryWriter};
-pub use particles_csv::write_particles_csv;
+pub use particles_csv::{write_particles_csv, write_particles_csv_with};
 pub use progress::Progress;
 pub use table::{csv_field, Table};
 pub use vtk::FrameWriter;

@@ -1,7 +1,9 @@
 //! `particles_final.csv`: the particle state at the end of a run.
 //!
 //! The column names are a contract with users' post-processing scripts:
-//! `id,body,X0,Y0[,Z0],x,y[,z],vx,vy[,vz],sxx,syy,szz,sxy[,syz,sxz],volume0,volume,mass`.
+//! `id,body,X0,Y0[,Z0],x,y[,z],vx,vy[,vz],sxx,syy,szz,sxy[,syz,sxz],volume0,volume,mass`,
+//! followed by extra columns only where the run has them (`eps_p`, the equivalent
+//! plastic strain, when a material has one).
 
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
@@ -45,8 +47,26 @@ fn header(dim: usize) -> String {
 /// Write every particle of `p` to `path` as CSV (columns in the module docs; `id` is the
 /// particle index, floats with round-trip precision).
 pub fn write_particles_csv<const D: usize>(path: &Path, p: &Particles<D>) -> io::Result<()> {
+    write_particles_csv_with(path, p, &[])
+}
+
+/// As `write_particles_csv`, with extra named columns (one value per particle)
+/// after the contract columns.
+pub fn write_particles_csv_with<const D: usize>(
+    path: &Path,
+    p: &Particles<D>,
+    extra: &[(&str, &[f64])],
+) -> io::Result<()> {
     let mut w = BufWriter::new(File::create(path)?);
-    w.write_all(header(D).as_bytes())?;
+    let mut head = header(D);
+    head.pop();
+    for (name, values) in extra {
+        assert_eq!(values.len(), p.len(), "extra column {name}");
+        head.push(',');
+        head.push_str(name);
+    }
+    head.push('\n');
+    w.write_all(head.as_bytes())?;
     let stress = stress_columns(D);
     for i in 0..p.len() {
         write!(w, "{},{}", i, p.body[i])?;
@@ -61,6 +81,10 @@ pub fn write_particles_csv<const D: usize>(path: &Path, p: &Particles<D>) -> io:
         for x in [p.volume0[i], p.volume[i], p.mass[i]] {
             w.write_all(b",")?;
             write_f64(&mut w, x)?;
+        }
+        for (_, values) in extra {
+            w.write_all(b",")?;
+            write_f64(&mut w, values[i])?;
         }
         w.write_all(b"\n")?;
     }

@@ -31,6 +31,11 @@ pub struct SceneConfig {
     pub stages: Vec<SolverConfig>,
     #[serde(default)]
     pub output: OutputConfig,
+    /// Geostatic (K0) initial stresses, set before the first stage.
+    pub geostatic: Option<GeostaticConfig>,
+    /// Search for the factor of safety by strength reduction (`mpm run` runs the
+    /// stages once per trial factor; docs/strength_reduction.md).
+    pub strength_reduction: Option<StrengthReductionConfig>,
     /// The analytical reference the scene's error is measured against (`mpm bench`).
     pub reference: Option<ReferenceConfig>,
     /// Settings of `mpm bench` for this scene.
@@ -240,6 +245,42 @@ pub struct LoadConfig {
     pub pulse_duration: Option<f64>,
 }
 
+/// The `[geostatic]` table: σ_v = −ρ g d, σ_h = K0 σ_v, with d the depth below
+/// the top surface of the particle's body at the particle's horizontal position.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GeostaticConfig {
+    /// Lateral earth pressure coefficient; default 1 − sin φ of each body's
+    /// material (Jáky).
+    pub k0: Option<f64>,
+}
+
+/// The `[strength_reduction]` table.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StrengthReductionConfig {
+    /// Initial bracket [F_low, F_high] of the search; widened if F_low fails or
+    /// F_high holds.
+    pub search: Vec<f64>,
+    /// Width of the final bracket (default 0.01).
+    pub tolerance: Option<f64>,
+    /// Monitored point: the particle nearest to it (reference position).
+    pub monitor: Option<Vec<f64>>,
+    /// A trial also fails when the monitored particle moves further than this.
+    pub max_displacement: Option<f64>,
+    /// Most trials the search may run (default 20).
+    pub max_trials: Option<usize>,
+}
+
+impl StrengthReductionConfig {
+    pub fn tolerance(&self) -> f64 {
+        self.tolerance.unwrap_or(0.01)
+    }
+    pub fn max_trials(&self) -> usize {
+        self.max_trials.unwrap_or(20)
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum SolverKind {
@@ -364,6 +405,9 @@ pub struct SolverConfig {
     pub krylov_tolerance: Option<f64>,
     pub krylov_restart: Option<usize>,
     pub krylov_max_iterations: Option<usize>,
+    /// Quasi-static: ramp gravity from zero over the stage (default true); false
+    /// applies it in full from the first step (after a geostatic initialisation).
+    pub gravity_ramp: Option<bool>,
 }
 
 impl SceneConfig {
@@ -435,6 +479,10 @@ impl SolverConfig {
     /// Times a failing step may be halved before the run stops (default 5).
     pub fn max_cutbacks(&self) -> usize {
         self.max_cutbacks.unwrap_or(5)
+    }
+    /// Quasi-static gravity ramps from zero over the stage (default true).
+    pub fn gravity_ramp(&self) -> bool {
+        self.gravity_ramp.unwrap_or(true)
     }
     /// Nodes whose particle support Σ_p V_p S_Ip is below this fraction of a cell
     /// volume are tied to two neighbours by linear extrapolation (default 1e-2;

@@ -103,6 +103,12 @@ pub fn validate(s: &SceneConfig) -> Check {
         "output.history_interval",
         "must be ≥ 0",
     )?;
+    if let Some(g) = &s.geostatic {
+        geostatic(g, s)?;
+    }
+    if let Some(r) = &s.strength_reduction {
+        strength_reduction(r, s)?;
+    }
     crate::reference::from_scene(s)?;
     if let Some(b) = &s.bench {
         bench(b, "bench")?;
@@ -766,6 +772,7 @@ fn explicit(s: &SolverConfig, prefix: &str) -> Check {
     forbidden(&s.max_iterations, format!("{prefix}.max_iterations"), what)?;
     forbidden(&s.line_search, format!("{prefix}.line_search"), what)?;
     forbidden(&s.max_cutbacks, format!("{prefix}.max_cutbacks"), what)?;
+    forbidden(&s.gravity_ramp, format!("{prefix}.gravity_ramp"), what)?;
     forbidden(
         &s.min_node_support,
         format!("{prefix}.min_node_support"),
@@ -811,6 +818,11 @@ fn implicit(s: &SolverConfig, prefix: &str) -> Check {
     match s.integrator() {
         Integrator::Newmark => {
             required(&s.dt, format!("{prefix}.dt"), "the Newmark integrator")?;
+            forbidden(
+                &s.gravity_ramp,
+                format!("{prefix}.gravity_ramp"),
+                "the Newmark integrator (gravity is always in full)",
+            )?;
             forbidden(
                 &s.load_steps,
                 format!("{prefix}.load_steps"),
@@ -911,5 +923,100 @@ fn linear_solver(s: &SolverConfig, prefix: &str) -> Check {
         s.krylov_max_iterations() >= 1,
         key("krylov_max_iterations"),
         "must be at least 1",
+    )
+}
+
+/// Models whose update integrates from the stored stress (so an initial stress
+/// persists); the hyperelastic ones compute the stress from F alone.
+fn carries_initial_stress(m: MaterialModel) -> bool {
+    matches!(
+        m,
+        MaterialModel::LinearElastic | MaterialModel::DruckerPrager | MaterialModel::MohrCoulomb
+    )
+}
+
+fn geostatic(g: &GeostaticConfig, s: &SceneConfig) -> Check {
+    let gravity = s.gravity.as_deref().unwrap_or(&[]);
+    let nonzero = gravity.iter().filter(|&&x| x != 0.0).count();
+    ensure(
+        nonzero == 1,
+        "geostatic",
+        "needs `gravity` along one grid axis (the vertical)",
+    )?;
+    if let Some(k0) = g.k0 {
+        ensure(
+            k0 > 0.0 && k0.is_finite(),
+            "geostatic.k0",
+            "must be a positive number",
+        )?;
+    }
+    for (i, b) in s.bodies.iter().enumerate() {
+        let m = s.materials.iter().find(|m| m.name == b.material).unwrap();
+        ensure(
+            carries_initial_stress(m.model),
+            format!("body.{i}.material"),
+            format!(
+                "[geostatic] needs models that integrate from the stored stress (linear_elastic, drucker_prager, mohr_coulomb); `{}` is {}",
+                m.name,
+                model_name(m.model)
+            ),
+        )?;
+        ensure(
+            g.k0.is_some() || m.friction_angle.is_some(),
+            "geostatic.k0",
+            format!(
+                "is required: material `{}` has no friction angle for K0 = 1 − sin φ",
+                m.name
+            ),
+        )?;
+    }
+    Ok(())
+}
+
+fn strength_reduction(r: &StrengthReductionConfig, s: &SceneConfig) -> Check {
+    let p = "strength_reduction";
+    ensure(
+        r.search.len() == 2
+            && r.search.iter().all(|f| f.is_finite())
+            && r.search[0] > 0.0
+            && r.search[1] > r.search[0],
+        format!("{p}.search"),
+        "must be [F_low, F_high] with 0 < F_low < F_high",
+    )?;
+    ensure(
+        r.tolerance() > 0.0 && r.tolerance().is_finite(),
+        format!("{p}.tolerance"),
+        "must be a positive number",
+    )?;
+    ensure(
+        r.max_trials() >= 2,
+        format!("{p}.max_trials"),
+        "must be at least 2",
+    )?;
+    if let Some(m) = &r.monitor {
+        vector(m, s.dimension, &format!("{p}.monitor"))?;
+    }
+    if let Some(d) = r.max_displacement {
+        required(&r.monitor, format!("{p}.monitor"), "max_displacement")?;
+        ensure(
+            d > 0.0 && d.is_finite(),
+            format!("{p}.max_displacement"),
+            "must be a positive length",
+        )?;
+    }
+    ensure(
+        s.materials.iter().any(|m| {
+            matches!(
+                m.model,
+                MaterialModel::DruckerPrager | MaterialModel::MohrCoulomb
+            )
+        }),
+        p,
+        "needs a drucker_prager or mohr_coulomb material (nothing to reduce)",
+    )?;
+    ensure(
+        s.stages().iter().any(|st| st.kind == SolverKind::Implicit),
+        p,
+        "needs an implicit stage: a trial fails when its Newton iteration does",
     )
 }

@@ -1,0 +1,252 @@
+//! Geostatic (K0) initialisation and the strength-reduction search.
+//!
+//! - K0: under level ground a laterally confined elastic layer with
+//!   K0 = ν/(1 − ν) is already in equilibrium, so full gravity on the geostatic
+//!   state must leave it (almost) where it is; the depth under a slope face is
+//!   the depth below the face directly above.
+//! - Strength reduction of the Griffiths & Lane (1999) slope on a coarse grid
+//!   (h = H/10, 1000 particles; the scene as shipped has h = H/30): published F = 1.38–1.40, limit-analysis bounds
+//!   1.366 ≤ F ≤ 1.393 (problems/limit_slope.toml). Bilinear MPM with isochoric
+//!   plastic flow (ψ = 0) locks and overestimates F on coarse grids: this grid
+//!   gives F ≈ 1.75 (+25 %), and F falls towards the published value as the grid
+//!   is refined (papers/slope_griffiths_lane/ has the trend). The test holds the
+//!   coarse result above the limit-analysis upper bound 1.393 (the direction of
+//!   the error) and below 1.30 × 1.40, and checks the search itself, the runaway
+//!   of the crest near the bracket and the mechanism.
+
+mod common;
+use common::{problem, run_problem, run_text, Table};
+use mpm::scene::Scene;
+use mpm::setup::Model;
+
+const LEVEL: &str = r#"dimension = 2
+gravity = [0.0, -10.0]
+
+[grid]
+min = [0.0, 0.0]
+max = [2.0, 5.0]
+cells = [2, 5]
+
+[[material]]
+name = "soil"
+model = "linear_elastic"
+density = 2.0
+youngs_modulus = 1.0e4
+poisson_ratio = 0.25
+
+[[body]]
+material = "soil"
+shape = "rectangle"
+min = [0.0, 0.0]
+max = [2.0, 4.0]
+
+[[boundary]]
+face = "xmin"
+condition = "roller"
+
+[[boundary]]
+face = "xmax"
+condition = "roller"
+
+[[boundary]]
+face = "ymin"
+condition = "fixed"
+
+[geostatic]
+k0 = 0.3333333333333333
+
+[solver]
+kind = "implicit"
+integrator = "quasi_static"
+end_time = 1.0
+load_steps = 1
+gravity_ramp = false
+
+[output]
+frames = 0
+"#;
+
+/// Largest particle displacement of a run.
+fn max_displacement(p: &Table) -> f64 {
+    let (x0, y0, x, y) = (p.col("X0"), p.col("Y0"), p.col("x"), p.col("y"));
+    (0..x.len())
+        .map(|i| (x[i] - x0[i]).hypot(y[i] - y0[i]))
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn k0_state_of_level_ground_is_in_equilibrium() {
+    // The settlement of the same layer when gravity is switched on from zero
+    // stress: ρ g H² / (2M) at the top, M = E(1 − ν)/((1 + ν)(1 − 2ν)).
+    let m = 1.0e4 * 0.75 / (1.25 * 0.5);
+    let settlement = 2.0 * 10.0 * 16.0 / (2.0 * m);
+    let (without, dir0) = run_text(
+        &LEVEL.replace("[geostatic]\nk0 = 0.3333333333333333", ""),
+        &[],
+    );
+    without.unwrap();
+    let u0 = max_displacement(&Table::read(&dir0.path().join("particles_final.csv")).unwrap());
+    let (with, dir) = run_text(LEVEL, &[]);
+    with.unwrap();
+    let p = Table::read(&dir.path().join("particles_final.csv")).unwrap();
+    let u = max_displacement(&p);
+    eprintln!("gravity on zero stress: top settlement {u0:.4e} (1D theory {settlement:.4e}); on the K0 state: largest displacement {u:.3e}");
+    assert!(
+        (u0 - settlement).abs() < 0.1 * settlement,
+        "gravity switch-on settles the layer"
+    );
+    assert!(
+        u < 1e-3 * settlement,
+        "the K0 state with K0 = ν/(1 − ν) stays put"
+    );
+    // The stresses are the geostatic ones: σ_yy = −ρ g (4 − Y), σ_xx = σ_zz = K0 σ_yy.
+    for i in 0..p.col("Y0").len() {
+        let sv = -20.0 * (4.0 - p.col("Y0")[i]);
+        assert!(
+            (p.col("syy")[i] - sv).abs() < 1e-3 * 80.0,
+            "σ_yy at particle {i}"
+        );
+        assert!(
+            (p.col("sxx")[i] - sv / 3.0).abs() < 1e-3 * 80.0,
+            "σ_xx at particle {i}"
+        );
+        assert!(
+            (p.col("szz")[i] - sv / 3.0).abs() < 1e-3 * 80.0,
+            "σ_zz at particle {i}"
+        );
+    }
+}
+
+#[test]
+fn k0_depth_is_measured_below_the_slope_face() {
+    let scene = Scene::load(&problem("slope_griffiths_lane.toml"), &[]).unwrap();
+    let mut model = Model::<2>::build(&scene).unwrap();
+    mpm::geostatic::initialise(&mut model, &scene.config);
+    let k0 = 1.0 - 20f64.to_radians().sin();
+    let p = &model.particles;
+    for q in 0..p.len() {
+        let (x, y) = (p.x0[q][0], p.x0[q][1]);
+        // Slope face y = (35 − x)/2 for 15 ≤ x ≤ 35, crest level 10 behind it.
+        let surface = if x <= 15.0 { 10.0 } else { (35.0 - x) / 2.0 };
+        let sv = -20.0 * (surface - y);
+        let s = p.stress[q];
+        assert!((s[(1, 1)] - sv).abs() < 1e-9, "σ_v at ({x}, {y})");
+        assert!((s[(0, 0)] - k0 * sv).abs() < 1e-9 && (s[(2, 2)] - k0 * sv).abs() < 1e-9);
+        assert_eq!(s[(0, 1)], 0.0);
+    }
+}
+
+#[test]
+fn griffiths_lane_slope_factor_of_safety_coarse() {
+    let (result, dir) = run_problem("slope_griffiths_lane.toml", &["grid.cells=[40,12]"]);
+    let s = result.unwrap().json;
+    let fos = s["factor_of_safety"].as_f64().unwrap();
+    let bracket: Vec<f64> = s["factor_of_safety_bracket"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    eprintln!("coarse Griffiths & Lane slope: F = {fos:.4} in {bracket:?}");
+    assert!(
+        bracket[1] - bracket[0] <= 0.01 + 1e-12,
+        "bracket within the tolerance"
+    );
+    assert!((fos - 0.5 * (bracket[0] + bracket[1])).abs() < 1e-12);
+    assert!(
+        fos > 1.393 && fos < 1.30 * 1.40,
+        "coarse F = {fos} between the limit-analysis upper bound 1.393 and 1.82"
+    );
+    // Every stable trial lies below every failed one.
+    let trials = s["trials"].as_array().unwrap();
+    let factors = |status: &str| -> Vec<f64> {
+        trials
+            .iter()
+            .filter(|t| t["status"] == status)
+            .map(|t| t["factor"].as_f64().unwrap())
+            .collect()
+    };
+    let (stable, failed) = (factors("stable"), factors("failed_newton"));
+    assert!(stable.iter().all(|s| failed.iter().all(|f| s < f)));
+    assert_eq!(stable.len() + failed.len(), trials.len());
+    // The crest runs away as F approaches the bracket: its displacement at the
+    // last stable F is many times the one at the lowest.
+    let crest = |f: f64| {
+        trials
+            .iter()
+            .find(|t| t["factor"].as_f64() == Some(f))
+            .unwrap()["monitor_displacement"]
+            .as_f64()
+            .unwrap()
+    };
+    let lowest = stable.iter().cloned().fold(f64::INFINITY, f64::min);
+    let (u_low, u_high) = (crest(lowest), crest(bracket[0]));
+    eprintln!(
+        "crest displacement: {u_low:.3e} at F = {lowest}, {u_high:.3e} at F = {}",
+        bracket[0]
+    );
+    assert!(u_high > 20.0 * u_low, "runaway of the crest near failure");
+    // The mechanism: in the last stable trial the plastic strain concentrates in a
+    // band that runs out at the toe (x ≈ 35, y ≈ 0), not at the back or the base
+    // behind the crest.
+    let dir_stable = dir.path().join(s["mechanism_stable"].as_str().unwrap());
+    let p = Table::read(&dir_stable.join("particles_final.csv")).unwrap();
+    let (x, y, e) = (p.col("X0"), p.col("Y0"), p.col("eps_p"));
+    let peak = e.iter().cloned().fold(0.0, f64::max);
+    assert!(peak > 0.0, "plastic strain at the bracket");
+    let near_toe = (0..e.len())
+        .filter(|&i| x[i] > 28.0 && y[i] < 3.0)
+        .map(|i| e[i])
+        .fold(0.0, f64::max);
+    let behind = (0..e.len())
+        .filter(|&i| x[i] < 5.0)
+        .map(|i| e[i])
+        .fold(0.0, f64::max);
+    eprintln!("eps_p: peak {peak:.3e}, near the toe {near_toe:.3e}, behind the crest (x < 5) {behind:.3e}");
+    assert!(near_toe > 0.1 * peak, "the band reaches the toe");
+    assert!(behind < 0.1 * peak, "no plastic flow far behind the crest");
+}
+
+#[test]
+fn bad_strength_reduction_and_geostatic_keys_are_named() {
+    let text = std::fs::read_to_string(problem("slope_griffiths_lane.toml")).unwrap();
+    let err = |overrides: &[&str]| {
+        let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+        Scene::parse("slope.toml", &text, &o)
+            .unwrap_err()
+            .to_string()
+    };
+    let e = err(&["strength_reduction.search=[1.5,1.2]"]);
+    assert!(
+        e.contains("slope.toml:") && e.contains("strength_reduction.search"),
+        "{e}"
+    );
+    let e = err(&[
+        "strength_reduction.max_displacement=0.5",
+        "strength_reduction.monitor=[1.0]",
+    ]);
+    assert!(
+        e.contains("strength_reduction.monitor") && e.contains("2 components"),
+        "{e}"
+    );
+    let e = err(&["geostatic.k0=-1.0"]);
+    assert!(e.contains("geostatic.k0") && e.contains("positive"), "{e}");
+    let e = Scene::parse(
+        "level.toml",
+        &LEVEL.replace("linear_elastic", "hencky"),
+        &[],
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("level.toml:") && e.contains("body.0.material") && e.contains("[geostatic]"),
+        "{e}"
+    );
+    let e = err(&["gravity=[0.0,0.0]"]);
+    assert!(e.contains("geostatic") && e.contains("gravity"), "{e}");
+    let e = err(&["solver.integrator=\"newmark\"", "solver.dt=0.1"]);
+    assert!(
+        e.contains("solver.gravity_ramp") && e.contains("Newmark"),
+        "{e}"
+    );
+}
