@@ -133,9 +133,7 @@ pub fn friction_contact<const D: usize>(
     constraint: &Constraint<D>,
     v: &Vector<D>,
 ) -> Vector<D> {
-    let mut v = on
-        .iter()
-        .fold(*v, |v, &f| faces[f as usize].contact(&v));
+    let mut v = on.iter().fold(*v, |v, &f| faces[f as usize].contact(&v));
     constraint.apply_velocity(&mut v);
     v
 }

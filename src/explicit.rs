@@ -243,7 +243,12 @@ fn friction_nodes<const D: usize>(m: &Model<D>, map: &NodeMap) -> Vec<(usize, Ve
         return Vec::new();
     }
     (0..map.len())
-        .map(|a| (a, node_friction(&m.grid, &m.friction, map.active[a] as usize)))
+        .map(|a| {
+            (
+                a,
+                node_friction(&m.grid, &m.friction, map.active[a] as usize),
+            )
+        })
         .filter(|(_, on)| !on.is_empty())
         .collect()
 }

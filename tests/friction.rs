@@ -57,7 +57,10 @@ fn block_sticks_when_tan_theta_is_below_mu() {
     // same damped run slides ~0.55 m.
     let (_, x) = slide(30.0, 0.7, 0.1);
     let (t, free) = slide(30.0, 0.0, 0.1);
-    println!("stick: x = {x:.2e} m; frictionless damped: {free:.3} m (undamped closed form {:.3})", closed_form(30.0, 0.0, t));
+    println!(
+        "stick: x = {x:.2e} m; frictionless damped: {free:.3} m (undamped closed form {:.3})",
+        closed_form(30.0, 0.0, t)
+    );
     assert!(free > 0.5, "frictionless damped run moved only {free}");
     assert!(x.abs() < 2e-3, "block crept {x} m with tan θ < μ");
 }

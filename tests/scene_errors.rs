@@ -356,10 +356,7 @@ fn friction_face_needs_a_valid_coefficient() {
         "{e}"
     );
     let e = err(&with("friction_coefficient = -0.1"));
-    assert!(
-        e.contains("scene.toml:25:24") && e.contains("≥ 0"),
-        "{e}"
-    );
+    assert!(e.contains("scene.toml:25:24") && e.contains("≥ 0"), "{e}");
     let e = err(&with("friction_coefficient = 0.4\nvelocity = [0.0, 0.0]"));
     assert!(e.contains("boundary.0.velocity"), "{e}");
 }
