@@ -2,9 +2,10 @@
 
 front  d_inf: the 99.5 % mass percentile of particle x (robust against a few
        particles that detach from the toe); the largest x is reported beside it.
-height h_inf: the largest particle y plus half a particle spacing is NOT added:
-       particle centres are used throughout, for the initial column too (d0, h0
-       are the body extents, the particle centres lie half a spacing inside).
+height h_inf: the largest particle y.
+Both are shifted by half a particle spacing (the gap between the outermost
+particle centres and the body's edges at the start), so that the initial column
+measures exactly d0 x h0.
 final: the run is final when the kinetic energy at the end is below 1 % of its
        peak (checked here and reported).
 """
