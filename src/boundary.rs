@@ -72,3 +72,116 @@ pub fn node_constraint<const D: usize>(
     }
     c
 }
+
+/// A rigid face with Coulomb friction (a rough base): a node on the face may
+/// separate from it, but not move into it, and slides along it only against a
+/// friction impulse of at most μ times the normal impulse (rigid-wall contact in
+/// the manner of Bardenhagen et al. 2001, with the wall as the rigid body).
+#[derive(Clone, Copy, Debug)]
+pub struct FrictionFace {
+    pub face: Face,
+    /// Coulomb friction coefficient μ ≥ 0 (0: a roller that lets go).
+    pub coefficient: f64,
+}
+
+impl FrictionFace {
+    /// Unit outward normal of the face (out of the grid, into the wall).
+    pub fn normal<const D: usize>(&self) -> Vector<D> {
+        let mut n = Vector::<D>::zeros();
+        n[self.face.axis] = if self.face.upper { 1.0 } else { -1.0 };
+        n
+    }
+
+    /// The nodal velocity after contact with the wall. Approaching (v·n > 0): the
+    /// normal component is removed, Δv_n = v·n, and the tangential speed drops by
+    /// μ Δv_n, to zero at most (stick). Separating: unchanged.
+    pub fn contact<const D: usize>(&self, v: &Vector<D>) -> Vector<D> {
+        let n = self.normal::<D>();
+        let vn = v.dot(&n);
+        if vn <= 0.0 {
+            return *v;
+        }
+        let vt = v - n * vn;
+        let speed = vt.norm();
+        let slip = speed - self.coefficient * vn;
+        if slip <= 0.0 {
+            Vector::<D>::zeros()
+        } else {
+            vt * (slip / speed)
+        }
+    }
+}
+
+/// Indices of the friction faces node `node` lies on (empty for most nodes).
+pub fn node_friction<const D: usize>(
+    grid: &Grid<D>,
+    faces: &[FrictionFace],
+    node: usize,
+) -> Vec<u8> {
+    let ijk = grid.node_ijk(node);
+    (0..faces.len())
+        .filter(|&f| grid.on_face(ijk, faces[f].face))
+        .map(|f| f as u8)
+        .collect()
+}
+
+/// Apply the friction faces `on` (from `node_friction`) to a nodal velocity, then
+/// the prescribed components of `constraint` (which win on a shared corner).
+pub fn friction_contact<const D: usize>(
+    faces: &[FrictionFace],
+    on: &[u8],
+    constraint: &Constraint<D>,
+    v: &Vector<D>,
+) -> Vector<D> {
+    let mut v = on.iter().fold(*v, |v, &f| faces[f as usize].contact(&v));
+    constraint.apply_velocity(&mut v);
+    v
+}
+
+#[cfg(test)]
+mod friction_tests {
+    use super::*;
+
+    fn base(mu: f64) -> FrictionFace {
+        FrictionFace {
+            face: Face {
+                axis: 1,
+                upper: false,
+            },
+            coefficient: mu,
+        }
+    }
+
+    #[test]
+    fn approaching_node_slides_with_reduced_speed() {
+        // v = (3, −1) into the ymin wall: Δv_n = 1, speed 3 − 0.5 × 1.
+        let v = base(0.5).contact(&Vector::<2>::new(3.0, -1.0));
+        assert!((v - Vector::<2>::new(2.5, 0.0)).norm() < 1e-14);
+    }
+
+    #[test]
+    fn approaching_node_sticks_when_friction_suffices() {
+        let v = base(0.5).contact(&Vector::<2>::new(-0.4, -1.0));
+        assert_eq!(v, Vector::<2>::zeros());
+    }
+
+    #[test]
+    fn separating_node_is_free() {
+        let v = Vector::<2>::new(3.0, 0.5);
+        assert_eq!(base(10.0).contact(&v), v);
+    }
+
+    #[test]
+    fn tangential_direction_is_kept_in_3d() {
+        let f = FrictionFace {
+            face: Face {
+                axis: 2,
+                upper: true,
+            },
+            coefficient: 0.2,
+        };
+        let v = f.contact(&Vector::<3>::new(3.0, 4.0, 5.0));
+        // speed 5 − 0.2 × 5 = 4 along (3, 4)/5.
+        assert!((v - Vector::<3>::new(2.4, 3.2, 0.0)).norm() < 1e-14);
+    }
+}

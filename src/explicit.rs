@@ -2,7 +2,7 @@
 //! and MUSL orderings of the stress update (§2.2.1), a PIC/FLIP blend, and local
 //! damping for dynamic relaxation.
 
-use crate::boundary::{node_constraint, Constraint};
+use crate::boundary::{friction_contact, node_constraint, node_friction, Constraint, FrictionFace};
 use crate::deformation::Trial;
 use crate::dim::Vector;
 use crate::scene::{Scheme, SolverConfig};
@@ -115,12 +115,14 @@ impl<const D: usize> Explicit<D> {
             .with_min_len(MIN_PARALLEL_LEN)
             .map(|&g| node_constraint(&m.grid, &m.faces, g as usize))
             .collect();
+        let contacts = friction_nodes(m, map);
         let tiny = TINY_MASS_FRACTION * p.mass.iter().cloned().fold(f64::INFINITY, f64::min);
 
         // Nodal velocity at the start of the step, with the conditions applied.
         let (mass, momentum) = mass_momentum(map, st, p);
         let raw_velocity = mass_average(&mass, &momentum);
-        let velocity = constrained(&raw_velocity, &constraint);
+        let mut velocity = constrained(&raw_velocity, &constraint);
+        apply_friction(&m.friction, &contacts, &constraint, &mut velocity);
         if self.scheme == Scheme::Usf {
             update_stress(m, &mut self.trial, st, map, &velocity, dt, step, t)?;
         }
@@ -133,7 +135,7 @@ impl<const D: usize> Explicit<D> {
         // Absorbing faces: dashpot (and spring) forces on the outer cell layer (2-63).
         m.absorbing
             .add_force(&m.grid, p, map, st, &velocity, &mut force);
-        let accel: Vec<Vector<D>> = (0..map.len())
+        let mut accel: Vec<Vector<D>> = (0..map.len())
             .into_par_iter()
             .with_min_len(MIN_PARALLEL_LEN)
             .map(|a| {
@@ -149,9 +151,14 @@ impl<const D: usize> Explicit<D> {
                 acc
             })
             .collect();
-        let velocity_new: Vec<Vector<D>> = (0..map.len())
+        let mut velocity_new: Vec<Vector<D>> = (0..map.len())
             .map(|a| raw_velocity[a] + accel[a] * dt)
             .collect();
+        // Friction faces act on the updated velocity; the acceleration follows.
+        apply_friction(&m.friction, &contacts, &constraint, &mut velocity_new);
+        for (a, _) in &contacts {
+            accel[*a] = (velocity_new[*a] - raw_velocity[*a]) / dt;
+        }
 
         // G2P: particle velocity (PIC/FLIP blend, 2-27) and position (2-26).
         let flip = self.flip;
@@ -180,7 +187,8 @@ impl<const D: usize> Explicit<D> {
             Scheme::Musl => {
                 // Map the updated particle momentum back and use that velocity.
                 let (_, momentum) = mass_momentum(map, st, &m.particles);
-                let velocity = constrained(&mass_average(&mass, &momentum), &constraint);
+                let mut velocity = constrained(&mass_average(&mass, &momentum), &constraint);
+                apply_friction(&m.friction, &contacts, &constraint, &mut velocity);
                 update_stress(m, &mut self.trial, st, map, &velocity, dt, step, t)?;
             }
         }
@@ -227,6 +235,34 @@ fn constrained<const D: usize>(v: &[Vector<D>], c: &[Constraint<D>]) -> Vec<Vect
             v
         })
         .collect()
+}
+
+/// The active nodes on friction faces, with the faces each lies on.
+fn friction_nodes<const D: usize>(m: &Model<D>, map: &NodeMap) -> Vec<(usize, Vec<u8>)> {
+    if m.friction.is_empty() {
+        return Vec::new();
+    }
+    (0..map.len())
+        .map(|a| {
+            (
+                a,
+                node_friction(&m.grid, &m.friction, map.active[a] as usize),
+            )
+        })
+        .filter(|(_, on)| !on.is_empty())
+        .collect()
+}
+
+/// Rigid-wall contact with Coulomb friction on the nodes of friction faces.
+fn apply_friction<const D: usize>(
+    faces: &[FrictionFace],
+    contacts: &[(usize, Vec<u8>)],
+    constraint: &[Constraint<D>],
+    v: &mut [Vector<D>],
+) {
+    for (a, on) in contacts {
+        v[*a] = friction_contact(faces, on, &constraint[*a], &v[*a]);
+    }
 }
 
 #[allow(clippy::too_many_arguments)]

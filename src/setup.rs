@@ -2,7 +2,7 @@
 //! materials, boundary conditions and loads.
 
 use crate::absorbing::Absorbing;
-use crate::boundary::{Constraint, FaceCondition};
+use crate::boundary::{Constraint, FaceCondition, FrictionFace};
 use crate::dim::Vector;
 use crate::grid::{Face, Grid};
 use crate::material::mohr_coulomb::{Softening, Strength};
@@ -24,6 +24,8 @@ pub struct Model<const D: usize> {
     pub particles: Particles<D>,
     pub materials: Vec<Box<dyn Material>>,
     pub faces: Vec<FaceCondition<D>>,
+    /// Rigid rough faces (Coulomb friction; explicit solver).
+    pub friction: Vec<FrictionFace>,
     /// Non-reflecting faces (Lysmer–Kuhlemeyer dashpots, optional springs).
     pub absorbing: Absorbing<D>,
     pub gravity: Vector<D>,
@@ -65,8 +67,17 @@ impl<const D: usize> Model<D> {
         let faces = c
             .boundaries
             .iter()
-            .filter(|b| b.condition != Condition::Absorbing)
+            .filter(|b| !matches!(b.condition, Condition::Absorbing | Condition::Friction))
             .map(|b| face_condition(b, D, &vec))
+            .collect();
+        let friction = c
+            .boundaries
+            .iter()
+            .filter(|b| b.condition == Condition::Friction)
+            .map(|b| FrictionFace {
+                face: Face::parse(&b.face, D).unwrap(),
+                coefficient: b.friction_coefficient.unwrap(),
+            })
             .collect();
         let absorbing = Absorbing::new(&c.boundaries, &materials);
         absorbing
@@ -138,6 +149,7 @@ impl<const D: usize> Model<D> {
             particles,
             materials,
             faces,
+            friction,
             absorbing,
             gravity,
             load_ramps,
@@ -310,7 +322,9 @@ fn face_condition<const D: usize>(
     match b.condition {
         Condition::Fixed => (0..D).for_each(|d| constraint.set(d, 0.0)),
         Condition::Roller => constraint.set(face.axis, 0.0),
-        Condition::Absorbing => unreachable!("absorbing faces are not velocity conditions"),
+        Condition::Absorbing | Condition::Friction => {
+            unreachable!("absorbing and friction faces are not velocity conditions")
+        }
         Condition::Velocity => {
             let v = vec(b.velocity.as_ref().unwrap());
             let comps: Vec<usize> = match &b.components {

@@ -426,3 +426,50 @@ fn geomaterial_keys_of_the_other_model_and_missing_keys() {
     ));
     assert!(e.contains("no strength"), "{e}");
 }
+
+#[test]
+fn friction_face_needs_a_valid_coefficient() {
+    let face = "\n[[boundary]]\nface = \"ymin\"\ncondition = \"friction\"\n";
+    let with = |extra: &str| GOOD.replace("[solver]", &format!("{face}{extra}\n[solver]"));
+    Scene::parse("scene.toml", &with("friction_coefficient = 0.4"), &[]).unwrap();
+    let e = err(&with(""));
+    assert!(
+        e.starts_with("scene.toml:") && e.contains("boundary.0.friction_coefficient"),
+        "{e}"
+    );
+    let e = err(&with("friction_coefficient = -0.1"));
+    assert!(e.contains("scene.toml:25:24") && e.contains("≥ 0"), "{e}");
+    let e = err(&with("friction_coefficient = 0.4\nvelocity = [0.0, 0.0]"));
+    assert!(e.contains("boundary.0.velocity"), "{e}");
+}
+
+#[test]
+fn friction_coefficient_only_on_friction_faces() {
+    let text = GOOD.replace(
+        "[solver]",
+        "[[boundary]]\nface = \"ymin\"\ncondition = \"roller\"\nfriction_coefficient = 0.4\n\n[solver]",
+    );
+    let e = err(&text);
+    assert!(
+        e.contains("boundary.0.friction_coefficient") && e.contains("only to friction"),
+        "{e}"
+    );
+}
+
+#[test]
+fn friction_face_is_rejected_by_the_implicit_solver() {
+    let text = GOOD
+        .replace(
+            "[solver]",
+            "[[boundary]]\nface = \"ymin\"\ncondition = \"friction\"\nfriction_coefficient = 0.4\n\n[solver]",
+        )
+        .replace(
+            "kind = \"explicit\"\nend_time = 1.0\ncfl = 0.5",
+            "kind = \"implicit\"\nend_time = 1.0\ndt = 0.1",
+        );
+    let e = err(&text);
+    assert!(
+        e.contains("boundary.0.condition") && e.contains("explicit solver only"),
+        "{e}"
+    );
+}

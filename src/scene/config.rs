@@ -197,6 +197,9 @@ pub enum Condition {
     /// Non-reflecting: Lysmer–Kuhlemeyer dashpots (thesis 2-59…2-63), optionally
     /// with springs in parallel (`spring_distance` or `spring_stiffness`).
     Absorbing,
+    /// Rigid rough wall: no penetration, Coulomb friction with
+    /// `friction_coefficient` (explicit solver).
+    Friction,
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -214,6 +217,8 @@ pub struct BoundaryConfig {
     /// Absorbing: springs in parallel with these stiffnesses per unit area,
     /// [normal, tangential].
     pub spring_stiffness: Option<Vec<f64>>,
+    /// Friction: the Coulomb coefficient μ of the rigid wall.
+    pub friction_coefficient: Option<f64>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]

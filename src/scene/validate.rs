@@ -78,6 +78,7 @@ pub fn validate(s: &SceneConfig) -> Check {
         load(l, i, s)?;
     }
     needs_krylov(s)?;
+    friction_only_explicit(s)?;
     match (&s.solver, s.stages.is_empty()) {
         (Some(solver_config), true) => solver(solver_config, "solver")?,
         (None, false) => {
@@ -618,11 +619,16 @@ fn boundary(b: &BoundaryConfig, i: usize, dim: usize) -> Check {
         format!("must be one of {face_names}"),
     )?;
     if b.condition != Condition::Absorbing {
-        let what = "a fixed, roller or velocity condition (only to absorbing)";
+        let what = "a fixed, roller, velocity or friction condition (only to absorbing)";
         forbidden(&b.spring_distance, key("spring_distance"), what)?;
         forbidden(&b.spring_stiffness, key("spring_stiffness"), what)?;
     }
+    if b.condition != Condition::Friction {
+        let what = "a fixed, roller, velocity or absorbing condition (only to friction)";
+        forbidden(&b.friction_coefficient, key("friction_coefficient"), what)?;
+    }
     match b.condition {
+        Condition::Friction => friction(b, i),
         Condition::Fixed | Condition::Roller => {
             forbidden(&b.velocity, key("velocity"), "fixed or roller conditions")?;
             forbidden(
@@ -646,6 +652,25 @@ fn boundary(b: &BoundaryConfig, i: usize, dim: usize) -> Check {
             Ok(())
         }
     }
+}
+
+/// Keys of a friction face: a coefficient μ ≥ 0 and no velocity.
+fn friction(b: &BoundaryConfig, i: usize) -> Check {
+    let key = |k: &str| format!("boundary.{i}.{k}");
+    let what = "a friction condition (the wall is at rest)";
+    forbidden(&b.velocity, key("velocity"), what)?;
+    forbidden(&b.components, key("components"), what)?;
+    required(
+        &b.friction_coefficient,
+        key("friction_coefficient"),
+        "a friction condition",
+    )?;
+    let mu = b.friction_coefficient.unwrap();
+    ensure(
+        mu >= 0.0 && mu.is_finite(),
+        key("friction_coefficient"),
+        format!("must be a finite number ≥ 0; got {mu}"),
+    )
 }
 
 /// Keys of an absorbing face: no velocity, at most one way of giving springs.
@@ -731,6 +756,28 @@ fn load(l: &LoadConfig, i: usize, s: &SceneConfig) -> Check {
             )
         }
     }
+}
+
+/// Friction faces act in the explicit solver only: an implicit solver or stage
+/// next to one is an error at the first friction face.
+fn friction_only_explicit(s: &SceneConfig) -> Check {
+    let Some(i) = s
+        .boundaries
+        .iter()
+        .position(|b| b.condition == Condition::Friction)
+    else {
+        return Ok(());
+    };
+    let implicit = s
+        .solver
+        .iter()
+        .chain(&s.stages)
+        .any(|st| st.kind == SolverKind::Implicit);
+    ensure(
+        !implicit,
+        format!("boundary.{i}.condition"),
+        "friction faces act in the explicit solver only; an implicit solver or stage needs a fixed or roller face here",
+    )
 }
 
 fn solver(s: &SolverConfig, prefix: &str) -> Check {
