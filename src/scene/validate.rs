@@ -73,6 +73,13 @@ pub fn validate(s: &SceneConfig) -> Check {
     }
     for (i, b) in s.boundaries.iter().enumerate() {
         boundary(b, i, dim)?;
+        let earlier = s.boundaries[..i].iter().any(|b| b.footing_width.is_some());
+        if b.footing_width.is_some() && earlier {
+            return Err((
+                format!("boundary.{i}.footing_width"),
+                "only one boundary may be a footing".into(),
+            ));
+        }
     }
     for (i, l) in s.loads.iter().enumerate() {
         load(l, i, s)?;
@@ -557,6 +564,17 @@ fn boundary(b: &BoundaryConfig, i: usize, dim: usize) -> Check {
         forbidden(&b.spring_distance, key("spring_distance"), what)?;
         forbidden(&b.spring_stiffness, key("spring_stiffness"), what)?;
     }
+    region(b, i, dim)?;
+    if b.condition != Condition::Velocity {
+        forbidden(&b.footing_width, key("footing_width"), "a velocity condition")?;
+    }
+    if let Some(w) = b.footing_width {
+        ensure(
+            w > 0.0 && w.is_finite(),
+            key("footing_width"),
+            format!("must be a positive width; got {w}"),
+        )?;
+    }
     match b.condition {
         Condition::Fixed | Condition::Roller => {
             forbidden(&b.velocity, key("velocity"), "fixed or roller conditions")?;
@@ -579,6 +597,31 @@ fn boundary(b: &BoundaryConfig, i: usize, dim: usize) -> Check {
                 )?;
             }
             Ok(())
+        }
+    }
+}
+
+/// A region of a face: both corners or neither, each with `dim` components, min ≤ max;
+/// not on absorbing faces.
+fn region(b: &BoundaryConfig, i: usize, dim: usize) -> Check {
+    let key = |k: &str| format!("boundary.{i}.{k}");
+    if b.condition == Condition::Absorbing {
+        let what = "a fixed, roller or velocity condition (not to absorbing)";
+        forbidden(&b.region_min, key("region_min"), what)?;
+        return forbidden(&b.region_max, key("region_max"), what);
+    }
+    match (&b.region_min, &b.region_max) {
+        (None, None) => Ok(()),
+        (Some(_), None) => required(&b.region_max, key("region_max"), "a face with region_min"),
+        (None, Some(_)) => required(&b.region_min, key("region_min"), "a face with region_max"),
+        (Some(lo), Some(hi)) => {
+            vector(lo, dim, &key("region_min"))?;
+            vector(hi, dim, &key("region_max"))?;
+            ensure(
+                lo.iter().zip(hi).all(|(a, b)| a <= b),
+                key("region_max"),
+                "must be ≥ region_min in every component",
+            )
         }
     }
 }
