@@ -4,8 +4,8 @@
 //! load–settlement curve to footing.csv and the limit pressure to summary.json.
 
 use crate::boundary::FaceCondition;
-use crate::grid::Grid;
 use crate::dim::Vector;
+use crate::grid::Grid;
 use serde_json::json;
 use std::io::Write;
 
@@ -82,7 +82,11 @@ impl FootingCurve {
             return json!({});
         };
         let limit = last[3];
-        let peak = self.rows.iter().map(|r| r[3]).fold(f64::NEG_INFINITY, f64::max);
+        let peak = self
+            .rows
+            .iter()
+            .map(|r| r[3])
+            .fold(f64::NEG_INFINITY, f64::max);
         let at_90 = self
             .rows
             .iter()

@@ -16,7 +16,8 @@ fn prandtl_nc(phi_deg: f64) -> f64 {
         return 2.0 + std::f64::consts::PI;
     }
     let phi = phi_deg.to_radians();
-    let nq = (std::f64::consts::PI * phi.tan()).exp() * (std::f64::consts::FRAC_PI_4 + phi / 2.0).tan().powi(2);
+    let nq = (std::f64::consts::PI * phi.tan()).exp()
+        * (std::f64::consts::FRAC_PI_4 + phi / 2.0).tan().powi(2);
     (nq - 1.0) / phi.tan()
 }
 
@@ -34,7 +35,8 @@ fn newton_order(r: &[f64]) -> (f64, usize) {
 
 /// Run a footing scene; check its limit pressure against N_c and the Newton
 /// iterations of the last (fully plastic) steps.
-fn footing(scene: &str, overrides: &[&str], phi: f64, tol: f64) {
+/// `max_iterations`: Newton iterations allowed in each of the last two steps.
+fn footing(scene: &str, overrides: &[&str], phi: f64, tol: f64, max_iterations: usize) {
     let (result, dir) = run_problem(scene, overrides);
     let summary = result.unwrap_or_else(|e| panic!("{scene}: {e}")).json;
     let nc = summary["bearing_capacity_factor"].as_f64().unwrap();
@@ -50,7 +52,10 @@ fn footing(scene: &str, overrides: &[&str], phi: f64, tol: f64) {
         summary["steps"],
         summary["wall_seconds"].as_f64().unwrap()
     );
-    assert!(error.abs() < tol, "{scene}: N_c within {tol:e}, got {error:+.3e}");
+    assert!(
+        error.abs() < tol,
+        "{scene}: N_c within {tol:e}, got {error:+.3e}"
+    );
     assert!(plateau.abs() < 0.01, "{scene}: the curve has flattened");
     // The curve: starts at zero, rises, and its end is the reported limit.
     let curve = Table::read(&dir.path().join("footing.csv")).unwrap();
@@ -69,14 +74,29 @@ fn footing(scene: &str, overrides: &[&str], phi: f64, tol: f64) {
             .collect();
         let (order, iterations) = newton_order(&r);
         eprintln!("   step {s}: residuals {r:?}: order {order:.2}, {iterations} iterations");
-        assert!(iterations <= 12, "{scene} step {s}: {iterations} Newton iterations");
-        assert!(order > 1.8, "{scene} step {s}: quadratic convergence, order {order:.2}");
+        assert!(
+            iterations <= max_iterations,
+            "{scene} step {s}: {iterations} Newton iterations"
+        );
+        assert!(
+            order > 1.8,
+            "{scene} step {s}: quadratic convergence, order {order:.2}"
+        );
     }
 }
 
 #[test]
 fn tresca_footing_reaches_prandtl() {
-    footing("footing_tresca.toml", &[], 0.0, 0.05);
+    footing("footing_tresca.toml", &[], 0.0, 0.05, 12);
+}
+
+/// φ = 20°, associated flow, with line search (as shipped). On the plateau each
+/// step needs 12 to 18 Newton iterations: the residual wanders between 1e-2 and
+/// 1e-4 for several iterations (the set of yielding particles still changing)
+/// before it drops quadratically (without line search: about 20, and a cut-back).
+#[test]
+fn mohr_coulomb_footing_reaches_prandtl() {
+    footing("footing_mc.toml", &[], 20.0, 0.05, 20);
 }
 
 /// A footing scene whose `[[boundary]]` table of the footing is replaced by `footing`.
@@ -91,36 +111,77 @@ fn with_footing(footing: &str) -> String {
 fn bad_footing_keys_are_named_with_their_line() {
     let base = "[[boundary]]\nface = \"ymax\"\ncondition = \"velocity\"\nvelocity = [0.0, -0.01]\ncomponents = [\"y\"]\n";
     for (extra, key, message) in [
-        ("region_min = [0.0, 3.0]", "boundary.3.region_max", "is required"),
-        ("region_min = [0.0, 3.0]\nregion_max = [1.0]", "boundary.3.region_max", "needs 2 components"),
-        ("region_min = [1.0, 3.0]\nregion_max = [0.0, 3.0]", "boundary.3.region_max", "≥ region_min"),
-        ("footing_width = -1.0", "boundary.3.footing_width", "positive width"),
+        (
+            "region_min = [0.0, 3.0]",
+            "boundary.3.region_max",
+            "is required",
+        ),
+        (
+            "region_min = [0.0, 3.0]\nregion_max = [1.0]",
+            "boundary.3.region_max",
+            "needs 2 components",
+        ),
+        (
+            "region_min = [1.0, 3.0]\nregion_max = [0.0, 3.0]",
+            "boundary.3.region_max",
+            "≥ region_min",
+        ),
+        (
+            "footing_width = -1.0",
+            "boundary.3.footing_width",
+            "positive width",
+        ),
     ] {
         let text = with_footing(&format!("{base}{extra}\n"));
-        let e = Scene::parse("footing.toml", &text, &[]).expect_err(extra).to_string();
+        let e = Scene::parse("footing.toml", &text, &[])
+            .expect_err(extra)
+            .to_string();
         eprintln!("{e}");
-        assert!(e.contains("footing.toml:") && e.contains(key) && e.contains(message), "{extra}: {e}");
+        assert!(
+            e.contains("footing.toml:") && e.contains(key) && e.contains(message),
+            "{extra}: {e}"
+        );
     }
     // Not on fixed faces, and not twice.
-    let text = with_footing("[[boundary]]\nface = \"ymax\"\ncondition = \"fixed\"\nfooting_width = 1.0\n");
-    let e = Scene::parse("footing.toml", &text, &[]).unwrap_err().to_string();
-    assert!(e.contains("boundary.3.footing_width") && e.contains("does not apply"), "{e}");
+    let text =
+        with_footing("[[boundary]]\nface = \"ymax\"\ncondition = \"fixed\"\nfooting_width = 1.0\n");
+    let e = Scene::parse("footing.toml", &text, &[])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("boundary.3.footing_width") && e.contains("does not apply"),
+        "{e}"
+    );
     let twice = format!("{base}footing_width = 1.0\n{base}footing_width = 1.0\n");
-    let e = Scene::parse("footing.toml", &with_footing(&twice), &[]).unwrap_err().to_string();
-    assert!(e.contains("boundary.4.footing_width") && e.contains("only one"), "{e}");
+    let e = Scene::parse("footing.toml", &with_footing(&twice), &[])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("boundary.4.footing_width") && e.contains("only one"),
+        "{e}"
+    );
     // A region that holds no node of its face is an error at build time.
-    let text = with_footing(&format!("{base}region_min = [0.0, 2.0]\nregion_max = [1.0, 2.5]\n"));
+    let text = with_footing(&format!(
+        "{base}region_min = [0.0, 2.0]\nregion_max = [1.0, 2.5]\n"
+    ));
     let scene = Scene::parse("footing.toml", &text, &[]).unwrap();
     let e = Model::<2>::build(&scene).unwrap_err().to_string();
     eprintln!("{e}");
-    assert!(e.contains("boundary.3.region_min") && e.contains("no grid node"), "{e}");
+    assert!(
+        e.contains("boundary.3.region_min") && e.contains("no grid node"),
+        "{e}"
+    );
 }
 
 /// The region selects exactly the face nodes inside the box, edges included, and
 /// the footing's load is the sum of their normal reactions.
 #[test]
 fn region_selects_the_face_nodes_in_the_box() {
-    let scene = Scene::load(&common::problem("footing_tresca.toml"), &["grid.shape_function=linear".into()]).unwrap();
+    let scene = Scene::load(
+        &common::problem("footing_tresca.toml"),
+        &["grid.shape_function=linear".into()],
+    )
+    .unwrap();
     let m = Model::<2>::build(&scene).unwrap();
     let f = m.footing.as_ref().expect("the scene has a footing");
     let g = &m.grid;

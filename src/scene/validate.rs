@@ -566,7 +566,11 @@ fn boundary(b: &BoundaryConfig, i: usize, dim: usize) -> Check {
     }
     region(b, i, dim)?;
     if b.condition != Condition::Velocity {
-        forbidden(&b.footing_width, key("footing_width"), "a velocity condition")?;
+        forbidden(
+            &b.footing_width,
+            key("footing_width"),
+            "a velocity condition",
+        )?;
     }
     if let Some(w) = b.footing_width {
         ensure(
