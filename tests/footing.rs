@@ -22,12 +22,14 @@ fn prandtl_nc(phi_deg: f64) -> f64 {
 }
 
 /// Orders p_k = ln(r_{k+1}/r_k) / ln(r_k/r_{k−1}) over the iterations whose
-/// residuals lie well above the round-off floor; the best, and the iterations.
+/// residuals lie well above the round-off floor and that at least halved the
+/// residual (a stalled iteration, r_k ≈ r_{k−1}, gives a meaningless quotient);
+/// the best, and the iterations.
 fn newton_order(r: &[f64]) -> (f64, usize) {
     let floor = *r.last().unwrap();
     let informative = |x: f64| x > 1e3 * floor;
     let best = (1..r.len() - 1)
-        .filter(|&k| informative(r[k - 1]) && informative(r[k]))
+        .filter(|&k| informative(r[k - 1]) && informative(r[k]) && r[k] < 0.5 * r[k - 1])
         .map(|k| (r[k + 1] / r[k]).ln() / (r[k] / r[k - 1]).ln())
         .fold(f64::NAN, f64::max);
     (best, r.len() - 1)
