@@ -4,6 +4,7 @@
 //! records what happened where.
 
 use crate::explicit::{check_state, Divergence, Explicit};
+use crate::footing::FootingCurve;
 use crate::implicit::{Implicit, NEWTON_CSV_HEADER};
 use crate::output::{
     body_centres, write_json, write_particles_csv_with, FrameWriter, HistoryWriter, Progress,
@@ -127,6 +128,14 @@ impl<const D: usize> Stepper<D> {
         })
     }
 
+    /// Reactions of the last step (implicit only; None for explicit steps).
+    fn reaction(&self) -> Option<&[(u32, crate::dim::Vector<D>)]> {
+        match self {
+            Stepper::Explicit(_) => None,
+            Stepper::Implicit(i) => Some(&i.reaction),
+        }
+    }
+
     fn active_nodes(&self) -> usize {
         match self {
             Stepper::Explicit(e) => e.active_nodes(),
@@ -192,6 +201,15 @@ fn run_dim<const D: usize>(
         writeln!(log, "{NEWTON_CSV_HEADER}")?;
         newton_log = Some(log);
     }
+    // footing.csv: the load–settlement curve after every implicit step.
+    let mut footing_curve = match &model.footing {
+        Some(_) => Some(FootingCurve::create(&out.join("footing.csv"))?),
+        None => None,
+    };
+    let mut settlement = 0.0;
+    if let (Some(curve), Some(f)) = (&mut footing_curve, &model.footing) {
+        curve.push(0.0, 0.0, 0.0, f.width)?;
+    }
     let frame_interval = (cfg.output.frames > 0).then(|| end_time / cfg.output.frames as f64);
     let progress = opts.progress.then(|| Progress::new(end_time));
     let dt_critical = Explicit::critical_dt(&model);
@@ -255,6 +273,12 @@ fn run_dim<const D: usize>(
             }
             t += dt;
             step += 1;
+            if let Some(f) = &model.footing {
+                settlement += f.settlement_rate() * dt;
+                if let (Some(curve), Some(reaction)) = (&mut footing_curve, stepper.reaction()) {
+                    curve.push(t, settlement, f.load(&model.grid, reaction), f.width)?;
+                }
+            }
             record(&model, t, external_work, false)?;
             if let Some(p) = &progress {
                 p.set(t, step);
@@ -304,6 +328,13 @@ fn run_dim<const D: usize>(
         ("stages", json!(stage_summaries)),
     ] {
         summary[key] = value;
+    }
+    if let (Some(curve), Some(f)) = (&footing_curve, &model.footing) {
+        if let serde_json::Value::Object(fields) = curve.summary(f.cohesion) {
+            for (key, value) in fields {
+                summary[key] = value;
+            }
+        }
     }
     if newton_log.is_some() {
         summary["newton_iterations"] = json!(newton_total);

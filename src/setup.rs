@@ -4,6 +4,7 @@
 use crate::absorbing::Absorbing;
 use crate::boundary::{Constraint, FaceCondition, FrictionFace};
 use crate::dim::Vector;
+use crate::footing::Footing;
 use crate::grid::{Face, Grid};
 use crate::material::mohr_coulomb::{Softening, Strength};
 use crate::material::{
@@ -26,6 +27,8 @@ pub struct Model<const D: usize> {
     pub faces: Vec<FaceCondition<D>>,
     /// Rigid rough faces (Coulomb friction; explicit solver).
     pub friction: Vec<FrictionFace>,
+    /// The velocity condition with a `footing_width`, if any.
+    pub footing: Option<Footing<D>>,
     /// Non-reflecting faces (Lysmer–Kuhlemeyer dashpots, optional springs).
     pub absorbing: Absorbing<D>,
     pub gravity: Vector<D>,
@@ -64,7 +67,7 @@ impl<const D: usize> Model<D> {
                 return Err(err(format!("body.{i}.shape"), "the body holds no particle centre: refine the grid or raise particles_per_cell".into()));
             }
         }
-        let faces = c
+        let faces: Vec<FaceCondition<D>> = c
             .boundaries
             .iter()
             .filter(|b| !matches!(b.condition, Condition::Absorbing | Condition::Friction))
@@ -79,6 +82,20 @@ impl<const D: usize> Model<D> {
                 coefficient: b.friction_coefficient.unwrap(),
             })
             .collect();
+        // A region must hold at least one node of its face.
+        let velocity_conditions =
+            c.boundaries.iter().enumerate().filter(|(_, b)| {
+                !matches!(b.condition, Condition::Absorbing | Condition::Friction)
+            });
+        for ((i, _), fc) in velocity_conditions.zip(&faces) {
+            if !(0..grid.node_count()).any(|g| fc.acts_on(&grid, grid.node_ijk(g))) {
+                return Err(err(
+                    format!("boundary.{i}.region_min"),
+                    "the region holds no grid node of the face".into(),
+                ));
+            }
+        }
+        let footing = footing(c, &faces, &grid, &particles);
         let absorbing = Absorbing::new(&c.boundaries, &materials);
         absorbing
             .check_adjacent(&grid, &particles)
@@ -150,6 +167,7 @@ impl<const D: usize> Model<D> {
             materials,
             faces,
             friction,
+            footing,
             absorbing,
             gravity,
             load_ramps,
@@ -334,7 +352,47 @@ fn face_condition<const D: usize>(
             comps.into_iter().for_each(|d| constraint.set(d, v[d]));
         }
     }
-    FaceCondition { face, constraint }
+    let region = b
+        .region_min
+        .as_ref()
+        .zip(b.region_max.as_ref())
+        .map(|(lo, hi)| (vec(lo), vec(hi)));
+    FaceCondition {
+        face,
+        constraint,
+        region,
+    }
+}
+
+/// The footing (the velocity condition with a `footing_width`), with the cohesion
+/// of the material of the particle nearest to the centre of its region.
+fn footing<const D: usize>(
+    c: &crate::scene::SceneConfig,
+    faces: &[FaceCondition<D>],
+    grid: &Grid<D>,
+    particles: &Particles<D>,
+) -> Option<Footing<D>> {
+    let (b, condition) = c
+        .boundaries
+        .iter()
+        .filter(|b| !matches!(b.condition, Condition::Absorbing | Condition::Friction))
+        .zip(faces)
+        .find(|(b, _)| b.footing_width.is_some())?;
+    let nodes: Vec<Vector<D>> = (0..grid.node_count())
+        .map(|g| grid.node_ijk(g))
+        .filter(|&ijk| condition.acts_on(grid, ijk))
+        .map(|ijk| grid.node_position(ijk))
+        .collect();
+    let centre = nodes.iter().sum::<Vector<D>>() / nodes.len() as f64;
+    let nearest = (0..particles.len()).min_by(|&a, &b| {
+        let (da, db) = (particles.x[a] - centre, particles.x[b] - centre);
+        da.norm_squared().total_cmp(&db.norm_squared())
+    });
+    Some(Footing {
+        condition: *condition,
+        width: b.footing_width.unwrap(),
+        cohesion: nearest.and_then(|q| c.materials[particles.material[q] as usize].cohesion),
+    })
 }
 
 /// Put particles on the lattice of `particles_per_cell` points per cell direction

@@ -139,6 +139,9 @@ pub struct Implicit<const D: usize> {
     absorbing: AbsorbingStep<D>,
     /// Newton iterations since the last `take_log`.
     log: Vec<NewtonRow>,
+    /// Reactions of the last converged step: (grid node, force the prescribed
+    /// components exert on the body), nodes with a non-zero reaction only.
+    pub reaction: Vec<(u32, Vector<D>)>,
     pub newton_iterations: usize,
     pub cutbacks: usize,
     /// Krylov iterations over all Newton corrections (0 with the direct solver).
@@ -173,6 +176,7 @@ impl<const D: usize> Implicit<D> {
             accel: Vec::new(),
             absorbing: AbsorbingStep::default(),
             log: Vec::new(),
+            reaction: Vec::new(),
             newton_iterations: 0,
             cutbacks: 0,
             krylov_iterations: 0,
@@ -310,7 +314,7 @@ impl<const D: usize> Implicit<D> {
         }
         dofs.follow_ties(&mut u);
         let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
-        let reference = norm(&dofs.reduce(f_ext)).max(norm(
+        let applied = norm(&dofs.reduce(f_ext)).max(norm(
             &dofs.reduce(&self.inertial_force(map, st, p, mass, u_tilde, inertia)),
         ));
         let mut method = "none";
@@ -322,6 +326,14 @@ impl<const D: usize> Implicit<D> {
             let r = self.residual(m, &u, u_tilde, mass, f_ext, inertia, dt)?;
             let r_free = dofs.reduce(&r);
             let r_norm = norm(&r_free);
+            // --- reactions in the reference force (begin) ---
+            // The residual is measured against the largest of the applied force,
+            // the inertial force and the reactions at the prescribed components
+            // (as FE codes do): a run driven only by prescribed displacements
+            // (weightless soil under a rigid footing) has no applied force.
+            let reaction = reactions(constraint, &r);
+            let reference = applied.max(norm(&reaction));
+            // --- reactions in the reference force (end) ---
             let scale = reference.max(f64::MIN_POSITIVE);
             let residual_ok = r_norm <= self.residual_tolerance * scale || r_norm == 0.0;
             let u_norm = norm(&dofs.values(&u));
@@ -353,6 +365,14 @@ impl<const D: usize> Implicit<D> {
             };
             if residual_ok && increment_ok {
                 self.log.push(row);
+                self.reaction = self
+                    .map
+                    .active
+                    .iter()
+                    .zip(reaction.chunks_exact(D))
+                    .map(|(&g, f)| (g, Vector::<D>::from_fn(|d, _| f[d])))
+                    .filter(|(_, f)| *f != Vector::<D>::zeros())
+                    .collect();
                 converged = true;
                 break;
             }
@@ -757,6 +777,17 @@ impl<const D: usize> Implicit<D> {
 /// Central-difference step of the numerical stress derivative (preconditioners
 /// of materials without an analytic tangent).
 const NUMERICAL_STEP: f64 = 1e-6;
+/// The residual at the prescribed components, r = f_int + inertia − f_ext: the
+/// reactions (node by node, D components each; zero at free components).
+fn reactions<const D: usize>(constraint: &[Constraint<D>], r: &[Vector<D>]) -> Vec<f64> {
+    let mut out = vec![0.0; r.len() * D];
+    for (a, (c, ra)) in constraint.iter().zip(r).enumerate() {
+        for d in (0..D).filter(|&d| c.fixed[d]) {
+            out[a * D + d] = ra[d];
+        }
+    }
+    out
+}
 
 #[cfg(test)]
 mod tests {

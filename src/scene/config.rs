@@ -219,6 +219,14 @@ pub struct BoundaryConfig {
     pub spring_stiffness: Option<Vec<f64>>,
     /// Friction: the Coulomb coefficient μ of the rigid wall.
     pub friction_coefficient: Option<f64>,
+    /// Fixed, roller or velocity: only the face nodes in the box
+    /// [region_min, region_max] (both or neither).
+    pub region_min: Option<Vec<f64>>,
+    pub region_max: Option<Vec<f64>>,
+    /// Velocity: the condition is a rigid footing of this width (the modelled
+    /// width; half the footing in a half model). The run writes footing.csv and
+    /// the limit pressure to summary.json.
+    pub footing_width: Option<f64>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]

@@ -73,6 +73,13 @@ pub fn validate(s: &SceneConfig) -> Check {
     }
     for (i, b) in s.boundaries.iter().enumerate() {
         boundary(b, i, dim)?;
+        let earlier = s.boundaries[..i].iter().any(|b| b.footing_width.is_some());
+        if b.footing_width.is_some() && earlier {
+            return Err((
+                format!("boundary.{i}.footing_width"),
+                "only one boundary may be a footing".into(),
+            ));
+        }
     }
     for (i, l) in s.loads.iter().enumerate() {
         load(l, i, s)?;
@@ -627,6 +634,21 @@ fn boundary(b: &BoundaryConfig, i: usize, dim: usize) -> Check {
         let what = "a fixed, roller, velocity or absorbing condition (only to friction)";
         forbidden(&b.friction_coefficient, key("friction_coefficient"), what)?;
     }
+    region(b, i, dim)?;
+    if b.condition != Condition::Velocity {
+        forbidden(
+            &b.footing_width,
+            key("footing_width"),
+            "a velocity condition",
+        )?;
+    }
+    if let Some(w) = b.footing_width {
+        ensure(
+            w > 0.0 && w.is_finite(),
+            key("footing_width"),
+            format!("must be a positive width; got {w}"),
+        )?;
+    }
     match b.condition {
         Condition::Friction => friction(b, i),
         Condition::Fixed | Condition::Roller => {
@@ -671,6 +693,31 @@ fn friction(b: &BoundaryConfig, i: usize) -> Check {
         key("friction_coefficient"),
         format!("must be a finite number ≥ 0; got {mu}"),
     )
+}
+
+/// A region of a face: both corners or neither, each with `dim` components, min ≤ max;
+/// not on absorbing faces.
+fn region(b: &BoundaryConfig, i: usize, dim: usize) -> Check {
+    let key = |k: &str| format!("boundary.{i}.{k}");
+    if matches!(b.condition, Condition::Absorbing | Condition::Friction) {
+        let what = "a fixed, roller or velocity condition (not to absorbing or friction)";
+        forbidden(&b.region_min, key("region_min"), what)?;
+        return forbidden(&b.region_max, key("region_max"), what);
+    }
+    match (&b.region_min, &b.region_max) {
+        (None, None) => Ok(()),
+        (Some(_), None) => required(&b.region_max, key("region_max"), "a face with region_min"),
+        (None, Some(_)) => required(&b.region_min, key("region_min"), "a face with region_max"),
+        (Some(lo), Some(hi)) => {
+            vector(lo, dim, &key("region_min"))?;
+            vector(hi, dim, &key("region_max"))?;
+            ensure(
+                lo.iter().zip(hi).all(|(a, b)| a <= b),
+                key("region_max"),
+                "must be ≥ region_min in every component",
+            )
+        }
+    }
 }
 
 /// Keys of an absorbing face: no velocity, at most one way of giving springs.

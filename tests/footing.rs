@@ -1,0 +1,209 @@
+//! Rigid smooth strip footing on weightless soil, displacement-controlled
+//! (`problems/footing_tresca.toml`, `problems/footing_mc.toml`): the plateau of
+//! the load–settlement curve against Prandtl's limit pressure, (2 + π) c_u for
+//! Tresca and N_c c with N_c = (N_q − 1) cot φ, N_q = e^{π tan φ} tan²(45° + φ/2)
+//! for Mohr–Coulomb; quadratic Newton convergence in the plastic steps; the keys
+//! of a footing (a velocity condition on a region of a face).
+
+mod common;
+use common::{run_problem, Table};
+use mpm::scene::Scene;
+use mpm::setup::Model;
+
+/// Prandtl's bearing capacity factor N_c for friction angle φ (degrees).
+fn prandtl_nc(phi_deg: f64) -> f64 {
+    if phi_deg == 0.0 {
+        return 2.0 + std::f64::consts::PI;
+    }
+    let phi = phi_deg.to_radians();
+    let nq = (std::f64::consts::PI * phi.tan()).exp()
+        * (std::f64::consts::FRAC_PI_4 + phi / 2.0).tan().powi(2);
+    (nq - 1.0) / phi.tan()
+}
+
+/// Orders p_k = ln(r_{k+1}/r_k) / ln(r_k/r_{k−1}) over the iterations whose
+/// residuals lie well above the round-off floor and that at least halved the
+/// residual (a stalled iteration, r_k ≈ r_{k−1}, gives a meaningless quotient);
+/// the best, and the iterations.
+fn newton_order(r: &[f64]) -> (f64, usize) {
+    let floor = *r.last().unwrap();
+    let informative = |x: f64| x > 1e3 * floor;
+    let best = (1..r.len() - 1)
+        .filter(|&k| informative(r[k - 1]) && informative(r[k]) && r[k] < 0.5 * r[k - 1])
+        .map(|k| (r[k + 1] / r[k]).ln() / (r[k] / r[k - 1]).ln())
+        .fold(f64::NAN, f64::max);
+    (best, r.len() - 1)
+}
+
+/// Run a footing scene; check its limit pressure against N_c and the Newton
+/// iterations of the last (fully plastic) steps.
+/// `max_iterations`: Newton iterations allowed in each of the last two steps.
+fn footing(scene: &str, overrides: &[&str], phi: f64, tol: f64, max_iterations: usize) {
+    let (result, dir) = run_problem(scene, overrides);
+    let summary = result.unwrap_or_else(|e| panic!("{scene}: {e}")).json;
+    let nc = summary["bearing_capacity_factor"].as_f64().unwrap();
+    let limit = summary["limit_pressure"].as_f64().unwrap();
+    let plateau = summary["plateau_change"].as_f64().unwrap();
+    let exact = prandtl_nc(phi);
+    let error = (nc - exact) / exact;
+    eprintln!(
+        "{scene}: limit pressure {limit:.5e}, N_c = {nc:.4} (Prandtl {exact:.4}), error {:+.2} %, plateau change {:.2e}, {} Newton iterations in {} steps, {:.1} s",
+        100.0 * error,
+        plateau,
+        summary["newton_iterations"],
+        summary["steps"],
+        summary["wall_seconds"].as_f64().unwrap()
+    );
+    assert!(
+        error.abs() < tol,
+        "{scene}: N_c within {tol:e}, got {error:+.3e}"
+    );
+    assert!(plateau.abs() < 0.01, "{scene}: the curve has flattened");
+    // The curve: starts at zero, rises, and its end is the reported limit.
+    let curve = Table::read(&dir.path().join("footing.csv")).unwrap();
+    let p = curve.col("pressure");
+    assert_eq!(p[0], 0.0);
+    assert!(p.len() == summary["steps"].as_u64().unwrap() as usize + 1);
+    assert_eq!(*p.last().unwrap(), limit);
+    // Newton in the last steps (on the plateau, plastic zone fully developed).
+    let newton = Table::read(&dir.path().join("newton.csv")).unwrap();
+    let (step, res) = (newton.col("step"), newton.col("residual"));
+    let last = step.iter().cloned().fold(0.0, f64::max);
+    for s in [last - 1.0, last] {
+        let r: Vec<f64> = (0..step.len())
+            .filter(|&i| step[i] == s)
+            .map(|i| res[i])
+            .collect();
+        let (order, iterations) = newton_order(&r);
+        eprintln!("   step {s}: residuals {r:?}: order {order:.2}, {iterations} iterations");
+        assert!(
+            iterations <= max_iterations,
+            "{scene} step {s}: {iterations} Newton iterations"
+        );
+        assert!(
+            order > 1.8,
+            "{scene} step {s}: quadratic convergence, order {order:.2}"
+        );
+    }
+}
+
+#[test]
+fn tresca_footing_reaches_prandtl() {
+    footing("footing_tresca.toml", &[], 0.0, 0.05, 12);
+}
+
+/// φ = 20°, associated flow, with line search (as shipped). On the plateau each
+/// step needs 12 to 18 Newton iterations: the residual wanders between 1e-2 and
+/// 1e-4 for several iterations (the set of yielding particles still changing)
+/// before it drops quadratically (without line search: about 20, and a cut-back).
+#[test]
+fn mohr_coulomb_footing_reaches_prandtl() {
+    footing("footing_mc.toml", &[], 20.0, 0.05, 20);
+}
+
+/// A footing scene whose `[[boundary]]` table of the footing is replaced by `footing`.
+fn with_footing(footing: &str) -> String {
+    let text = std::fs::read_to_string(common::problem("footing_tresca.toml")).unwrap();
+    let start = text.find("[[boundary]]\nface = \"ymax\"").unwrap();
+    let end = text.find("[solver]").unwrap();
+    format!("{}{footing}\n{}", &text[..start], &text[end..])
+}
+
+#[test]
+fn bad_footing_keys_are_named_with_their_line() {
+    let base = "[[boundary]]\nface = \"ymax\"\ncondition = \"velocity\"\nvelocity = [0.0, -0.01]\ncomponents = [\"y\"]\n";
+    for (extra, key, message) in [
+        (
+            "region_min = [0.0, 3.0]",
+            "boundary.3.region_max",
+            "is required",
+        ),
+        (
+            "region_min = [0.0, 3.0]\nregion_max = [1.0]",
+            "boundary.3.region_max",
+            "needs 2 components",
+        ),
+        (
+            "region_min = [1.0, 3.0]\nregion_max = [0.0, 3.0]",
+            "boundary.3.region_max",
+            "≥ region_min",
+        ),
+        (
+            "footing_width = -1.0",
+            "boundary.3.footing_width",
+            "positive width",
+        ),
+    ] {
+        let text = with_footing(&format!("{base}{extra}\n"));
+        let e = Scene::parse("footing.toml", &text, &[])
+            .expect_err(extra)
+            .to_string();
+        eprintln!("{e}");
+        assert!(
+            e.contains("footing.toml:") && e.contains(key) && e.contains(message),
+            "{extra}: {e}"
+        );
+    }
+    // Not on fixed faces, and not twice.
+    let text =
+        with_footing("[[boundary]]\nface = \"ymax\"\ncondition = \"fixed\"\nfooting_width = 1.0\n");
+    let e = Scene::parse("footing.toml", &text, &[])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("boundary.3.footing_width") && e.contains("does not apply"),
+        "{e}"
+    );
+    let twice = format!("{base}footing_width = 1.0\n{base}footing_width = 1.0\n");
+    let e = Scene::parse("footing.toml", &with_footing(&twice), &[])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("boundary.4.footing_width") && e.contains("only one"),
+        "{e}"
+    );
+    // A region that holds no node of its face is an error at build time.
+    let text = with_footing(&format!(
+        "{base}region_min = [0.0, 2.0]\nregion_max = [1.0, 2.5]\n"
+    ));
+    let scene = Scene::parse("footing.toml", &text, &[]).unwrap();
+    let e = Model::<2>::build(&scene).unwrap_err().to_string();
+    eprintln!("{e}");
+    assert!(
+        e.contains("boundary.3.region_min") && e.contains("no grid node"),
+        "{e}"
+    );
+}
+
+/// The region selects exactly the face nodes inside the box, edges included, and
+/// the footing's load is the sum of their normal reactions.
+#[test]
+fn region_selects_the_face_nodes_in_the_box() {
+    let scene = Scene::load(
+        &common::problem("footing_tresca.toml"),
+        &["grid.shape_function=linear".into()],
+    )
+    .unwrap();
+    let m = Model::<2>::build(&scene).unwrap();
+    let f = m.footing.as_ref().expect("the scene has a footing");
+    let g = &m.grid;
+    let nodes: Vec<f64> = (0..g.node_count())
+        .map(|n| g.node_ijk(n))
+        .filter(|&ijk| f.condition.acts_on(g, ijk))
+        .map(|ijk| g.node_position(ijk)[0])
+        .collect();
+    // h = 0.25: x = 0, 0.25, 0.5, 0.75, 1.0 on y = 3.
+    assert_eq!(nodes, vec![0.0, 0.25, 0.5, 0.75, 1.0]);
+    assert_eq!(f.width, 1.0);
+    assert_eq!(f.cohesion, Some(1.0e4));
+    assert_eq!(f.settlement_rate(), 0.01);
+    // Reactions: a node under the footing pushed down by 2, one beside it (not
+    // part of the footing) by 5.
+    let under = g.node_index([2, 12]) as u32;
+    let beside = g.node_index([6, 12]) as u32;
+    let r = [
+        (under, mpm::dim::Vector::<2>::new(0.3, -2.0)),
+        (beside, mpm::dim::Vector::<2>::new(0.0, -5.0)),
+    ];
+    assert_eq!(f.load(g, &r), 2.0);
+}
