@@ -265,9 +265,9 @@ fn apply_friction<const D: usize>(
     }
 }
 
-#[allow(clippy::too_many_arguments)]
 /// ΔF = I + Δt L with L_p = Σ v_I ⊗ ∇S_Ip, then F, V and the stress (2-31, 2-32):
 /// the shared deformation update with the nodal displacement u_I = Δt v_I.
+#[allow(clippy::too_many_arguments)]
 fn update_stress<const D: usize>(
     m: &mut Model<D>,
     trial: &mut Trial,

@@ -8,7 +8,7 @@
 //! The quasi-static runs also check the Newton iterations of the plastic steps.
 
 mod common;
-use common::{problem, run_text, Table};
+use common::{problem, read_newton, run_text, Table};
 
 const C: f64 = 1.0e4;
 
@@ -17,11 +17,6 @@ const C: f64 = 1.0e4;
 fn strength(j: f64) -> f64 {
     let phi = 30f64.to_radians();
     -2.0 * C * phi.cos() / (j * (1.0 - phi.sin()))
-}
-
-/// newton.csv (its text column is read too).
-fn read_newton(path: &std::path::Path) -> Table {
-    Table::read(path).unwrap()
 }
 
 /// Drucker–Prager fitted in plane strain. Its limit needs steady plastic flow
