@@ -315,7 +315,10 @@ impl Cantilever {
                     .solve(&r)
                     .map_err(|e| format!("load step {step}: {e}"))?;
                 if std::env::var("FE_DEBUG").is_ok() {
-                    eprintln!("step {step} it {iterations}: r {r_norm:.3e} du {:.3e}", norm(&du));
+                    eprintln!(
+                        "step {step} it {iterations}: r {r_norm:.3e} du {:.3e}",
+                        norm(&du)
+                    );
                 }
                 x.iter_mut().zip(&du).for_each(|(a, b)| *a += b);
                 iterations += 1;

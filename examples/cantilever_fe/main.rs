@@ -78,7 +78,17 @@ fn main() {
     let wall = start.elapsed().as_secs_f64();
     println!(
         "{:>9} {:>6} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10} {:>8} {:>8} {:>3}",
-        "P (kN)", "k_a", "v (m)", "u (m)", "v_mid", "u_mid", "v/a", "u/a", "dv_el %", "dv_re %", "it"
+        "P (kN)",
+        "k_a",
+        "v (m)",
+        "u (m)",
+        "v_mid",
+        "u_mid",
+        "v/a",
+        "u/a",
+        "dv_el %",
+        "dv_re %",
+        "it"
     );
     for l in &levels {
         let k = l.force * arm * arm / ei;
@@ -105,10 +115,21 @@ fn main() {
     let (v_r, u_r, _) = elastica(k, last.force / ea, last.force / kga);
     let k10 = last.force * arm * arm / (beam.youngs_modulus * depth.powi(3) / 12.0);
     let (v_10, u_10, _) = elastica(k10, 0.0, 0.0);
-    println!("final: v = {:.6} m, u = {:.6} m ({wall:.2} s)", last.v, last.u);
+    println!(
+        "final: v = {:.6} m, u = {:.6} m ({wall:.2} s)",
+        last.v, last.u
+    );
     for (name, v_ref, u_ref) in [
-        (format!("classical elastica, EI plane strain (k = {k:.4})"), v_c, u_c),
-        (format!("classical elastica, EI = E d^3/12 (k = {k10:.4})"), v_10, u_10),
+        (
+            format!("classical elastica, EI plane strain (k = {k:.4})"),
+            v_c,
+            u_c,
+        ),
+        (
+            format!("classical elastica, EI = E d^3/12 (k = {k10:.4})"),
+            v_10,
+            u_10,
+        ),
         ("Reissner (extension + shear)".to_string(), v_r, u_r),
     ] {
         println!(
