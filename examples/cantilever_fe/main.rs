@@ -3,7 +3,7 @@
 //! 9-node quadrilaterals, total Lagrangian, Newton with the exact tangent (fe.rs).
 //!
 //!   cargo run --release --example cantilever_fe -- [NX NY] [--strip W] [--steps N]
-//!       [--force P] [--depth D]
+//!       [--force P] [--depth D] [--csv]
 //!
 //! NX × NY elements (default 40 × 4). Load: a dead vertical force P (default 100 kN)
 //! in N equal steps (default 50), as a uniform traction on the end section, or with
@@ -11,7 +11,8 @@
 //! loaded particle column: W = h/ppc, 1/12 m at 4 cells through the depth and 3 ppc).
 //! Prints, at each load level, the load-weighted mean tip deflection v (down) and
 //! axial displacement u (towards the clamp), the mid-line tip node's, and the
-//! classical and Reissner elastica of the load's arm a (L, or L − W/2).
+//! classical and Reissner elastica of the load's arm a (L, or L − W/2). `--csv`
+//! prints only the load levels as CSV (papers/cantilever_elastica/elastica.py reads it).
 
 #[path = "fe.rs"]
 mod fe;
@@ -23,8 +24,13 @@ fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let mut positional = Vec::new();
     let (mut strip, mut steps, mut force, mut depth) = (None, 50usize, 100.0e3, 1.0);
+    let mut csv = false;
     let mut it = args.iter();
     while let Some(a) = it.next() {
+        if a == "--csv" {
+            csv = true;
+            continue;
+        }
         let mut value = |name: &str| -> f64 {
             it.next()
                 .and_then(|v| v.parse().ok())
@@ -68,6 +74,17 @@ fn main() {
     let arm = load.arm(beam.length);
 
     let model = Cantilever::new(&beam, nx, ny, load);
+    if csv {
+        let levels = model.solve(force, steps).unwrap_or_else(|e| fail(&e));
+        println!("force,v,u,v_mid,u_mid,iterations");
+        for l in &levels {
+            println!(
+                "{:e},{:e},{:e},{:e},{:e},{}",
+                l.force, l.v, l.u, l.v_mid, l.u_mid, l.iterations
+            );
+        }
+        return;
+    }
     println!(
         "FE cantilever: {nx} x {ny} Q9 elements, {} free dofs, load {load:?}, arm a = {arm:.6} m, \
          P = {force:.4e} N in {steps} steps",

@@ -10,10 +10,14 @@ Standard library only. Usage:
     python3 elastica.py small [SHAPE ...]  # mpm at P = 100 N against the linear beam
     python3 elastica.py slender [SHAPE ...] # L/d = 20 (d = 0.5 m) at the same k = 9.6
     python3 elastica.py support [SHAPE ...] # full load against solver.min_node_support
+    python3 elastica.py fe                 # finite-element reference: mesh convergence
+    python3 elastica.py fe-mpm [SHAPE ...] # mpm against the finite-element reference
 
 The mpm binary is taken from $MPM, else ../../target/release/mpm relative to
 this folder, else $CARGO_TARGET_DIR/release/mpm. Runs go to $OUT (default a
-temporary directory).
+temporary directory). The finite-element reference (examples/cantilever_fe,
+`cargo build --release --example cantilever_fe`) is taken from $FE, else
+target/release/examples/cantilever_fe under $CARGO_TARGET_DIR or ../../target.
 
 Reference: a vertical dead load P at the tip of a cantilever of length L,
     EI theta''(s) = -P cos(theta),  theta(0) = 0,  theta'(L) = 0,
@@ -34,6 +38,7 @@ import os
 import subprocess
 import sys
 import tempfile
+import time
 
 # Published elastica values (Mattiasson 1981), k: (v/L, u/L).
 MATTIASSON = {1: (0.30172, 0.05643), 2: (0.49346, 0.16064),
@@ -291,6 +296,121 @@ def cmd_small(shapes):
             sys.stdout.flush()
 
 
+def find_fe():
+    here = os.path.dirname(os.path.abspath(__file__))
+    candidates = [os.environ.get("FE", "")]
+    if os.environ.get("CARGO_TARGET_DIR"):
+        candidates.append(os.path.join(os.environ["CARGO_TARGET_DIR"], "release", "examples",
+                                       "cantilever_fe"))
+    candidates.append(os.path.join(here, "..", "..", "target", "release", "examples",
+                                   "cantilever_fe"))
+    for c in candidates:
+        if c and os.path.exists(c):
+            return c
+    sys.exit("cantilever_fe not found: set FE or CARGO_TARGET_DIR "
+             "(cargo build --release --example cantilever_fe)")
+
+
+def run_fe(nx, ny, strip=None, depth=DEPTH, force=P_END, steps=50):
+    """The FE reference on nx x ny Q9 elements; returns ({P: (v, u)}, wall seconds).
+    strip=None: traction on the end section, else a body force on X >= L - strip."""
+    args = [find_fe(), str(nx), str(ny), "--csv", "--depth", repr(depth),
+            "--force", repr(force), "--steps", str(steps)]
+    if strip is not None:
+        args += ["--strip", repr(strip)]
+    start = time.time()
+    proc = subprocess.run(args, capture_output=True, text=True)
+    if proc.returncode != 0:
+        sys.exit(f"cantilever_fe {' '.join(args[1:])}: {proc.stderr.strip()}")
+    lines = proc.stdout.split()
+    header = lines[0].split(",")
+    levels = {}
+    for line in lines[1:]:
+        r = dict(zip(header, map(float, line.split(","))))
+        levels[round(r["force"], 6)] = (r["v"], r["u"])
+    return levels, time.time() - start
+
+
+def fe_errors(v, u, a, p, depth=DEPTH):
+    """(v, u) against the classical elastica with E/(1-nu^2), with E (Mattiasson's
+    k = PL^2/EI at E I), and Reissner's beam, all for the arm a: percentages."""
+    ei = EI_PLANE_STRAIN * (depth / DEPTH) ** 3
+    out = []
+    for k, a_e, a_s in [(p * a * a / ei, 0.0, 0.0),
+                        (p * a * a / (EI_PLANE_STRESS * (depth / DEPTH) ** 3), 0.0, 0.0),
+                        (p * a * a / ei, p / (E / (1.0 - NU * NU) * depth), p / (KAPPA * G * depth))]:
+        vr, ur, _ = elastica(k, a_e, a_s)
+        out += [100 * (v / (vr * a) - 1), 100 * (u / (ur * a) - 1)]
+    return out
+
+
+def cmd_fe():
+    """FE mesh convergence at full load: traction on the end section, and the body
+    force on the strip of the MPM's loaded particle column (4 cells/depth, 3 ppc)."""
+    meshes = [(10, 1), (20, 2), (40, 4), (80, 8), (160, 16)]
+    print("| load | elements | v (m) | u (m) | v/a | u/a | v, u vs finest | "
+          "vs elastica E/(1-ν²) (v, u) | vs elastica E (v, u) | vs Reissner (v, u) | wall (s) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    for label, strip in [("end section", None), ("strip h/3, h = d/4", DEPTH / 12.0)]:
+        a = L if strip is None else L - 0.5 * strip
+        rows = []
+        for nx, ny in meshes:
+            levels, wall = run_fe(nx, ny, strip)
+            rows.append((nx, ny, *levels[round(P_END, 6)], wall))
+        v_f, u_f = rows[-1][2], rows[-1][3]
+        for nx, ny, v, u, wall in rows:
+            e = fe_errors(v, u, a, P_END)
+            print(f"| {label} | {nx} x {ny} | {v:.6f} | {u:.6f} | {v / a:.6f} | {u / a:.6f} | "
+                  f"{100 * (v / v_f - 1):+.4f} %, {100 * (u / u_f - 1):+.4f} % | "
+                  f"{e[0]:+.3f} %, {e[1]:+.3f} % | {e[2]:+.3f} %, {e[3]:+.3f} % | "
+                  f"{e[4]:+.3f} %, {e[5]:+.3f} % | {wall:.2f} |")
+            sys.stdout.flush()
+
+
+FE_MESH = (80, 8)   # 0.01 % from 160 x 16 (python3 elastica.py fe)
+
+
+def cmd_fe_mpm(shapes):
+    """mpm against the FE reference of the same continuum and load (the strip of
+    the loaded particle column, width h/ppc): load path at 4 x 3, full load at
+    several resolutions, and the slender beam."""
+    shapes = shapes or ["bspline2", "ugimp", "cpdi"]
+    out_root = os.environ.get("OUT") or tempfile.mkdtemp(prefix="cantilever_fe_")
+    print("| shape | L/d | cells/depth | ppc | P (kN) | FE v/a | mpm v/a | mpm vs FE, v | "
+          "FE u/a | mpm u/a | mpm vs FE, u | FE vs elastica (v, u) | mpm wall (s) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    cases = [(4, 3, p, DEPTH) for p in [10e3, 20e3, 40e3, 60e3, 80e3]]
+    cases += [(c, ppc, P_END, DEPTH) for c, ppc in [(4, 2), (4, 3), (4, 4), (8, 2), (8, 3)]]
+    cases += [(4, ppc, P_END / 8.0, 0.5) for ppc in [2, 3]]
+    fe_cache = {}
+    for shape in shapes:
+        for cells, ppc, p, depth in cases:
+            h = depth / cells
+            strip = h / ppc
+            a = L - 0.5 * strip
+            force = P_END * (depth / DEPTH) ** 3
+            nx, ny = FE_MESH if depth == DEPTH else (2 * FE_MESH[0], FE_MESH[1])
+            key = (strip, depth)
+            if key not in fe_cache:
+                fe_cache[key] = run_fe(nx, ny, strip, depth, force)[0]
+            v_fe, u_fe = fe_cache[key][round(p, 6)]
+            steps = max(1, round(50 * p / force))
+            out = os.path.join(out_root, f"{shape}_{cells}_{ppc}_{p / 1e3:.1f}_{depth}")
+            os.makedirs(out, exist_ok=True)
+            status, wall, v, u, msg = run_mpm(shape, cells, ppc, p, steps, out, depth)
+            e = fe_errors(v_fe, u_fe, a, p, depth)
+            head = (f"| {shape} | {L / depth:.0f} | {cells} | {ppc} | {p / 1e3:.1f} | "
+                    f"{v_fe / a:.5f} |")
+            tail = f"{e[0]:+.2f} %, {e[1]:+.2f} % | {wall:.2f} |"
+            if status != "completed":
+                print(f"{head} {status} | | {u_fe / a:.5f} | | | {tail}")
+                print(f"<!-- {msg.splitlines()[-1] if msg else ''} -->")
+            else:
+                print(f"{head} {v / a:.5f} | {100 * (v / v_fe - 1):+.2f} % | {u_fe / a:.5f} | "
+                      f"{u / a:.5f} | {100 * (u / u_fe - 1):+.2f} % | {tail}")
+            sys.stdout.flush()
+
+
 if __name__ == "__main__":
     cmd = sys.argv[1] if len(sys.argv) > 1 else "table"
     if cmd == "table":
@@ -307,5 +427,9 @@ if __name__ == "__main__":
         cmd_slender(sys.argv[2:])
     elif cmd == "support":
         cmd_support(sys.argv[2:])
+    elif cmd == "fe":
+        cmd_fe()
+    elif cmd == "fe-mpm":
+        cmd_fe_mpm(sys.argv[2:])
     else:
         sys.exit(__doc__)
