@@ -13,6 +13,8 @@
 //! axial displacement u (towards the clamp), the mid-line tip node's, and the
 //! classical and Reissner elastica of the load's arm a (L, or L − W/2). `--csv`
 //! prints only the load levels as CSV (papers/cantilever_elastica/elastica.py reads it).
+//! With the environment variable FE_DEBUG set, each Newton iteration's ‖r‖ and ‖Δu‖
+//! go to stderr.
 
 #[path = "fe.rs"]
 mod fe;
