@@ -437,7 +437,7 @@ fn fe_tangent_matches_finite_differences() {
 }
 
 /// The FE reference is mesh-converged: 20 × 2 and 40 × 4 Q9 elements agree to
-/// 0.1 % at full load (measured −0.05 % v, −0.06 % u; the converged value,
+/// 0.1 % at full load (measured −0.04 % v, −0.06 % u; the converged value,
 /// 160 × 16, differs from 40 × 4 by 0.01 %: papers/cantilever_elastica/), and its
 /// gap to the classical elastica is the (d/L)² continuum effect the MPM shows.
 #[test]
