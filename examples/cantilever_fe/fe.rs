@@ -155,7 +155,7 @@ fn increment(f: &Mat3) -> Increment<'static> {
 }
 
 /// First Piola–Kirchhoff stress P = J σ F⁻ᵀ and, if asked, A_iJkL = ∂P_iJ/∂F_kL
-/// (in-plane indices, flattened 2 (2i + J) ... as a[2i + J][2k + L]).
+/// (in-plane indices, stored as a[2i + J][2k + L]).
 fn piola(mat: &Hencky, f: &Mat3, tangent: bool) -> (Mat3, Option<[[f64; 4]; 4]>) {
     let inc = increment(f);
     let sigma = mat.update(&inc, &mut []);
