@@ -233,7 +233,12 @@ fn small_load_clamp_and_plane_strain_stiffness() {
 }
 
 /// Full load (k = 9.6), 50 load steps: the tip of the loaded column against the
-/// elastica. Required (issue): within 2 %. The 2D continuum with L/d = 10 is not
+/// elastica. Required (issue): within 2 %. Against the elastica as the reference
+/// item tabulates it (Mattiasson 1981, k = P L²/(E I) with E = 12 MPa, so k = 10 at
+/// the tip) it is asserted within 2 % in v and u (measured v +1.94 / +1.75 / +1.75 %,
+/// u +0.19 / −0.05 / −0.17 %); that agreement is partly an offset of two effects
+/// (plane strain stiffens the bending by 1/(1 − ν²), shear and extension soften it),
+/// hence the checks that follow. The 2D continuum with L/d = 10 is not
 /// the inextensible, shear-rigid classical elastica: it is asserted within 2 % of
 /// Reissner's beam (the elastica with extension and shear, the beam model of a 2D
 /// continuum) and within 3 % of the classical elastica. The slender beam below
@@ -289,6 +294,24 @@ fn full_load_tip_matches_the_elastica() {
                 100.0 * ev_r,
                 100.0 * eu_r,
                 100.0 * ev_c
+            ));
+        }
+        // The reference item's elastica as tabulated (Mattiasson 1981): k = P a² / (E I)
+        // with E = 12 MPa as given (k = 10 at the tip), i.e. without the plane-strain
+        // factor 1/(1 − ν²) that stiffens the 2D continuum by 4 %.
+        let k_e = P_END * a * a / (E * DEPTH.powi(3) / 12.0);
+        let (v_e, u_e, _) = elastica(k_e, 0.0, 0.0);
+        let (ev_e, eu_e) = (v / (v_e * a) - 1.0, u / (u_e * a) - 1.0);
+        println!(
+            "          against the tabulated elastica with E I (k = {k_e:.3}): v {:+.2} %, u {:+.2} %",
+            100.0 * ev_e,
+            100.0 * eu_e
+        );
+        if ev_e.abs() > 0.02 || eu_e.abs() > 0.02 {
+            failures.push(format!(
+                "{shape}: v {:+.2} %, u {:+.2} % against the tabulated elastica (k with E I)",
+                100.0 * ev_e,
+                100.0 * eu_e
             ));
         }
         let (ev_fe, eu_fe) = (v / v_fe - 1.0, u / u_fe - 1.0);
