@@ -259,7 +259,10 @@ fn run_dim<const D: usize>(
     let mut summary = json!({});
     let (mut newton_total, mut cutbacks_total, mut krylov_total) = (0u64, 0u64, 0u64);
     for (k, sc) in stages.iter().enumerate() {
-        if let Some(f) = sc.strength_reduction_factor.filter(|&f| f != strength_factor) {
+        if let Some(f) = sc
+            .strength_reduction_factor
+            .filter(|&f| f != strength_factor)
+        {
             model.reduce_strength(&cfg.materials, f);
             strength_factor = f;
         }
