@@ -95,6 +95,26 @@ pub fn node_constraint<const D: usize>(
     c
 }
 
+/// The constraint of node `node` in an implicit step: the face conditions, and
+/// every friction face held fixed (no slip: a rough rigid base at rest); on a
+/// corner shared with a face condition its prescribed components win.
+pub fn implicit_node_constraint<const D: usize>(
+    grid: &Grid<D>,
+    faces: &[FaceCondition<D>],
+    friction: &[FrictionFace],
+    node: usize,
+) -> Constraint<D> {
+    let mut c = node_constraint(grid, faces, node);
+    if !node_friction(grid, friction, node).is_empty() {
+        for d in 0..D {
+            if !c.fixed[d] {
+                c.set(d, 0.0);
+            }
+        }
+    }
+    c
+}
+
 /// A rigid face with Coulomb friction (a rough base): a node on the face may
 /// separate from it, but not move into it, and slides along it only against a
 /// friction impulse of at most μ times the normal impulse (rigid-wall contact in

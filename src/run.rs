@@ -180,8 +180,11 @@ fn run_dim<const D: usize>(
 ) -> Result<RunSummary, RunError> {
     let cfg = &scene.config;
     let mut model = Model::<D>::build(scene)?;
-    if let Some(factor) = opts.strength_factor {
-        model.reduce_strength(factor);
+    // A search trial's factor holds for the whole run; otherwise each stage may
+    // set its own (validation keeps the two apart).
+    let mut strength_factor = opts.strength_factor.unwrap_or(1.0);
+    if strength_factor != 1.0 {
+        model.reduce_strength(&cfg.materials, strength_factor);
     }
     if cfg.geostatic.is_some() {
         crate::geostatic::initialise(&mut model, cfg);
@@ -256,6 +259,13 @@ fn run_dim<const D: usize>(
     let mut summary = json!({});
     let (mut newton_total, mut cutbacks_total, mut krylov_total) = (0u64, 0u64, 0u64);
     for (k, sc) in stages.iter().enumerate() {
+        if let Some(f) = sc
+            .strength_reduction_factor
+            .filter(|&f| f != strength_factor)
+        {
+            model.reduce_strength(&cfg.materials, f);
+            strength_factor = f;
+        }
         let mut stepper = Stepper::<D>::new(cfg.grid.shape_function, sc, t);
         let (stage_start, stage_end) = (t, t + sc.end_time);
         let (stage_clock, steps_before) = (Instant::now(), step);
@@ -294,6 +304,9 @@ fn run_dim<const D: usize>(
             "active_nodes_last_step": stepper.active_nodes(),
         });
         stepper.describe(sc, &mut stage);
+        if sc.strength_reduction_factor.is_some() {
+            stage["strength_reduction_factor"] = json!(strength_factor);
+        }
         newton_total += stage["newton_iterations"].as_u64().unwrap_or(0);
         cutbacks_total += stage["cutbacks"].as_u64().unwrap_or(0);
         krylov_total += stage["krylov_iterations"].as_u64().unwrap_or(0);

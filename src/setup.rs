@@ -25,7 +25,7 @@ pub struct Model<const D: usize> {
     pub particles: Particles<D>,
     pub materials: Vec<Box<dyn Material>>,
     pub faces: Vec<FaceCondition<D>>,
-    /// Rigid rough faces (Coulomb friction; explicit solver).
+    /// Rigid rough faces (Coulomb friction; held fixed in implicit steps).
     pub friction: Vec<FrictionFace>,
     /// The velocity condition with a `footing_width`, if any.
     pub footing: Option<Footing<D>>,
@@ -180,14 +180,18 @@ impl<const D: usize> Model<D> {
         self.load_ramps.iter().map(|r| r.factor(t)).collect()
     }
 
-    /// Replace every material that has a frictional strength by the same material
-    /// with c/F, tan φ/F, tan ψ/F (strength reduction).
-    pub fn reduce_strength(&mut self, factor: f64) {
-        for m in &mut self.materials {
-            if let Some(reduced) = m.with_reduced_strength(factor) {
-                *m = reduced;
-            }
-        }
+    /// Set every material to the scene's one with c/F, tan φ/F, tan ψ/F when it
+    /// has a frictional strength (strength reduction; F = 1: as given). Not
+    /// cumulative: each call starts from the scene's values. The particles keep
+    /// their stresses; the next stress update returns them to the new surface.
+    pub fn reduce_strength(&mut self, scene: &[MaterialConfig], factor: f64) {
+        self.materials = scene
+            .iter()
+            .map(|c| {
+                let m = material(c);
+                m.with_reduced_strength(factor).unwrap_or(m)
+            })
+            .collect();
     }
 
     /// Equivalent plastic strain of every particle (0 where the material has

@@ -457,7 +457,7 @@ fn friction_coefficient_only_on_friction_faces() {
 }
 
 #[test]
-fn friction_face_is_rejected_by_the_implicit_solver() {
+fn friction_face_is_accepted_by_the_implicit_solver() {
     let text = GOOD
         .replace(
             "[solver]",
@@ -467,9 +467,83 @@ fn friction_face_is_rejected_by_the_implicit_solver() {
             "kind = \"explicit\"\nend_time = 1.0\ncfl = 0.5",
             "kind = \"implicit\"\nend_time = 1.0\ndt = 0.1",
         );
+    // Held fixed in implicit steps (docs/scene.md, friction faces).
+    Scene::parse("scene.toml", &text, &[]).unwrap();
+}
+
+/// GEO as two stages: implicit gravity, then explicit with `factor` (a line of
+/// TOML for the second stage, e.g. "strength_reduction_factor = 2.0").
+fn staged_geo(factor: &str) -> String {
+    GEO.replace(
+        "[solver]\nkind = \"explicit\"\nend_time = 1.0\n",
+        &format!(
+            "[[stage]]\nkind = \"implicit\"\nintegrator = \"quasi_static\"\nend_time = 1.0\nload_steps = 1\n\n\
+             [[stage]]\nkind = \"explicit\"\nend_time = 1.0\n{factor}\n"
+        ),
+    )
+}
+
+#[test]
+fn stage_strength_reduction_factor_is_checked() {
+    let s = Scene::parse(
+        "scene.toml",
+        &staged_geo("strength_reduction_factor = 2.0"),
+        &[],
+    );
+    assert_eq!(
+        s.unwrap().config.stages[1].strength_reduction_factor,
+        Some(2.0)
+    );
+    for bad in ["0.0", "-1.5", "nan"] {
+        let e = err(&staged_geo(&format!("strength_reduction_factor = {bad}")));
+        assert!(
+            e.contains("scene.toml:48:29")
+                && e.contains("stage.1.strength_reduction_factor")
+                && e.contains("positive number"),
+            "{bad}: {e}"
+        );
+    }
+    let e = err(&staged_geo("strength_reduction_factor = \"2\""));
+    assert!(
+        e.contains("scene.toml:48:29") && e.contains("expected f64"),
+        "{e}"
+    );
+    // Overrides are checked like the file.
+    let e = Scene::parse(
+        "scene.toml",
+        &staged_geo(""),
+        &["stage.0.strength_reduction_factor=-2".into()],
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("stage.0.strength_reduction_factor"), "{e}");
+}
+
+#[test]
+fn stage_strength_reduction_factor_in_the_wrong_place() {
+    // Nothing to reduce: only elastic materials.
+    let text = GOOD.replace("cfl = 0.5", "cfl = 0.5\nstrength_reduction_factor = 2.0");
     let e = err(&text);
     assert!(
-        e.contains("boundary.0.condition") && e.contains("explicit solver only"),
+        e.contains("scene.toml:25:29") && e.contains("nothing to reduce"),
+        "{e}"
+    );
+    // A material key it is not.
+    let e = err(&GEO.replace(
+        "tensile_strength = 1.0e3",
+        "tensile_strength = 1.0e3\nstrength_reduction_factor = 2.0",
+    ));
+    assert!(
+        e.contains("scene.toml:22:1") && e.contains("unknown field `strength_reduction_factor`"),
+        "{e}"
+    );
+    // With a [strength_reduction] search, whose trial factor holds in every stage.
+    let search = "strength_reduction_factor = 2.0\n\n[strength_reduction]\nsearch = [1.0, 2.0]";
+    let e = err(&staged_geo(search));
+    assert!(
+        e.contains("scene.toml:48:29")
+            && e.contains("stage.1.strength_reduction_factor")
+            && e.contains("[strength_reduction] search"),
         "{e}"
     );
 }

@@ -10,7 +10,7 @@ pub mod child;
 pub mod configurations;
 mod plots;
 
-use crate::boundary::node_constraint;
+use crate::boundary::implicit_node_constraint;
 use crate::explicit::Explicit;
 use crate::implicit::tangent::Dofs;
 use crate::output::{csv_field, Table};
@@ -617,7 +617,7 @@ fn unknowns_dim<const D: usize>(
         let fixed = map
             .active
             .iter()
-            .map(|&g| node_constraint(&m.grid, &m.faces, g as usize).fixed);
+            .map(|&g| implicit_node_constraint(&m.grid, &m.faces, &m.friction, g as usize).fixed);
         Dofs::new(fixed).free
     } else {
         D * map.len()

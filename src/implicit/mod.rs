@@ -17,7 +17,7 @@ pub mod support;
 pub mod tangent;
 
 use crate::absorbing::AbsorbingStep;
-use crate::boundary::{node_constraint, Constraint};
+use crate::boundary::{implicit_node_constraint, Constraint};
 use crate::deformation::Trial;
 use crate::dim::Vector;
 use crate::explicit::{check_state, Divergence};
@@ -489,7 +489,7 @@ impl<const D: usize> Implicit<D> {
             .active
             .par_iter()
             .with_min_len(MIN_PARALLEL_LEN)
-            .map(|&g| node_constraint(&m.grid, &m.faces, g as usize))
+            .map(|&g| implicit_node_constraint(&m.grid, &m.faces, &m.friction, g as usize))
             .collect();
         let support = nodal_support(map, st, &p.volume, m.grid.cell_volume());
         let ties = ties(&m.grid, map, &support, &constraint, self.min_node_support);

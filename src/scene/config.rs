@@ -198,7 +198,7 @@ pub enum Condition {
     /// with springs in parallel (`spring_distance` or `spring_stiffness`).
     Absorbing,
     /// Rigid rough wall: no penetration, Coulomb friction with
-    /// `friction_coefficient` (explicit solver).
+    /// `friction_coefficient` (explicit solver; fixed in implicit steps).
     Friction,
 }
 
@@ -388,6 +388,10 @@ impl PreconditionerKind {
 pub struct SolverConfig {
     /// Stage name (for `[[stage]]` tables; optional).
     pub name: Option<String>,
+    /// From this stage on, c, tan φ and tan ψ of the frictional materials are the
+    /// scene's values divided by this factor (default: the previous stage's, 1 at
+    /// the start). docs/strength_reduction.md.
+    pub strength_reduction_factor: Option<f64>,
     pub kind: SolverKind,
     /// Duration of the run or stage (implicit quasi-static: the pseudo-time over
     /// which the loads rise to full value).

@@ -85,12 +85,15 @@ pub fn validate(s: &SceneConfig) -> Check {
         load(l, i, s)?;
     }
     needs_krylov(s)?;
-    friction_only_explicit(s)?;
     match (&s.solver, s.stages.is_empty()) {
-        (Some(solver_config), true) => solver(solver_config, "solver")?,
+        (Some(solver_config), true) => {
+            solver(solver_config, "solver")?;
+            stage_strength_factor(solver_config, "solver", s)?;
+        }
         (None, false) => {
             for (k, st) in s.stages.iter().enumerate() {
                 solver(st, &format!("stage.{k}"))?;
+                stage_strength_factor(st, &format!("stage.{k}"), s)?;
             }
         }
         (Some(_), false) => {
@@ -805,25 +808,38 @@ fn load(l: &LoadConfig, i: usize, s: &SceneConfig) -> Check {
     }
 }
 
-/// Friction faces act in the explicit solver only: an implicit solver or stage
-/// next to one is an error at the first friction face.
-fn friction_only_explicit(s: &SceneConfig) -> Check {
-    let Some(i) = s
-        .boundaries
-        .iter()
-        .position(|b| b.condition == Condition::Friction)
-    else {
+/// Whether the scene has a material whose strength a factor divides.
+fn has_frictional_material(s: &SceneConfig) -> bool {
+    s.materials.iter().any(|m| {
+        matches!(
+            m.model,
+            MaterialModel::DruckerPrager | MaterialModel::MohrCoulomb
+        )
+    })
+}
+
+/// A stage's `strength_reduction_factor`: F > 0, something to reduce, and no
+/// `[strength_reduction]` search (whose trial factor holds for every stage).
+fn stage_strength_factor(st: &SolverConfig, prefix: &str, s: &SceneConfig) -> Check {
+    let Some(f) = st.strength_reduction_factor else {
         return Ok(());
     };
-    let implicit = s
-        .solver
-        .iter()
-        .chain(&s.stages)
-        .any(|st| st.kind == SolverKind::Implicit);
+    let key = format!("{prefix}.strength_reduction_factor");
     ensure(
-        !implicit,
-        format!("boundary.{i}.condition"),
-        "friction faces act in the explicit solver only; an implicit solver or stage needs a fixed or roller face here",
+        f > 0.0 && f.is_finite(),
+        key.clone(),
+        format!("must be a positive number (c and tan φ are divided by it); got {f}"),
+    )?;
+    ensure(
+        has_frictional_material(s),
+        key.clone(),
+        "needs a drucker_prager or mohr_coulomb material (nothing to reduce)",
+    )?;
+    ensure(
+        s.strength_reduction.is_none(),
+        key,
+        "cannot be combined with a [strength_reduction] search: each trial divides the \
+         strengths by its own factor in every stage; remove one of the two",
     )
 }
 
@@ -1099,12 +1115,7 @@ fn strength_reduction(r: &StrengthReductionConfig, s: &SceneConfig) -> Check {
         )?;
     }
     ensure(
-        s.materials.iter().any(|m| {
-            matches!(
-                m.model,
-                MaterialModel::DruckerPrager | MaterialModel::MohrCoulomb
-            )
-        }),
+        has_frictional_material(s),
         p,
         "needs a drucker_prager or mohr_coulomb material (nothing to reduce)",
     )?;
