@@ -245,3 +245,160 @@ pub fn tangent_triplets<const D: usize>(
     triplets.extend(per_cell.into_iter().flatten());
     triplets
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::deformation::Trial;
+    use crate::dim::{Mat3, Tensor, Vector};
+    use crate::scene::Scene;
+    use crate::setup::Model;
+    use crate::shape::Stencils;
+    use crate::transfer::NodeMap;
+
+    /// A Hencky block whose edges cut the cells anywhere, 4 × 4 particles per cell.
+    const BLOCK: &str = r#"dimension = 2
+[grid]
+min = [0.0, 0.0]
+max = [4.0, 4.0]
+cells = [12, 12]
+[[material]]
+name = "m"
+model = "hencky"
+density = 1000.0
+youngs_modulus = 1.0e5
+poisson_ratio = 0.45
+[[body]]
+material = "m"
+shape = "rectangle"
+min = [0.31, 0.27]
+max = [3.73, 3.58]
+particles_per_cell = 4
+[solver]
+kind = "implicit"
+integrator = "quasi_static"
+end_time = 1.0
+load_steps = 1
+"#;
+
+    /// Trial states without and with F-bar under nodal displacements u(x).
+    fn trials(shape: &str, u: impl Fn(&Vector<2>) -> Vector<2>) -> (Trial, Trial) {
+        let overrides = vec![format!("grid.shape_function={shape}")];
+        let scene = Scene::parse("block.toml", BLOCK, &overrides).unwrap();
+        let m = Model::<2>::build(&scene).unwrap();
+        let p = &m.particles;
+        let mut st = Stencils::default();
+        st.compute(
+            scene.config.grid.shape_function,
+            &m.grid,
+            &p.x,
+            &p.half_length0,
+            &p.f,
+        );
+        let mut map = NodeMap::default();
+        map.build(&st, m.grid.node_count());
+        let nodal: Vec<Vector<2>> = map
+            .active
+            .iter()
+            .map(|&g| u(&m.grid.node_position(m.grid.node_ijk(g as usize))))
+            .collect();
+        let (mut plain, mut fbar) = (Trial::default(), Trial::default());
+        assert!(plain
+            .evaluate(p, &m.materials, &st, &map, &nodal, 1.0)
+            .is_none());
+        fbar.use_fbar(&m.grid, &p.x);
+        assert!(fbar
+            .evaluate(p, &m.materials, &st, &map, &nodal, 1.0)
+            .is_none());
+        (plain, fbar)
+    }
+
+    fn max_difference(a: &[Mat3], b: &[Mat3]) -> f64 {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| (x - y).amax())
+            .fold(0.0, f64::max)
+    }
+
+    /// Under a homogeneous deformation every particle has ΔJ_p = ΔJ̄_c, so F-bar
+    /// changes nothing: ΔF, σ and V agree with the plain update to round-off, for
+    /// every shape function that reproduces linear fields.
+    #[test]
+    fn homogeneous_deformation_is_unchanged() {
+        let a = Tensor::<2>::new(0.03, -0.02, 0.015, -0.04);
+        for shape in ["linear", "ugimp", "cpdi", "bspline2", "bspline3"] {
+            let (plain, fbar) = trials(shape, |x| a * x + Vector::<2>::new(0.1, -0.2));
+            let ddf = max_difference(&plain.df, &fbar.df);
+            let scale = plain.stress.iter().map(|s| s.amax()).fold(0.0, f64::max);
+            let dstress = max_difference(&plain.stress, &fbar.stress) / scale;
+            let dvolume = plain
+                .volume
+                .iter()
+                .zip(&fbar.volume)
+                .map(|(x, y)| ((x - y) / x).abs())
+                .fold(0.0, f64::max);
+            println!("{shape}: |ΔF̄ − ΔF| = {ddf:.1e}, |σ̄ − σ|/|σ| = {dstress:.1e}, |V̄ − V|/V = {dvolume:.1e}");
+            assert!(
+                ddf < 1e-14 && dstress < 1e-12 && dvolume < 1e-14,
+                "{shape}"
+            );
+        }
+    }
+
+    /// Under a non-homogeneous deformation every particle of a cell takes the
+    /// cell's volume-weighted mean dilatation (det ΔF̄_p = ΔJ̄_c), the deviatoric
+    /// part of ΔF_p is kept (ΔF̄_p ∝ ΔF_p), and the result is bit-identical for 1
+    /// and 2 threads.
+    #[test]
+    fn each_cell_takes_its_mean_dilatation_on_any_number_of_threads() {
+        let u = |x: &Vector<2>| {
+            Vector::<2>::new(
+                0.02 * (1.3 * x[1]).sin() + 0.01 * x[0] * x[0],
+                -0.03 * x[0] * x[1],
+            )
+        };
+        for shape in ["linear", "bspline2"] {
+            let (plain, fbar) = trials(shape, u);
+            let state = fbar.fbar.as_ref().unwrap();
+            let cells = &state.cells;
+            let mut worst_j: f64 = 0.0;
+            let mut worst_shape: f64 = 0.0;
+            let mut spread: f64 = 0.0;
+            for c in 0..cells.len() {
+                let members = cells.members(c);
+                let (mut v, mut vj) = (0.0, 0.0);
+                for &q in members {
+                    let q = q as usize;
+                    v += fbar.volume[q] / fbar.df[q].determinant();
+                    vj += fbar.volume[q] / fbar.df[q].determinant() * plain.df[q].determinant();
+                }
+                for &q in members {
+                    let q = q as usize;
+                    worst_j = worst_j.max((fbar.df[q].determinant() - vj / v).abs());
+                    let beta = fbar.df[q][(0, 0)] / plain.df[q][(0, 0)];
+                    let mut expected = plain.df[q] * beta;
+                    expected[(2, 2)] = 1.0;
+                    worst_shape = worst_shape.max((fbar.df[q] - expected).amax());
+                    spread = spread.max((plain.df[q].determinant() - vj / v).abs());
+                }
+            }
+            println!(
+                "{shape}: {} cells; |det ΔF̄ − ΔJ̄| = {worst_j:.1e} (spread of det ΔF in the cells {spread:.1e}), \
+                 |ΔF̄ − βΔF| = {worst_shape:.1e}",
+                cells.len()
+            );
+            assert!(spread > 1e-4, "{shape}: the field varies within the cells");
+            assert!(worst_j < 1e-14 && worst_shape < 1e-14, "{shape}");
+            let on = |threads: usize| {
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap()
+                    .install(|| trials(shape, u).1)
+            };
+            let (one, two) = (on(1), on(2));
+            assert!(one.df.len() > 1024, "enough particles to run in parallel");
+            assert_eq!(one.df, two.df, "{shape}: ΔF̄ differs between 1 and 2 threads");
+            assert_eq!(one.stress, two.stress);
+        }
+    }
+}
