@@ -337,10 +337,7 @@ load_steps = 1
                 .map(|(x, y)| ((x - y) / x).abs())
                 .fold(0.0, f64::max);
             println!("{shape}: |ΔF̄ − ΔF| = {ddf:.1e}, |σ̄ − σ|/|σ| = {dstress:.1e}, |V̄ − V|/V = {dvolume:.1e}");
-            assert!(
-                ddf < 1e-14 && dstress < 1e-12 && dvolume < 1e-14,
-                "{shape}"
-            );
+            assert!(ddf < 1e-14 && dstress < 1e-12 && dvolume < 1e-14, "{shape}");
         }
     }
 
@@ -397,7 +394,10 @@ load_steps = 1
             };
             let (one, two) = (on(1), on(2));
             assert!(one.df.len() > 1024, "enough particles to run in parallel");
-            assert_eq!(one.df, two.df, "{shape}: ΔF̄ differs between 1 and 2 threads");
+            assert_eq!(
+                one.df, two.df,
+                "{shape}: ΔF̄ differs between 1 and 2 threads"
+            );
             assert_eq!(one.stress, two.stress);
         }
     }

@@ -105,12 +105,7 @@ fn tresca_footing_reaches_prandtl() {
 #[test]
 fn tresca_footing_with_linear_shapes_locks_and_fbar_cures_it() {
     let linear = |cells: &'static str, fbar: &'static str| {
-        [
-            "grid.shape_function=linear",
-            cells,
-            fbar,
-            "output.frames=0",
-        ]
+        ["grid.shape_function=linear", cells, fbar, "output.frames=0"]
     };
     let coarse = footing(
         "footing_tresca.toml",
@@ -136,10 +131,18 @@ fn tresca_footing_with_linear_shapes_locks_and_fbar_cures_it() {
         .unwrap();
     let locked = nc / prandtl_nc(0.0) - 1.0;
     let rate = (coarse / fine).log2();
-    eprintln!("F-bar N_c errors {coarse:.4}, {fine:.4} (rate {rate:.2}); without F-bar {locked:.4}");
+    eprintln!(
+        "F-bar N_c errors {coarse:.4}, {fine:.4} (rate {rate:.2}); without F-bar {locked:.4}"
+    );
     assert!(rate > 0.9, "F-bar error falls with h at rate {rate:.2}");
-    assert!(locked > 0.3, "bilinear MPM locks without F-bar: +{locked:.3}");
-    assert!(fine < 0.2 * locked, "F-bar: {fine:.3} against {locked:.3} locked");
+    assert!(
+        locked > 0.3,
+        "bilinear MPM locks without F-bar: +{locked:.3}"
+    );
+    assert!(
+        fine < 0.2 * locked,
+        "F-bar: {fine:.3} against {locked:.3} locked"
+    );
 }
 
 /// φ = 20°, associated flow, with line search (as shipped). On the plateau each
