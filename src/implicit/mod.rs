@@ -853,9 +853,18 @@ dt = 0.01
         } else {
             BLOCK.to_string()
         };
-        let scene = Scene::parse("block.toml", &text, overrides).unwrap();
-        let m = Model::<2>::build(&scene).unwrap();
-        let mut solver = Implicit::<2>::new(
+        tangent_error_of::<2>(&text, overrides, absorbing)
+    }
+
+    /// `tangent_error` of any scene, in D dimensions.
+    fn tangent_error_of<const D: usize>(
+        text: &str,
+        overrides: &[String],
+        absorbing: bool,
+    ) -> (f64, usize, usize, usize) {
+        let scene = Scene::parse("block.toml", text, overrides).unwrap();
+        let m = Model::<D>::build(&scene).unwrap();
+        let mut solver = Implicit::<D>::new(
             scene.config.grid.shape_function,
             scene.config.stages()[0],
             0.0,
@@ -865,27 +874,23 @@ dt = 0.01
         assert_eq!(solver.absorbing.is_empty(), !absorbing);
         // A smooth, finite-strain iterate (strains of a few per cent).
         let nodes: Vec<usize> = solver.map.active.iter().map(|&g| g as usize).collect();
-        let mut u: Vec<Vector<2>> = nodes
+        let mut u: Vec<Vector<D>> = nodes
             .iter()
             .zip(&sys.constraint)
             .map(|(&g, c)| {
                 let x = m.grid.node_position(m.grid.node_ijk(g));
-                let mut v = Vector::<2>::new(
-                    0.03 * (0.7 * x[1]).sin() + 0.01 * x[0],
-                    -0.02 * x[0] * x[1] / 4.0,
-                );
-                for d in 0..2 {
-                    if c.fixed[d] {
-                        v[d] = 0.0;
-                    }
-                }
-                v
+                Vector::<D>::from_fn(|d, _| match d {
+                    _ if c.fixed[d] => 0.0,
+                    0 => 0.03 * (0.7 * x[1]).sin() + 0.01 * x[0],
+                    1 => -0.02 * x[0] * x[1] / 4.0,
+                    _ => 0.02 * (0.9 * x[0]).cos() * x[2] - 0.01 * x[1],
+                })
             })
             .collect();
         sys.dofs.follow_ties(&mut u);
         let tied = sys.dofs.ties.iter().filter(|t| t.is_some()).count();
         let dt = 0.01;
-        let res = |solver: &mut Implicit<2>, u: &[Vector<2>]| {
+        let res = |solver: &mut Implicit<D>, u: &[Vector<D>]| {
             let r = solver
                 .residual(&m, u, &sys.u_tilde, &sys.mass, &sys.f_ext, sys.inertia, dt)
                 .unwrap();
@@ -1002,7 +1007,55 @@ dt = 0.01
                 "F-bar {name} {shape}: tangent off by {error:.2e} of its largest entry"
             );
         }
+        // 3D: ΔF scaled as a whole (n = 3).
+        for (name, material, shape) in [
+            ("hencky", hencky.clone(), "linear"),
+            ("mohr_coulomb ψ=0", mohr_coulomb(0.0), "bspline2"),
+        ] {
+            let mut overrides = material;
+            overrides.extend([
+                format!("grid.shape_function={shape}"),
+                "solver.fbar=true".to_string(),
+            ]);
+            let (error, n, tied, plastic) = tangent_error_of::<3>(BLOCK_3D, &overrides, false);
+            println!(
+                "F-bar 3D {name} {shape}: {n} unknowns, {tied} tied nodes, {plastic} plastic \
+                 particles, max |K − K_fd| / max|K| = {error:.2e}"
+            );
+            assert!(error < 1e-6, "F-bar 3D {name} {shape}: {error:.2e}");
+            if name.starts_with("mohr") {
+                assert!(plastic > 0, "F-bar 3D {name} {shape}: no plastic particle");
+            }
+        }
     }
+
+    /// A small 3D block for the F-bar tangent check, 2 × 2 × 2 particles per cell.
+    const BLOCK_3D: &str = r#"dimension = 3
+[grid]
+min = [0.0, 0.0, 0.0]
+max = [3.0, 3.0, 3.0]
+cells = [3, 3, 3]
+[[material]]
+name = "m"
+model = "hencky"
+density = 1000.0
+youngs_modulus = 1.0e5
+poisson_ratio = 0.3
+[[body]]
+material = "m"
+shape = "box"
+min = [0.5, 0.0, 0.0]
+max = [2.5, 2.0, 1.5]
+particles_per_cell = 2
+[[boundary]]
+face = "ymin"
+condition = "fixed"
+[solver]
+kind = "implicit"
+integrator = "newmark"
+end_time = 1.0
+dt = 0.01
+"#;
 
     /// Tied nodes follow a linear field exactly, so every particle's gradient of
     /// a linear nodal field is exact (linear consistency survives the ties), and
