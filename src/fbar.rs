@@ -19,6 +19,7 @@
 use crate::dim::{Mat3, Vector};
 use crate::grid::Grid;
 use crate::implicit::tangent::{push_terms, stiffness_triplets, Dofs, Pk1Derivative, Triplets};
+use crate::shape::linear::{cell_coordinate, cell_index};
 use crate::shape::Stencils;
 use crate::transfer::{NodeMap, MIN_PARALLEL_LEN};
 use rayon::prelude::*;
@@ -41,8 +42,7 @@ impl Cells {
     pub fn locate<const D: usize>(grid: &Grid<D>, x: &[Vector<D>]) -> Cells {
         let cell = |x: &Vector<D>| {
             (0..D).rev().fold(0usize, |acc, d| {
-                let xi = ((x[d] - grid.min[d]) / grid.h[d]).clamp(0.0, grid.cells[d] as f64);
-                acc * grid.cells[d] + (xi.floor() as usize).min(grid.cells[d] - 1)
+                acc * grid.cells[d] + cell_index(cell_coordinate(grid, x, d), grid.cells[d])
             })
         };
         let mut pairs: Vec<(usize, u32)> = x
