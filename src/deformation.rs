@@ -3,9 +3,12 @@
 //! u_I = Δt v_I, i.e. ΔF = I + Δt L, thesis 2-31), F ← ΔF F, V = det F V0, and the
 //! material's stress update from the start-of-increment state. The result is a
 //! trial state, so an implicit solver can evaluate it at every Newton iterate
-//! without drift and commit it once the step has converged.
+//! without drift and commit it once the step has converged. With F-bar (`fbar`)
+//! the particles follow ΔF̄ instead of ΔF.
 
 use crate::dim::{embed_deformation, Mat3, Tensor, Vector};
+use crate::fbar::{scale_factor, scaled, Cells, FBarState};
+use crate::grid::Grid;
 use crate::material::{Increment, Material};
 use crate::particles::Particles;
 use crate::shape::Stencils;
@@ -15,16 +18,25 @@ use rayon::prelude::*;
 /// The state the particles would reach under a displacement increment.
 #[derive(Clone, Debug, Default)]
 pub struct Trial {
-    /// Incremental deformation gradient ΔF_p.
+    /// Incremental deformation gradient ΔF_p (ΔF̄_p with F-bar).
     pub df: Vec<Mat3>,
     pub f: Vec<Mat3>,
     pub stress: Vec<Mat3>,
     pub volume: Vec<f64>,
     /// History variables, laid out like `Particles::history.data`.
     pub history: Vec<f64>,
+    /// F-bar (None: off): the cells of this step, set by `use_fbar`.
+    pub fbar: Option<FBarState>,
 }
 
 impl Trial {
+    /// Turn F-bar on for the coming evaluations, with the particles grouped by
+    /// the cells of their step-start positions `x` (call once per step).
+    pub fn use_fbar<const D: usize>(&mut self, grid: &Grid<D>, x: &[Vector<D>]) {
+        let state = self.fbar.get_or_insert_with(FBarState::default);
+        state.cells = Cells::locate(grid, x);
+    }
+
     /// Evaluate the trial state under nodal displacements `u` (one per active node).
     /// Returns the first particle whose deformation inverts (det F ≤ 0), if any.
     pub fn evaluate<const D: usize>(
@@ -42,11 +54,39 @@ impl Trial {
         self.stress.resize(n, Mat3::zeros());
         self.volume.resize(n, 0.0);
         self.history.clone_from(&p.history.data);
+        // ΔF_p = I + Σ_I u_I ⊗ ∇S_Ip.
+        self.df
+            .par_iter_mut()
+            .enumerate()
+            .with_min_len(MIN_PARALLEL_LEN)
+            .for_each(|(q, df)| {
+                let grad_u: Tensor<D> = gradient(map, st, q, u);
+                *df = embed_deformation::<D>(&(Tensor::<D>::identity() + grad_u));
+            });
+        if let Some(fbar) = &mut self.fbar {
+            // ΔF̄_p = (ΔJ̄_c / ΔJ_p)^{1/n} ΔF_p (Coombs et al. 2018); needs ΔJ_p > 0.
+            let dj: Vec<f64> = self.df.iter().map(|f| f.determinant()).collect();
+            if let Some(q) = dj.iter().position(|&j| j <= 0.0) {
+                self.f[q] = self.df[q] * p.f[q];
+                return Some(q);
+            }
+            fbar.dj_bar = fbar.cells.mean_dilatation(&p.volume, &dj);
+            fbar.df.clone_from(&self.df);
+            let (cells, dj_bar) = (&fbar.cells, &fbar.dj_bar);
+            self.df
+                .par_iter_mut()
+                .enumerate()
+                .with_min_len(MIN_PARALLEL_LEN)
+                .for_each(|(q, df)| {
+                    let beta = scale_factor::<D>(dj_bar[cells.of[q] as usize], dj[q]);
+                    *df = scaled::<D>(df, beta);
+                });
+        }
         let history_old = p.history.slots(&p.history.data);
         let mut history = p.history.slots_mut(&mut self.history);
         let inverted = self
             .df
-            .par_iter_mut()
+            .par_iter()
             .zip(self.f.par_iter_mut())
             .zip(self.stress.par_iter_mut())
             .zip(self.volume.par_iter_mut())
@@ -54,8 +94,6 @@ impl Trial {
             .enumerate()
             .with_min_len(MIN_PARALLEL_LEN)
             .map(|(q, ((((df, f), stress), volume), hist))| {
-                let grad_u: Tensor<D> = gradient(map, st, q, u);
-                *df = embed_deformation::<D>(&(Tensor::<D>::identity() + grad_u));
                 let inc = Increment {
                     f_old: p.f[q],
                     df: *df,

@@ -50,6 +50,8 @@ pub struct Explicit<const D: usize> {
     pub fixed_dt: Option<f64>,
     pub flip: f64,
     pub damping: f64,
+    /// F-bar against volumetric locking (`crate::fbar`).
+    pub fbar: bool,
     stencils: Stencils<D>,
     map: NodeMap,
     trial: Trial,
@@ -64,6 +66,7 @@ impl<const D: usize> Explicit<D> {
             fixed_dt: s.dt,
             flip: s.flip(),
             damping: s.damping(),
+            fbar: s.fbar(),
             stencils: Stencils::default(),
             map: NodeMap::default(),
             trial: Trial::default(),
@@ -108,6 +111,9 @@ impl<const D: usize> Explicit<D> {
         self.stencils
             .compute(self.shape, &m.grid, &p.x, &p.half_length0, &p.f);
         self.map.build(&self.stencils, m.grid.node_count());
+        if self.fbar {
+            self.trial.use_fbar(&m.grid, &p.x);
+        }
         let (st, map) = (&self.stencils, &self.map);
         let constraint: Vec<Constraint<D>> = map
             .active

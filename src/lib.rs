@@ -11,6 +11,7 @@ pub mod boundary;
 pub mod deformation;
 pub mod dim;
 pub mod explicit;
+pub mod fbar;
 pub mod footing;
 pub mod geostatic;
 pub mod grid;

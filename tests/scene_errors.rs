@@ -221,6 +221,26 @@ fn linear_solver_keys_are_checked() {
 }
 
 #[test]
+fn fbar_is_checked() {
+    // Explicit, implicit direct and implicit GMRES accept it.
+    for text in [
+        GOOD.replace("cfl = 0.5", "cfl = 0.5\nfbar = true"),
+        implicit("fbar = true"),
+        implicit("fbar = true\nlinear_solver = \"gmres\""),
+    ] {
+        Scene::parse("scene.toml", &text, &[]).unwrap();
+    }
+    // CG cannot solve the unsymmetric F-bar tangent.
+    let e = err(&implicit("linear_solver = \"cg\"\nfbar = true"));
+    assert!(
+        e.contains("scene.toml:26:8") && e.contains("key `solver.fbar`") && e.contains("gmres"),
+        "{e}"
+    );
+    let e = err(&implicit("fbar = 1"));
+    assert!(e.contains("scene.toml:25:8") && e.contains("bool"), "{e}");
+}
+
+#[test]
 fn a_model_without_tangent_needs_a_krylov_solver() {
     let ogden = |solver: &str| {
         implicit(solver).replace(

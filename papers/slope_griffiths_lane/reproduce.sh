@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Regenerate the factor-of-safety table of README.md: strength reduction of
-# problems/slope_griffiths_lane.toml on refined grids (h = H/10 … H/40).
+# Regenerate the factor-of-safety tables of README.md: strength reduction of
+# problems/slope_griffiths_lane.toml on refined grids (h = H/10 … H/50).
 # Usage: papers/slope_griffiths_lane/reproduce.sh [OUT_DIR]   (from the repository root)
 # Needs a release build: cargo build --release (mpm on the PATH or in $MPM).
 set -euo pipefail
@@ -8,10 +8,12 @@ MPM=${MPM:-mpm}
 OUT=${1:-out/slope_griffiths_lane}
 SCENE=problems/slope_griffiths_lane.toml
 mkdir -p "$OUT"
-# cells (40 m × 12 m grid) → h = 1, 1/2, 1/3, 1/4, 1/5 m
+# FBAR=false reproduces the table without F-bar (the scene ships fbar = true);
+# cells (40 m × 12 m grid) → h = 1, 1/2, 1/3, 1/4, 1/5 m.
+FBAR=${FBAR:-true}
 for cells in 40,12 80,24 120,36 160,48 200,60; do
   dir="$OUT/cells_${cells/,/x}"
-  "$MPM" run "$SCENE" --out "$dir" --set "grid.cells=[$cells]" > "$dir.log" 2>&1 || true
+  "$MPM" run "$SCENE" --out "$dir" --set "grid.cells=[$cells]" --set "solver.fbar=$FBAR" > "$dir.log" 2>&1 || true
 done
 python3 - "$OUT" <<'PY'
 import json, sys, pathlib
@@ -19,7 +21,7 @@ out = pathlib.Path(sys.argv[1])
 print("| h (m) | particles | F (bracket) | F / 1.40 | F at crest displacement > 0.1 m | trials | wall s | Newton it. per converged trial |")
 print("|---|---|---|---|---|---|---|---|")
 rows = []
-for d in sorted(out.glob("cells_*"), key=lambda p: int(p.name.split("_")[1].split("x")[0])):
+for d in sorted(out.glob("cells_*[0-9]"), key=lambda p: int(p.name.split("_")[1].split("x")[0])):
     s = json.loads((d / "summary.json").read_text())
     nx = int(d.name.split("_")[1].split("x")[0])
     lo, hi = s.get("factor_of_safety_bracket", [float("nan")] * 2)
@@ -50,4 +52,5 @@ if len(rows) >= 3:
         print("\nno monotone refinement trend to extrapolate")
 PY
 # The mechanism of the finest grid (last stable trial).
-python3 "$(dirname "$0")/mechanism.py" "$OUT/cells_160x48" "$(dirname "$0")/mechanism.svg"
+svg=mechanism_fbar.svg; [ "$FBAR" = true ] || svg=mechanism.svg
+python3 "$(dirname "$0")/mechanism.py" "$OUT/cells_160x48" "$(dirname "$0")/$svg"

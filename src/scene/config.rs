@@ -425,6 +425,8 @@ pub struct SolverConfig {
     /// Quasi-static: ramp gravity from zero over the stage (default true); false
     /// applies it in full from the first step (after a geostatic initialisation).
     pub gravity_ramp: Option<bool>,
+    /// F-bar against volumetric locking (explicit and implicit; default false).
+    pub fbar: Option<bool>,
 }
 
 impl SceneConfig {
@@ -506,6 +508,11 @@ impl SolverConfig {
     /// 0 turns it off). See `implicit::support`.
     pub fn min_node_support(&self) -> f64 {
         self.min_node_support.unwrap_or(1e-2)
+    }
+    /// F-bar: per background cell, the particles' volume change is the cell
+    /// average (default false). See `fbar`.
+    pub fn fbar(&self) -> bool {
+        self.fbar.unwrap_or(false)
     }
     /// Linear solver of the Newton corrections (default direct).
     pub fn linear_solver(&self) -> LinearSolver {

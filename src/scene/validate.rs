@@ -1011,11 +1011,19 @@ fn linear_solver(s: &SolverConfig, prefix: &str) -> Check {
             forbidden(&s.krylov_restart, key("krylov_restart"), what)?;
             return forbidden(&s.krylov_max_iterations, key("krylov_max_iterations"), what);
         }
-        LinearSolver::Cg => forbidden(
-            &s.krylov_restart,
-            key("krylov_restart"),
-            "linear_solver = \"cg\" (it is the GMRES restart length)",
-        )?,
+        LinearSolver::Cg => {
+            forbidden(
+                &s.krylov_restart,
+                key("krylov_restart"),
+                "linear_solver = \"cg\" (it is the GMRES restart length)",
+            )?;
+            ensure(
+                !s.fbar(),
+                key("fbar"),
+                "F-bar makes the tangent unsymmetric, which linear_solver = \"cg\" cannot \
+                 solve: use linear_solver = \"gmres\" or \"direct\"",
+            )?
+        }
         LinearSolver::Gmres => ensure(
             s.krylov_restart() >= 1,
             key("krylov_restart"),

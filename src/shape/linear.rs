@@ -22,12 +22,12 @@ pub(super) struct AxisFactors {
 
 /// Position of `x` along axis `d` in cell units, clamped to [0, cells] so that
 /// round-off at the max face cannot push it outside.
-pub(super) fn cell_coordinate<const D: usize>(grid: &Grid<D>, x: &Vector<D>, d: usize) -> f64 {
+pub(crate) fn cell_coordinate<const D: usize>(grid: &Grid<D>, x: &Vector<D>, d: usize) -> f64 {
     ((x[d] - grid.min[d]) / grid.h[d]).clamp(0.0, grid.cells[d] as f64)
 }
 
 /// Cell containing cell coordinate `xi`; a point on the max face belongs to the last cell.
-pub(super) fn cell_index(xi: f64, cells: usize) -> usize {
+pub(crate) fn cell_index(xi: f64, cells: usize) -> usize {
     (xi.floor() as usize).min(cells - 1)
 }
 
