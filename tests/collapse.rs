@@ -1,15 +1,16 @@
 //! Plane-strain granular column collapse (`problems/collapse.toml`: aluminium
-//! rods, cohesionless Mohr–Coulomb φ = 19.8°, ψ = 0, rough base μ = tan φ)
+//! rods, cohesionless Mohr–Coulomb φ = 19.8°, ψ = 0, rough base μ = 0.30)
 //! against the experimental laws of the reference README item 6
 //! (Bui et al. 2008, Lube et al. 2005): h∞/h0 = 1 for a < 0.65 and
 //! (d∞ − d0)/d0 = 3.80 a^0.73 for a > 1.5.
 //!
-//! CI runs the coarse grid (cells of d0/10) at a = 0.5 and a = 2. There the
-//! runout is short of the law (the base friction acts on the half cell of
-//! material lumped at the base nodes, a boundary layer that thins under
-//! refinement): the a = 2 runout is checked within 20 %, the height of the
-//! squat column within 10 %. The full set, its refinement and the 10 % target
-//! are in papers/granular_collapse.
+//! The base friction is not given by the reference: μ = 0.30 was calibrated
+//! against the runout laws at a = 1 and 2 on cells of d0/20
+//! (papers/granular_collapse, where a = 0.5 and 4 are the checks). CI runs the
+//! coarse grid (cells of d0/10) at a = 0.5 and a = 2: the squat column keeps its
+//! height within 10 %, the a = 2 runout is within 10 % of the law (measured
+//! −6.4 %; −1.3 % on the finer grid). With the former μ = tan φ = 0.36 it was
+//! −18.5 %, so the runout check can fail.
 //!
 //! Measured as in papers/granular_collapse/measure.py: the front is the 99.5 %
 //! mass percentile of particle x, the height the largest particle y (both
@@ -96,7 +97,7 @@ fn tall_column_runout_follows_the_law_on_a_coarse_grid() {
     );
     assert!(heap.ke_ratio < 0.01, "not at rest: {}", heap.ke_ratio);
     assert!(
-        (heap.runout / law - 1.0).abs() < 0.2,
+        (heap.runout / law - 1.0).abs() < 0.1,
         "runout {} vs {law}",
         heap.runout
     );
