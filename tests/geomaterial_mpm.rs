@@ -171,3 +171,45 @@ fn explicit_and_newmark_reach_the_limit() {
         }
     }
 }
+
+/// The matrix-free path (GMRES on finite-difference Jacobian products, no
+/// assembled plastic tangent) reaches the same limit as the direct path, for
+/// both models, and ends on the same stresses.
+#[test]
+fn matrix_free_newton_krylov_reaches_the_limit() {
+    let text = scene(None);
+    let krylov = ["solver.linear_solver=gmres", "solver.krylov_tolerance=1e-8"];
+    let mc = ["solver.load_steps=3"];
+    let dp = ["solver.load_steps=6", DP[0], DP[1], DP[2]];
+    for (name, models, tol) in [
+        ("MC ψ = 10°", mc.to_vec(), 1e-3),
+        ("DP plane strain ψ = 10°", dp.to_vec(), 1e-2),
+    ] {
+        let (direct, _d) = run(&text, &models);
+        let overrides: Vec<&str> = models.iter().chain(krylov.iter()).copied().collect();
+        let (gmres, g) = run(&text, &overrides);
+        check(&format!("GMRES {name}"), &gmres, tol);
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(g.path().join("summary.json")).unwrap())
+                .unwrap();
+        let (solver, iterations) = (&summary["linear_solver"], &summary["krylov_iterations"]);
+        eprintln!("   {solver}: {iterations} Krylov iterations");
+        assert_eq!(solver, "gmres");
+        assert!(iterations.as_u64().unwrap() > 0);
+        let diff = (gmres.syy - direct.syy).abs() / direct.syy.abs();
+        let dj = (gmres.j - direct.j).abs();
+        eprintln!("   GMRES vs direct σ_yy: {diff:.1e}, V/V0: {dj:.1e}");
+        assert!(
+            dj < 1e-8,
+            "{name}: GMRES V/V0 {} vs direct {}",
+            gmres.j,
+            direct.j
+        );
+        assert!(
+            diff < 1e-6,
+            "{name}: GMRES σ_yy {} vs direct {}",
+            gmres.syy,
+            direct.syy
+        );
+    }
+}
