@@ -302,6 +302,32 @@ fn cli_exits_non_zero_without_panicking() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("cannot read"));
 }
 
+/// `mpm check` and `mpm run` on a limit-analysis file or a bench settings file say
+/// which command takes it.
+#[test]
+fn other_kinds_of_file_get_a_hint() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("problems");
+    for (file, hint) in [
+        ("limit_slope.toml", "run it with `mpm limit`"),
+        ("bench/column_bench.toml", "`mpm bench SCENE --config FILE`"),
+    ] {
+        for command in ["check", "run"] {
+            let out = Command::new(env!("CARGO_BIN_EXE_mpm"))
+                .args([command, root.join(file).to_str().unwrap()])
+                .args(
+                    ["--out", "/nonexistent/never-written"]
+                        .iter()
+                        .take(if command == "run" { 2 } else { 0 }),
+                )
+                .output()
+                .unwrap();
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(out.status.code(), Some(2), "{stderr}");
+            assert!(stderr.contains(hint), "{command} {file}: {stderr}");
+        }
+    }
+}
+
 const GEO: &str = r#"dimension = 2
 
 [grid]

@@ -181,7 +181,7 @@ fn main() -> ExitCode {
                 ExitCode::SUCCESS
             }
             Err(e) => {
-                eprintln!("error: {e}");
+                eprintln!("error: {e}{}", other_kind_of_file(&scene));
                 ExitCode::from(2)
             }
         },
@@ -203,7 +203,7 @@ fn main() -> ExitCode {
             let scene = match Scene::load(&scene, &overrides) {
                 Ok(s) => s,
                 Err(e) => {
-                    eprintln!("error: {e}");
+                    eprintln!("error: {e}{}", other_kind_of_file(&scene));
                     return ExitCode::from(2);
                 }
             };
@@ -237,6 +237,30 @@ fn main() -> ExitCode {
                 }
             }
         }
+    }
+}
+
+/// A hint when a scene that `run`/`check` rejects is a limit-analysis file (top-level
+/// `problem`) or a bench settings file (only a `[bench]` table); empty otherwise.
+fn other_kind_of_file(path: &std::path::Path) -> String {
+    let Some(table) = std::fs::read_to_string(path)
+        .ok()
+        .and_then(|t| t.parse::<toml::Table>().ok())
+    else {
+        return String::new();
+    };
+    if table.contains_key("problem") {
+        format!(
+            "\nhint: {} is a limit-analysis file (top-level `problem`): run it with `mpm limit`",
+            path.display()
+        )
+    } else if table.contains_key("bench") && !table.contains_key("dimension") {
+        format!(
+            "\nhint: {} is a bench settings file: pass it as `mpm bench SCENE --config FILE`",
+            path.display()
+        )
+    } else {
+        String::new()
     }
 }
 
