@@ -5,7 +5,6 @@
 
 mod common;
 use common::{run_problem, Table};
-use std::process::Command;
 
 fn syy_errors(dir: &std::path::Path, l0: f64) -> Vec<(f64, f64)> {
     let p = Table::read(&dir.join("particles_final.csv")).unwrap();
@@ -150,25 +149,8 @@ fn implicit_results_do_not_depend_on_threads() {
         ("vibrating_bar_implicit.toml", "solver.end_time=5"),
     ] {
         let run = |threads: usize| {
-            let dir = tempfile::tempdir().unwrap();
-            let out = Command::new(env!("CARGO_BIN_EXE_mpm"))
-                .args([
-                    "run",
-                    common::problem(scene).to_str().unwrap(),
-                    "--threads",
-                    &threads.to_string(),
-                    "--out",
-                ])
-                .arg(dir.path())
-                .args(["--set", extra, "--set", "output.frames=0"])
-                .output()
-                .unwrap();
-            assert!(
-                out.status.success(),
-                "{}",
-                String::from_utf8_lossy(&out.stderr)
-            );
-            std::fs::read(dir.path().join("particles_final.csv")).unwrap()
+            let dir = common::run_cli(scene, threads, &[extra, "output.frames=0"]);
+            common::read_output(&dir, "particles_final.csv")
         };
         assert!(
             run(1) == run(2),

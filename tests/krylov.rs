@@ -5,7 +5,7 @@
 //! Krylov failure handled like a Newton failure.
 
 mod common;
-use common::{problem, read_newton, run_problem, run_text, Table};
+use common::{problem, read_newton, read_output, run_cli, run_problem, run_text, Table};
 use mpm::run::RunError;
 
 /// One run: final particles, Newton rows and summary.
@@ -348,32 +348,17 @@ fn krylov_failure_cuts_back_then_stops_cleanly() {
 /// (1,440 particles) for the parallel loops to split.
 #[test]
 fn krylov_results_do_not_depend_on_threads() {
+    let overrides = [
+        "load.0.force=[0,-100]",
+        "solver.load_steps=1",
+        "solver.linear_solver=cg",
+        "output.frames=0",
+    ];
     let run = |threads: usize| {
-        let dir = tempfile::tempdir().unwrap();
-        let out = std::process::Command::new(env!("CARGO_BIN_EXE_mpm"))
-            .args(["run", problem("cantilever.toml").to_str().unwrap()])
-            .args(["--threads", &threads.to_string(), "--out"])
-            .arg(dir.path())
-            .args([
-                "--set",
-                "load.0.force=[0,-100]",
-                "--set",
-                "solver.load_steps=1",
-            ])
-            .args([
-                "--set",
-                "solver.linear_solver=cg",
-                "--set",
-                "output.frames=0",
-            ])
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        std::fs::read(dir.path().join("particles_final.csv")).unwrap()
+        read_output(
+            &run_cli("cantilever.toml", threads, &overrides),
+            "particles_final.csv",
+        )
     };
     assert!(
         run(1) == run(2),

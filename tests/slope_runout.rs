@@ -27,10 +27,9 @@
 //!   strengths.
 
 mod common;
-use common::{problem, run_problem, Table};
+use common::{problem, read_output, run_problem, Table};
 use mpm::scene::Scene;
 use mpm::setup::Model;
-use std::process::Command;
 use std::sync::OnceLock;
 
 const COARSE: [&str; 2] = ["grid.cells=[60,12]", "output.frames=0"];
@@ -181,22 +180,11 @@ fn gravity_work_is_the_lost_potential_energy_and_is_dissipated() {
 #[test]
 fn one_and_two_threads_give_identical_runout() {
     let run_cli = |threads: usize| {
-        let dir = tempfile::tempdir().unwrap();
-        let mut cmd = Command::new(env!("CARGO_BIN_EXE_mpm"));
-        cmd.args(["run", problem(SCENE).to_str().unwrap()])
-            .args(["--threads", &threads.to_string(), "--out"])
-            .arg(dir.path());
-        for o in coarse(&["stage.1.end_time=1.5"]) {
-            cmd.args(["--set", &o]);
-        }
-        let out = cmd.output().unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let read = |f: &str| std::fs::read(dir.path().join(f)).unwrap();
-        (read("particles_final.csv"), read("history.csv"))
+        let dir = common::run_cli(SCENE, threads, &coarse(&["stage.1.end_time=1.5"]));
+        (
+            read_output(&dir, "particles_final.csv"),
+            read_output(&dir, "history.csv"),
+        )
     };
     let (p1, h1) = run_cli(1);
     let (p2, h2) = run_cli(2);

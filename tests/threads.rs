@@ -1,26 +1,22 @@
 //! Results do not depend on the number of threads: the same scene run with 1 and
 //! 2 threads gives byte-identical outputs.
 
-use std::process::Command;
+mod common;
+
+use common::{read_output, run_cli};
 
 fn run(threads: usize, shape: &str, fbar: bool) -> (Vec<u8>, Vec<u8>) {
-    let dir = tempfile::tempdir().unwrap();
-    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/problems/disks.toml");
-    let out = Command::new(env!("CARGO_BIN_EXE_mpm"))
-        .args(["run", scene, "--threads", &threads.to_string(), "--out"])
-        .arg(dir.path())
-        .args(["--set", "solver.end_time=2.0", "--set", "output.frames=0"])
-        .args(["--set", &format!("grid.shape_function={shape}")])
-        .args(["--set", &format!("solver.fbar={fbar}")])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let read = |f: &str| std::fs::read(dir.path().join(f)).unwrap();
-    (read("particles_final.csv"), read("history.csv"))
+    let overrides = [
+        "solver.end_time=2.0".to_string(),
+        "output.frames=0".to_string(),
+        format!("grid.shape_function={shape}"),
+        format!("solver.fbar={fbar}"),
+    ];
+    let dir = run_cli("disks.toml", threads, &overrides);
+    (
+        read_output(&dir, "particles_final.csv"),
+        read_output(&dir, "history.csv"),
+    )
 }
 
 #[test]

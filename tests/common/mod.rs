@@ -47,3 +47,30 @@ pub fn run_text(
 pub fn read_newton(path: &Path) -> Table {
     Table::read(path).unwrap_or_else(|e| panic!("{e}"))
 }
+
+/// `mpm run problems/NAME --threads N --out DIR --set O …` through the program
+/// itself; panics with its stderr unless it succeeds. Returns the output
+/// directory (for thread-independence checks: compare its files byte by byte).
+pub fn run_cli<S: AsRef<str>>(name: &str, threads: usize, overrides: &[S]) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_mpm"));
+    cmd.arg("run")
+        .arg(problem(name))
+        .args(["--threads", &threads.to_string(), "--out"])
+        .arg(dir.path());
+    for o in overrides {
+        cmd.args(["--set", o.as_ref()]);
+    }
+    let out = cmd.output().unwrap();
+    assert!(
+        out.status.success(),
+        "mpm run {name} --threads {threads}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    dir
+}
+
+/// The bytes of an output file.
+pub fn read_output(dir: &tempfile::TempDir, file: &str) -> Vec<u8> {
+    std::fs::read(dir.path().join(file)).unwrap()
+}
