@@ -65,14 +65,15 @@ impl Trial {
             });
         if let Some(fbar) = &mut self.fbar {
             // ΔF̄_p = (ΔJ̄_c / ΔJ_p)^{1/n} ΔF_p (Coombs et al. 2018); needs ΔJ_p > 0.
-            let dj: Vec<f64> = self.df.iter().map(|f| f.determinant()).collect();
-            if let Some(q) = dj.iter().position(|&j| j <= 0.0) {
+            fbar.dj.clear();
+            fbar.dj.extend(self.df.iter().map(|f| f.determinant()));
+            if let Some(q) = fbar.dj.iter().position(|&j| j <= 0.0) {
                 self.f[q] = self.df[q] * p.f[q];
                 return Some(q);
             }
-            fbar.dj_bar = fbar.cells.mean_dilatation(&p.volume, &dj);
+            fbar.dj_bar = fbar.cells.mean_dilatation(&p.volume, &fbar.dj);
             fbar.df.clone_from(&self.df);
-            let (cells, dj_bar) = (&fbar.cells, &fbar.dj_bar);
+            let (cells, dj, dj_bar) = (&fbar.cells, &fbar.dj, &fbar.dj_bar);
             self.df
                 .par_iter_mut()
                 .enumerate()

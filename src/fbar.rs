@@ -116,13 +116,15 @@ pub fn scaled<const D: usize>(df: &Mat3, beta: f64) -> Mat3 {
     out
 }
 
-/// The F-bar state of a trial: ΔF_p before the modification, the cells and the
-/// cells' mean dilatation.
+/// The F-bar state of a trial: ΔF_p before the modification and its determinant,
+/// the cells and the cells' mean dilatation.
 #[derive(Clone, Debug, Default)]
 pub struct FBarState {
     pub cells: Cells,
     /// ΔF_p = I + Σ u_I ⊗ ∇S_Ip (before F-bar).
     pub df: Vec<Mat3>,
+    /// ΔJ_p = det ΔF_p.
+    pub dj: Vec<f64>,
     /// ΔJ̄_c of every occupied cell.
     pub dj_bar: Vec<f64>,
 }
@@ -149,7 +151,7 @@ pub fn tangent_triplets<const D: usize>(
 ) -> Triplets {
     let n = D as f64;
     let cells = &state.cells;
-    let dj: Vec<f64> = state.df.iter().map(|f| f.determinant()).collect();
+    let dj = &state.dj;
     let beta: Vec<f64> = (0..volume.len())
         .map(|q| scale_factor::<D>(state.dj_bar[cells.of[q] as usize], dj[q]))
         .collect();
