@@ -108,9 +108,7 @@ impl<const D: usize> Explicit<D> {
         step: usize,
     ) -> Result<f64, Divergence> {
         let p = &m.particles;
-        self.stencils
-            .compute(self.shape, &m.grid, &p.x, &p.half_length0, &p.f);
-        self.map.build(&self.stencils, m.grid.node_count());
+        m.stencils_and_nodes(self.shape, &mut self.stencils, &mut self.map);
         if self.fbar {
             self.trial.use_fbar(&m.grid, &p.x);
         }

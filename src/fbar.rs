@@ -288,16 +288,8 @@ load_steps = 1
         let scene = Scene::parse("block.toml", BLOCK, &overrides).unwrap();
         let m = Model::<2>::build(&scene).unwrap();
         let p = &m.particles;
-        let mut st = Stencils::default();
-        st.compute(
-            scene.config.grid.shape_function,
-            &m.grid,
-            &p.x,
-            &p.half_length0,
-            &p.f,
-        );
-        let mut map = NodeMap::default();
-        map.build(&st, m.grid.node_count());
+        let (mut st, mut map) = (Stencils::default(), NodeMap::default());
+        m.stencils_and_nodes(scene.config.grid.shape_function, &mut st, &mut map);
         let nodal: Vec<Vector<2>> = map
             .active
             .iter()

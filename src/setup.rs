@@ -17,6 +17,8 @@ use crate::scene::{
     expr, BodyConfig, Condition, LoadKind, MaterialConfig, MaterialModel, MohrCoulombFit, Scene,
     SceneError, Shape,
 };
+use crate::shape::{ShapeFunction, Stencils};
+use crate::transfer::NodeMap;
 
 /// Everything a solver needs, in dimension D.
 #[derive(Debug)]
@@ -178,6 +180,19 @@ impl<const D: usize> Model<D> {
     /// Load factor of each load time history at time t.
     pub fn load_scales(&self, t: f64) -> Vec<f64> {
         self.load_ramps.iter().map(|r| r.factor(t)).collect()
+    }
+
+    /// The particles' shape-function stencils on the grid and the active nodes
+    /// they touch: what every step starts from.
+    pub fn stencils_and_nodes(
+        &self,
+        shape: ShapeFunction,
+        st: &mut Stencils<D>,
+        map: &mut NodeMap,
+    ) {
+        let p = &self.particles;
+        st.compute(shape, &self.grid, &p.x, &p.half_length0, &p.f);
+        map.build(st, self.grid.node_count());
     }
 
     /// Set every material to the scene's one with c/F, tan φ/F, tan ψ/F when it

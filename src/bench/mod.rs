@@ -602,17 +602,8 @@ fn unknowns_dim<const D: usize>(
     implicit: bool,
 ) -> Result<(usize, usize), SceneError> {
     let m = Model::<D>::build(scene)?;
-    let p = &m.particles;
-    let mut st = Stencils::<D>::default();
-    st.compute(
-        scene.config.grid.shape_function,
-        &m.grid,
-        &p.x,
-        &p.half_length0,
-        &p.f,
-    );
-    let mut map = NodeMap::default();
-    map.build(&st, m.grid.node_count());
+    let (mut st, mut map) = (Stencils::<D>::default(), NodeMap::default());
+    m.stencils_and_nodes(scene.config.grid.shape_function, &mut st, &mut map);
     let n = if implicit {
         let fixed = map
             .active
@@ -622,7 +613,7 @@ fn unknowns_dim<const D: usize>(
     } else {
         D * map.len()
     };
-    Ok((p.len(), n))
+    Ok((m.particles.len(), n))
 }
 
 /// The explicit critical step of the base scene at t = 0 (for implicit

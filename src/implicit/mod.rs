@@ -481,9 +481,7 @@ impl<const D: usize> Implicit<D> {
     fn prepare(&mut self, m: &Model<D>, t: f64, dt: f64) -> StepSystem<D> {
         let dynamic = self.integrator == Integrator::Newmark;
         let p = &m.particles;
-        self.stencils
-            .compute(self.shape, &m.grid, &p.x, &p.half_length0, &p.f);
-        self.map.build(&self.stencils, m.grid.node_count());
+        m.stencils_and_nodes(self.shape, &mut self.stencils, &mut self.map);
         if self.fbar {
             self.trial.use_fbar(&m.grid, &p.x);
         }
