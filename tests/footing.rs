@@ -6,7 +6,7 @@
 //! of a footing (a velocity condition on a region of a face).
 
 mod common;
-use common::{run_problem, Table};
+use common::{newton_order, run_problem, step_residuals, Table};
 use mpm::scene::Scene;
 use mpm::setup::Model;
 
@@ -19,20 +19,6 @@ fn prandtl_nc(phi_deg: f64) -> f64 {
     let nq = (std::f64::consts::PI * phi.tan()).exp()
         * (std::f64::consts::FRAC_PI_4 + phi / 2.0).tan().powi(2);
     (nq - 1.0) / phi.tan()
-}
-
-/// Orders p_k = ln(r_{k+1}/r_k) / ln(r_k/r_{k−1}) over the iterations whose
-/// residuals lie well above the round-off floor and that at least halved the
-/// residual (a stalled iteration, r_k ≈ r_{k−1}, gives a meaningless quotient);
-/// the best, and the iterations.
-fn newton_order(r: &[f64]) -> (f64, usize) {
-    let floor = *r.last().unwrap();
-    let informative = |x: f64| x > 1e3 * floor;
-    let best = (1..r.len() - 1)
-        .filter(|&k| informative(r[k - 1]) && informative(r[k]) && r[k] < 0.5 * r[k - 1])
-        .map(|k| (r[k + 1] / r[k]).ln() / (r[k] / r[k - 1]).ln())
-        .fold(f64::NAN, f64::max);
-    (best, r.len() - 1)
 }
 
 /// Run a footing scene; check its limit pressure against N_c and the Newton
@@ -68,13 +54,9 @@ fn footing(scene: &str, overrides: &[&str], phi: f64, tol: f64, max_iterations: 
     assert_eq!(*p.last().unwrap(), limit);
     // Newton in the last steps (on the plateau, plastic zone fully developed).
     let newton = Table::read(&dir.path().join("newton.csv")).unwrap();
-    let (step, res) = (newton.col("step"), newton.col("residual"));
-    let last = step.iter().cloned().fold(0.0, f64::max);
+    let last = newton.col("step").iter().cloned().fold(0.0, f64::max);
     for s in [last - 1.0, last] {
-        let r: Vec<f64> = (0..step.len())
-            .filter(|&i| step[i] == s)
-            .map(|i| res[i])
-            .collect();
+        let r = step_residuals(&newton, s);
         let (order, iterations) = newton_order(&r);
         eprintln!("   step {s}: residuals {r:?}: order {order:.2}, {iterations} iterations");
         assert!(

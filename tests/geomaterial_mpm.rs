@@ -8,7 +8,7 @@
 //! The quasi-static runs also check the Newton iterations of the plastic steps.
 
 mod common;
-use common::{problem, read_newton, run_text, Table};
+use common::{newton_order, problem, read_newton, run_text, step_residuals, Table};
 
 const C: f64 = 1.0e4;
 
@@ -98,19 +98,6 @@ fn check(name: &str, r: &Result, tol: f64) {
     );
 }
 
-/// Orders p_k = ln(r_{k+1}/r_k) / ln(r_k/r_{k−1}) of the residuals of one step,
-/// over the iterations whose residuals lie well above the round-off floor (the
-/// last residual of the step); the best of them, and the number of iterations.
-fn newton_order(r: &[f64]) -> (f64, usize) {
-    let floor = *r.last().unwrap();
-    let informative = |x: f64| x > 1e3 * floor;
-    let best = (1..r.len() - 1)
-        .filter(|&k| informative(r[k - 1]) && informative(r[k]))
-        .map(|k| (r[k + 1] / r[k]).ln() / (r[k] / r[k - 1]).ln())
-        .fold(f64::NAN, f64::max);
-    (best, r.len() - 1)
-}
-
 #[test]
 fn quasi_static_reaches_the_limit_with_quadratic_newton() {
     let text = scene(None);
@@ -126,12 +113,8 @@ fn quasi_static_reaches_the_limit_with_quadratic_newton() {
         let (r, dir) = run(&text, &overrides);
         check(&format!("quasi-static {name}"), &r, tol);
         let newton = read_newton(&dir.path().join("newton.csv"));
-        let (step, res) = (newton.col("step"), newton.col("residual"));
         for s in [2.0, 3.0] {
-            let r: Vec<f64> = (0..step.len())
-                .filter(|&i| step[i] == s)
-                .map(|i| res[i])
-                .collect();
+            let r = step_residuals(&newton, s);
             let (order, iterations) = newton_order(&r);
             eprintln!("   step {s}: residuals {r:?}: order {order:.2}, {iterations} iterations");
             assert!(

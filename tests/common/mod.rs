@@ -74,3 +74,26 @@ pub fn run_cli<S: AsRef<str>>(name: &str, threads: usize, overrides: &[S]) -> te
 pub fn read_output(dir: &tempfile::TempDir, file: &str) -> Vec<u8> {
     std::fs::read(dir.path().join(file)).unwrap()
 }
+
+/// The normalised residuals of load step `step` in newton.csv, in order.
+pub fn step_residuals(newton: &Table, step: f64) -> Vec<f64> {
+    let (steps, res) = (newton.col("step"), newton.col("residual"));
+    (0..steps.len())
+        .filter(|&i| steps[i] == step)
+        .map(|i| res[i])
+        .collect()
+}
+
+/// Orders p_k = ln(r_{k+1}/r_k) / ln(r_k/r_{k−1}) of one step's residuals over
+/// the iterations whose residuals lie well above the round-off floor (the last
+/// residual) and that at least halved the residual (a stalled iteration,
+/// r_k ≈ r_{k−1}, gives a meaningless quotient); the best, and the iterations.
+pub fn newton_order(r: &[f64]) -> (f64, usize) {
+    let floor = *r.last().unwrap();
+    let informative = |x: f64| x > 1e3 * floor;
+    let best = (1..r.len() - 1)
+        .filter(|&k| informative(r[k - 1]) && informative(r[k]) && r[k] < 0.5 * r[k - 1])
+        .map(|k| (r[k + 1] / r[k]).ln() / (r[k] / r[k - 1]).ln())
+        .fold(f64::NAN, f64::max);
+    (best, r.len() - 1)
+}
