@@ -1,0 +1,135 @@
+#!/usr/bin/env bash
+# Do two builds of `mpm` give the same results on every shipped scene?
+#
+#   scripts/same_results.sh run MPM DIR      run every scene of problems/ with MPM into DIR
+#   scripts/same_results.sh diff DIR_A DIR_B compare two such directories
+#   scripts/same_results.sh REV              build REV (a git revision) in a worktree, run
+#                                            both it and this tree's release build, compare
+#
+# Add --full before the command to run the long scenes at their shipped settings
+# (about 3 minutes on 2 cores) instead of the quick settings below (about 1 minute).
+#
+# Compared byte for byte: particles_final.csv (every one, strength-reduction trials
+# included), history.csv, footing.csv and the ParaView frames. Compared after dropping
+# the wall-clock fields: summary.json (wall_seconds, particle_steps_per_second, and the
+# solver timings of limit analysis), newton.csv, strength_reduction.csv and
+# refinement.csv (their wall_seconds and solver-time columns). Exit status 0 when
+# everything agrees, 1 otherwise, with one line per difference.
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+full=0
+if [ "${1:-}" = "--full" ]; then full=1; shift; fi
+
+# Shorter runs of the long scenes (their behaviour is exercised all the same).
+quick_overrides() {
+  case "$1" in
+    collapse) echo "--set solver.end_time=0.25" ;;
+    limit_slope) echo "--set mesh.refinements=[0]" ;;
+    limit_footing_mc) echo "--set mesh.refinements=[0]" ;;
+    *) echo "" ;;
+  esac
+}
+
+run_all() {
+  local mpm="$1" out="$2"
+  mkdir -p "$out"
+  for scene in "$root"/problems/*.toml; do
+    local name cmd extra
+    name="$(basename "$scene" .toml)"
+    case "$name" in limit_*) cmd=limit ;; *) cmd=run ;; esac
+    extra=""
+    [ "$full" = 1 ] || extra="$(quick_overrides "$name")"
+    rm -rf "${out:?}/$name"
+    # shellcheck disable=SC2086
+    if "$mpm" "$cmd" "$scene" --out "$out/$name" $extra >"$out/$name.log" 2>&1; then
+      echo "ran $name"
+    else
+      echo "ran $name (exit $?)"
+    fi
+  done
+}
+
+diff_all() {
+  python3 - "$1" "$2" <<'EOF'
+import csv, io, json, os, sys
+a_root, b_root = sys.argv[1], sys.argv[2]
+TIMING_KEYS = {"seconds", "wall_seconds", "particle_steps_per_second", "solver_seconds",
+               "lower_seconds", "upper_seconds", "setup_seconds"}
+TIMING_COLUMNS = TIMING_KEYS | {"lower_solver_seconds", "upper_solver_seconds"}
+BYTES = ("particles_final.csv", "history.csv", "footing.csv")
+TABLES = ("newton.csv", "strength_reduction.csv", "refinement.csv", "trials.csv")
+
+def strip(v, root):
+    """Without wall-clock fields, and with the output directory in messages as OUT."""
+    if isinstance(v, dict):
+        return {k: strip(x, root) for k, x in v.items() if k not in TIMING_KEYS and not k.endswith("_seconds")}
+    if isinstance(v, list):
+        return [strip(x, root) for x in v]
+    if isinstance(v, str):
+        return v.replace(root, "OUT")
+    return v
+
+def table(path):
+    rows = list(csv.reader(open(path, newline="")))
+    if not rows:
+        return rows
+    keep = [i for i, h in enumerate(rows[0]) if h not in TIMING_COLUMNS and not h.endswith("_seconds")]
+    return [[r[i] for i in keep if i < len(r)] for r in rows]
+
+def files(root):
+    out = set()
+    for d, _, names in os.walk(root):
+        for n in names:
+            out.add(os.path.relpath(os.path.join(d, n), root))
+    return out
+
+bad = 0
+a_files, b_files = files(a_root), files(b_root)
+for rel in sorted(a_files ^ b_files):
+    if rel.endswith(".log"):
+        continue
+    print(f"only in {'A' if rel in a_files else 'B'}: {rel}")
+    bad += 1
+checked = 0
+for rel in sorted(a_files & b_files):
+    name = os.path.basename(rel)
+    pa, pb = os.path.join(a_root, rel), os.path.join(b_root, rel)
+    if name in BYTES or name.endswith(".vtu") or name.endswith(".pvd"):
+        same = open(pa, "rb").read() == open(pb, "rb").read()
+    elif name == "summary.json":
+        same = strip(json.load(open(pa)), a_root) == strip(json.load(open(pb)), b_root)
+    elif name in TABLES:
+        same = table(pa) == table(pb)
+    else:
+        continue
+    checked += 1
+    if not same:
+        print(f"differs: {rel}")
+        bad += 1
+print(f"{checked} files compared, {bad} differences")
+sys.exit(1 if bad else 0)
+EOF
+}
+
+case "${1:-}" in
+  run) run_all "$2" "$3" ;;
+  diff) diff_all "$2" "$3" ;;
+  "" | -h | --help) sed -n '2,17p' "$0" ;;
+  *)
+    rev="$1"
+    work="$(mktemp -d)"
+    trap 'git -C "$root" worktree remove --force "$work/src" >/dev/null 2>&1 || true; rm -rf "$work"' EXIT
+    git -C "$root" worktree add --detach "$work/src" "$rev" >/dev/null
+    echo "building $rev"
+    # Its own target directory under this tree's, kept between calls.
+    CARGO_TARGET_DIR="$root/target/same_results" cargo build --release --quiet \
+      --manifest-path "$work/src/Cargo.toml" --bin mpm
+    cp "$root/target/same_results/release/mpm" "$work/mpm_base"
+    echo "building this tree"
+    cargo build --release --quiet --manifest-path "$root/Cargo.toml" --bin mpm
+    # The scenes of this tree for both (scene files do not change).
+    run_all "$work/mpm_base" "$work/a" >/dev/null
+    run_all "$root/target/release/mpm" "$work/b" >/dev/null
+    diff_all "$work/a" "$work/b"
+    ;;
+esac
