@@ -26,17 +26,17 @@ use faer::sparse::linalg::cholesky::{
 };
 use faer::sparse::{Pair, SparseColMat, SymbolicSparseColMat, Triplet};
 use faer::Side;
-use mpm::boundary::node_constraint;
-use mpm::deformation::Trial;
+use mpm::physics::boundary::node_constraint;
+use mpm::physics::deformation::Trial;
 use mpm::dim::Vector;
-use mpm::implicit::tangent::{pk1_derivative, stiffness_triplets, Dofs, Pk1Derivative};
-use mpm::implicit::Implicit;
-use mpm::linear::direct::{DirectSolver, Structure};
+use mpm::solver::implicit::tangent::{pk1_derivative, stiffness_triplets, Dofs, Pk1Derivative};
+use mpm::solver::implicit::Implicit;
+use mpm::solver::linear::direct::{DirectSolver, Structure};
 use mpm::material::{Increment, StressDerivative};
 use mpm::scene::Scene;
-use mpm::setup::Model;
-use mpm::shape::{ShapeFunction, Stencils};
-use mpm::transfer::{external_force, NodeMap};
+use mpm::model::Model;
+use mpm::physics::shape::{ShapeFunction, Stencils};
+use mpm::physics::transfer::{external_force, NodeMap};
 use rayon::prelude::*;
 use std::hint::black_box;
 

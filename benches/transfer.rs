@@ -7,10 +7,10 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use mpm::dim::{Mat3, Tensor, Vector};
-use mpm::grid::Grid;
-use mpm::particles::Particles;
-use mpm::shape::{ShapeFunction, Stencils};
-use mpm::transfer::{gradient, interpolate, mass_momentum, nodal_force, NodeMap};
+use mpm::model::grid::Grid;
+use mpm::model::particles::Particles;
+use mpm::physics::shape::{ShapeFunction, Stencils};
+use mpm::physics::transfer::{gradient, interpolate, mass_momentum, nodal_force, NodeMap};
 use rayon::prelude::*;
 
 const SHAPES: [ShapeFunction; 6] = [

@@ -31,7 +31,7 @@ fn mpm(args: &[&str]) -> std::process::Output {
         .expect("mpm runs")
 }
 
-/// σ_yy error of one run, computed here (independently of mpm::reference).
+/// σ_yy error of one run, computed here (independently of mpm::analyses::reference).
 fn column_error(particles: &Path) -> f64 {
     let p = Table::read(particles).unwrap();
     let (y0, syy, v0) = (p.col("Y0"), p.col("syy"), p.col("volume0"));

@@ -4,7 +4,7 @@
 //! load P = 100 kN at the free end in 50 load steps.
 //!
 //! Reference: the elastica EI θ'' = −P cos θ, θ(0) = 0, θ'(L) = 0, solved by
-//! shooting on θ'(0) (RK4, bisection; `mpm::reference::elastica`, also the reference
+//! shooting on θ'(0) (RK4, bisection; `mpm::analyses::reference::elastica`, also the reference
 //! of `mpm bench` for this scene) and checked here against Mattiasson (1981).
 //! Bending stiffness: the 2D model is plane strain (ε_zz = 0) with σ_yy ≈ 0 in the
 //! beam, so a fibre's modulus is E/(1 − ν²) and EI = E d³/(12 (1 − ν²)): k = 9.6 at
@@ -29,7 +29,7 @@ mod common;
 #[path = "../examples/cantilever_fe/fe.rs"]
 mod fe;
 use common::{run_problem, Table};
-use mpm::reference::elastica::elastica;
+use mpm::analyses::reference::elastica::elastica;
 
 const L: f64 = 10.0;
 const DEPTH: f64 = 1.0;

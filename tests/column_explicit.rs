@@ -3,11 +3,11 @@
 //! the sides, fixed base. At the material point from height Y the exact Cauchy stress
 //! is σ_yy = −ρ g (l0 − Y): the weight above it over an unchanged cross-section, so
 //! it holds at finite strain too. Error (normalised L2 over the reference volume):
-//! e = √(Σ V0_p (σ_yy,p − σ_a(Y_p))²) / (ρ g l0 √(Σ V0_p)) (`mpm::reference::column`).
+//! e = √(Σ V0_p (σ_yy,p − σ_a(Y_p))²) / (ρ g l0 √(Σ V0_p)) (`mpm::analyses::reference::column`).
 
 mod common;
 use common::{run_problem, Table};
-use mpm::reference::column::Column;
+use mpm::analyses::reference::column::Column;
 
 fn column_error(shape: &str, cells: usize, extra: &[&str]) -> f64 {
     let mut args = vec![

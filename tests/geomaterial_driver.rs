@@ -14,7 +14,7 @@ use mpm::dim::Mat3;
 use mpm::material::driver::{run_mixed, MixedResponse, StressControl};
 use mpm::material::drucker_prager::{Cone, MohrCoulombFit};
 use mpm::material::mohr_coulomb::{Softening, Strength};
-use mpm::material::principal::Elasticity;
+use mpm::material::return_mapping::Elasticity;
 use mpm::material::{DruckerPrager, Material, MohrCoulomb};
 
 const E: f64 = 5.0e7;

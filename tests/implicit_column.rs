@@ -3,11 +3,11 @@
 //! rollers on the sides and the base. σ_yy = −ρ g (l0 − Y) at the material point
 //! from height Y (exact at finite strain). Error (normalised L2 over the reference
 //! volume) e = √(Σ V0 (σ_yy − σ_a)²) / (ρ g l0 √(Σ V0)), computed by
-//! `mpm::reference::column` (also the error of `mpm bench` for this scene).
+//! `mpm::analyses::reference::column` (also the error of `mpm bench` for this scene).
 
 mod common;
 use common::{run_problem, Table};
-use mpm::reference::column::Column;
+use mpm::analyses::reference::column::Column;
 
 const RHO_G: f64 = 80.0 * 10.0;
 const L0: f64 = 50.0;
@@ -38,7 +38,7 @@ fn column(shape: &str, cells: usize, extra: &[&str]) -> Run {
     }
 }
 
-/// σ_yy = −ρ g (l0 − Y) (mpm::reference::column, the `[reference]` of column.toml).
+/// σ_yy = −ρ g (l0 − Y) (mpm::analyses::reference::column, the `[reference]` of column.toml).
 const COLUMN: Column = Column {
     axis: 1,
     rho_g: RHO_G,

@@ -3,10 +3,10 @@
 //! small enough for CI. The refinement study with finer meshes is in
 //! papers/limit_analysis/.
 
-use mpm::limit_analysis::config::LimitScene;
-use mpm::limit_analysis::lower_bound::lower_bound;
-use mpm::limit_analysis::reduction::factor_of_safety;
-use mpm::limit_analysis::upper_bound::upper_bound;
+use mpm::analyses::limit_analysis::config::LimitScene;
+use mpm::analyses::limit_analysis::lower_bound::lower_bound;
+use mpm::analyses::limit_analysis::reduction::factor_of_safety;
+use mpm::analyses::limit_analysis::upper_bound::upper_bound;
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 use std::process::Command;

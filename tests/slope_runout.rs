@@ -29,7 +29,7 @@
 mod common;
 use common::{problem, read_output, run_problem, Table};
 use mpm::scene::Scene;
-use mpm::setup::Model;
+use mpm::model::Model;
 use std::sync::OnceLock;
 
 const COARSE: [&str; 2] = ["grid.cells=[60,12]", "output.frames=0"];

@@ -17,7 +17,7 @@
 mod common;
 use common::{problem, run_problem, run_text, Table};
 use mpm::scene::Scene;
-use mpm::setup::Model;
+use mpm::model::Model;
 
 const LEVEL: &str = r#"dimension = 2
 gravity = [0.0, -10.0]
@@ -121,7 +121,7 @@ fn k0_state_of_level_ground_is_in_equilibrium() {
 fn k0_depth_is_measured_below_the_slope_face() {
     let scene = Scene::load(&problem("slope_griffiths_lane.toml"), &[]).unwrap();
     let mut model = Model::<2>::build(&scene).unwrap();
-    mpm::geostatic::initialise(&mut model, &scene.config);
+    mpm::physics::geostatic::initialise(&mut model, &scene.config);
     let k0 = 1.0 - 20f64.to_radians().sin();
     let p = &model.particles;
     for q in 0..p.len() {

@@ -20,7 +20,7 @@
 //! - Newton with the exact tangent, the sparse direct solver of the project.
 
 use mpm::dim::Mat3;
-use mpm::linear::direct::{DirectSolver, Structure};
+use mpm::solver::linear::direct::{DirectSolver, Structure};
 use mpm::material::{Hencky, Increment, Material};
 
 /// The cantilever: length, depth, plane-strain Hencky constants.

@@ -20,7 +20,7 @@
 mod fe;
 
 use fe::{Beam, Cantilever, TipLoad};
-use mpm::reference::elastica::elastica;
+use mpm::analyses::reference::elastica::elastica;
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();

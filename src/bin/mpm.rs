@@ -3,7 +3,7 @@
 //! (docs/bench.md).
 
 use clap::{Parser, Subcommand};
-use mpm::bench::{bench, BenchError, BenchOptions};
+use mpm::analyses::bench::{bench, BenchError, BenchOptions};
 use mpm::run::{run, RunError, RunOptions};
 use mpm::scene::Scene;
 use std::path::PathBuf;
@@ -265,7 +265,7 @@ fn other_kind_of_file(path: &std::path::Path) -> String {
 }
 
 fn limit(scene: &std::path::Path, out: &std::path::Path, overrides: &[String]) -> ExitCode {
-    use mpm::limit_analysis::{config::LimitScene, run::run_limit};
+    use mpm::analyses::limit_analysis::{config::LimitScene, run::run_limit};
     let scene = match LimitScene::load(scene, overrides) {
         Ok(s) => s,
         Err(e) => {

@@ -35,7 +35,7 @@
 //!
 //! History: one slot, the equivalent plastic strain ε̄p.
 
-use super::principal::{self, Elasticity, Principal, PrincipalTangent, Return, ReturnMapping};
+use super::return_mapping::{self, Elasticity, Principal, PrincipalTangent, Return, ReturnMapping};
 use super::{Increment, Material, StressDerivative};
 use crate::dim::Mat3;
 
@@ -207,7 +207,7 @@ impl Material for DruckerPrager {
     }
 
     fn update(&self, inc: &Increment, history_new: &mut [f64]) -> Mat3 {
-        principal::update(self, inc, history_new)
+        return_mapping::update(self, inc, history_new)
     }
 
     fn p_wave_modulus(&self) -> f64 {
@@ -216,11 +216,11 @@ impl Material for DruckerPrager {
     }
 
     fn strain_energy_density(&self, f: &Mat3, stress: &Mat3, _history: &[f64]) -> f64 {
-        principal::stored_energy_density(&self.elastic(), f, stress)
+        return_mapping::stored_energy_density(&self.elastic(), f, stress)
     }
 
     fn stress_derivative(&self, inc: &Increment) -> Option<StressDerivative> {
-        principal::stress_derivative(self, inc)
+        return_mapping::stress_derivative(self, inc)
     }
 }
 

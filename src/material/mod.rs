@@ -15,7 +15,7 @@ pub mod mohr_coulomb;
 pub mod mooney_rivlin;
 pub mod neo_hookean;
 pub mod ogden;
-pub mod principal;
+pub mod return_mapping;
 
 pub use drucker_prager::DruckerPrager;
 pub use hencky::Hencky;

@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 
 use super::{write_f64, AXES};
 use crate::dim::Vector;
-use crate::particles::Particles;
+use crate::model::particles::Particles;
 
 /// Rows are flushed to disk at least this often even if the caller never calls `flush`.
 const AUTO_FLUSH: Duration = Duration::from_secs(1);

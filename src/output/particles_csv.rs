@@ -10,7 +10,7 @@ use std::io::{self, BufWriter, Write};
 use std::path::Path;
 
 use super::{write_f64, AXES};
-use crate::particles::Particles;
+use crate::model::particles::Particles;
 
 /// Stress components written for dimension `dim`, as (column name, row, column) of the
 /// 3×3 Cauchy stress. Plane strain (2D) still carries σ_zz.

@@ -16,7 +16,7 @@ use vtkio::model::{
 };
 
 use super::f64_string;
-use crate::particles::Particles;
+use crate::model::particles::Particles;
 
 /// Writer of ParaView frames `{prefix}_{NNNNN}.vtu` and the collection `{prefix}.pvd`.
 ///

@@ -4,7 +4,7 @@
 //! `model`, `shape` or `kind` needs is checked in `validate`. Vectors are arrays
 //! whose length must equal `dimension`.
 
-use crate::shape::ShapeFunction;
+use crate::physics::shape::ShapeFunction;
 use serde::Deserialize;
 
 #[derive(Clone, Debug, Deserialize)]
@@ -578,7 +578,7 @@ pub enum Beam {
 }
 
 /// The `[reference]` table: which analytical solution the scene has
-/// (`crate::reference`).
+/// (`crate::analyses::reference`).
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ReferenceConfig {

@@ -13,7 +13,7 @@
 
 use super::linear::{cell_coordinate, cell_index, tensor_product, AxisFactors, MAX_PER_AXIS};
 use crate::dim::Vector;
-use crate::grid::Grid;
+use crate::model::grid::Grid;
 
 /// Unit hat φ(t) = max(0, 1 − |t|).
 fn hat(t: f64) -> f64 {
@@ -83,8 +83,8 @@ pub fn evaluate<const D: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shape::linear;
-    use crate::shape::tests::*;
+    use crate::physics::shape::linear;
+    use crate::physics::shape::tests::*;
 
     fn eval<const D: usize>(g: &Grid<D>, x: &Vector<D>, half: &Vector<D>) -> Stencil<D> {
         Stencil::collect(3usize.pow(D as u32), |n, w, gr| {

@@ -17,7 +17,7 @@
 
 use super::linear;
 use crate::dim::{Tensor, Vector};
-use crate::grid::Grid;
+use crate::model::grid::Grid;
 
 /// Add `weight`, `gradient` to the entry of `id`, or append a new entry; returns the count.
 fn accumulate<const D: usize>(
@@ -92,8 +92,8 @@ pub fn evaluate<const D: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shape::gimp;
-    use crate::shape::tests::*;
+    use crate::physics::shape::gimp;
+    use crate::physics::shape::tests::*;
 
     fn eval<const D: usize>(g: &Grid<D>, x: &Vector<D>, r: &Tensor<D>) -> Stencil<D> {
         Stencil::collect(4usize.pow(D as u32), |n, w, gr| evaluate(g, x, r, n, w, gr))

@@ -16,7 +16,7 @@
 
 use crate::dim::Mat3;
 use crate::scene::{BodyConfig, SceneConfig, Shape};
-use crate::setup::Model;
+use crate::model::Model;
 
 /// Set the K0 stresses of every particle (`c.geostatic` must be present).
 pub fn initialise<const D: usize>(model: &mut Model<D>, c: &SceneConfig) {

@@ -8,7 +8,7 @@
 
 use super::linear::{cell_coordinate, cell_index, tensor_product, AxisFactors, MAX_PER_AXIS};
 use crate::dim::Vector;
-use crate::grid::Grid;
+use crate::model::grid::Grid;
 
 /// Knot `k` (cell units) of the clamped uniform knot vector of degree `p` on `cells` cells.
 fn knot(k: usize, p: usize, cells: usize) -> f64 {
@@ -103,8 +103,8 @@ pub fn evaluate<const D: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shape::linear;
-    use crate::shape::tests::*;
+    use crate::physics::shape::linear;
+    use crate::physics::shape::tests::*;
 
     fn eval<const D: usize>(g: &Grid<D>, x: &Vector<D>, p: usize) -> Stencil<D> {
         Stencil::collect((p + 1).pow(D as u32), |n, w, gr| {

@@ -36,15 +36,15 @@
 use super::tangent::{Dofs, Pk1Derivative};
 use super::{Failure, Implicit};
 use crate::dim::Vector;
-use crate::linear::cg::cg;
-use crate::linear::direct::Structure;
-use crate::linear::gmres::gmres;
-use crate::linear::iterative::{Identity, Outcome, Preconditioner, Settings};
-use crate::linear::preconditioner::{BlockJacobi, Factorized, Jacobi};
+use crate::solver::linear::cg::cg;
+use crate::solver::linear::direct::Structure;
+use crate::solver::linear::gmres::gmres;
+use crate::solver::linear::iterative::{Identity, Outcome, Preconditioner, Settings};
+use crate::solver::linear::preconditioner::{BlockJacobi, Factorized, Jacobi};
 use crate::scene::{LinearSolver, MassMatrix, PreconditionerKind, SolverConfig};
-use crate::setup::Model;
-use crate::shape::Stencils;
-use crate::transfer::NodeMap;
+use crate::model::Model;
+use crate::physics::shape::Stencils;
+use crate::physics::transfer::NodeMap;
 use nalgebra::SMatrix;
 
 /// The lagged factorization is refreshed when a linear solve with it needed more
@@ -260,7 +260,7 @@ impl<const D: usize> Implicit<D> {
         if iteration == 0 {
             state.forcing.reset();
         }
-        let r_norm = crate::linear::iterative::norm(r_free);
+        let r_norm = crate::solver::linear::iterative::norm(r_free);
         let eta = state.forcing.next(r_norm, stop);
         let built = self.build_preconditioner(m, dofs, mass, inertia)?;
 
@@ -580,7 +580,7 @@ load_steps = 1
         for (r, c, val) in triplets {
             kv[r] += val * v[c];
         }
-        let kv_norm = crate::linear::iterative::norm(&kv);
+        let kv_norm = crate::solver::linear::iterative::norm(&kv);
         let errors = steps
             .iter()
             .map(|&eps| {
@@ -600,7 +600,7 @@ load_steps = 1
                     )
                     .unwrap();
                 let diff: Vec<f64> = jv.iter().zip(&kv).map(|(a, b)| a - b).collect();
-                crate::linear::iterative::norm(&diff) / kv_norm
+                crate::solver::linear::iterative::norm(&diff) / kv_norm
             })
             .collect();
         let chosen = difference_step(m.grid.h_min(), max_norm_free(&u, dofs), 1.0);

@@ -16,22 +16,20 @@ pub mod newmark;
 pub mod support;
 pub mod tangent;
 
-use crate::absorbing::AbsorbingStep;
-use crate::boundary::{implicit_node_constraint, Constraint};
-use crate::deformation::Trial;
+use crate::physics::absorbing::AbsorbingStep;
+use crate::physics::boundary::{implicit_node_constraint, Constraint};
+use crate::physics::deformation::Trial;
 use crate::dim::Vector;
-use crate::explicit::{check_state, Divergence};
-use crate::fbar;
-use crate::linear::direct::{DirectSolver, Structure};
+use crate::solver::explicit::{check_state, Divergence};
+use crate::physics::fbar;
+use crate::solver::linear::direct::{DirectSolver, Structure};
 use crate::material::driver::numerical_stress_derivative;
 use crate::material::Increment;
 use crate::scene::{Integrator, MassMatrix, SolverConfig};
-use crate::setup::{load_factor, Model};
-use crate::shape::{ShapeFunction, Stencils};
-use crate::transfer::{
-    applied_force, external_force, interpolate, mass_momentum, nodal_force, NodeMap,
-    MIN_PARALLEL_LEN,
-};
+use crate::model::{load_factor, Model};
+use crate::physics::shape::{ShapeFunction, Stencils};
+use crate::physics::transfer::{applied_force, external_force, interpolate, mass_momentum, nodal_force, NodeMap};
+use crate::parallel::MIN_PARALLEL_LEN;
 use newmark::Newmark;
 use rayon::prelude::*;
 use std::time::Instant;
@@ -128,7 +126,7 @@ pub struct Implicit<const D: usize> {
     max_cutbacks: usize,
     /// Nodes with less particle support (cells) are tied to their neighbours.
     min_node_support: f64,
-    /// F-bar against volumetric locking (`crate::fbar`).
+    /// F-bar against volumetric locking (`crate::physics::fbar`).
     fbar: bool,
     stencils: Stencils<D>,
     map: NodeMap,
@@ -260,7 +258,7 @@ impl<const D: usize> Implicit<D> {
         let load = |q: usize| load_factor(&m.load_ramp_of, q, &scales);
         let mut force = nodal_force(&self.map, &self.stencils, p, &(m.gravity * g), &load);
         let (mass, momentum) = mass_momentum(&self.map, &self.stencils, p);
-        let v = crate::explicit::mass_average(&mass, &momentum);
+        let v = crate::solver::explicit::mass_average(&mass, &momentum);
         m.absorbing
             .add_force(&m.grid, p, &self.map, &self.stencils, &v, &mut force);
         let a: Vec<Vector<D>> = force
@@ -565,7 +563,7 @@ impl<const D: usize> Implicit<D> {
         &self,
         map: &NodeMap,
         st: &Stencils<D>,
-        p: &crate::particles::Particles<D>,
+        p: &crate::model::particles::Particles<D>,
         mass: &[f64],
         w: &[Vector<D>],
         inertia: f64,
@@ -1107,7 +1105,7 @@ dt = 0.01
                 .fold(0.0, f64::max);
             let grad_error = (0..m.particles.len())
                 .map(|q| {
-                    (crate::transfer::gradient(&solver.map, &solver.stencils, q, &u) - a).amax()
+                    (crate::physics::transfer::gradient(&solver.map, &solver.stencils, q, &u) - a).amax()
                 })
                 .fold(0.0, f64::max);
             println!(

@@ -11,7 +11,7 @@ pub mod gimp;
 pub mod linear;
 
 use crate::dim::{restrict, Mat3, Tensor, Vector};
-use crate::grid::Grid;
+use crate::model::grid::Grid;
 use rayon::prelude::*;
 use serde::Deserialize;
 
@@ -137,7 +137,7 @@ impl<const D: usize> Stencils<D> {
             .zip(self.weight.par_chunks_mut(stride))
             .zip(self.grad.par_chunks_mut(stride))
             .enumerate()
-            .with_min_len(crate::transfer::MIN_PARALLEL_LEN)
+            .with_min_len(crate::parallel::MIN_PARALLEL_LEN)
             .for_each(|(p, (((c, nd), w), g))| {
                 *c = shape.evaluate(grid, &x[p], &half_length0[p], &f[p], nd, w, g) as u32;
             });

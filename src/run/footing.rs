@@ -3,9 +3,9 @@
 //! is that load over the width (unit thickness in 2D). The run writes the
 //! load–settlement curve to footing.csv and the limit pressure to summary.json.
 
-use crate::boundary::FaceCondition;
+use crate::physics::boundary::FaceCondition;
 use crate::dim::Vector;
-use crate::grid::Grid;
+use crate::model::grid::Grid;
 use serde_json::json;
 use std::io::Write;
 

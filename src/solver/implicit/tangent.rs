@@ -10,8 +10,9 @@
 
 use crate::dim::{restrict, Mat3, Tensor, Vector};
 use crate::material::StressDerivative;
-use crate::shape::Stencils;
-use crate::transfer::{NodeMap, MIN_PARALLEL_LEN};
+use crate::physics::shape::Stencils;
+use crate::physics::transfer::NodeMap;
+use crate::parallel::MIN_PARALLEL_LEN;
 use nalgebra::SMatrix;
 use rayon::prelude::*;
 

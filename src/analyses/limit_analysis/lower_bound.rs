@@ -151,8 +151,8 @@ pub fn lower_bound(model: &Model) -> Result<Bound, SolverFailure> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::limit_analysis::cone::MohrCoulomb;
-    use crate::limit_analysis::model::{MeshSize, SlopeGeometry};
+    use crate::analyses::limit_analysis::cone::MohrCoulomb;
+    use crate::analyses::limit_analysis::model::{MeshSize, SlopeGeometry};
 
     fn slope_patch() -> Model {
         let strength = MohrCoulomb {

@@ -1,24 +1,27 @@
 //! From a validated scene to the objects a solver works on: grid, particles,
 //! materials, boundary conditions and loads.
 
-use crate::absorbing::Absorbing;
-use crate::boundary::{Constraint, FaceCondition, FrictionFace};
+pub mod grid;
+pub mod particles;
+
+use crate::physics::absorbing::Absorbing;
+use crate::physics::boundary::{Constraint, FaceCondition, FrictionFace};
 use crate::dim::Vector;
-use crate::footing::Footing;
-use crate::grid::{Face, Grid};
+use crate::run::footing::Footing;
+use crate::model::grid::{Face, Grid};
 use crate::material::mohr_coulomb::{Softening, Strength};
 use crate::material::{
     drucker_prager, DruckerPrager, Hencky, LinearElastic, Material, MohrCoulomb, MooneyRivlin,
     NeoHookean, Ogden,
 };
-use crate::particles::Particles;
+use crate::model::particles::Particles;
 use crate::scene::validate::{axis, body_bounds};
 use crate::scene::{
     expr, BodyConfig, Condition, LoadKind, MaterialConfig, MaterialModel, MohrCoulombFit, Scene,
     SceneError, Shape,
 };
-use crate::shape::{ShapeFunction, Stencils};
-use crate::transfer::NodeMap;
+use crate::physics::shape::{ShapeFunction, Stencils};
+use crate::physics::transfer::NodeMap;
 
 /// Everything a solver needs, in dimension D.
 #[derive(Debug)]

@@ -4,7 +4,7 @@
 //! the nodes of that layer inside a box (`region`, e.g. a rigid footing).
 
 use crate::dim::Vector;
-use crate::grid::{Face, Grid};
+use crate::model::grid::{Face, Grid};
 
 /// Which velocity components of a node are prescribed, and their values.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -7,12 +7,13 @@
 //! the particles follow ΔF̄ instead of ΔF.
 
 use crate::dim::{embed_deformation, Mat3, Tensor, Vector};
-use crate::fbar::{scale_factor, scaled, Cells, FBarState};
-use crate::grid::Grid;
+use crate::physics::fbar::{scale_factor, scaled, Cells, FBarState};
+use crate::model::grid::Grid;
 use crate::material::{Increment, Material};
-use crate::particles::Particles;
-use crate::shape::Stencils;
-use crate::transfer::{gradient, NodeMap, MIN_PARALLEL_LEN};
+use crate::model::particles::Particles;
+use crate::physics::shape::Stencils;
+use crate::physics::transfer::{gradient, NodeMap};
+use crate::parallel::MIN_PARALLEL_LEN;
 use rayon::prelude::*;
 
 /// The state the particles would reach under a displacement increment.

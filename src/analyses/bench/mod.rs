@@ -10,16 +10,16 @@ pub mod child;
 pub mod configurations;
 mod plots;
 
-use crate::boundary::implicit_node_constraint;
-use crate::explicit::Explicit;
-use crate::implicit::tangent::Dofs;
+use crate::physics::boundary::implicit_node_constraint;
+use crate::solver::explicit::Explicit;
+use crate::solver::implicit::tangent::Dofs;
 use crate::output::{csv_field, Table};
 use crate::scene::overrides;
 use crate::scene::validate;
 use crate::scene::{BenchConfig, Integrator, Scene, SceneConfig, SceneError, SolverKind};
-use crate::setup::Model;
-use crate::shape::Stencils;
-use crate::transfer::NodeMap;
+use crate::model::Model;
+use crate::physics::shape::Stencils;
+use crate::physics::transfer::NodeMap;
 use child::{run_child, Exit};
 use configurations::Configuration;
 use std::io::Write;
@@ -501,7 +501,7 @@ fn run_point(
     read_outputs(&mut row, &run_dir);
     row.status = status(child.exit, &run_dir, timeout);
     if row.is_ok() {
-        match crate::reference::from_scene(cfg) {
+        match crate::analyses::reference::from_scene(cfg) {
             Ok(Some(measure)) => match measure.error(&run_dir) {
                 Ok(e) => row.error = Some(e),
                 Err(m) => row.note = format!("no error: {m}"),

@@ -6,13 +6,10 @@
 //! its own stencil.
 
 use crate::dim::{Tensor, Vector};
-use crate::particles::Particles;
-use crate::shape::Stencils;
+use crate::model::particles::Particles;
+use crate::parallel::MIN_PARALLEL_LEN;
+use crate::physics::shape::Stencils;
 use rayon::prelude::*;
-
-/// Smallest number of items a parallel loop hands to one task: below it, the
-/// cost of waking threads exceeds the work (small scenes run serially).
-pub const MIN_PARALLEL_LEN: usize = 512;
 
 /// Active nodes of one step and, for each, the stencil entries that touch it.
 #[derive(Clone, Debug, Default)]
@@ -182,15 +179,4 @@ pub fn gradient<const D: usize>(
     st.range(p).fold(Tensor::<D>::zeros(), |acc, e| {
         acc + u[map.local[st.node[e] as usize] as usize] * st.grad[e].transpose()
     })
-}
-
-/// Sum of `f(i)` for i in 0..n, in parallel but with a fixed chunking so that the
-/// floating-point result does not depend on the number of threads.
-pub fn deterministic_sum(n: usize, f: impl Fn(usize) -> f64 + Sync) -> f64 {
-    const CHUNK: usize = 4096;
-    let partial: Vec<f64> = (0..n.div_ceil(CHUNK))
-        .into_par_iter()
-        .map(|c| (c * CHUNK..((c + 1) * CHUNK).min(n)).map(&f).sum())
-        .collect();
-    partial.iter().sum()
 }

@@ -2,16 +2,14 @@
 //! and MUSL orderings of the stress update (§2.2.1), a PIC/FLIP blend, and local
 //! damping for dynamic relaxation.
 
-use crate::boundary::{friction_contact, node_constraint, node_friction, Constraint, FrictionFace};
-use crate::deformation::Trial;
+use crate::physics::boundary::{friction_contact, node_constraint, node_friction, Constraint, FrictionFace};
+use crate::physics::deformation::Trial;
 use crate::dim::Vector;
 use crate::scene::{Scheme, SolverConfig};
-use crate::setup::{load_factor, Model};
-use crate::shape::{ShapeFunction, Stencils};
-use crate::transfer::{
-    applied_force, deterministic_sum, interpolate, mass_momentum, nodal_force, NodeMap,
-    MIN_PARALLEL_LEN,
-};
+use crate::model::{load_factor, Model};
+use crate::physics::shape::{ShapeFunction, Stencils};
+use crate::physics::transfer::{applied_force, interpolate, mass_momentum, nodal_force, NodeMap};
+use crate::parallel::{deterministic_sum, MIN_PARALLEL_LEN};
 use rayon::prelude::*;
 
 /// Nodes lighter than this fraction of the lightest particle get no acceleration:
@@ -50,7 +48,7 @@ pub struct Explicit<const D: usize> {
     pub fixed_dt: Option<f64>,
     pub flip: f64,
     pub damping: f64,
-    /// F-bar against volumetric locking (`crate::fbar`).
+    /// F-bar against volumetric locking (`crate::physics::fbar`).
     pub fbar: bool,
     stencils: Stencils<D>,
     map: NodeMap,

@@ -17,11 +17,12 @@
 //! are those of the particles' step-start positions.
 
 use crate::dim::{Mat3, Vector};
-use crate::grid::Grid;
-use crate::implicit::tangent::{push_terms, stiffness_triplets, Dofs, Pk1Derivative, Triplets};
-use crate::shape::linear::{cell_coordinate, cell_index};
-use crate::shape::Stencils;
-use crate::transfer::{NodeMap, MIN_PARALLEL_LEN};
+use crate::model::grid::Grid;
+use crate::solver::implicit::tangent::{push_terms, stiffness_triplets, Dofs, Pk1Derivative, Triplets};
+use crate::physics::shape::linear::{cell_coordinate, cell_index};
+use crate::physics::shape::Stencils;
+use crate::physics::transfer::NodeMap;
+use crate::parallel::MIN_PARALLEL_LEN;
 use rayon::prelude::*;
 
 /// The occupied background cells and their particles.
@@ -250,12 +251,12 @@ pub fn tangent_triplets<const D: usize>(
 
 #[cfg(test)]
 mod tests {
-    use crate::deformation::Trial;
+    use crate::physics::deformation::Trial;
     use crate::dim::{Mat3, Tensor, Vector};
     use crate::scene::Scene;
-    use crate::setup::Model;
-    use crate::shape::Stencils;
-    use crate::transfer::NodeMap;
+    use crate::model::Model;
+    use crate::physics::shape::Stencils;
+    use crate::physics::transfer::NodeMap;
 
     /// A Hencky block whose edges cut the cells anywhere, 4 × 4 particles per cell.
     const BLOCK: &str = r#"dimension = 2

@@ -13,11 +13,11 @@
 //! tangent stays the exact derivative of the (constrained) residual.
 
 use super::tangent::Tie;
-use crate::boundary::Constraint;
+use crate::physics::boundary::Constraint;
 use crate::dim::Vector;
-use crate::grid::Grid;
-use crate::shape::Stencils;
-use crate::transfer::NodeMap;
+use crate::model::grid::Grid;
+use crate::physics::shape::Stencils;
+use crate::physics::transfer::NodeMap;
 
 /// Σ_p V_p S_Ip / (cell volume) at every active node.
 pub fn nodal_support<const D: usize>(

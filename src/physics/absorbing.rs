@@ -27,14 +27,14 @@
 //! unit displacement).
 
 use crate::dim::Vector;
-use crate::grid::{Face, Grid};
-use crate::implicit::newmark::Newmark;
-use crate::implicit::tangent::{push_terms, Dofs, Triplets};
+use crate::model::grid::{Face, Grid};
+use crate::solver::implicit::newmark::Newmark;
+use crate::solver::implicit::tangent::{push_terms, Dofs, Triplets};
 use crate::material::{Increment, Material};
-use crate::particles::Particles;
+use crate::model::particles::Particles;
 use crate::scene::{BoundaryConfig, Condition};
-use crate::shape::Stencils;
-use crate::transfer::{interpolate, NodeMap};
+use crate::physics::shape::Stencils;
+use crate::physics::transfer::{interpolate, NodeMap};
 
 /// How the springs of one absorbing face are given.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -366,7 +366,7 @@ mod tests {
     use super::*;
     use crate::material::{Hencky, LinearElastic, MooneyRivlin, NeoHookean};
     use crate::scene::Scene;
-    use crate::setup::Model;
+    use crate::model::Model;
 
     /// The shear modulus read off the stress derivative at rest is G for every
     /// model, and the P-wave modulus of the trait is consistent with it.

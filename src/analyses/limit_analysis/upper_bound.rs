@@ -242,8 +242,8 @@ pub fn upper_bound(model: &Model) -> Result<Bound, SolverFailure> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::limit_analysis::cone::MohrCoulomb;
-    use crate::limit_analysis::model::MeshSize;
+    use crate::analyses::limit_analysis::cone::MohrCoulomb;
+    use crate::analyses::limit_analysis::model::MeshSize;
 
     /// The quadratic shape functions reproduce linear and quadratic fields:
     /// Σ ∇N_a x_a = (1, 0), Σ ∇N_a = 0, and ∇(x²) at a vertex is (2x, 0).

@@ -3,16 +3,19 @@
 //! stops the run cleanly: everything written so far is flushed and summary.json
 //! records what happened where.
 
-use crate::explicit::{check_state, Divergence, Explicit};
-use crate::footing::FootingCurve;
-use crate::implicit::{Implicit, NEWTON_CSV_HEADER};
+
+pub mod footing;
+
+use crate::solver::explicit::{check_state, Divergence, Explicit};
+use crate::run::footing::FootingCurve;
+use crate::solver::implicit::{Implicit, NEWTON_CSV_HEADER};
 use crate::output::{
     body_centres, write_json, write_particles_csv_with, FrameWriter, HistoryWriter, Progress,
 };
 use crate::scene::{Integrator, LinearSolver, SolverConfig, SolverKind};
 use crate::scene::{Scene, SceneError};
-use crate::setup::Model;
-use crate::transfer::deterministic_sum;
+use crate::model::Model;
+use crate::parallel::deterministic_sum;
 use serde_json::json;
 use std::io::Write;
 use std::path::Path;
@@ -56,7 +59,7 @@ pub struct RunOptions {
 pub fn run(scene: &Scene, out: &Path, opts: &RunOptions) -> Result<RunSummary, RunError> {
     std::fs::create_dir_all(out)?;
     if scene.config.strength_reduction.is_some() && opts.strength_factor.is_none() {
-        return crate::strength_reduction::search(scene, out, opts);
+        return crate::analyses::strength_reduction::search(scene, out, opts);
     }
     match scene.config.dimension {
         2 => run_dim::<2>(scene, out, opts),
@@ -90,7 +93,7 @@ enum Stepper<const D: usize> {
 type NewtonLog = Option<std::io::BufWriter<std::fs::File>>;
 
 impl<const D: usize> Stepper<D> {
-    fn new(shape: crate::shape::ShapeFunction, s: &SolverConfig, t_start: f64) -> Self {
+    fn new(shape: crate::physics::shape::ShapeFunction, s: &SolverConfig, t_start: f64) -> Self {
         match s.kind {
             SolverKind::Explicit => Stepper::Explicit(Box::new(Explicit::new(shape, s))),
             SolverKind::Implicit => Stepper::Implicit(Box::new(Implicit::new(shape, s, t_start))),
@@ -187,7 +190,7 @@ fn run_dim<const D: usize>(
         model.reduce_strength(&cfg.materials, strength_factor);
     }
     if cfg.geostatic.is_some() {
-        crate::geostatic::initialise(&mut model, cfg);
+        crate::physics::geostatic::initialise(&mut model, cfg);
     }
     let monitor = opts
         .monitor

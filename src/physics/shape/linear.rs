@@ -5,7 +5,7 @@
 //! (linear, GIMP, B-splines).
 
 use crate::dim::Vector;
-use crate::grid::Grid;
+use crate::model::grid::Grid;
 
 /// Most nodes a separable family touches per direction (cubic B-spline).
 pub(super) const MAX_PER_AXIS: usize = 4;
@@ -106,7 +106,7 @@ pub fn evaluate<const D: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shape::tests::*;
+    use crate::physics::shape::tests::*;
 
     fn eval<const D: usize>(g: &Grid<D>, x: &Vector<D>) -> Stencil<D> {
         Stencil::collect(1 << D, |n, w, gr| evaluate(g, x, n, w, gr))

@@ -1,0 +1,11 @@
+//! Physics shared by the explicit and the implicit solver: shape functions,
+//! particle–grid transfers, the stress update, F-bar kinematics, and the laws of
+//! the boundary conditions. Nothing here knows which solver calls it.
+
+pub mod absorbing;
+pub mod boundary;
+pub mod deformation;
+pub mod fbar;
+pub mod geostatic;
+pub mod shape;
+pub mod transfer;
