@@ -26,17 +26,17 @@ use faer::sparse::linalg::cholesky::{
 };
 use faer::sparse::{Pair, SparseColMat, SymbolicSparseColMat, Triplet};
 use faer::Side;
+use mpm::dim::Vector;
+use mpm::material::{Increment, StressDerivative};
+use mpm::model::Model;
 use mpm::physics::boundary::node_constraint;
 use mpm::physics::deformation::Trial;
-use mpm::dim::Vector;
+use mpm::physics::shape::{ShapeFunction, Stencils};
+use mpm::physics::transfer::{external_force, NodeMap};
+use mpm::scene::Scene;
 use mpm::solver::implicit::tangent::{pk1_derivative, stiffness_triplets, Dofs, Pk1Derivative};
 use mpm::solver::implicit::Implicit;
 use mpm::solver::linear::direct::{DirectSolver, Structure};
-use mpm::material::{Increment, StressDerivative};
-use mpm::scene::Scene;
-use mpm::model::Model;
-use mpm::physics::shape::{ShapeFunction, Stencils};
-use mpm::physics::transfer::{external_force, NodeMap};
 use rayon::prelude::*;
 use std::hint::black_box;
 

@@ -14,10 +14,10 @@ mod common;
 
 use common::{problem, run_problem, run_text, Table};
 use mpm::dim::Vector;
-use mpm::solver::explicit::Explicit;
+use mpm::model::Model;
 use mpm::run::{kinetic_energy, strain_energy};
 use mpm::scene::Scene;
-use mpm::model::Model;
+use mpm::solver::explicit::Explicit;
 
 /// (incident work W, energy left at the end) from a finished run's history.csv.
 fn energies(dir: &std::path::Path) -> (f64, f64) {

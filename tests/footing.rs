@@ -7,8 +7,8 @@
 
 mod common;
 use common::{newton_order, run_problem, step_residuals, Table};
-use mpm::scene::Scene;
 use mpm::model::Model;
+use mpm::scene::Scene;
 
 /// Prandtl's bearing capacity factor N_c for friction angle φ (degrees).
 fn prandtl_nc(phi_deg: f64) -> f64 {

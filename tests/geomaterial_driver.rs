@@ -12,10 +12,12 @@
 
 use mpm::dim::Mat3;
 use mpm::material::driver::{run_mixed, MixedResponse, StressControl};
+use mpm::material::drucker_prager::DruckerPrager;
 use mpm::material::drucker_prager::{Cone, MohrCoulombFit};
+use mpm::material::mohr_coulomb::MohrCoulomb;
 use mpm::material::mohr_coulomb::{Softening, Strength};
 use mpm::material::return_mapping::Elasticity;
-use mpm::material::{DruckerPrager, Material, MohrCoulomb};
+use mpm::material::Material;
 
 const E: f64 = 5.0e7;
 const NU: f64 = 0.3;

@@ -27,7 +27,8 @@ fn bar(dt: f64, end: f64, extra: &[&str]) -> Table {
 }
 
 fn period(h: &Table) -> f64 {
-    mpm::analyses::reference::bar::period(h.col("t"), h.col("body0_vx")).expect("two zero crossings")
+    mpm::analyses::reference::bar::period(h.col("t"), h.col("body0_vx"))
+        .expect("two zero crossings")
 }
 
 fn energy(h: &Table) -> Vec<f64> {

@@ -28,8 +28,8 @@
 
 mod common;
 use common::{problem, read_output, run_problem, Table};
-use mpm::scene::Scene;
 use mpm::model::Model;
+use mpm::scene::Scene;
 use std::sync::OnceLock;
 
 const COARSE: [&str; 2] = ["grid.cells=[60,12]", "output.frames=0"];

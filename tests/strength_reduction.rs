@@ -16,8 +16,8 @@
 
 mod common;
 use common::{problem, run_problem, run_text, Table};
-use mpm::scene::Scene;
 use mpm::model::Model;
+use mpm::scene::Scene;
 
 const LEVEL: &str = r#"dimension = 2
 gravity = [0.0, -10.0]

@@ -20,8 +20,9 @@
 //! - Newton with the exact tangent, the sparse direct solver of the project.
 
 use mpm::dim::Mat3;
+use mpm::material::hencky::Hencky;
+use mpm::material::{Increment, Material};
 use mpm::solver::linear::direct::{DirectSolver, Structure};
-use mpm::material::{Hencky, Increment, Material};
 
 /// The cantilever: length, depth, plane-strain Hencky constants.
 #[derive(Clone, Copy, Debug)]

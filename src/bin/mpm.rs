@@ -4,7 +4,8 @@
 
 use clap::{Parser, Subcommand};
 use mpm::analyses::bench::{bench, BenchError, BenchOptions};
-use mpm::run::{run, RunError, RunOptions};
+use mpm::analyses::{check, run_scene};
+use mpm::run::{RunError, RunOptions};
 use mpm::scene::Scene;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -159,7 +160,7 @@ fn main() -> ExitCode {
             out,
             overrides,
         } => limit(&scene, &out, &overrides),
-        Command::Check { scene, overrides } => match Scene::load(&scene, &overrides) {
+        Command::Check { scene, overrides } => match load(&scene, &overrides) {
             Ok(s) => {
                 let c = &s.config;
                 let stages: Vec<String> = c
@@ -200,14 +201,14 @@ fn main() -> ExitCode {
                     return ExitCode::from(2);
                 }
             }
-            let scene = match Scene::load(&scene, &overrides) {
+            let scene = match load(&scene, &overrides) {
                 Ok(s) => s,
                 Err(e) => {
                     eprintln!("error: {e}{}", other_kind_of_file(&scene));
                     return ExitCode::from(2);
                 }
             };
-            match run(
+            match run_scene(
                 &scene,
                 &out,
                 &RunOptions {
@@ -238,6 +239,14 @@ fn main() -> ExitCode {
             }
         }
     }
+}
+
+/// A scene for `mpm run` and `mpm check`: parsed, validated, and its analysis
+/// tables checked.
+fn load(path: &std::path::Path, overrides: &[String]) -> Result<Scene, mpm::scene::SceneError> {
+    let scene = Scene::load(path, overrides)?;
+    check(&scene)?;
+    Ok(scene)
 }
 
 /// A hint when a scene that `run`/`check` rejects is a limit-analysis file (top-level

@@ -17,14 +17,6 @@ pub mod neo_hookean;
 pub mod ogden;
 pub mod return_mapping;
 
-pub use drucker_prager::DruckerPrager;
-pub use hencky::Hencky;
-pub use linear_elastic::LinearElastic;
-pub use mohr_coulomb::MohrCoulomb;
-pub use mooney_rivlin::MooneyRivlin;
-pub use neo_hookean::NeoHookean;
-pub use ogden::Ogden;
-
 use crate::dim::Mat3;
 use nalgebra::SMatrix;
 
@@ -124,4 +116,29 @@ pub fn lame(youngs_modulus: f64, poisson_ratio: f64) -> (f64, f64) {
     let lambda =
         youngs_modulus * poisson_ratio / ((1.0 + poisson_ratio) * (1.0 - 2.0 * poisson_ratio));
     (lambda, g)
+}
+
+/// Small-strain shear modulus of a material: ∂σ_xy/∂ΔF_xy at rest (unstressed,
+/// undeformed), from its stress derivative, or by a central difference of its
+/// stress update when it has none. For isotropic elasticity this is G.
+pub fn shear_modulus(m: &dyn Material) -> f64 {
+    let history = vec![0.0; m.n_history()];
+    let at_rest = |df| Increment {
+        f_old: Mat3::identity(),
+        df,
+        dt: 0.0,
+        stress_old: Mat3::zeros(),
+        history_old: &history,
+    };
+    if let Some(d) = m.stress_derivative(&at_rest(Mat3::identity())) {
+        return d[(1, 1)];
+    }
+    let h = 1e-7;
+    let sigma_xy = |s: f64| {
+        let mut df = Mat3::identity();
+        df[(0, 1)] = s;
+        let mut scratch = history.clone();
+        m.update(&at_rest(df), &mut scratch)[(0, 1)]
+    };
+    (sigma_xy(h) - sigma_xy(-h)) / (2.0 * h)
 }

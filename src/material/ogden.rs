@@ -111,7 +111,8 @@ impl Material for Ogden {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::material::{driver, NeoHookean};
+    use crate::material::driver;
+    use crate::material::neo_hookean::NeoHookean;
 
     fn general_f() -> Mat3 {
         Mat3::new(1.2, 0.3, -0.1, 0.05, 0.9, 0.15, 0.02, -0.1, 1.1)

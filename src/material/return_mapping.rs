@@ -207,7 +207,8 @@ pub fn stored_energy_density(el: &Elasticity, f: &Mat3, stress: &Mat3) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::material::{driver, Hencky, Material};
+    use crate::material::hencky::Hencky;
+    use crate::material::{driver, Material};
 
     /// The purely elastic return: the framework must reproduce the Hencky model.
     #[derive(Debug)]

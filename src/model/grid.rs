@@ -8,6 +8,7 @@
 //! face act on exactly one layer of nodes in every family.
 
 use crate::dim::Vector;
+use crate::scene::Face;
 
 #[derive(Clone, Debug)]
 pub struct Grid<const D: usize> {
@@ -20,39 +21,6 @@ pub struct Grid<const D: usize> {
     pub degree: usize,
     /// Nodes per direction: `cells + degree`.
     pub nodes: [usize; D],
-}
-
-/// One face of the grid box: `axis` 0..D, `upper` false for the min face.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Face {
-    pub axis: usize,
-    pub upper: bool,
-}
-
-impl Face {
-    /// Parse "xmin", "ymax", "zmin", ...
-    pub fn parse(name: &str, dim: usize) -> Option<Face> {
-        let axis = match name.as_bytes().first()? {
-            b'x' => 0,
-            b'y' => 1,
-            b'z' => 2,
-            _ => return None,
-        };
-        let upper = match &name[1..] {
-            "min" => false,
-            "max" => true,
-            _ => return None,
-        };
-        (axis < dim).then_some(Face { axis, upper })
-    }
-
-    pub fn name(&self) -> String {
-        format!(
-            "{}{}",
-            ["x", "y", "z"][self.axis],
-            if self.upper { "max" } else { "min" }
-        )
-    }
 }
 
 impl<const D: usize> Grid<D> {
@@ -119,6 +87,16 @@ impl<const D: usize> Grid<D> {
         self.h.min()
     }
 
+    /// Is x in the outermost layer of cells of `face` (within one cell size of it)?
+    pub fn in_outer_layer(&self, face: Face, x: &Vector<D>) -> bool {
+        let a = face.axis;
+        if face.upper {
+            self.max[a] - x[a] < self.h[a]
+        } else {
+            x[a] - self.min[a] < self.h[a]
+        }
+    }
+
     pub fn cell_volume(&self) -> f64 {
         self.h.product()
     }
@@ -157,25 +135,5 @@ mod tests {
         // Quadratic clamped on 5 cells: knots 0,0,0,1,2,3,4,5,5,5 -> 0, .5, 1.5, 2.5, 3.5, 4.5, 5
         let g: Vec<f64> = (0..7).map(|i| greville(i, 2, 5)).collect();
         assert_eq!(g, vec![0.0, 0.5, 1.5, 2.5, 3.5, 4.5, 5.0]);
-    }
-
-    #[test]
-    fn faces_parse() {
-        assert_eq!(
-            Face::parse("ymax", 2),
-            Some(Face {
-                axis: 1,
-                upper: true
-            })
-        );
-        assert_eq!(Face::parse("zmin", 2), None);
-        assert_eq!(
-            Face::parse("zmin", 3),
-            Some(Face {
-                axis: 2,
-                upper: false
-            })
-        );
-        assert_eq!(Face::parse("xmid", 3), None);
     }
 }

@@ -1,27 +1,31 @@
 //! From a validated scene to the objects a solver works on: grid, particles,
 //! materials, boundary conditions and loads.
 
+pub mod conditions;
 pub mod grid;
 pub mod particles;
 
-use crate::physics::absorbing::Absorbing;
-use crate::physics::boundary::{Constraint, FaceCondition, FrictionFace};
 use crate::dim::Vector;
-use crate::run::footing::Footing;
-use crate::model::grid::{Face, Grid};
+use crate::material::drucker_prager::DruckerPrager;
+use crate::material::hencky::Hencky;
+use crate::material::linear_elastic::LinearElastic;
+use crate::material::mohr_coulomb::MohrCoulomb;
 use crate::material::mohr_coulomb::{Softening, Strength};
-use crate::material::{
-    drucker_prager, DruckerPrager, Hencky, LinearElastic, Material, MohrCoulomb, MooneyRivlin,
-    NeoHookean, Ogden,
-};
+use crate::material::mooney_rivlin::MooneyRivlin;
+use crate::material::neo_hookean::NeoHookean;
+use crate::material::ogden::Ogden;
+use crate::material::{drucker_prager, Material};
+use crate::model::conditions::Absorbing;
+use crate::model::conditions::Footing;
+use crate::model::conditions::{Constraint, FaceCondition, FrictionFace};
+use crate::model::grid::Grid;
 use crate::model::particles::Particles;
 use crate::scene::validate::{axis, body_bounds};
+use crate::scene::Face;
 use crate::scene::{
     expr, BodyConfig, Condition, LoadKind, MaterialConfig, MaterialModel, MohrCoulombFit, Scene,
     SceneError, Shape,
 };
-use crate::physics::shape::{ShapeFunction, Stencils};
-use crate::physics::transfer::NodeMap;
 
 /// Everything a solver needs, in dimension D.
 #[derive(Debug)]
@@ -183,19 +187,6 @@ impl<const D: usize> Model<D> {
     /// Load factor of each load time history at time t.
     pub fn load_scales(&self, t: f64) -> Vec<f64> {
         self.load_ramps.iter().map(|r| r.factor(t)).collect()
-    }
-
-    /// The particles' shape-function stencils on the grid and the active nodes
-    /// they touch: what every step starts from.
-    pub fn stencils_and_nodes(
-        &self,
-        shape: ShapeFunction,
-        st: &mut Stencils<D>,
-        map: &mut NodeMap,
-    ) {
-        let p = &self.particles;
-        st.compute(shape, &self.grid, &p.x, &p.half_length0, &p.f);
-        map.build(st, self.grid.node_count());
     }
 
     /// Set every material to the scene's one with c/F, tan φ/F, tan ψ/F when it

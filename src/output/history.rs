@@ -5,7 +5,7 @@ use std::io::{self, BufWriter, Write};
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use super::{write_f64, AXES};
+use super::text::{write_f64, AXES};
 use crate::dim::Vector;
 use crate::model::particles::Particles;
 

@@ -9,7 +9,7 @@ use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::Path;
 
-use super::{write_f64, AXES};
+use super::text::{write_f64, AXES};
 use crate::model::particles::Particles;
 
 /// Stress components written for dimension `dim`, as (column name, row, column) of the

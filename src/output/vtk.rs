@@ -15,7 +15,7 @@ use vtkio::model::{
     UnstructuredGridPiece, Version, VertexNumbers, Vtk,
 };
 
-use super::f64_string;
+use super::text::f64_string;
 use crate::model::particles::Particles;
 
 /// Writer of ParaView frames `{prefix}_{NNNNN}.vtu` and the collection `{prefix}.pvd`.

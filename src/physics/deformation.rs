@@ -7,13 +7,13 @@
 //! the particles follow ΔF̄ instead of ΔF.
 
 use crate::dim::{embed_deformation, Mat3, Tensor, Vector};
-use crate::physics::fbar::{scale_factor, scaled, Cells, FBarState};
-use crate::model::grid::Grid;
 use crate::material::{Increment, Material};
+use crate::model::grid::Grid;
 use crate::model::particles::Particles;
+use crate::parallel::MIN_PARALLEL_LEN;
+use crate::physics::fbar::{scale_factor, scaled, Cells, FBarState};
 use crate::physics::shape::Stencils;
 use crate::physics::transfer::{gradient, NodeMap};
-use crate::parallel::MIN_PARALLEL_LEN;
 use rayon::prelude::*;
 
 /// The state the particles would reach under a displacement increment.

@@ -15,8 +15,8 @@
 //! K0 is the scene's `k0`, else Jáky's 1 − sin φ of the body's material.
 
 use crate::dim::Mat3;
-use crate::scene::{BodyConfig, SceneConfig, Shape};
 use crate::model::Model;
+use crate::scene::{BodyConfig, SceneConfig, Shape};
 
 /// Set the K0 stresses of every particle (`c.geostatic` must be present).
 pub fn initialise<const D: usize>(model: &mut Model<D>, c: &SceneConfig) {

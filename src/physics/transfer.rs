@@ -7,8 +7,9 @@
 
 use crate::dim::{Tensor, Vector};
 use crate::model::particles::Particles;
+use crate::model::Model;
 use crate::parallel::MIN_PARALLEL_LEN;
-use crate::physics::shape::Stencils;
+use crate::physics::shape::{ShapeFunction, Stencils};
 use rayon::prelude::*;
 
 /// Active nodes of one step and, for each, the stencil entries that touch it.
@@ -102,6 +103,19 @@ impl NodeMap {
             })
             .collect()
     }
+}
+
+/// The particles' shape-function stencils on the grid and the active nodes they
+/// touch: what every step starts from.
+pub fn stencils_and_nodes<const D: usize>(
+    m: &Model<D>,
+    shape: ShapeFunction,
+    st: &mut Stencils<D>,
+    map: &mut NodeMap,
+) {
+    let p = &m.particles;
+    st.compute(shape, &m.grid, &p.x, &p.half_length0, &p.f);
+    map.build(st, m.grid.node_count());
 }
 
 /// Nodal mass (2-24) and momentum (2-25).

@@ -3,49 +3,8 @@
 //! is that load over the width (unit thickness in 2D). The run writes the
 //! load–settlement curve to footing.csv and the limit pressure to summary.json.
 
-use crate::physics::boundary::FaceCondition;
-use crate::dim::Vector;
-use crate::model::grid::Grid;
 use serde_json::json;
 use std::io::Write;
-
-/// The footing of a scene (at most one).
-#[derive(Clone, Debug)]
-pub struct Footing<const D: usize> {
-    pub condition: FaceCondition<D>,
-    /// Width the load is spread over (the modelled width: B/2 in a half model).
-    pub width: f64,
-    /// Cohesion of the material under the footing centre, if it has one.
-    pub cohesion: Option<f64>,
-}
-
-impl<const D: usize> Footing<D> {
-    /// +1 on an upper face (the footing pushes towards −axis), −1 on a lower one.
-    fn outward(&self) -> f64 {
-        if self.condition.face.upper {
-            1.0
-        } else {
-            -1.0
-        }
-    }
-
-    /// Rate at which the footing moves into the body.
-    pub fn settlement_rate(&self) -> f64 {
-        -self.outward() * self.condition.constraint.value[self.condition.face.axis]
-    }
-
-    /// Load the footing exerts on the body, from the reactions (grid node,
-    /// force of the prescribed components on the body) of a converged step.
-    pub fn load(&self, grid: &Grid<D>, reaction: &[(u32, Vector<D>)]) -> f64 {
-        let axis = self.condition.face.axis;
-        let total: f64 = reaction
-            .iter()
-            .filter(|(g, _)| self.condition.acts_on(grid, grid.node_ijk(*g as usize)))
-            .map(|(_, f)| f[axis])
-            .sum();
-        -self.outward() * total
-    }
-}
 
 /// The load–settlement curve, written to footing.csv as it grows.
 pub struct FootingCurve {

@@ -3,19 +3,18 @@
 //! stops the run cleanly: everything written so far is flushed and summary.json
 //! records what happened where.
 
-
 pub mod footing;
 
-use crate::solver::explicit::{check_state, Divergence, Explicit};
-use crate::run::footing::FootingCurve;
-use crate::solver::implicit::{Implicit, NEWTON_CSV_HEADER};
+use crate::model::Model;
 use crate::output::{
     body_centres, write_json, write_particles_csv_with, FrameWriter, HistoryWriter, Progress,
 };
+use crate::parallel::deterministic_sum;
+use crate::run::footing::FootingCurve;
 use crate::scene::{Integrator, LinearSolver, SolverConfig, SolverKind};
 use crate::scene::{Scene, SceneError};
-use crate::model::Model;
-use crate::parallel::deterministic_sum;
+use crate::solver::explicit::{check_state, Divergence, Explicit};
+use crate::solver::implicit::{Implicit, NEWTON_CSV_HEADER};
 use serde_json::json;
 use std::io::Write;
 use std::path::Path;
@@ -47,8 +46,7 @@ pub struct RunOptions {
     /// Show a progress bar (only drawn when stderr is a terminal).
     pub progress: bool,
     /// Run with the strengths reduced by this factor (one trial of a strength
-    /// reduction search; `None`: as given, or the search itself when the scene
-    /// has `[strength_reduction]`).
+    /// reduction search; `None`: as given).
     pub strength_factor: Option<f64>,
     /// Report the displacement of the particle nearest to this point
     /// (summary.json `monitor_displacement`).
@@ -58,9 +56,6 @@ pub struct RunOptions {
 /// Run a scene, writing its outputs into `out`.
 pub fn run(scene: &Scene, out: &Path, opts: &RunOptions) -> Result<RunSummary, RunError> {
     std::fs::create_dir_all(out)?;
-    if scene.config.strength_reduction.is_some() && opts.strength_factor.is_none() {
-        return crate::analyses::strength_reduction::search(scene, out, opts);
-    }
     match scene.config.dimension {
         2 => run_dim::<2>(scene, out, opts),
         3 => run_dim::<3>(scene, out, opts),

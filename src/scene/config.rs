@@ -4,7 +4,7 @@
 //! `model`, `shape` or `kind` needs is checked in `validate`. Vectors are arrays
 //! whose length must equal `dimension`.
 
-use crate::physics::shape::ShapeFunction;
+use super::grid::GridConfig;
 use serde::Deserialize;
 
 #[derive(Clone, Debug, Deserialize)]
@@ -40,20 +40,6 @@ pub struct SceneConfig {
     pub reference: Option<ReferenceConfig>,
     /// Settings of `mpm bench` for this scene.
     pub bench: Option<BenchConfig>,
-}
-
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct GridConfig {
-    pub min: Vec<f64>,
-    pub max: Vec<f64>,
-    pub cells: Vec<usize>,
-    #[serde(default = "default_shape")]
-    pub shape_function: ShapeFunction,
-}
-
-fn default_shape() -> ShapeFunction {
-    ShapeFunction::Linear
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]

@@ -8,11 +8,13 @@
 mod config;
 mod error;
 pub mod expr;
+mod grid;
 pub mod overrides;
 pub mod validate;
 
 pub use config::*;
 pub use error::SceneError;
+pub use grid::*;
 
 use std::path::Path;
 

@@ -2,7 +2,7 @@
 //! path (`material.0.poisson_ratio`) so the error can point at its line.
 
 use super::config::*;
-use crate::model::grid::Face;
+use super::grid::{Face, GridConfig};
 
 type Check = Result<(), (String, String)>;
 
@@ -120,7 +120,6 @@ pub fn validate(s: &SceneConfig) -> Check {
     if let Some(r) = &s.strength_reduction {
         strength_reduction(r, s)?;
     }
-    crate::analyses::reference::from_scene(s)?;
     if let Some(b) = &s.bench {
         bench(b, "bench")?;
     }

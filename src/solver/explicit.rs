@@ -2,14 +2,16 @@
 //! and MUSL orderings of the stress update (§2.2.1), a PIC/FLIP blend, and local
 //! damping for dynamic relaxation.
 
-use crate::physics::boundary::{friction_contact, node_constraint, node_friction, Constraint, FrictionFace};
-use crate::physics::deformation::Trial;
 use crate::dim::Vector;
-use crate::scene::{Scheme, SolverConfig};
+use crate::model::conditions::{Constraint, FrictionFace};
 use crate::model::{load_factor, Model};
+use crate::parallel::{deterministic_sum, MIN_PARALLEL_LEN};
+use crate::physics::absorbing;
+use crate::physics::boundary::{friction_contact, node_constraint, node_friction};
+use crate::physics::deformation::Trial;
 use crate::physics::shape::{ShapeFunction, Stencils};
 use crate::physics::transfer::{applied_force, interpolate, mass_momentum, nodal_force, NodeMap};
-use crate::parallel::{deterministic_sum, MIN_PARALLEL_LEN};
+use crate::scene::{Scheme, SolverConfig};
 use rayon::prelude::*;
 
 /// Nodes lighter than this fraction of the lightest particle get no acceleration:
@@ -106,7 +108,12 @@ impl<const D: usize> Explicit<D> {
         step: usize,
     ) -> Result<f64, Divergence> {
         let p = &m.particles;
-        m.stencils_and_nodes(self.shape, &mut self.stencils, &mut self.map);
+        crate::physics::transfer::stencils_and_nodes(
+            m,
+            self.shape,
+            &mut self.stencils,
+            &mut self.map,
+        );
         if self.fbar {
             self.trial.use_fbar(&m.grid, &p.x);
         }
@@ -135,8 +142,7 @@ impl<const D: usize> Explicit<D> {
         let load_factor = |q: usize| load_factor(&m.load_ramp_of, q, &scales);
         let mut force = nodal_force(map, st, p, &m.gravity, &load_factor);
         // Absorbing faces: dashpot (and spring) forces on the outer cell layer (2-63).
-        m.absorbing
-            .add_force(&m.grid, p, map, st, &velocity, &mut force);
+        absorbing::add_force(&m.absorbing, &m.grid, p, map, st, &velocity, &mut force);
         let mut accel: Vec<Vector<D>> = (0..map.len())
             .into_par_iter()
             .with_min_len(MIN_PARALLEL_LEN)

@@ -2,7 +2,8 @@
 //! and read its CSV outputs by column name.
 #![allow(dead_code)]
 
-use mpm::run::{run, RunError, RunOptions, RunSummary};
+use mpm::analyses::run_scene;
+use mpm::run::{RunError, RunOptions, RunSummary};
 use mpm::scene::Scene;
 use std::path::{Path, PathBuf};
 
@@ -20,16 +21,16 @@ pub fn run_problem(
     let dir = tempfile::tempdir().unwrap();
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     let scene = Scene::load(&problem(name), &overrides).expect("scene loads");
-    let result = run(&scene, dir.path(), &RunOptions::default());
+    let result = run_scene(&scene, dir.path(), &RunOptions::default());
     (result, dir)
 }
 
+#[allow(unused_imports)]
+pub use mpm::analyses::reference::bar::zero_crossings;
 /// CSV outputs by column name, and the zero crossings of a sampled signal: the
 /// library's own (used by the error measures of `mpm bench`).
 #[allow(unused_imports)]
 pub use mpm::output::Table;
-#[allow(unused_imports)]
-pub use mpm::reference::bar::zero_crossings;
 
 /// Run scene text (named `scene.toml` in errors) with overrides.
 pub fn run_text(
@@ -39,7 +40,7 @@ pub fn run_text(
     let dir = tempfile::tempdir().unwrap();
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     let scene = Scene::parse("scene.toml", text, &overrides).expect("scene parses");
-    let result = run(&scene, dir.path(), &RunOptions::default());
+    let result = run_scene(&scene, dir.path(), &RunOptions::default());
     (result, dir)
 }
 

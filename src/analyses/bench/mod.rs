@@ -10,16 +10,16 @@ pub mod child;
 pub mod configurations;
 mod plots;
 
-use crate::physics::boundary::implicit_node_constraint;
-use crate::solver::explicit::Explicit;
-use crate::solver::implicit::tangent::Dofs;
+use crate::model::Model;
 use crate::output::{csv_field, Table};
+use crate::physics::boundary::implicit_node_constraint;
+use crate::physics::shape::Stencils;
+use crate::physics::transfer::NodeMap;
 use crate::scene::overrides;
 use crate::scene::validate;
 use crate::scene::{BenchConfig, Integrator, Scene, SceneConfig, SceneError, SolverKind};
-use crate::model::Model;
-use crate::physics::shape::Stencils;
-use crate::physics::transfer::NodeMap;
+use crate::solver::explicit::Explicit;
+use crate::solver::implicit::tangent::Dofs;
 use child::{run_child, Exit};
 use configurations::Configuration;
 use std::io::Write;
@@ -603,7 +603,12 @@ fn unknowns_dim<const D: usize>(
 ) -> Result<(usize, usize), SceneError> {
     let m = Model::<D>::build(scene)?;
     let (mut st, mut map) = (Stencils::<D>::default(), NodeMap::default());
-    m.stencils_and_nodes(scene.config.grid.shape_function, &mut st, &mut map);
+    crate::physics::transfer::stencils_and_nodes(
+        &m,
+        scene.config.grid.shape_function,
+        &mut st,
+        &mut map,
+    );
     let n = if implicit {
         let fixed = map
             .active

@@ -12,93 +12,41 @@ pub mod linear;
 
 use crate::dim::{restrict, Mat3, Tensor, Vector};
 use crate::model::grid::Grid;
+pub use crate::scene::ShapeFunction;
 use rayon::prelude::*;
-use serde::Deserialize;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum ShapeFunction {
-    /// Standard MPM: piecewise-linear (bilinear, trilinear) hat functions.
-    Linear,
-    /// Uniform GIMP: fixed axis-aligned particle domain.
-    Ugimp,
-    /// Contiguous-particle GIMP: axis-aligned domain stretched by the diagonal of F.
-    Cpgimp,
-    /// Convected particle domain interpolation (CPDI1): parallelogram/parallelepiped
-    /// spanned by r_i = F r_i⁰, weights from the corners.
-    Cpdi,
-    /// Quadratic B-spline on a clamped uniform knot vector.
-    Bspline2,
-    /// Cubic B-spline on a clamped uniform knot vector.
-    Bspline3,
-}
-
-impl ShapeFunction {
-    pub fn name(&self) -> &'static str {
-        match self {
-            ShapeFunction::Linear => "linear",
-            ShapeFunction::Ugimp => "ugimp",
-            ShapeFunction::Cpgimp => "cpgimp",
-            ShapeFunction::Cpdi => "cpdi",
-            ShapeFunction::Bspline2 => "bspline2",
-            ShapeFunction::Bspline3 => "bspline3",
+/// Evaluate the nodes, weights and gradients of one particle. Writes at most
+/// `max_support` entries into the output slices and returns how many it wrote.
+/// `half_length0` is the reference half-size of the particle domain and `f` its
+/// deformation gradient (used by cpGIMP and CPDI).
+#[allow(clippy::too_many_arguments)]
+pub fn evaluate<const D: usize>(
+    shape: ShapeFunction,
+    grid: &Grid<D>,
+    x: &Vector<D>,
+    half_length0: &Vector<D>,
+    f: &Mat3,
+    node: &mut [u32],
+    w: &mut [f64],
+    grad: &mut [Vector<D>],
+) -> usize {
+    match shape {
+        ShapeFunction::Linear => linear::evaluate(grid, x, node, w, grad),
+        ShapeFunction::Ugimp => gimp::evaluate(grid, x, half_length0, node, w, grad),
+        ShapeFunction::Cpgimp => {
+            // Stretched by F_dd, kept within (0, h/2] so the support stays 3^D
+            // nodes: a domain stretched beyond a cell is capped at one cell.
+            let half = Vector::<D>::from_fn(|d, _| {
+                (half_length0[d] * f[(d, d)]).clamp(1e-3 * half_length0[d], 0.5 * grid.h[d])
+            });
+            gimp::evaluate(grid, x, &half, node, w, grad)
         }
-    }
-
-    /// Polynomial degree of the underlying grid basis (sets the node layout).
-    pub fn degree(&self) -> usize {
-        match self {
-            ShapeFunction::Bspline2 => 2,
-            ShapeFunction::Bspline3 => 3,
-            _ => 1,
+        ShapeFunction::Cpdi => {
+            let r: Tensor<D> = restrict::<D>(f) * Tensor::<D>::from_diagonal(half_length0);
+            cpdi::evaluate(grid, x, &r, node, w, grad)
         }
-    }
-
-    /// Largest number of nodes one particle can touch.
-    pub fn max_support(&self, dim: usize) -> usize {
-        let per_dir: usize = match self {
-            ShapeFunction::Linear => 2,
-            ShapeFunction::Ugimp | ShapeFunction::Cpgimp => 3,
-            ShapeFunction::Cpdi => 4,
-            ShapeFunction::Bspline2 => 3,
-            ShapeFunction::Bspline3 => 4,
-        };
-        per_dir.pow(dim as u32)
-    }
-
-    /// Evaluate the nodes, weights and gradients of one particle. Writes at most
-    /// `max_support` entries into the output slices and returns how many it wrote.
-    /// `half_length0` is the reference half-size of the particle domain and `f` its
-    /// deformation gradient (used by cpGIMP and CPDI).
-    #[allow(clippy::too_many_arguments)]
-    pub fn evaluate<const D: usize>(
-        &self,
-        grid: &Grid<D>,
-        x: &Vector<D>,
-        half_length0: &Vector<D>,
-        f: &Mat3,
-        node: &mut [u32],
-        w: &mut [f64],
-        grad: &mut [Vector<D>],
-    ) -> usize {
-        match self {
-            ShapeFunction::Linear => linear::evaluate(grid, x, node, w, grad),
-            ShapeFunction::Ugimp => gimp::evaluate(grid, x, half_length0, node, w, grad),
-            ShapeFunction::Cpgimp => {
-                // Stretched by F_dd, kept within (0, h/2] so the support stays 3^D
-                // nodes: a domain stretched beyond a cell is capped at one cell.
-                let half = Vector::<D>::from_fn(|d, _| {
-                    (half_length0[d] * f[(d, d)]).clamp(1e-3 * half_length0[d], 0.5 * grid.h[d])
-                });
-                gimp::evaluate(grid, x, &half, node, w, grad)
-            }
-            ShapeFunction::Cpdi => {
-                let r: Tensor<D> = restrict::<D>(f) * Tensor::<D>::from_diagonal(half_length0);
-                cpdi::evaluate(grid, x, &r, node, w, grad)
-            }
-            ShapeFunction::Bspline2 => bspline::evaluate(grid, x, 2, node, w, grad),
-            ShapeFunction::Bspline3 => bspline::evaluate(grid, x, 3, node, w, grad),
-        }
+        ShapeFunction::Bspline2 => bspline::evaluate(grid, x, 2, node, w, grad),
+        ShapeFunction::Bspline3 => bspline::evaluate(grid, x, 3, node, w, grad),
     }
 }
 
@@ -139,7 +87,7 @@ impl<const D: usize> Stencils<D> {
             .enumerate()
             .with_min_len(crate::parallel::MIN_PARALLEL_LEN)
             .for_each(|(p, (((c, nd), w), g))| {
-                *c = shape.evaluate(grid, &x[p], &half_length0[p], &f[p], nd, w, g) as u32;
+                *c = evaluate(shape, grid, &x[p], &half_length0[p], &f[p], nd, w, g) as u32;
             });
     }
 
@@ -411,8 +359,9 @@ pub(crate) mod tests {
                     f *= 2.0 * reach / widest;
                 }
                 let half0 = g.h / 4.0;
-                let s =
-                    Stencil::collect(cap, |n, w, gr| shape.evaluate(&g, &x, &half0, &f, n, w, gr));
+                let s = Stencil::collect(cap, |n, w, gr| {
+                    evaluate(shape, &g, &x, &half0, &f, n, w, gr)
+                });
                 s.check_partition_of_unity(&g);
             }
         }

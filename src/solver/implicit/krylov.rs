@@ -36,15 +36,15 @@
 use super::tangent::{Dofs, Pk1Derivative};
 use super::{Failure, Implicit};
 use crate::dim::Vector;
+use crate::model::Model;
+use crate::physics::shape::Stencils;
+use crate::physics::transfer::NodeMap;
+use crate::scene::{LinearSolver, MassMatrix, PreconditionerKind, SolverConfig};
 use crate::solver::linear::cg::cg;
 use crate::solver::linear::direct::Structure;
 use crate::solver::linear::gmres::gmres;
 use crate::solver::linear::iterative::{Identity, Outcome, Preconditioner, Settings};
 use crate::solver::linear::preconditioner::{BlockJacobi, Factorized, Jacobi};
-use crate::scene::{LinearSolver, MassMatrix, PreconditionerKind, SolverConfig};
-use crate::model::Model;
-use crate::physics::shape::Stencils;
-use crate::physics::transfer::NodeMap;
 use nalgebra::SMatrix;
 
 /// The lagged factorization is refreshed when a linear solve with it needed more

@@ -16,20 +16,22 @@ pub mod newmark;
 pub mod support;
 pub mod tangent;
 
-use crate::physics::absorbing::AbsorbingStep;
-use crate::physics::boundary::{implicit_node_constraint, Constraint};
-use crate::physics::deformation::Trial;
 use crate::dim::Vector;
-use crate::solver::explicit::{check_state, Divergence};
-use crate::physics::fbar;
-use crate::solver::linear::direct::{DirectSolver, Structure};
 use crate::material::driver::numerical_stress_derivative;
 use crate::material::Increment;
-use crate::scene::{Integrator, MassMatrix, SolverConfig};
+use crate::model::conditions::Constraint;
 use crate::model::{load_factor, Model};
-use crate::physics::shape::{ShapeFunction, Stencils};
-use crate::physics::transfer::{applied_force, external_force, interpolate, mass_momentum, nodal_force, NodeMap};
 use crate::parallel::MIN_PARALLEL_LEN;
+use crate::physics::absorbing::{self, AbsorbingStep};
+use crate::physics::boundary::implicit_node_constraint;
+use crate::physics::deformation::Trial;
+use crate::physics::shape::{ShapeFunction, Stencils};
+use crate::physics::transfer::{
+    applied_force, external_force, interpolate, mass_momentum, nodal_force, NodeMap,
+};
+use crate::scene::{Integrator, MassMatrix, SolverConfig};
+use crate::solver::explicit::{check_state, Divergence};
+use crate::solver::linear::direct::{DirectSolver, Structure};
 use newmark::Newmark;
 use rayon::prelude::*;
 use std::time::Instant;
@@ -259,8 +261,15 @@ impl<const D: usize> Implicit<D> {
         let mut force = nodal_force(&self.map, &self.stencils, p, &(m.gravity * g), &load);
         let (mass, momentum) = mass_momentum(&self.map, &self.stencils, p);
         let v = crate::solver::explicit::mass_average(&mass, &momentum);
-        m.absorbing
-            .add_force(&m.grid, p, &self.map, &self.stencils, &v, &mut force);
+        absorbing::add_force(
+            &m.absorbing,
+            &m.grid,
+            p,
+            &self.map,
+            &self.stencils,
+            &v,
+            &mut force,
+        );
         let a: Vec<Vector<D>> = force
             .iter()
             .zip(&mass)
@@ -479,7 +488,12 @@ impl<const D: usize> Implicit<D> {
     fn prepare(&mut self, m: &Model<D>, t: f64, dt: f64) -> StepSystem<D> {
         let dynamic = self.integrator == Integrator::Newmark;
         let p = &m.particles;
-        m.stencils_and_nodes(self.shape, &mut self.stencils, &mut self.map);
+        crate::physics::transfer::stencils_and_nodes(
+            m,
+            self.shape,
+            &mut self.stencils,
+            &mut self.map,
+        );
         if self.fbar {
             self.trial.use_fbar(&m.grid, &p.x);
         }
@@ -548,14 +562,28 @@ impl<const D: usize> Implicit<D> {
     /// their velocity as a function of u through Newmark (none when quasi-static).
     fn prepare_absorbing(&mut self, m: &Model<D>, sys: &StepSystem<D>, dt: f64) {
         let newmark = (self.integrator == Integrator::Newmark).then_some((&self.newmark, dt));
-        self.absorbing = AbsorbingStep::new(
-            &m.absorbing,
-            &m.grid,
-            &m.particles,
-            &sys.a_n,
-            &sys.u_tilde,
-            newmark,
-        );
+        let layer = absorbing::layer(&m.absorbing, &m.grid, &m.particles);
+        if layer.is_empty() {
+            self.absorbing = AbsorbingStep::default();
+            return;
+        }
+        let n = sys.a_n.len();
+        let (velocity_offset, rate) = match newmark {
+            Some((nm, dt)) => (
+                (0..n)
+                    .map(|a| {
+                        nm.end_velocity(dt, &Vector::<D>::zeros(), &sys.u_tilde[a], &sys.a_n[a])
+                    })
+                    .collect(),
+                nm.velocity_rate(dt),
+            ),
+            None => (vec![Vector::<D>::zeros(); n], 0.0),
+        };
+        self.absorbing = AbsorbingStep {
+            layer,
+            velocity_offset,
+            rate,
+        };
     }
 
     /// M (u − ũ) / (βΔt²) at the active nodes (lumped or consistent M).
@@ -712,13 +740,18 @@ impl<const D: usize> Implicit<D> {
         let (mut triplets, symmetric) = match &self.trial.fbar {
             None => stiffness_triplets(&self.map, &self.stencils, dofs, &p.volume, &a),
             Some(state) => (
-                fbar::tangent_triplets(&self.map, &self.stencils, dofs, &p.volume, state, &a),
+                tangent::fbar_triplets(&self.map, &self.stencils, dofs, &p.volume, state, &a),
                 false,
             ),
         };
         // Absorbing faces: Σ S_I S_J (γ/(βΔt) C + K), symmetric.
-        self.absorbing
-            .add_tangent(&self.map, &self.stencils, dofs, &mut triplets);
+        tangent::absorbing_triplets(
+            &self.absorbing,
+            &self.map,
+            &self.stencils,
+            dofs,
+            &mut triplets,
+        );
         if inertia > 0.0 {
             match self.mass_matrix {
                 MassMatrix::Lumped => {
@@ -959,7 +992,7 @@ dt = 0.01
         }
     }
 
-    /// The F-bar tangent (`fbar::tangent_triplets`: each particle couples to the
+    /// The F-bar tangent (`tangent::fbar_triplets`: each particle couples to the
     /// nodes of every particle in its cell) against central differences of the
     /// F-bar residual, with linear and smooth shape functions, through ties, and
     /// with Mohr-Coulomb in a plastic state (c small against the stresses of the
@@ -1105,7 +1138,8 @@ dt = 0.01
                 .fold(0.0, f64::max);
             let grad_error = (0..m.particles.len())
                 .map(|q| {
-                    (crate::physics::transfer::gradient(&solver.map, &solver.stencils, q, &u) - a).amax()
+                    (crate::physics::transfer::gradient(&solver.map, &solver.stencils, q, &u) - a)
+                        .amax()
                 })
                 .fold(0.0, f64::max);
             println!(

@@ -13,8 +13,8 @@
 //! tangent stays the exact derivative of the (constrained) residual.
 
 use super::tangent::Tie;
-use crate::physics::boundary::Constraint;
 use crate::dim::Vector;
+use crate::model::conditions::Constraint;
 use crate::model::grid::Grid;
 use crate::physics::shape::Stencils;
 use crate::physics::transfer::NodeMap;

@@ -1,0 +1,129 @@
+//! The scene's background grid: its box, its cells, the shape-function family on
+//! it, and the names of its faces (`xmin` … `zmax`), which boundary conditions
+//! and tractions refer to.
+
+use serde::Deserialize;
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GridConfig {
+    pub min: Vec<f64>,
+    pub max: Vec<f64>,
+    pub cells: Vec<usize>,
+    #[serde(default = "default_shape")]
+    pub shape_function: ShapeFunction,
+}
+
+fn default_shape() -> ShapeFunction {
+    ShapeFunction::Linear
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ShapeFunction {
+    /// Standard MPM: piecewise-linear (bilinear, trilinear) hat functions.
+    Linear,
+    /// Uniform GIMP: fixed axis-aligned particle domain.
+    Ugimp,
+    /// Contiguous-particle GIMP: axis-aligned domain stretched by the diagonal of F.
+    Cpgimp,
+    /// Convected particle domain interpolation (CPDI1): parallelogram/parallelepiped
+    /// spanned by r_i = F r_i⁰, weights from the corners.
+    Cpdi,
+    /// Quadratic B-spline on a clamped uniform knot vector.
+    Bspline2,
+    /// Cubic B-spline on a clamped uniform knot vector.
+    Bspline3,
+}
+
+impl ShapeFunction {
+    pub fn name(&self) -> &'static str {
+        match self {
+            ShapeFunction::Linear => "linear",
+            ShapeFunction::Ugimp => "ugimp",
+            ShapeFunction::Cpgimp => "cpgimp",
+            ShapeFunction::Cpdi => "cpdi",
+            ShapeFunction::Bspline2 => "bspline2",
+            ShapeFunction::Bspline3 => "bspline3",
+        }
+    }
+
+    /// Polynomial degree of the underlying grid basis (sets the node layout).
+    pub fn degree(&self) -> usize {
+        match self {
+            ShapeFunction::Bspline2 => 2,
+            ShapeFunction::Bspline3 => 3,
+            _ => 1,
+        }
+    }
+
+    /// Largest number of nodes one particle can touch.
+    pub fn max_support(&self, dim: usize) -> usize {
+        let per_dir: usize = match self {
+            ShapeFunction::Linear => 2,
+            ShapeFunction::Ugimp | ShapeFunction::Cpgimp => 3,
+            ShapeFunction::Cpdi => 4,
+            ShapeFunction::Bspline2 => 3,
+            ShapeFunction::Bspline3 => 4,
+        };
+        per_dir.pow(dim as u32)
+    }
+}
+
+/// One face of the grid box: `axis` 0..D, `upper` false for the min face.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Face {
+    pub axis: usize,
+    pub upper: bool,
+}
+
+impl Face {
+    /// Parse "xmin", "ymax", "zmin", ...
+    pub fn parse(name: &str, dim: usize) -> Option<Face> {
+        let axis = match name.as_bytes().first()? {
+            b'x' => 0,
+            b'y' => 1,
+            b'z' => 2,
+            _ => return None,
+        };
+        let upper = match &name[1..] {
+            "min" => false,
+            "max" => true,
+            _ => return None,
+        };
+        (axis < dim).then_some(Face { axis, upper })
+    }
+
+    pub fn name(&self) -> String {
+        format!(
+            "{}{}",
+            ["x", "y", "z"][self.axis],
+            if self.upper { "max" } else { "min" }
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn faces_parse() {
+        assert_eq!(
+            Face::parse("ymax", 2),
+            Some(Face {
+                axis: 1,
+                upper: true
+            })
+        );
+        assert_eq!(Face::parse("zmin", 2), None);
+        assert_eq!(
+            Face::parse("zmin", 3),
+            Some(Face {
+                axis: 2,
+                upper: false
+            })
+        );
+        assert_eq!(Face::parse("xmid", 3), None);
+    }
+}
