@@ -10,10 +10,12 @@
 # (about 3 minutes on 2 cores) instead of the quick settings below (about 1 minute).
 #
 # Compared byte for byte: particles_final.csv (every one, strength-reduction trials
-# included), history.csv, footing.csv and the ParaView frames. Compared after dropping
-# the wall-clock fields: summary.json (wall_seconds, particle_steps_per_second, and the
-# solver timings of limit analysis), newton.csv, strength_reduction.csv and
-# refinement.csv (their wall_seconds and solver-time columns). Exit status 0 when
+# included), history.csv and the ParaView frames. Compared after dropping the
+# wall-clock fields: summary.json (wall_seconds, particle_steps_per_second, and the
+# solver timings of limit analysis; the output directory in messages), and, value by
+# value (numbers as numbers, so only the text format of a number may differ),
+# footing.csv, newton.csv, strength_reduction.csv and refinement.csv without their
+# wall_seconds and solver-time columns. Exit status 0 when
 # everything agrees, 1 otherwise, with one line per difference.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
@@ -56,8 +58,8 @@ a_root, b_root = sys.argv[1], sys.argv[2]
 TIMING_KEYS = {"seconds", "wall_seconds", "particle_steps_per_second", "solver_seconds",
                "lower_seconds", "upper_seconds", "setup_seconds"}
 TIMING_COLUMNS = TIMING_KEYS | {"lower_solver_seconds", "upper_solver_seconds"}
-BYTES = ("particles_final.csv", "history.csv", "footing.csv")
-TABLES = ("newton.csv", "strength_reduction.csv", "refinement.csv", "trials.csv")
+BYTES = ("particles_final.csv", "history.csv")
+TABLES = ("footing.csv", "newton.csv", "strength_reduction.csv", "refinement.csv", "trials.csv")
 
 def strip(v, root):
     """Without wall-clock fields, and with the output directory in messages as OUT."""
@@ -69,12 +71,20 @@ def strip(v, root):
         return v.replace(root, "OUT")
     return v
 
+def value(field):
+    """A number as its float (so 7.65e-1 and 0.765 agree; NaN equals NaN), else the text."""
+    try:
+        x = float(field)
+    except ValueError:
+        return field
+    return "NaN" if x != x else x
+
 def table(path):
     rows = list(csv.reader(open(path, newline="")))
     if not rows:
         return rows
     keep = [i for i, h in enumerate(rows[0]) if h not in TIMING_COLUMNS and not h.endswith("_seconds")]
-    return [[r[i] for i in keep if i < len(r)] for r in rows]
+    return [rows[0]] + [[value(r[i]) for i in keep if i < len(r)] for r in rows[1:]]
 
 def files(root):
     out = set()

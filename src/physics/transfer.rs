@@ -131,6 +131,19 @@ pub fn mass_momentum<const D: usize>(
     (mass, momentum)
 }
 
+/// v_I = p_I / m_I (2-25); zero on a node whose mass is exactly zero.
+pub fn mass_average<const D: usize>(mass: &[f64], momentum: &[Vector<D>]) -> Vec<Vector<D>> {
+    (0..mass.len())
+        .map(|a| {
+            if mass[a] > 0.0 {
+                momentum[a] / mass[a]
+            } else {
+                Vector::<D>::zeros()
+            }
+        })
+        .collect()
+}
+
 /// Nodal force f_ext − f_int: internal −Σ V_p σ_p ∇S_Ip (2-51), external
 /// Σ S_Ip (m_p g + s_p f_p) (2-52) with s_p the load factor of particle p.
 pub fn nodal_force<const D: usize>(

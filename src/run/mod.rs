@@ -11,10 +11,11 @@ use crate::output::{
 };
 use crate::parallel::deterministic_sum;
 use crate::run::footing::FootingCurve;
-use crate::scene::{Integrator, LinearSolver, SolverConfig, SolverKind};
+use crate::scene::SolverKind;
 use crate::scene::{Scene, SceneError};
-use crate::solver::explicit::{check_state, Divergence, Explicit};
-use crate::solver::implicit::{Implicit, NEWTON_CSV_HEADER};
+use crate::solver::divergence::{check_state, Divergence};
+use crate::solver::explicit::Explicit;
+use crate::solver::report::{NewtonRow, SolverReport};
 use serde_json::json;
 use std::io::Write;
 use std::path::Path;
@@ -78,95 +79,36 @@ pub fn strain_energy<const D: usize>(m: &Model<D>) -> f64 {
     })
 }
 
-/// The time stepper of one stage.
-enum Stepper<const D: usize> {
-    Explicit(Box<Explicit<D>>),
-    Implicit(Box<Implicit<D>>),
-}
-
 /// newton.csv, opened when the run has an implicit stage.
 type NewtonLog = Option<std::io::BufWriter<std::fs::File>>;
 
-impl<const D: usize> Stepper<D> {
-    fn new(shape: crate::physics::shape::ShapeFunction, s: &SolverConfig, t_start: f64) -> Self {
-        match s.kind {
-            SolverKind::Explicit => Stepper::Explicit(Box::new(Explicit::new(shape, s))),
-            SolverKind::Implicit => Stepper::Implicit(Box::new(Implicit::new(shape, s, t_start))),
-        }
-    }
+pub const NEWTON_CSV_HEADER: &str =
+    "step,time,dt,cutback,iteration,residual,increment,wall_seconds,krylov_iterations,forcing,linear_solver";
 
-    fn dt(&self, m: &Model<D>, s: &SolverConfig) -> f64 {
-        match self {
-            Stepper::Explicit(e) => e.dt(m),
-            Stepper::Implicit(_) => s.implicit_dt(),
-        }
-    }
+/// One row of newton.csv.
+fn newton_csv(r: &NewtonRow) -> String {
+    format!(
+        "{},{},{},{},{},{:e},{:e},{:e},{},{:e},{}",
+        r.step,
+        r.time,
+        r.dt,
+        r.cutback,
+        r.iteration,
+        r.residual,
+        r.increment,
+        r.wall_seconds,
+        r.krylov_iterations,
+        r.forcing,
+        r.linear_solver
+    )
+}
 
-    /// One step; the outer error is an output failure, the inner one a divergence.
-    fn step(
-        &mut self,
-        m: &mut Model<D>,
-        t: f64,
-        dt: f64,
-        step: usize,
-        log: &mut NewtonLog,
-    ) -> std::io::Result<Result<f64, Divergence>> {
-        Ok(match self {
-            Stepper::Explicit(e) => e.step(m, t, dt, step),
-            Stepper::Implicit(i) => {
-                let result = i.advance(m, t, dt, step);
-                if let Some(log) = log {
-                    for row in i.take_log() {
-                        writeln!(log, "{}", row.csv())?;
-                    }
-                    log.flush()?;
-                }
-                result
-            }
-        })
-    }
-
-    /// Reactions of the last step (implicit only; None for explicit steps).
-    fn reaction(&self) -> Option<&[(u32, crate::dim::Vector<D>)]> {
-        match self {
-            Stepper::Explicit(_) => None,
-            Stepper::Implicit(i) => Some(&i.reaction),
-        }
-    }
-
-    fn active_nodes(&self) -> usize {
-        match self {
-            Stepper::Explicit(e) => e.active_nodes(),
-            Stepper::Implicit(i) => i.active_nodes(),
-        }
-    }
-
-    /// Solver fields of summary.json.
-    fn describe(&self, s: &SolverConfig, summary: &mut serde_json::Value) {
-        match self {
-            Stepper::Explicit(_) => {
-                summary["solver"] = json!("explicit");
-                summary["scheme"] = json!(s.scheme().name());
-            }
-            Stepper::Implicit(i) => {
-                summary["solver"] = json!("implicit");
-                summary["integrator"] = json!(match s.integrator() {
-                    Integrator::Newmark => "newmark",
-                    Integrator::QuasiStatic => "quasi_static",
-                });
-                summary["newton_iterations"] = json!(i.newton_iterations);
-                summary["cutbacks"] = json!(i.cutbacks);
-                summary["linear_solver"] = json!(s.linear_solver().name());
-                summary["krylov_iterations"] = json!(i.krylov_iterations);
-                if s.linear_solver() != LinearSolver::Direct {
-                    summary["preconditioner"] = json!(s.preconditioner().name());
-                    summary["lagged_factorizations"] = json!(i.lagged_factorizations());
-                }
-                if s.integrator() == Integrator::Newmark {
-                    summary["beta"] = json!(s.beta());
-                    summary["gamma"] = json!(s.gamma());
-                }
-            }
+/// Write the solver fields of `report` into a summary.json object.
+fn describe(report: &SolverReport, summary: &mut serde_json::Value) {
+    let fields = serde_json::to_value(report).expect("a report serialises");
+    if let serde_json::Value::Object(fields) = fields {
+        for (key, value) in fields {
+            summary[key] = value;
         }
     }
 }
@@ -264,7 +206,7 @@ fn run_dim<const D: usize>(
             model.reduce_strength(&cfg.materials, f);
             strength_factor = f;
         }
-        let mut stepper = Stepper::<D>::new(cfg.grid.shape_function, sc, t);
+        let mut stepper = crate::solver::stepper::<D>(cfg.grid.shape_function, sc, t);
         let (stage_start, stage_end) = (t, t + sc.end_time);
         let (stage_clock, steps_before) = (Instant::now(), step);
         let mut last_dt = 0.0;
@@ -273,9 +215,16 @@ fn run_dim<const D: usize>(
                 t = stage_end;
                 break Ok(());
             }
-            let dt = stepper.dt(&model, sc).min(stage_end - t);
+            let dt = stepper.dt(&model).min(stage_end - t);
             last_dt = dt;
-            match stepper.step(&mut model, t, dt, step, &mut newton_log)? {
+            let result = stepper.step(&mut model, t, dt, step);
+            if let Some(log) = &mut newton_log {
+                for row in stepper.take_newton_rows() {
+                    writeln!(log, "{}", newton_csv(&row))?;
+                }
+                log.flush()?;
+            }
+            match result {
                 Ok(work) => external_work += work,
                 Err(d) => break Err(d),
             }
@@ -301,7 +250,7 @@ fn run_dim<const D: usize>(
             "wall_seconds": stage_clock.elapsed().as_secs_f64(),
             "active_nodes_last_step": stepper.active_nodes(),
         });
-        stepper.describe(sc, &mut stage);
+        describe(&stepper.report(), &mut stage);
         if sc.strength_reduction_factor.is_some() {
             stage["strength_reduction_factor"] = json!(strength_factor);
         }
@@ -309,7 +258,7 @@ fn run_dim<const D: usize>(
         cutbacks_total += stage["cutbacks"].as_u64().unwrap_or(0);
         krylov_total += stage["krylov_iterations"].as_u64().unwrap_or(0);
         // The top level carries the solver fields of the last stage that ran.
-        stepper.describe(sc, &mut summary);
+        describe(&stepper.report(), &mut summary);
         summary["dt"] = json!(last_dt);
         summary["active_nodes_last_step"] = json!(stepper.active_nodes());
         stage_summaries.push(stage);

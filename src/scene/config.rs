@@ -280,7 +280,7 @@ impl StrengthReductionConfig {
     }
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum SolverKind {
     Explicit,
@@ -305,7 +305,7 @@ impl Scheme {
     }
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Integrator {
     /// Newmark with Newton-Raphson (thesis 2-33…2-38).
@@ -314,7 +314,7 @@ pub enum Integrator {
     QuasiStatic,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum MassMatrix {
     Lumped,
@@ -322,7 +322,7 @@ pub enum MassMatrix {
 }
 
 /// How the implicit solver solves each Newton correction (thesis 2-38).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum LinearSolver {
     /// Assembled consistent tangent, sparse Cholesky / LU (needs an analytic tangent).
@@ -344,7 +344,7 @@ impl LinearSolver {
 }
 
 /// Preconditioner of the Krylov solvers.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum PreconditionerKind {
     None,

@@ -10,38 +10,19 @@ use crate::physics::absorbing;
 use crate::physics::boundary::{friction_contact, node_constraint, node_friction};
 use crate::physics::deformation::Trial;
 use crate::physics::shape::{ShapeFunction, Stencils};
-use crate::physics::transfer::{applied_force, interpolate, mass_momentum, nodal_force, NodeMap};
+use crate::physics::transfer::{
+    applied_force, interpolate, mass_average, mass_momentum, nodal_force, NodeMap,
+};
 use crate::scene::{Scheme, SolverConfig};
+use crate::solver::divergence::{check_state, Divergence};
+use crate::solver::report::SolverReport;
+use crate::solver::stepper::Stepper;
 use rayon::prelude::*;
 
 /// Nodes lighter than this fraction of the lightest particle get no acceleration:
 /// f_I/m_I is ill-conditioned there (f_I need not vanish with m_I), while the
 /// velocity p_I/m_I, a mass-weighted average of particle velocities, is always kept.
 pub const TINY_MASS_FRACTION: f64 = 1e-9;
-
-/// Why a run stopped early.
-#[derive(Clone, Debug)]
-pub struct Divergence {
-    pub step: usize,
-    pub time: f64,
-    /// The offending particle, when there is one (not for a Newton failure).
-    pub particle: Option<usize>,
-    pub message: String,
-}
-
-impl std::fmt::Display for Divergence {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "diverged at step {} (t = {:.6e}): ",
-            self.step, self.time
-        )?;
-        if let Some(q) = self.particle {
-            write!(f, "particle {q} ")?;
-        }
-        write!(f, "{}", self.message)
-    }
-}
 
 pub struct Explicit<const D: usize> {
     pub shape: ShapeFunction,
@@ -220,19 +201,6 @@ fn local_damping<const D: usize>(f: &Vector<D>, v: &Vector<D>, alpha: f64) -> Ve
     Vector::<D>::from_fn(|d, _| f[d] - alpha * f[d].abs() * sign(v[d]))
 }
 
-/// v_I = p_I / m_I (2-25); zero on a node whose mass is exactly zero.
-pub(crate) fn mass_average<const D: usize>(mass: &[f64], momentum: &[Vector<D>]) -> Vec<Vector<D>> {
-    (0..mass.len())
-        .map(|a| {
-            if mass[a] > 0.0 {
-                momentum[a] / mass[a]
-            } else {
-                Vector::<D>::zeros()
-            }
-        })
-        .collect()
-}
-
 /// Nodal velocities with the prescribed components imposed.
 fn constrained<const D: usize>(v: &[Vector<D>], c: &[Constraint<D>]) -> Vec<Vector<D>> {
     v.iter()
@@ -299,46 +267,22 @@ fn update_stress<const D: usize>(
     Ok(())
 }
 
-/// Stop on non-finite state or particles outside the grid (first offender).
-pub fn check_state<const D: usize>(m: &Model<D>, step: usize, time: f64) -> Result<(), Divergence> {
-    let p = &m.particles;
-    let bad = (0..p.len())
-        .into_par_iter()
-        .with_min_len(MIN_PARALLEL_LEN)
-        .find_first(|&q| {
-            !(p.x[q].iter().all(|v| v.is_finite())
-                && p.v[q].iter().all(|v| v.is_finite())
-                && p.stress[q].iter().all(|v| v.is_finite())
-                && m.grid.contains(&p.x[q]))
-        });
-    match bad {
-        None => Ok(()),
-        Some(q) => {
-            let finite = p.x[q]
-                .iter()
-                .chain(p.v[q].iter())
-                .chain(p.stress[q].iter())
-                .all(|v| v.is_finite());
-            let message = if finite {
-                format!(
-                    "(body {}) left the grid: x = {:?}",
-                    p.body[q],
-                    p.x[q].as_slice()
-                )
-            } else {
-                format!(
-                    "(body {}) has a non-finite state: x = {:?}, v = {:?}",
-                    p.body[q],
-                    p.x[q].as_slice(),
-                    p.v[q].as_slice()
-                )
-            };
-            Err(Divergence {
-                step,
-                time,
-                particle: Some(q),
-                message,
-            })
+impl<const D: usize> Stepper<D> for Explicit<D> {
+    fn dt(&self, m: &Model<D>) -> f64 {
+        Explicit::dt(self, m)
+    }
+
+    fn step(&mut self, m: &mut Model<D>, t: f64, dt: f64, step: usize) -> Result<f64, Divergence> {
+        Explicit::step(self, m, t, dt, step)
+    }
+
+    fn active_nodes(&self) -> usize {
+        Explicit::active_nodes(self)
+    }
+
+    fn report(&self) -> SolverReport {
+        SolverReport::Explicit {
+            scheme: self.scheme,
         }
     }
 }

@@ -29,8 +29,10 @@ use crate::physics::shape::{ShapeFunction, Stencils};
 use crate::physics::transfer::{
     applied_force, external_force, interpolate, mass_momentum, nodal_force, NodeMap,
 };
-use crate::scene::{Integrator, MassMatrix, SolverConfig};
-use crate::solver::explicit::{check_state, Divergence};
+use crate::scene::{Integrator, LinearSolver, MassMatrix, SolverConfig};
+use crate::solver::divergence::{check_state, Divergence};
+use crate::solver::report::{ImplicitReport, NewtonRow, SolverReport};
+use crate::solver::stepper::Stepper;
 use crate::solver::linear::direct::{DirectSolver, Structure};
 use newmark::Newmark;
 use rayon::prelude::*;
@@ -40,50 +42,6 @@ use tangent::{
     internal_force, pk1_derivative, push_terms, relative_pk1, stiffness_triplets, Dofs,
     Pk1Derivative,
 };
-
-/// One Newton iteration, as written to newton.csv.
-#[derive(Clone, Debug)]
-pub struct NewtonRow {
-    pub step: usize,
-    pub time: f64,
-    pub dt: f64,
-    /// How many times this step was halved.
-    pub cutback: usize,
-    pub iteration: usize,
-    /// ‖r‖ / reference force.
-    pub residual: f64,
-    /// ‖δu‖ / ‖u‖ of the correction that follows (NaN on the converged row).
-    pub increment: f64,
-    pub wall_seconds: f64,
-    pub linear_solver: &'static str,
-    /// Krylov iterations of the correction that follows (0: direct solver or
-    /// converged row).
-    pub krylov_iterations: usize,
-    /// Forcing term η of that correction (NaN: direct solver or converged row).
-    pub forcing: f64,
-}
-
-pub const NEWTON_CSV_HEADER: &str =
-    "step,time,dt,cutback,iteration,residual,increment,wall_seconds,krylov_iterations,forcing,linear_solver";
-
-impl NewtonRow {
-    pub fn csv(&self) -> String {
-        format!(
-            "{},{},{},{},{},{:e},{:e},{:e},{},{:e},{}",
-            self.step,
-            self.time,
-            self.dt,
-            self.cutback,
-            self.iteration,
-            self.residual,
-            self.increment,
-            self.wall_seconds,
-            self.krylov_iterations,
-            self.forcing,
-            self.linear_solver
-        )
-    }
-}
 
 /// Why one attempt at a step failed.
 #[derive(Clone, Debug)]
@@ -113,6 +71,8 @@ struct StepSystem<const D: usize> {
 
 pub struct Implicit<const D: usize> {
     shape: ShapeFunction,
+    /// The step size (Newmark `dt`, or end_time / load_steps).
+    dt: f64,
     integrator: Integrator,
     newmark: Newmark,
     mass_matrix: MassMatrix,
@@ -157,6 +117,7 @@ impl<const D: usize> Implicit<D> {
         Implicit {
             t_start,
             shape,
+            dt: s.implicit_dt(),
             integrator: s.integrator(),
             newmark: Newmark {
                 beta: s.beta(),
@@ -260,7 +221,7 @@ impl<const D: usize> Implicit<D> {
         let load = |q: usize| load_factor(&m.load_ramp_of, q, &scales);
         let mut force = nodal_force(&self.map, &self.stencils, p, &(m.gravity * g), &load);
         let (mass, momentum) = mass_momentum(&self.map, &self.stencils, p);
-        let v = crate::solver::explicit::mass_average(&mass, &momentum);
+        let v = crate::physics::transfer::mass_average(&mass, &momentum);
         absorbing::add_force(
             &m.absorbing,
             &m.grid,
@@ -815,6 +776,44 @@ impl<const D: usize> Implicit<D> {
             length *= 0.5;
         }
         Ok(length)
+    }
+}
+
+impl<const D: usize> Stepper<D> for Implicit<D> {
+    fn dt(&self, _m: &Model<D>) -> f64 {
+        self.dt
+    }
+
+    fn step(&mut self, m: &mut Model<D>, t: f64, dt: f64, step: usize) -> Result<f64, Divergence> {
+        self.advance(m, t, dt, step)
+    }
+
+    fn active_nodes(&self) -> usize {
+        Implicit::active_nodes(self)
+    }
+
+    fn reaction(&self) -> Option<&[(u32, Vector<D>)]> {
+        Some(&self.reaction)
+    }
+
+    fn take_newton_rows(&mut self) -> Vec<NewtonRow> {
+        self.take_log()
+    }
+
+    fn report(&self) -> SolverReport {
+        let krylov = self.krylov.as_ref().map(|k| k.config);
+        let newmark = self.integrator == Integrator::Newmark;
+        SolverReport::Implicit(ImplicitReport {
+            integrator: self.integrator,
+            newton_iterations: self.newton_iterations,
+            cutbacks: self.cutbacks,
+            linear_solver: krylov.map_or(LinearSolver::Direct, |k| k.method),
+            krylov_iterations: self.krylov_iterations,
+            preconditioner: krylov.map(|k| k.preconditioner),
+            lagged_factorizations: krylov.map(|_| self.lagged_factorizations()),
+            beta: newmark.then_some(self.newmark.beta),
+            gamma: newmark.then_some(self.newmark.gamma),
+        })
     }
 }
 

@@ -1,0 +1,33 @@
+//! The interface the stage loop of a run drives: one time stepper per stage,
+//! explicit or implicit.
+
+use crate::dim::Vector;
+use crate::model::Model;
+use crate::solver::divergence::Divergence;
+use crate::solver::report::{NewtonRow, SolverReport};
+
+pub trait Stepper<const D: usize> {
+    /// The step to take now (at most what is left of the stage is taken).
+    fn dt(&self, m: &Model<D>) -> f64;
+
+    /// Advance the model from t to t + dt, the run's step number `step`; returns
+    /// the work of gravity and applied loads over the step.
+    fn step(&mut self, m: &mut Model<D>, t: f64, dt: f64, step: usize) -> Result<f64, Divergence>;
+
+    /// Active grid nodes of the last step.
+    fn active_nodes(&self) -> usize;
+
+    /// Reactions of the last converged step: (grid node, force the prescribed
+    /// components exert on the body); `None` when the stepper computes none.
+    fn reaction(&self) -> Option<&[(u32, Vector<D>)]> {
+        None
+    }
+
+    /// The Newton iterations since the last call (for newton.csv).
+    fn take_newton_rows(&mut self) -> Vec<NewtonRow> {
+        Vec::new()
+    }
+
+    /// The solver fields of summary.json, counts so far.
+    fn report(&self) -> SolverReport;
+}
