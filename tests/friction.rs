@@ -13,6 +13,7 @@
 
 mod common;
 use common::{run_problem, Table};
+use mpm::run::summary::Status;
 
 const G: f64 = 9.81;
 
@@ -27,7 +28,7 @@ fn slide(theta_deg: f64, mu: f64, damping: f64) -> (f64, f64) {
         &[&gravity, &mu, &damping, "solver.flip=0.99"],
     );
     let summary = result.unwrap();
-    assert_eq!(summary.json["status"], "completed");
+    assert_eq!(summary.status, Status::Completed);
     let h = Table::read(&dir.path().join("history.csv")).unwrap();
     let (t, x) = (h.col("t"), h.col("body0_x"));
     (*t.last().unwrap(), x.last().unwrap() - x[0])
@@ -110,7 +111,7 @@ fn friction_face_is_fixed_in_implicit_steps() {
             "{f} differs: friction base vs fixed base"
         );
     }
-    assert!(rough.json["limit_pressure"].as_f64().unwrap() > 0.0);
+    assert!(rough.footing.unwrap().limit_pressure > 0.0);
 
     // A block on a base tilted by 30° with μ = 0.3 < tan 30° slides in the
     // explicit solver (sliding_block_follows_the_closed_form); in a quasi-static

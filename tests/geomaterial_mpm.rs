@@ -9,6 +9,7 @@
 
 mod common;
 use common::{newton_order, problem, read_newton, run_text, step_residuals, Table};
+use mpm::run::summary::Status;
 
 const C: f64 = 1.0e4;
 
@@ -56,7 +57,7 @@ struct Result {
 fn run(text: &str, overrides: &[&str]) -> (Result, tempfile::TempDir) {
     let (result, dir) = run_text(text, overrides);
     let summary = result.unwrap_or_else(|e| panic!("{overrides:?}: {e}"));
-    assert_eq!(summary.json["status"], "completed");
+    assert_eq!(summary.status, Status::Completed);
     let p = Table::read(&dir.path().join("particles_final.csv")).unwrap();
     let n = p.col("syy").len() as f64;
     let syy = p.col("syy").iter().sum::<f64>() / n;

@@ -85,7 +85,9 @@ fn conditionally_stable_newmark() {
         ],
     );
     match result {
-        Err(mpm::run::RunError::Diverged(m)) => assert!(m.contains("diverged at step"), "{m}"),
+        Err(mpm::run::RunError::Diverged { message: m, .. }) => {
+            assert!(m.contains("diverged at step"), "{m}")
+        }
         other => panic!("β = 0.1 at Δt = 0.4 should blow up, got {other:?}"),
     }
 }
