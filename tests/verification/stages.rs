@@ -6,8 +6,7 @@
 //! the quadrature change when the explicit step evaluates the shape functions at
 //! the moved particles.
 
-mod common;
-use common::{run_problem, Table};
+use crate::common::{run_problem, Table};
 use mpm::scene::{Integrator, SolverKind};
 
 #[test]
@@ -71,7 +70,7 @@ fn quasi_static_then_explicit_then_newmark() {
 
 #[test]
 fn solver_and_stages_are_exclusive() {
-    let text = std::fs::read_to_string(common::problem("column_staged.toml")).unwrap()
+    let text = std::fs::read_to_string(crate::common::problem("column_staged.toml")).unwrap()
         + "\n[solver]\nkind = \"explicit\"\nend_time = 1.0\n";
     let e = mpm::scene::Scene::parse("staged.toml", &text, &[])
         .unwrap_err()
@@ -83,7 +82,7 @@ fn solver_and_stages_are_exclusive() {
     assert!(e.contains("unknown field `stagex`"), "{e}");
     let e = mpm::scene::Scene::parse(
         "staged.toml",
-        &std::fs::read_to_string(common::problem("column_staged.toml"))
+        &std::fs::read_to_string(crate::common::problem("column_staged.toml"))
             .unwrap()
             .replace("scheme = \"musl\"", "scheme = \"musl\"\nbeta = 0.3"),
         &[],

@@ -5,8 +5,7 @@
 //! for Mohr–Coulomb; quadratic Newton convergence in the plastic steps; the keys
 //! of a footing (a velocity condition on a region of a face).
 
-mod common;
-use common::{newton_order, run_problem, step_residuals, Table};
+use crate::common::{newton_order, run_problem, step_residuals, Table};
 use mpm::model::Model;
 use mpm::scene::Scene;
 
@@ -142,7 +141,7 @@ fn mohr_coulomb_footing_reaches_prandtl() {
 
 /// A footing scene whose `[[boundary]]` table of the footing is replaced by `footing`.
 fn with_footing(footing: &str) -> String {
-    let text = std::fs::read_to_string(common::problem("footing_tresca.toml")).unwrap();
+    let text = std::fs::read_to_string(crate::common::problem("footing_tresca.toml")).unwrap();
     let start = text.find("[[boundary]]\nface = \"ymax\"").unwrap();
     let end = text.find("[solver]").unwrap();
     format!("{}{footing}\n{}", &text[..start], &text[end..])
@@ -219,7 +218,7 @@ fn bad_footing_keys_are_named_with_their_line() {
 #[test]
 fn region_selects_the_face_nodes_in_the_box() {
     let scene = Scene::load(
-        &common::problem("footing_tresca.toml"),
+        &crate::common::problem("footing_tresca.toml"),
         &["grid.shape_function=linear".into()],
     )
     .unwrap();

@@ -17,8 +17,7 @@
 //! shifted by the half particle spacing, so that the initial column measures
 //! d0 × h0); "final" is kinetic energy below 1 % of its peak.
 
-mod common;
-use common::{run_problem, Table};
+use crate::common::{run_problem, Table};
 use mpm::run::summary::Status;
 
 const D0: f64 = 0.2;

@@ -3,8 +3,7 @@
 //! recovery, and a clean stop when cut-backs are not allowed), and results that do
 //! not depend on the number of threads.
 
-mod common;
-use common::{run_problem, Table};
+use crate::common::{run_problem, Table};
 
 fn syy_errors(dir: &std::path::Path, l0: f64) -> Vec<(f64, f64)> {
     let p = Table::read(&dir.join("particles_final.csv")).unwrap();
@@ -149,8 +148,8 @@ fn implicit_results_do_not_depend_on_threads() {
         ("vibrating_bar_implicit.toml", "solver.end_time=5"),
     ] {
         let run = |threads: usize| {
-            let dir = common::run_cli(scene, threads, &[extra, "output.frames=0"]);
-            common::read_output(&dir, "particles_final.csv")
+            let dir = crate::common::run_cli(scene, threads, &[extra, "output.frames=0"]);
+            crate::common::read_output(&dir, "particles_final.csv")
         };
         assert!(
             run(1) == run(2),

@@ -7,8 +7,7 @@
 //! strain) once the block has been compressed three times its yield strain.
 //! The quasi-static runs also check the Newton iterations of the plastic steps.
 
-mod common;
-use common::{newton_order, problem, read_newton, run_text, step_residuals, Table};
+use crate::common::{newton_order, problem, read_newton, run_text, step_residuals, Table};
 use mpm::run::summary::Status;
 
 const C: f64 = 1.0e4;

@@ -14,8 +14,7 @@
 //!   upper bound and ten times further from 1.40, and checks the search itself,
 //!   the runaway of the crest near the bracket and the mechanism.
 
-mod common;
-use common::{problem, run_text, search_problem, Table};
+use crate::common::{problem, run_text, search_problem, Table};
 use mpm::analyses::strength_reduction::TrialStatus;
 use mpm::model::Model;
 use mpm::scene::Scene;

@@ -26,8 +26,7 @@
 //! - The stage factor is not cumulative: each stage starts from the scene's
 //!   strengths.
 
-mod common;
-use common::{problem, read_output, run_problem, Table};
+use crate::common::{problem, read_output, run_problem, Table};
 use mpm::model::Model;
 use mpm::run::summary::{Status, Summary};
 use mpm::scene::Scene;
@@ -177,7 +176,7 @@ fn gravity_work_is_the_lost_potential_energy_and_is_dissipated() {
 #[test]
 fn one_and_two_threads_give_identical_runout() {
     let run_cli = |threads: usize| {
-        let dir = common::run_cli(SCENE, threads, &coarse(&["stage.1.end_time=1.5"]));
+        let dir = crate::common::run_cli(SCENE, threads, &coarse(&["stage.1.end_time=1.5"]));
         (
             read_output(&dir, "particles_final.csv"),
             read_output(&dir, "history.csv"),

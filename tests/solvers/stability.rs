@@ -7,8 +7,7 @@
 //! while USL needs a step below h/c. A run past the limit stops with a message
 //! naming the step and the particle and keeps what it wrote.
 
-mod common;
-use common::{run_problem, Table};
+use crate::common::{run_problem, Table};
 use mpm::run::summary::Status;
 use mpm::run::RunError;
 

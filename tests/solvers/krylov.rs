@@ -4,8 +4,7 @@
 //! Eisenstat–Walker forcing terms; a material without an analytic tangent; a
 //! Krylov failure handled like a Newton failure.
 
-mod common;
-use common::{problem, read_newton, read_output, run_cli, run_problem, run_text, Table};
+use crate::common::{problem, read_newton, read_output, run_cli, run_problem, run_text, Table};
 use mpm::run::summary::Summary;
 use mpm::run::RunError;
 
