@@ -160,7 +160,8 @@ impl StepSettings {
         let (constraint, dofs) = number_unknowns(m, st, map, self.min_node_support);
         let n = map.len();
 
-        // External force at the end of the step; inertia terms (Newmark).
+        // External force at the end of the step; inertia terms: the Newmark
+        // predictor ũ (2-36) from the projected velocities and accelerations.
         let (g_new, scales_new) = self.load_factors(m, t + dt);
         let load_new = |q: usize| load_factor(&m.load_ramp_of, q, &scales_new);
         let f_ext = external_force(map, st, p, &(m.gravity * g_new), &load_new);
@@ -190,9 +191,16 @@ impl StepSettings {
         } else {
             0.0
         };
-        (sys.t, sys.dt) = (t, dt);
-        (sys.constraint, sys.dofs, sys.mass, sys.f_ext) = (constraint, dofs, mass, f_ext);
-        (sys.a_n, sys.u_tilde, sys.g_new, sys.scales_new) = (a_n, u_tilde, g_new, scales_new);
+        sys.t = t;
+        sys.dt = dt;
+        sys.constraint = constraint;
+        sys.dofs = dofs;
+        sys.mass = mass;
+        sys.f_ext = f_ext;
+        sys.a_n = a_n;
+        sys.u_tilde = u_tilde;
+        sys.g_new = g_new;
+        sys.scales_new = scales_new;
     }
 
     /// Particle accelerations at t = 0 from M a = f_ext − f_int (lumped).
