@@ -8,8 +8,10 @@
 //!
 //! Scenes: the column of problems/column.toml refined to 1×N cells (uGIMP, 2×2
 //! particles per cell, 4N particles; its matrix is banded, so there is almost no
-//! fill-in), and a square block of 64×64 cells under self-weight with a fixed base
-//! (16,384 particles, 2D coupling, real fill-in).
+//! fill-in), and the square block of problems/bench/block.toml on 64×64 cells
+//! under self-weight with a fixed base (16,384 particles, 2D coupling, real
+//! fill-in). The solver's own pieces build the matrix: `stencils_and_nodes`, its
+//! numbering of the unknowns and its particle tangents.
 //!
 //! At the initial lattice the particles sit where the outer uGIMP weights vanish,
 //! so each particle touches 2×2 nodes instead of 3×3 and the first-step matrix
@@ -29,12 +31,15 @@ use faer::Side;
 use mpm::dim::Vector;
 use mpm::material::{Increment, StressDerivative};
 use mpm::model::Model;
-use mpm::physics::boundary::node_constraint;
 use mpm::physics::deformation::Trial;
 use mpm::physics::shape::{ShapeFunction, Stencils};
-use mpm::physics::transfer::{external_force, NodeMap};
+use mpm::physics::transfer::{external_force, stencils_and_nodes, NodeMap};
 use mpm::scene::Scene;
-use mpm::solver::implicit::tangent::{pk1_derivative, stiffness_triplets, Dofs, Pk1Derivative};
+use mpm::solver::implicit::assembly::stiffness::{
+    particle_tangents, stiffness_triplets, Pk1Derivative,
+};
+use mpm::solver::implicit::assembly::Dofs;
+use mpm::solver::implicit::step::number_unknowns;
 use mpm::solver::implicit::Implicit;
 use mpm::solver::linear::direct::{DirectSolver, Structure};
 use rayon::prelude::*;
@@ -42,46 +47,9 @@ use std::hint::black_box;
 
 const COLUMN: &str = include_str!("../problems/column.toml");
 
-/// A 64×64-cell square block (10 m × 10 m, 2×2 particles per cell, uGIMP) under
-/// self-weight in 20 load steps, fixed base, free sides and top.
-const BLOCK: &str = r#"
-dimension = 2
-gravity = [0.0, -10.0]
-
-[grid]
-min = [0.0, 0.0]
-max = [10.0, 10.0]
-cells = [64, 64]
-shape_function = "ugimp"
-
-[[material]]
-name = "soil"
-model = "hencky"
-density = 80.0
-youngs_modulus = 1.0e6
-poisson_ratio = 0.3
-
-[[body]]
-name = "block"
-material = "soil"
-shape = "rectangle"
-min = [0.0, 0.0]
-max = [10.0, 10.0]
-particles_per_cell = 2
-
-[[boundary]]
-face = "ymin"
-condition = "fixed"
-
-[solver]
-kind = "implicit"
-integrator = "quasi_static"
-end_time = 1.0
-load_steps = 20
-
-[output]
-frames = 0
-"#;
+/// The 10 m × 10 m block of problems/bench/block.toml (uGIMP, 2×2 particles per
+/// cell, self-weight, fixed base), here on 64×64 cells in 20 load steps.
+const BLOCK: &str = include_str!("../problems/bench/block.toml");
 
 /// Everything one Newton iteration works on, built with the public API.
 struct Problem {
@@ -118,7 +86,12 @@ impl Problem {
     }
 
     fn block() -> Problem {
-        Problem::new("block_64x64".into(), "block.toml", BLOCK, &[])
+        Problem::new(
+            "block_64x64".into(),
+            "problems/bench/block.toml",
+            BLOCK,
+            &["grid.cells=[64,64]".into(), "solver.load_steps=20".into()],
+        )
     }
 
     /// The same problem after `steps` converged load steps of the real solver: the
@@ -147,22 +120,13 @@ struct Workspace {
 
 /// Stencils at the step-start positions and the active-node map.
 fn stencils_and_map(p: &Problem, w: &mut Workspace) {
-    let m = &p.model;
-    let x = &m.particles;
-    w.stencils
-        .compute(p.shape, &m.grid, &x.x, &x.half_length0, &x.f);
-    w.map.build(&w.stencils, m.grid.node_count());
+    stencils_and_nodes(&p.model, p.shape, &mut w.stencils, &mut w.map);
 }
 
-/// Equation numbers of the free components of the active nodes.
+/// The solver's numbering of the unknowns (weakly supported nodes tied).
 fn dofs(p: &Problem, w: &Workspace) -> Dofs {
-    let m = &p.model;
-    Dofs::new(
-        w.map
-            .active
-            .iter()
-            .map(|&g| node_constraint(&m.grid, &m.faces, g as usize).fixed),
-    )
+    let min_node_support = p.scene.config.stages()[0].min_node_support();
+    number_unknowns(&p.model, &w.stencils, &w.map, min_node_support).1
 }
 
 /// Trial state at u = 0 (the first iterate of a quasi-static step).
@@ -178,25 +142,7 @@ fn trial_at_zero(p: &Problem, w: &mut Workspace) {
 
 /// A_p = ∂P/∂ΔF of every particle at the trial state.
 fn pk1_derivatives(p: &Problem, w: &Workspace) -> Vec<Pk1Derivative> {
-    let x = &p.model.particles;
-    let history_old = x.history.slots(&x.history.data);
-    (0..x.len())
-        .into_par_iter()
-        .with_min_len(512)
-        .map(|q| {
-            let inc = Increment {
-                f_old: x.f[q],
-                df: w.trial.df[q],
-                dt: 0.0,
-                stress_old: x.stress[q],
-                history_old: history_old[q],
-            };
-            let ds = p.model.materials[x.material[q] as usize]
-                .stress_derivative(&inc)
-                .expect("analytic tangent");
-            pk1_derivative(&w.trial.df[q], &w.trial.stress[q], &ds)
-        })
-        .collect()
+    particle_tangents(&p.model, &w.trial, false).expect("analytic tangent")
 }
 
 /// ∂σ/∂ΔF of every particle alone (the material part of `pk1_derivatives`).

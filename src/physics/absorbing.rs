@@ -136,7 +136,7 @@ fn add_layer_forces<const D: usize>(
         }
         let f = lp.force(&interpolate(map, st, q, v), &u_p);
         for e in st.range(q) {
-            out[map.local[st.node[e] as usize] as usize] += f * (st.weight[e] * sign);
+            out[map.local_of(st, e)] += f * (st.weight[e] * sign);
         }
     }
 }

@@ -1,11 +1,13 @@
-//! Particle-to-grid and grid-to-particle transfers (thesis 2-20…2-27, GIMP 2-50…2-52).
+//! Particle-to-grid and grid-to-particle transfers (thesis 2-20…2-27, GIMP 2-50…2-52),
+//! for both solvers: one gather per nodal quantity (mass, momentum, internal and
+//! external force, the consistent-mass product) and the interpolations back.
 //!
 //! Only nodes touched by a particle are active. P2G is a gather: every active node
 //! sums its particle contributions in increasing particle order, so the result is
 //! bit-identical for any number of threads. G2P loops over particles, each reading
 //! its own stencil.
 
-use crate::dim::{Tensor, Vector};
+use crate::dim::{restrict, Mat3, Tensor, Vector};
 use crate::model::particles::Particles;
 use crate::model::Model;
 use crate::parallel::MIN_PARALLEL_LEN;
@@ -57,7 +59,8 @@ impl NodeMap {
         self.start.resize(self.active.len() + 1, 0);
         for p in 0..n_particles {
             for e in st.range(p) {
-                self.start[self.local[st.node[e] as usize] as usize + 1] += 1;
+                let a = self.local_of(st, e);
+                self.start[a + 1] += 1;
             }
         }
         for a in 0..self.active.len() {
@@ -67,7 +70,7 @@ impl NodeMap {
         self.entries.resize(*self.start.last().unwrap() as usize, 0);
         for p in 0..n_particles {
             for e in st.range(p) {
-                let a = self.local[st.node[e] as usize] as usize;
+                let a = self.local_of(st, e);
                 self.entries[next[a] as usize] = e as u32;
                 next[a] += 1;
             }
@@ -80,6 +83,11 @@ impl NodeMap {
 
     pub fn is_empty(&self) -> bool {
         self.active.is_empty()
+    }
+
+    /// Active index of the node of stencil entry e (the node must be active).
+    pub fn local_of<const D: usize>(&self, st: &Stencils<D>, e: usize) -> usize {
+        self.local[st.node[e] as usize] as usize
     }
 
     /// Entries of active node a.
@@ -125,10 +133,21 @@ pub fn mass_momentum<const D: usize>(
     p: &Particles<D>,
 ) -> (Vec<f64>, Vec<Vector<D>>) {
     let mass = map.gather(st.stride, 0.0, |q, e| p.mass[q] * st.weight[e]);
-    let momentum = map.gather(st.stride, Vector::<D>::zeros(), |q, e| {
-        p.v[q] * (p.mass[q] * st.weight[e])
-    });
-    (mass, momentum)
+    (mass, mass_weighted(map, st, p, &p.v))
+}
+
+/// Σ_p m_p S_Ip a_p at every active node: the nodal momentum (2-25) of a particle
+/// field, velocities, or accelerations for the Newmark projection of the implicit
+/// solver.
+pub fn mass_weighted<const D: usize>(
+    map: &NodeMap,
+    st: &Stencils<D>,
+    p: &Particles<D>,
+    a: &[Vector<D>],
+) -> Vec<Vector<D>> {
+    map.gather(st.stride, Vector::<D>::zeros(), |q, e| {
+        a[q] * (p.mass[q] * st.weight[e])
+    })
 }
 
 /// v_I = p_I / m_I (2-25); zero on a node whose mass is exactly zero.
@@ -144,8 +163,69 @@ pub fn mass_average<const D: usize>(mass: &[f64], momentum: &[Vector<D>]) -> Vec
         .collect()
 }
 
-/// Nodal force f_ext − f_int: internal −Σ V_p σ_p ∇S_Ip (2-51), external
-/// Σ S_Ip (m_p g + s_p f_p) (2-52) with s_p the load factor of particle p.
+/// scale · Σ_J M_IJ w_J with the consistent mass matrix M_IJ = Σ_p m_p S_Ip S_Jp
+/// (2-24 before lumping): the implicit inertial force with a consistent mass.
+pub fn consistent_mass_product<const D: usize>(
+    map: &NodeMap,
+    st: &Stencils<D>,
+    p: &Particles<D>,
+    w: &[Vector<D>],
+    scale: f64,
+) -> Vec<Vector<D>> {
+    let at_particles: Vec<Vector<D>> = (0..p.len()).map(|q| interpolate(map, st, q, w)).collect();
+    map.gather(st.stride, Vector::<D>::zeros(), |q, e| {
+        at_particles[q] * (p.mass[q] * st.weight[e] * scale)
+    })
+}
+
+/// Internal force of a particle at one stencil entry, V τ ∇S_I: the Cauchy stress
+/// and the current volume (2-51), or the relative first Piola-Kirchhoff stress and
+/// the step-start volume (the implicit step, 2-21 pulled back).
+fn internal_force_at<const D: usize>(stress: &Mat3, volume: f64, grad: &Vector<D>) -> Vector<D> {
+    let tau: Tensor<D> = restrict::<D>(stress);
+    tau * grad * volume
+}
+
+/// External force of particle q at a stencil entry of weight S_Iq:
+/// S_Iq (m_q g + s_q f_q) (2-52).
+fn external_force_at<const D: usize>(
+    p: &Particles<D>,
+    q: usize,
+    weight: f64,
+    gravity: &Vector<D>,
+    load_factor: &impl Fn(usize) -> f64,
+) -> Vector<D> {
+    applied_force(p, q, gravity, load_factor) * weight
+}
+
+/// Internal force f_I = Σ_p V_p τ_p ∇S_Ip at every active node, for the stress
+/// measure τ and volumes V given (see `internal_force_at`).
+pub fn internal_force<const D: usize>(
+    map: &NodeMap,
+    st: &Stencils<D>,
+    volume: &[f64],
+    stress: &[Mat3],
+) -> Vec<Vector<D>> {
+    map.gather(st.stride, Vector::<D>::zeros(), |q, e| {
+        internal_force_at(&stress[q], volume[q], &st.grad[e])
+    })
+}
+
+/// External nodal force Σ_p S_Ip (m_p g + s_p f_p) (2-52), s_p the load factor.
+pub fn external_force<const D: usize>(
+    map: &NodeMap,
+    st: &Stencils<D>,
+    p: &Particles<D>,
+    gravity: &Vector<D>,
+    load_factor: &(impl Fn(usize) -> f64 + Sync),
+) -> Vec<Vector<D>> {
+    map.gather(st.stride, Vector::<D>::zeros(), |q, e| {
+        external_force_at(p, q, st.weight[e], gravity, load_factor)
+    })
+}
+
+/// Nodal force f_ext − f_int with the particles' Cauchy stress and current volume
+/// (2-51, 2-52), summed entry by entry (one gather).
 pub fn nodal_force<const D: usize>(
     map: &NodeMap,
     st: &Stencils<D>,
@@ -154,10 +234,8 @@ pub fn nodal_force<const D: usize>(
     load_factor: &(impl Fn(usize) -> f64 + Sync),
 ) -> Vec<Vector<D>> {
     map.gather(st.stride, Vector::<D>::zeros(), |q, e| {
-        let sigma: Tensor<D> = crate::dim::restrict::<D>(&p.stress[q]);
-        let internal = sigma * st.grad[e] * p.volume[q];
-        let external = applied_force(p, q, gravity, load_factor) * st.weight[e];
-        external - internal
+        external_force_at(p, q, st.weight[e], gravity, load_factor)
+            - internal_force_at(&p.stress[q], p.volume[q], &st.grad[e])
     })
 }
 
@@ -171,19 +249,6 @@ pub fn applied_force<const D: usize>(
     gravity * p.mass[q] + p.load[q] * load_factor(q)
 }
 
-/// External nodal force Σ_p S_Ip (m_p g + s_p f_p) (2-52), s_p the load factor.
-pub fn external_force<const D: usize>(
-    map: &NodeMap,
-    st: &Stencils<D>,
-    p: &Particles<D>,
-    gravity: &Vector<D>,
-    load_factor: &(impl Fn(usize) -> f64 + Sync),
-) -> Vec<Vector<D>> {
-    map.gather(st.stride, Vector::<D>::zeros(), |q, e| {
-        applied_force(p, q, gravity, load_factor) * st.weight[e]
-    })
-}
-
 /// Σ_I S_Ip u_I for particle p (interpolation of a nodal vector field).
 pub fn interpolate<const D: usize>(
     map: &NodeMap,
@@ -192,7 +257,7 @@ pub fn interpolate<const D: usize>(
     u: &[Vector<D>],
 ) -> Vector<D> {
     st.range(p).fold(Vector::<D>::zeros(), |acc, e| {
-        acc + u[map.local[st.node[e] as usize] as usize] * st.weight[e]
+        acc + u[map.local_of(st, e)] * st.weight[e]
     })
 }
 
@@ -204,6 +269,6 @@ pub fn gradient<const D: usize>(
     u: &[Vector<D>],
 ) -> Tensor<D> {
     st.range(p).fold(Tensor::<D>::zeros(), |acc, e| {
-        acc + u[map.local[st.node[e] as usize] as usize] * st.grad[e].transpose()
+        acc + u[map.local_of(st, e)] * st.grad[e].transpose()
     })
 }

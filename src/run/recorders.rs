@@ -134,7 +134,7 @@ impl Recorders {
                 r.wall_seconds.into(),
                 r.krylov_iterations.into(),
                 r.forcing.into(),
-                r.linear_solver.into(),
+                Field::from(&r.linear_solver),
             ])?;
         }
         csv.flush()

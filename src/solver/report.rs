@@ -18,7 +18,8 @@ pub struct NewtonRow {
     /// ‖δu‖ / ‖u‖ of the correction that follows (NaN on the converged row).
     pub increment: f64,
     pub wall_seconds: f64,
-    pub linear_solver: &'static str,
+    /// The linear solver of that correction (`direct` method, or `gmres/jacobi` …).
+    pub linear_solver: String,
     /// Krylov iterations of the correction that follows (0: direct solver or
     /// converged row).
     pub krylov_iterations: usize,

@@ -13,7 +13,6 @@ mod plots;
 use crate::analyses::strength_reduction::SearchSummary;
 use crate::model::Model;
 use crate::output::{CsvWriter, Field, Table};
-use crate::physics::boundary::implicit_node_constraint;
 use crate::physics::shape::Stencils;
 use crate::physics::transfer::NodeMap;
 use crate::run::summary::Summary;
@@ -21,7 +20,6 @@ use crate::scene::overrides;
 use crate::scene::validate;
 use crate::scene::{BenchConfig, Integrator, Scene, SceneConfig, SceneError, SolverKind};
 use crate::solver::explicit::Explicit;
-use crate::solver::implicit::tangent::Dofs;
 use child::{run_child, Exit};
 use configurations::Configuration;
 use std::path::{Path, PathBuf};
@@ -618,41 +616,27 @@ fn status(exit: Exit, dir: &Path, timeout: f64) -> String {
     }
 }
 
-/// Particles and unknowns at the first step: the free components of the active
-/// nodes for implicit runs (the size of the Newton system), D × active nodes for
-/// explicit ones.
+/// Particles and unknowns at the first step: the size of the first Newton system
+/// for implicit runs (`solver::implicit::unknowns`, of the first implicit stage),
+/// D × active nodes for explicit ones.
 fn unknowns(scene: &Scene) -> Result<(usize, usize), SceneError> {
-    let implicit = scene
-        .config
-        .stages()
-        .iter()
-        .any(|s| s.kind == SolverKind::Implicit);
     match scene.config.dimension {
-        2 => unknowns_dim::<2>(scene, implicit),
-        _ => unknowns_dim::<3>(scene, implicit),
+        2 => unknowns_dim::<2>(scene),
+        _ => unknowns_dim::<3>(scene),
     }
 }
 
-fn unknowns_dim<const D: usize>(
-    scene: &Scene,
-    implicit: bool,
-) -> Result<(usize, usize), SceneError> {
+fn unknowns_dim<const D: usize>(scene: &Scene) -> Result<(usize, usize), SceneError> {
     let m = Model::<D>::build(scene)?;
-    let (mut st, mut map) = (Stencils::<D>::default(), NodeMap::default());
-    crate::physics::transfer::stencils_and_nodes(
-        &m,
-        scene.config.grid.shape_function,
-        &mut st,
-        &mut map,
-    );
-    let n = if implicit {
-        let fixed = map
-            .active
-            .iter()
-            .map(|&g| implicit_node_constraint(&m.grid, &m.faces, &m.friction, g as usize).fixed);
-        Dofs::new(fixed).free
-    } else {
-        D * map.len()
+    let shape = scene.config.grid.shape_function;
+    let stages = scene.config.stages();
+    let n = match stages.iter().find(|s| s.kind == SolverKind::Implicit) {
+        Some(s) => crate::solver::implicit::unknowns(&m, shape, s),
+        None => {
+            let (mut st, mut map) = (Stencils::<D>::default(), NodeMap::default());
+            crate::physics::transfer::stencils_and_nodes(&m, shape, &mut st, &mut map);
+            D * map.len()
+        }
     };
     Ok((m.particles.len(), n))
 }

@@ -33,17 +33,18 @@
 //! forming K; or K itself assembled and factorized with the direct solver and
 //! kept while it works (lagged, see [`LAGGED_REFRESH_ITERATIONS`]).
 
-use super::tangent::{Dofs, Pk1Derivative};
-use super::{Failure, Implicit};
+use super::assembly::stiffness::{coupling, particle_tangents, Pk1Derivative};
+use super::assembly::Dofs;
+use super::failure::Failure;
+use super::residual::{residual, tangent};
+use super::step::StepSystem;
 use crate::dim::Vector;
 use crate::model::Model;
-use crate::physics::shape::Stencils;
-use crate::physics::transfer::NodeMap;
 use crate::scene::{LinearSolver, MassMatrix, PreconditionerKind, SolverConfig};
 use crate::solver::linear::cg::cg;
-use crate::solver::linear::direct::Structure;
+use crate::solver::linear::direct::{DirectSolver, Structure};
 use crate::solver::linear::gmres::gmres;
-use crate::solver::linear::iterative::{Identity, Outcome, Preconditioner, Settings};
+use crate::solver::linear::iterative::{norm, Identity, Outcome, Preconditioner, Settings};
 use crate::solver::linear::preconditioner::{BlockJacobi, Factorized, Jacobi};
 use nalgebra::SMatrix;
 
@@ -135,51 +136,33 @@ impl KrylovConfig {
     }
 
     /// "gmres/jacobi" and so on, for newton.csv.
-    pub fn name(&self) -> &'static str {
-        use LinearSolver::*;
-        use PreconditionerKind::*;
-        match (self.method, self.preconditioner) {
-            (Cg, None) => "cg/none",
-            (Cg, Jacobi) => "cg/jacobi",
-            (Cg, BlockJacobi) => "cg/block_jacobi",
-            (Cg, LaggedDirect) => "cg/lagged_direct",
-            (_, None) => "gmres/none",
-            (_, Jacobi) => "gmres/jacobi",
-            (_, BlockJacobi) => "gmres/block_jacobi",
-            (_, LaggedDirect) => "gmres/lagged_direct",
-        }
+    pub fn name(&self) -> String {
+        format!("{}/{}", self.method.name(), self.preconditioner.name())
     }
 }
 
 /// The Krylov solver's state across Newton iterations and steps.
-#[derive(Clone, Debug)]
 pub struct KrylovState {
     pub config: KrylovConfig,
     forcing: Forcing,
-    /// Active nodes and unknown numbering the lagged factorization belongs to.
+    /// The lagged_direct preconditioner's factorization, and the active nodes and
+    /// unknown numbering it belongs to.
+    lagged: DirectSolver,
     lagged_for: Option<(Vec<u32>, Vec<u32>)>,
     refresh: bool,
     /// Lagged factorizations computed so far.
     pub factorizations: usize,
+    /// Krylov iterations over all Newton corrections.
+    pub iterations: usize,
 }
 
-impl KrylovState {
-    pub fn new(config: KrylovConfig) -> KrylovState {
-        KrylovState {
-            config,
-            forcing: Forcing::new(config.fixed_tolerance),
-            lagged_for: None,
-            refresh: true,
-            factorizations: 0,
-        }
-    }
-}
-
-/// One Newton correction and how it was obtained.
+/// One Newton correction and how it was obtained (by this solver or the direct
+/// one).
 #[derive(Clone, Debug)]
 pub struct Correction {
     pub du: Vec<f64>,
-    pub method: &'static str,
+    /// The linear solver, for newton.csv.
+    pub method: String,
     pub krylov_iterations: usize,
     /// η of an inexact solve (NaN for the direct solver).
     pub forcing: f64,
@@ -190,37 +173,28 @@ pub struct Correction {
 /// plus the inertia M_II/(βΔt²) (2-40; lumped, or Σ_p m_p S_Ip² for the consistent
 /// mass). Deterministic (a gather). Components are not yet restricted to the
 /// free unknowns.
-#[allow(clippy::too_many_arguments)]
 pub fn diagonal_blocks<const D: usize>(
-    map: &NodeMap,
-    st: &Stencils<D>,
-    volume: &[f64],
-    particle_mass: &[f64],
+    m: &Model<D>,
+    sys: &StepSystem<D>,
     a: &[Pk1Derivative],
-    lumped_mass: &[f64],
-    mass_matrix: MassMatrix,
-    inertia: f64,
 ) -> Vec<SMatrix<f64, D, D>> {
-    let consistent = mass_matrix == MassMatrix::Consistent;
-    let mut blocks = map.gather(st.stride, SMatrix::<f64, D, D>::zeros(), |q, e| {
-        let g = &st.grad[e];
-        let mut b = SMatrix::<f64, D, D>::from_fn(|i, k| {
-            let mut v = 0.0;
-            for j in 0..D {
-                for l in 0..D {
-                    v += g[j] * a[q][(3 * i + j, 3 * k + l)] * g[l];
-                }
+    let p = &m.particles;
+    let (st, inertia) = (&sys.stencils, sys.inertia);
+    let consistent = sys.mass_matrix == MassMatrix::Consistent;
+    let mut blocks = sys
+        .map
+        .gather(st.stride, SMatrix::<f64, D, D>::zeros(), |q, e| {
+            let g = &st.grad[e];
+            let mut b =
+                SMatrix::<f64, D, D>::from_fn(|i, k| coupling(g, &a[q], g, i, k) * p.volume[q]);
+            if consistent {
+                let w = st.weight[e];
+                b += SMatrix::<f64, D, D>::identity() * (p.mass[q] * w * w * inertia);
             }
-            v * volume[q]
+            b
         });
-        if consistent {
-            let w = st.weight[e];
-            b += SMatrix::<f64, D, D>::identity() * (particle_mass[q] * w * w * inertia);
-        }
-        b
-    });
     if !consistent {
-        for (b, m) in blocks.iter_mut().zip(lumped_mass) {
+        for (b, m) in blocks.iter_mut().zip(&sys.mass) {
             *b += SMatrix::<f64, D, D>::identity() * (m * inertia);
         }
     }
@@ -232,88 +206,77 @@ enum Built {
     Identity,
     Jacobi(Jacobi),
     Blocks(BlockJacobi),
-    /// Use the direct solver's current factors.
+    /// Use the lagged factorization.
     Lagged,
 }
 
-impl<const D: usize> Implicit<D> {
+impl KrylovState {
+    pub fn new(config: KrylovConfig) -> KrylovState {
+        KrylovState {
+            config,
+            forcing: Forcing::new(config.fixed_tolerance),
+            lagged: DirectSolver::new(),
+            lagged_for: None,
+            refresh: true,
+            factorizations: 0,
+            iterations: 0,
+        }
+    }
+
     /// δu with ‖r + J δu‖ ≤ η ‖r‖ by GMRES or CG on difference products at the
     /// iterate `u` (whose residual `r_free` the trial state holds). `stop` is the
     /// Newton tolerance on ‖r‖; `iteration` 0 starts a new forcing sequence.
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn krylov_correction(
+    pub fn correction<const D: usize>(
         &mut self,
         m: &Model<D>,
-        dofs: &Dofs,
+        sys: &mut StepSystem<D>,
         u: &[Vector<D>],
         r_free: &[f64],
         stop: f64,
         iteration: usize,
-        u_tilde: &[Vector<D>],
-        mass: &[f64],
-        f_ext: &[Vector<D>],
-        inertia: f64,
-        dt: f64,
     ) -> Result<Correction, Failure> {
-        let state = self.krylov.as_mut().expect("a Krylov solver is configured");
-        let config = state.config;
+        let config = self.config;
         if iteration == 0 {
-            state.forcing.reset();
+            self.forcing.reset();
         }
-        let r_norm = crate::solver::linear::iterative::norm(r_free);
-        let eta = state.forcing.next(r_norm, stop);
-        let built = self.build_preconditioner(m, dofs, mass, inertia)?;
+        let eta = self.forcing.next(norm(r_free), stop);
+        let built = self.build_preconditioner(m, sys)?;
 
         let h = m.grid.h_min();
-        let u_max = max_norm_free(u, dofs);
+        let u_max = max_norm_free(u, &sys.dofs);
         let b: Vec<f64> = r_free.iter().map(|x| -x).collect();
-        let mut du = vec![0.0; dofs.free];
+        let mut du = vec![0.0; sys.dofs.free];
         let settings = Settings {
             tolerance: eta,
             max_iterations: config.max_iterations,
             restart: config.restart,
         };
-        // The direct solver leaves `self` for the solve: the difference products
-        // need `self` mutably (trial states), the lagged preconditioner its factors.
-        let solver = std::mem::take(&mut self.solver);
-        let outcome = {
-            let mut product = |v: &[f64], out: &mut [f64]| -> Result<(), Failure> {
-                let v_max = v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-                if v_max == 0.0 {
-                    out.iter_mut().for_each(|o| *o = 0.0);
-                    return Ok(());
-                }
-                let eps = difference_step(h, u_max, v_max);
-                let jv = self.difference_product(
-                    m, dofs, u, r_free, v, eps, u_tilde, mass, f_ext, inertia, dt,
-                )?;
-                out.copy_from_slice(&jv);
-                Ok(())
-            };
-            let factors = Factorized(&solver);
-            let pre: &dyn Preconditioner = match &built {
-                Built::Identity => &Identity,
-                Built::Jacobi(j) => j,
-                Built::Blocks(b) => b,
-                Built::Lagged => &factors,
-            };
-            match config.method {
-                LinearSolver::Cg => cg(&mut product, pre, &b, &mut du, &settings),
-                _ => gmres(&mut product, pre, &b, &mut du, &settings),
+        let product = |v: &[f64], out: &mut [f64]| -> Result<(), Failure> {
+            let v_max = v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+            if v_max == 0.0 {
+                out.iter_mut().for_each(|o| *o = 0.0);
+                return Ok(());
             }
+            let eps = difference_step(h, u_max, v_max);
+            out.copy_from_slice(&difference_product(m, sys, u, r_free, v, eps)?);
+            Ok(())
         };
-        self.solver = solver;
-        let outcome: Outcome = outcome?;
-        self.krylov_iterations += outcome.iterations;
-        let state = self.krylov.as_mut().unwrap();
+        let factors = Factorized(&self.lagged);
+        let pre: &dyn Preconditioner = match &built {
+            Built::Identity => &Identity,
+            Built::Jacobi(j) => j,
+            Built::Blocks(b) => b,
+            Built::Lagged => &factors,
+        };
+        let outcome: Outcome = match config.method {
+            LinearSolver::Cg => cg(product, pre, &b, &mut du, &settings),
+            _ => gmres(product, pre, &b, &mut du, &settings),
+        }?;
+        self.iterations += outcome.iterations;
         if !outcome.converged || outcome.iterations > LAGGED_REFRESH_ITERATIONS {
-            state.refresh = true;
+            self.refresh = true;
         }
         if !outcome.converged {
-            let name = match config.method {
-                LinearSolver::Cg => "CG",
-                _ => "GMRES",
-            };
             let why = outcome
                 .breakdown
                 .map(|b| format!("stopped: {b}"))
@@ -323,9 +286,10 @@ impl<const D: usize> Implicit<D> {
             return Err(Failure {
                 particle: None,
                 message: format!(
-                    "{name} ({} preconditioner) did not reach the forcing tolerance η = {eta:.2e} \
+                    "{} ({} preconditioner) did not reach the forcing tolerance η = {eta:.2e} \
                      in Newton iteration {iteration}: relative linear residual {:.2e} after {} \
                      iterations, {why}",
+                    config.method.name().to_uppercase(),
                     config.preconditioner.name(),
                     outcome.relative_residual,
                     outcome.iterations
@@ -340,65 +304,21 @@ impl<const D: usize> Implicit<D> {
         })
     }
 
-    /// (r(u + ε v) − r(u)) / ε over the free unknowns (2-39); `r_free` is r(u).
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn difference_product(
-        &mut self,
-        m: &Model<D>,
-        dofs: &Dofs,
-        u: &[Vector<D>],
-        r_free: &[f64],
-        v: &[f64],
-        eps: f64,
-        u_tilde: &[Vector<D>],
-        mass: &[f64],
-        f_ext: &[Vector<D>],
-        inertia: f64,
-        dt: f64,
-    ) -> Result<Vec<f64>, Failure> {
-        let mut up = u.to_vec();
-        dofs.apply_correction(&mut up, v, eps);
-        let r = self
-            .residual(m, &up, u_tilde, mass, f_ext, inertia, dt)
-            .map_err(|f| Failure {
-                particle: f.particle,
-                message: format!("{} (in a finite-difference product, 2-39)", f.message),
-            })?;
-        Ok(dofs
-            .reduce(&r)
-            .iter()
-            .zip(r_free)
-            .map(|(rp, r0)| (rp - r0) / eps)
-            .collect())
-    }
-
     /// The preconditioner at the current iterate (the trial state).
-    fn build_preconditioner(
+    fn build_preconditioner<const D: usize>(
         &mut self,
         m: &Model<D>,
-        dofs: &Dofs,
-        mass: &[f64],
-        inertia: f64,
+        sys: &StepSystem<D>,
     ) -> Result<Built, Failure> {
-        let kind = self.krylov.as_ref().unwrap().config.preconditioner;
-        let blocks = |this: &Self| -> Result<Vec<SMatrix<f64, D, D>>, Failure> {
-            let a = this.particle_tangents(m, true)?;
-            let p = &m.particles;
-            Ok(diagonal_blocks(
-                &this.map,
-                &this.stencils,
-                &p.volume,
-                &p.mass,
-                &a,
-                mass,
-                this.mass_matrix,
-                inertia,
-            ))
+        let dofs = &sys.dofs;
+        let blocks = || -> Result<Vec<SMatrix<f64, D, D>>, Failure> {
+            let a = particle_tangents(m, &sys.trial, true)?;
+            Ok(diagonal_blocks(m, sys, &a))
         };
-        Ok(match kind {
+        Ok(match self.config.preconditioner {
             PreconditionerKind::None => Built::Identity,
             PreconditionerKind::Jacobi => {
-                let blocks = blocks(self)?;
+                let blocks = blocks()?;
                 let mut diagonal = vec![0.0; dofs.free];
                 for (a, block) in blocks.iter().enumerate() {
                     for d in 0..D {
@@ -410,7 +330,7 @@ impl<const D: usize> Implicit<D> {
                 Built::Jacobi(Jacobi::new(diagonal))
             }
             PreconditionerKind::BlockJacobi => {
-                let blocks = blocks(self)?;
+                let blocks = blocks()?;
                 let mut unknowns: Vec<Vec<usize>> = Vec::with_capacity(blocks.len());
                 let mut values: Vec<Vec<f64>> = Vec::with_capacity(blocks.len());
                 for (a, block) in blocks.iter().enumerate() {
@@ -432,7 +352,7 @@ impl<const D: usize> Implicit<D> {
                 ))
             }
             PreconditionerKind::LaggedDirect => {
-                self.refresh_lagged(m, dofs, mass, inertia)?;
+                self.refresh_lagged(m, sys)?;
                 Built::Lagged
             }
         })
@@ -441,40 +361,60 @@ impl<const D: usize> Implicit<D> {
     /// Assemble and factorize the tangent at the current iterate if the kept
     /// factorization is missing, belongs to other unknowns, or has stopped
     /// working (see [`LAGGED_REFRESH_ITERATIONS`]).
-    fn refresh_lagged(
+    fn refresh_lagged<const D: usize>(
         &mut self,
         m: &Model<D>,
-        dofs: &Dofs,
-        mass: &[f64],
-        inertia: f64,
+        sys: &StepSystem<D>,
     ) -> Result<(), Failure> {
-        let state = self.krylov.as_ref().unwrap();
-        let same_unknowns = state
+        let same_unknowns = self
             .lagged_for
             .as_ref()
-            .is_some_and(|(active, index)| *active == self.map.active && *index == dofs.index);
-        if same_unknowns && !state.refresh {
+            .is_some_and(|(active, index)| *active == sys.map.active && *index == sys.dofs.index);
+        if same_unknowns && !self.refresh {
             return Ok(());
         }
-        let (triplets, symmetric) = self.tangent(m, dofs, mass, inertia)?;
+        // The lagged preconditioner accepts a numerical tangent.
+        let (triplets, symmetric) = tangent(m, sys, true)?;
         let structure = if symmetric {
             Structure::Symmetric
         } else {
             Structure::General
         };
-        self.solver
-            .factorize(dofs.free, &triplets, structure)
+        self.lagged
+            .factorize(sys.dofs.free, &triplets, structure)
             .map_err(|e| Failure {
                 particle: None,
                 message: format!("lagged_direct preconditioner: factorization failed: {e}"),
             })?;
-        let active = self.map.active.clone();
-        let state = self.krylov.as_mut().unwrap();
-        state.lagged_for = Some((active, dofs.index.clone()));
-        state.refresh = false;
-        state.factorizations += 1;
+        self.lagged_for = Some((sys.map.active.clone(), sys.dofs.index.clone()));
+        self.refresh = false;
+        self.factorizations += 1;
         Ok(())
     }
+}
+
+/// (r(u + ε v) − r(u)) / ε over the free unknowns (2-39); `r_free` is r(u).
+pub fn difference_product<const D: usize>(
+    m: &Model<D>,
+    sys: &mut StepSystem<D>,
+    u: &[Vector<D>],
+    r_free: &[f64],
+    v: &[f64],
+    eps: f64,
+) -> Result<Vec<f64>, Failure> {
+    let mut up = u.to_vec();
+    sys.dofs.apply_correction(&mut up, v, eps);
+    let r = residual(m, sys, &up).map_err(|f| Failure {
+        particle: f.particle,
+        message: format!("{} (in a finite-difference product, 2-39)", f.message),
+    })?;
+    Ok(sys
+        .dofs
+        .reduce(&r)
+        .iter()
+        .zip(r_free)
+        .map(|(rp, r0)| (rp - r0) / eps)
+        .collect())
 }
 
 /// max |u_i| over the free components.
@@ -486,49 +426,26 @@ fn max_norm_free<const D: usize>(u: &[Vector<D>], dofs: &Dofs) -> f64 {
 mod tests {
     use super::*;
     use crate::scene::Scene;
+    use crate::solver::implicit::tests::BLOCK;
+    use crate::solver::implicit::Implicit;
 
-    /// A 4×4-cell block with cell size h = `length`, Hencky,
-    /// fixed base, gravity and a corner load, quasi-static, uGIMP.
+    /// The block of the implicit tests (`super::super::tests::BLOCK`) scaled to
+    /// cell size h = `length`, uGIMP, quasi-static in one load step.
     fn block(length: f64) -> String {
-        format!(
-            r#"dimension = 2
-gravity = [0.0, -10.0]
-[grid]
-min = [0.0, 0.0]
-max = [{g}, {g}]
-cells = [4, 4]
-shape_function = "ugimp"
-[[material]]
-name = "m"
-model = "hencky"
-density = 1000.0
-youngs_modulus = 1.0e5
-poisson_ratio = 0.3
-[[body]]
-material = "m"
-shape = "rectangle"
-min = [{b0}, 0.0]
-max = [{b1}, {b2}]
-[[boundary]]
-face = "ymin"
-condition = "fixed"
-[[load]]
-kind = "point"
-region_min = [{b2}, {b1x}]
-region_max = [{b1}, {b2}]
-force = [3.0e3, -1.0e3]
-[solver]
-kind = "implicit"
-integrator = "quasi_static"
-end_time = 1.0
-load_steps = 1
-"#,
-            g = 4.0 * length,
-            b0 = 0.5 * length,
-            b1 = 3.0 * length,
-            b2 = 2.5 * length,
-            b1x = 2.0 * length,
-        )
+        let l = |x: f64| x * length;
+        let text =
+            crate::scene::overrides::unset("block.toml", BLOCK, &["solver.dt".into()]).unwrap();
+        let overrides = [
+            format!("grid.max=[{},{}]", l(4.0), l(4.0)),
+            "grid.shape_function=ugimp".to_string(),
+            format!("body.0.min=[{},0.0]", l(0.5)),
+            format!("body.0.max=[{},{}]", l(3.0), l(2.5)),
+            format!("load.0.region_min=[{},{}]", l(2.5), l(2.0)),
+            format!("load.0.region_max=[{},{}]", l(3.0), l(2.5)),
+            "solver.integrator=quasi_static".to_string(),
+            "solver.load_steps=1".to_string(),
+        ];
+        crate::scene::overrides::apply("block.toml", &text, &overrides).unwrap()
     }
 
     /// Relative error ‖J_fd v − K v‖ / ‖K v‖ of the difference product against the
@@ -542,8 +459,9 @@ load_steps = 1
             scene.config.stages()[0],
             0.0,
         );
-        let sys = solver.prepare(&m, 0.0, 1.0);
-        let nodes: Vec<usize> = solver.map.active.iter().map(|&g| g as usize).collect();
+        solver.prepare(&m, 0.0, 1.0);
+        let sys = &mut solver.system;
+        let nodes: Vec<usize> = sys.map.active.iter().map(|&g| g as usize).collect();
         // Strains of a few per cent: displacements scale with the length.
         let u: Vec<Vector<2>> = nodes
             .iter()
@@ -562,15 +480,9 @@ load_steps = 1
                 v
             })
             .collect();
-        let dofs = &sys.dofs;
-        let res = |s: &mut Implicit<2>, u: &[Vector<2>]| {
-            let r = s
-                .residual(&m, u, &sys.u_tilde, &sys.mass, &sys.f_ext, sys.inertia, 1.0)
-                .unwrap();
-            dofs.reduce(&r)
-        };
-        let r0 = res(&mut solver, &u);
-        let (triplets, _) = solver.tangent(&m, dofs, &sys.mass, sys.inertia).unwrap();
+        let dofs = sys.dofs.clone();
+        let r0 = dofs.reduce(&residual(&m, sys, &u).unwrap());
+        let (triplets, _) = tangent(&m, sys, false).unwrap();
         // A smooth direction with ‖v‖_∞ = 1.
         let n = dofs.free;
         let v: Vec<f64> = (0..n).map(|i| (0.37 * i as f64).sin()).collect();
@@ -580,30 +492,16 @@ load_steps = 1
         for (r, c, val) in triplets {
             kv[r] += val * v[c];
         }
-        let kv_norm = crate::solver::linear::iterative::norm(&kv);
+        let kv_norm = norm(&kv);
         let errors = steps
             .iter()
             .map(|&eps| {
-                let jv = solver
-                    .difference_product(
-                        &m,
-                        dofs,
-                        &u,
-                        &r0,
-                        &v,
-                        eps,
-                        &sys.u_tilde,
-                        &sys.mass,
-                        &sys.f_ext,
-                        sys.inertia,
-                        1.0,
-                    )
-                    .unwrap();
+                let jv = difference_product(&m, sys, &u, &r0, &v, eps).unwrap();
                 let diff: Vec<f64> = jv.iter().zip(&kv).map(|(a, b)| a - b).collect();
-                crate::solver::linear::iterative::norm(&diff) / kv_norm
+                norm(&diff) / kv_norm
             })
             .collect();
-        let chosen = difference_step(m.grid.h_min(), max_norm_free(&u, dofs), 1.0);
+        let chosen = difference_step(m.grid.h_min(), max_norm_free(&u, &dofs), 1.0);
         (errors, chosen)
     }
 

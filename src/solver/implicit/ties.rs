@@ -12,7 +12,7 @@
 //! stay a partition of unity and keep reproducing linear fields exactly, and the
 //! tangent stays the exact derivative of the (constrained) residual.
 
-use super::tangent::Tie;
+use super::assembly::Tie;
 use crate::dim::Vector;
 use crate::model::conditions::Constraint;
 use crate::model::grid::Grid;

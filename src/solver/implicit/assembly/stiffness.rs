@@ -1,0 +1,200 @@
+//! The stiffness of the implicit step: the particles' internal-force derivative.
+//!
+//! With ΔF_p = I + Σ_I u_I ⊗ ∇S_Ip (gradients at the step-start positions) and the
+//! relative first Piola-Kirchhoff stress P = J σ ΔF⁻ᵀ (J = det ΔF), the internal
+//! force is f_Ii = Σ_p V_p P_ij ∂S_Ip/∂X_j (thesis 2-21 pulled back,
+//! `physics::transfer::internal_force`), and its derivative is
+//! K_(Ii)(Jk) = Σ_p V_p ∂S_Ip/∂X_j A_ijkl ∂S_Jp/∂X_l with A = ∂P/∂ΔF. A holds both
+//! the material part (from the exact derivative of the stress update, 2-41) and
+//! the geometric part (2-42).
+
+use super::{push_stencil_pairs, Components, Dofs, Triplets};
+use crate::dim::{Mat3, Vector};
+use crate::material::driver::numerical_stress_derivative;
+use crate::material::{Increment, StressDerivative};
+use crate::model::Model;
+use crate::parallel::MIN_PARALLEL_LEN;
+use crate::physics::deformation::Trial;
+use crate::physics::shape::Stencils;
+use crate::physics::transfer::NodeMap;
+use crate::solver::implicit::failure::Failure;
+use nalgebra::SMatrix;
+use rayon::prelude::*;
+
+/// ∂P_ij/∂ΔF_kl, row 3i + j, column 3k + l.
+pub type Pk1Derivative = SMatrix<f64, 9, 9>;
+
+/// Central-difference step of the numerical stress derivative (preconditioners
+/// of materials without an analytic tangent).
+const NUMERICAL_STEP: f64 = 1e-6;
+
+/// P = J σ ΔF⁻ᵀ.
+pub fn relative_pk1(df: &Mat3, sigma: &Mat3) -> Mat3 {
+    let inv_t = df.try_inverse().unwrap_or_else(Mat3::zeros).transpose();
+    sigma * inv_t * df.determinant()
+}
+
+/// A_ijkl = ∂P_ij/∂ΔF_kl = J [G_kl (σG)_ij + (∂σ_im/∂ΔF_kl) G_mj − (σG)_il G_kj],
+/// G = ΔF⁻ᵀ (from ∂J/∂ΔF = J G and ∂G_mj/∂ΔF_kl = −G_ml G_kj).
+pub fn pk1_derivative(df: &Mat3, sigma: &Mat3, dsigma: &StressDerivative) -> Pk1Derivative {
+    let j = df.determinant();
+    let g = df.try_inverse().unwrap_or_else(Mat3::zeros).transpose();
+    let sg = sigma * g;
+    Pk1Derivative::from_fn(|row, col| {
+        let (i, jj, k, l) = (row / 3, row % 3, col / 3, col % 3);
+        let material: f64 = (0..3).map(|m| dsigma[(3 * i + m, col)] * g[(m, jj)]).sum();
+        j * (g[(k, l)] * sg[(i, jj)] + material - sg[(i, l)] * g[(k, jj)])
+    })
+}
+
+/// A_p = ∂P/∂ΔF of every particle at the trial state: from the material's
+/// exact stress derivative, or, when `numerical` (Krylov preconditioners
+/// only), from central differences of its stress update if it has none.
+pub fn particle_tangents<const D: usize>(
+    m: &Model<D>,
+    trial: &Trial,
+    numerical: bool,
+) -> Result<Vec<Pk1Derivative>, Failure> {
+    let p = &m.particles;
+    let history_old = p.history.slots(&p.history.data);
+    let a: Vec<Option<Pk1Derivative>> = (0..p.len())
+        .into_par_iter()
+        .with_min_len(MIN_PARALLEL_LEN)
+        .map(|q| {
+            let inc = Increment {
+                f_old: p.f[q],
+                df: trial.df[q],
+                dt: 0.0,
+                stress_old: p.stress[q],
+                history_old: history_old[q],
+            };
+            let mat = m.materials[p.material[q] as usize].as_ref();
+            mat.stress_derivative(&inc)
+                .or_else(|| {
+                    numerical.then(|| numerical_stress_derivative(mat, &inc, NUMERICAL_STEP))
+                })
+                .map(|ds| pk1_derivative(&trial.df[q], &trial.stress[q], &ds))
+        })
+        .collect();
+    if let Some(q) = a.iter().position(|x| x.is_none()) {
+        let model = m.materials[p.material[q] as usize].model();
+        return Err(Failure {
+            particle: Some(q),
+            message: format!(
+                "material model `{model}` has no analytic tangent, which the direct solver \
+                 needs; choose a matrix-free solver: linear_solver = \"gmres\" (or \"cg\" \
+                 for symmetric problems) in [solver] or the [[stage]]"
+            ),
+        });
+    }
+    Ok(a.into_iter().map(|x| x.unwrap()).collect())
+}
+
+/// ∇S_I · A · ∇S_J for components (i, k): Σ_jl ∂S_I/∂X_j A_ijkl ∂S_J/∂X_l.
+pub fn coupling<const D: usize>(
+    grad_i: &Vector<D>,
+    a: &Pk1Derivative,
+    grad_j: &Vector<D>,
+    i: usize,
+    k: usize,
+) -> f64 {
+    let mut v = 0.0;
+    for j in 0..D {
+        for l in 0..D {
+            v += grad_i[j] * a[(3 * i + j, 3 * k + l)] * grad_j[l];
+        }
+    }
+    v
+}
+
+/// Triplets of Σ_p V_p ∇S_I A_p ∇S_J over the free unknowns, particle by particle
+/// in order (deterministic). Also reports whether every A_p has major symmetry
+/// (A_ijkl = A_klij), i.e. whether the assembled matrix is symmetric.
+pub fn stiffness_triplets<const D: usize>(
+    map: &NodeMap,
+    st: &Stencils<D>,
+    dofs: &Dofs,
+    volume: &[f64],
+    a: &[Pk1Derivative],
+) -> (Triplets, bool) {
+    let per_particle: Vec<(Triplets, bool)> = (0..volume.len())
+        .into_par_iter()
+        .with_min_len(MIN_PARALLEL_LEN / 8)
+        .map(|q| {
+            let ap = &a[q];
+            let symmetric =
+                (ap - ap.transpose()).amax() <= 1e-10 * ap.amax().max(f64::MIN_POSITIVE);
+            let mut out = Vec::new();
+            push_stencil_pairs(
+                &mut out,
+                map,
+                st,
+                dofs,
+                q,
+                Components::All,
+                |e1, e2, i, k| coupling(&st.grad[e1], ap, &st.grad[e2], i, k) * volume[q],
+            );
+            (out, symmetric)
+        })
+        .collect();
+    let symmetric = per_particle.iter().all(|(_, s)| *s);
+    (
+        per_particle.into_iter().flat_map(|(t, _)| t).collect(),
+        symmetric,
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::neo_hookean::NeoHookean;
+    use crate::material::{Increment, Material};
+
+    /// A = ∂P/∂ΔF against central differences of P(ΔF) = J σ(ΔF) ΔF⁻ᵀ.
+    #[test]
+    fn pk1_derivative_matches_finite_differences() {
+        let m = NeoHookean::new(1000.0, 1.0e6, 0.3);
+        let f_old = Mat3::new(1.1, 0.2, 0.0, -0.1, 0.9, 0.05, 0.0, 0.03, 1.02);
+        let df = Mat3::new(1.02, 0.05, 0.01, -0.03, 0.97, 0.02, 0.01, -0.02, 1.01);
+        let stress_old = m.cauchy(&f_old);
+        let pk1 = |df: &Mat3| {
+            let inc = Increment {
+                f_old,
+                df: *df,
+                dt: 0.0,
+                stress_old,
+                history_old: &[],
+            };
+            relative_pk1(df, &m.update(&inc, &mut []))
+        };
+        let inc = Increment {
+            f_old,
+            df,
+            dt: 0.0,
+            stress_old,
+            history_old: &[],
+        };
+        let a = pk1_derivative(
+            &df,
+            &m.update(&inc, &mut []),
+            &m.stress_derivative(&inc).unwrap(),
+        );
+        let h = 1e-6;
+        let mut worst: f64 = 0.0;
+        for col in 0..9 {
+            let mut dp = df;
+            let mut dm = df;
+            dp[(col / 3, col % 3)] += h;
+            dm[(col / 3, col % 3)] -= h;
+            let fd = (pk1(&dp) - pk1(&dm)) / (2.0 * h);
+            for row in 0..9 {
+                worst = worst.max((fd[(row / 3, row % 3)] - a[(row, col)]).abs());
+            }
+        }
+        assert!(
+            worst < 1e-6 * a.amax(),
+            "max |A − A_fd| = {worst:.3e} (scale {:.3e})",
+            a.amax()
+        );
+    }
+}

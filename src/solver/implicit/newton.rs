@@ -1,0 +1,297 @@
+//! Newton-Raphson on the increment u of one implicit step (thesis 2-37…2-40).
+//!
+//! From the predictor ũ with the prescribed components imposed, every iteration
+//! 1. evaluates the residual r(u) from the step-start state (2-37, `residual`);
+//! 2. stops when ‖r‖ is small against a reference force and the last correction
+//!    was small against u;
+//! 3. solves the correction K δu = −r (2-38), with the assembled consistent
+//!    tangent (2-40) and the sparse direct solver, or matrix-free by GMRES or CG on
+//!    difference products of the residual (2-39, `krylov`);
+//! 4. with `line_search`, shortens δu until ‖r‖ decreases;
+//! 5. updates u ← u + s δu; tied nodes follow their masters.
+//!
+//! A non-finite residual, an inverted particle, a failed linear solve or no
+//! convergence in `max_iterations` fails the attempt: the caller cuts the step
+//! back. Every iteration is a row of newton.csv.
+
+use super::failure::Failure;
+use super::krylov::{Correction, KrylovConfig, KrylovState};
+use super::residual::{inertial_force, reactions, residual, tangent};
+use super::step::StepSystem;
+use crate::dim::Vector;
+use crate::model::Model;
+use crate::scene::SolverConfig;
+use crate::solver::linear::direct::{DirectSolver, Structure};
+use crate::solver::linear::iterative::norm;
+use crate::solver::report::NewtonRow;
+use std::time::Instant;
+
+/// The Newton settings of a stage and what the iteration keeps across steps.
+pub struct Newton {
+    pub residual_tolerance: f64,
+    pub displacement_tolerance: f64,
+    pub max_iterations: usize,
+    pub line_search: bool,
+    /// How the corrections are solved.
+    pub linear: Linear,
+    /// Iterations since the last time the solver's rows were taken (newton.csv).
+    pub log: Vec<NewtonRow>,
+    /// Corrections so far.
+    pub iterations: usize,
+}
+
+/// The linear solver of the corrections K δu = −r (2-38).
+pub enum Linear {
+    /// The assembled tangent, factorized.
+    Direct(DirectSolver),
+    /// Matrix-free GMRES or CG on difference products (2-39).
+    Krylov(KrylovState),
+}
+
+/// The converged increment of a step, and the reactions at its active nodes.
+pub struct Converged<const D: usize> {
+    pub u: Vec<Vector<D>>,
+    pub reaction: Vec<Vector<D>>,
+}
+
+impl Newton {
+    pub fn new(s: &SolverConfig) -> Newton {
+        Newton {
+            residual_tolerance: s.residual_tolerance(),
+            displacement_tolerance: s.displacement_tolerance(),
+            max_iterations: s.max_iterations(),
+            line_search: s.line_search(),
+            linear: match KrylovConfig::of(s) {
+                Some(config) => Linear::Krylov(KrylovState::new(config)),
+                None => Linear::Direct(DirectSolver::new()),
+            },
+            log: Vec::new(),
+            iterations: 0,
+        }
+    }
+
+    /// The Krylov solver, if the corrections are matrix-free.
+    pub fn krylov(&self) -> Option<&KrylovState> {
+        match &self.linear {
+            Linear::Krylov(k) => Some(k),
+            Linear::Direct(_) => None,
+        }
+    }
+
+    /// Krylov iterations over all corrections (0 with the direct solver).
+    pub fn krylov_iterations(&self) -> usize {
+        self.krylov().map_or(0, |k| k.iterations)
+    }
+
+    /// Solve r(u) = 0 for the step of `sys`; the rows of newton.csv carry the run's
+    /// step number `step`, the cut-back level and the wall time since `started`.
+    pub fn solve<const D: usize>(
+        &mut self,
+        m: &Model<D>,
+        sys: &mut StepSystem<D>,
+        step: usize,
+        cutback: usize,
+        started: Instant,
+    ) -> Result<Converged<D>, Failure> {
+        // Initial iterate: the predictor, with the prescribed components imposed.
+        let mut u = sys.u_tilde.clone();
+        for (ua, c) in u.iter_mut().zip(&sys.constraint) {
+            for d in (0..D).filter(|&d| c.fixed[d]) {
+                ua[d] = c.value[d] * sys.dt;
+            }
+        }
+        sys.dofs.follow_ties(&mut u);
+        let inertial = inertial_force(&m.particles, sys, &sys.u_tilde);
+        let mut test = Convergence {
+            residual_tolerance: self.residual_tolerance,
+            displacement_tolerance: self.displacement_tolerance,
+            applied: norm(&sys.dofs.reduce(&sys.f_ext)).max(norm(&sys.dofs.reduce(&inertial))),
+            previous_residual: f64::INFINITY,
+            last_increment: f64::NAN,
+        };
+        let mut method = "none".to_string();
+        for iteration in 0..=self.max_iterations {
+            // Residual at the current iterate, from the step-start state (2-37).
+            let r = residual(m, sys, &u)?;
+            let r_free = sys.dofs.reduce(&r);
+            let r_norm = norm(&r_free);
+            let reaction = reactions(&sys.constraint, &r);
+            let reference = test.reference(&reaction);
+            if !r_norm.is_finite() {
+                return Err(Failure {
+                    particle: None,
+                    message: format!("non-finite residual in Newton iteration {iteration}"),
+                });
+            }
+            let mut row = NewtonRow {
+                step: step + 1,
+                time: sys.t + sys.dt,
+                dt: sys.dt,
+                cutback,
+                iteration,
+                residual: r_norm / reference,
+                increment: f64::NAN,
+                wall_seconds: started.elapsed().as_secs_f64(),
+                linear_solver: method.clone(),
+                krylov_iterations: 0,
+                forcing: f64::NAN,
+            };
+            if test.converged(iteration, r_norm, reference) {
+                self.log.push(row);
+                return Ok(Converged { u, reaction });
+            }
+            if iteration == self.max_iterations {
+                self.log.push(row);
+                break;
+            }
+            // Correction K δu = −r (2-38): the assembled tangent (2-40) and the direct
+            // solver, or matrix-free Krylov (2-39) to the forcing term.
+            let krylov_before = self.krylov_iterations();
+            let correction = match &mut self.linear {
+                Linear::Direct(solver) => direct_correction(m, sys, solver, &r_free),
+                Linear::Krylov(krylov) => {
+                    let stop = self.residual_tolerance * reference;
+                    krylov.correction(m, sys, &u, &r_free, stop, iteration)
+                }
+            };
+            let Correction {
+                du,
+                method: used,
+                krylov_iterations,
+                forcing,
+            } = match correction {
+                Ok(c) => c,
+                Err(f) => {
+                    // Keep the failing iteration in newton.csv.
+                    row.wall_seconds = started.elapsed().as_secs_f64();
+                    row.krylov_iterations = self.krylov_iterations() - krylov_before;
+                    self.log.push(row);
+                    return Err(f);
+                }
+            };
+            method = used;
+            // Update u ← u + s δu, s from the line search (or 1).
+            let step_length = if self.line_search {
+                line_search(m, sys, &u, &du, r_norm)
+            } else {
+                1.0
+            };
+            let u_norm = norm(&sys.dofs.values(&u));
+            sys.dofs.apply_correction(&mut u, &du, step_length);
+            test.last_increment = step_length * norm(&du)
+                / norm(&sys.dofs.values(&u))
+                    .max(u_norm)
+                    .max(f64::MIN_POSITIVE);
+            row.increment = test.last_increment;
+            row.linear_solver = method.clone();
+            row.krylov_iterations = krylov_iterations;
+            row.forcing = forcing;
+            row.wall_seconds = started.elapsed().as_secs_f64();
+            self.log.push(row);
+            self.iterations += 1;
+        }
+        Err(Failure {
+            particle: None,
+            message: format!(
+                "Newton did not converge in {} iterations",
+                self.max_iterations
+            ),
+        })
+    }
+}
+
+/// The convergence test of one attempt: ‖r‖ small against a reference force, and
+/// the last correction small against u.
+struct Convergence {
+    residual_tolerance: f64,
+    displacement_tolerance: f64,
+    /// The larger of the applied and the predictor's inertial force, ‖f_ext‖ and
+    /// ‖M ũ/(βΔt²)‖ over the unknowns.
+    applied: f64,
+    /// ‖r‖ of the previous iteration.
+    previous_residual: f64,
+    /// ‖δu‖ / ‖u‖ of the last correction (NaN before the first).
+    last_increment: f64,
+}
+
+impl Convergence {
+    /// The force ‖r‖ is measured against: the largest of the applied force, the
+    /// inertial force and the reactions at the prescribed components (as FE codes
+    /// do): a run driven only by prescribed displacements (weightless soil under a
+    /// rigid footing) has no applied force.
+    fn reference<const D: usize>(&self, reaction: &[Vector<D>]) -> f64 {
+        let reaction_norm = reaction
+            .iter()
+            .map(|f| f.norm_squared())
+            .sum::<f64>()
+            .sqrt();
+        self.applied.max(reaction_norm).max(f64::MIN_POSITIVE)
+    }
+
+    /// Has iteration `iteration`, whose residual norm is `r_norm`, converged?
+    fn converged(&mut self, iteration: usize, r_norm: f64, reference: f64) -> bool {
+        let residual_ok = r_norm <= self.residual_tolerance * reference || r_norm == 0.0;
+        // Near rest (e.g. settled on absorbing faces) ‖u‖ → 0 and ‖δu‖/‖u‖ stalls
+        // at round-off: a converged residual that a correction no longer halves
+        // is at the round-off floor and accepted.
+        let stalled = iteration >= 2 && r_norm >= 0.5 * self.previous_residual;
+        self.previous_residual = r_norm;
+        let increment_ok =
+            iteration == 0 || self.last_increment <= self.displacement_tolerance || stalled;
+        residual_ok && increment_ok
+    }
+}
+
+/// δu = −K⁻¹ r with the assembled consistent tangent (2-40), factorized by the
+/// direct solver.
+fn direct_correction<const D: usize>(
+    m: &Model<D>,
+    sys: &StepSystem<D>,
+    solver: &mut DirectSolver,
+    r_free: &[f64],
+) -> Result<Correction, Failure> {
+    let (triplets, symmetric) = tangent(m, sys, false)?;
+    let structure = if symmetric {
+        Structure::Symmetric
+    } else {
+        Structure::General
+    };
+    let failed = |e: String| Failure {
+        particle: None,
+        message: format!("linear solve failed: {e}"),
+    };
+    let used = solver
+        .factorize(sys.dofs.free, &triplets, structure)
+        .map_err(|e| failed(e.to_string()))?;
+    let rhs: Vec<f64> = r_free.iter().map(|x| -x).collect();
+    let du = solver.solve(&rhs).map_err(|e| failed(e.to_string()))?;
+    Ok(Correction {
+        du,
+        method: used.name().to_string(),
+        krylov_iterations: 0,
+        forcing: f64::NAN,
+    })
+}
+
+/// Backtracking on ‖r‖: halve the step length until the residual decreases
+/// (at most 6 halvings; the last length is taken anyway).
+fn line_search<const D: usize>(
+    m: &Model<D>,
+    sys: &mut StepSystem<D>,
+    u: &[Vector<D>],
+    du: &[f64],
+    r_norm: f64,
+) -> f64 {
+    let mut length = 1.0;
+    for _ in 0..6 {
+        let mut trial_u = u.to_vec();
+        sys.dofs.apply_correction(&mut trial_u, du, length);
+        if let Ok(r) = residual(m, sys, &trial_u) {
+            if norm(&sys.dofs.reduce(&r)) < r_norm {
+                return length;
+            }
+        }
+        length *= 0.5;
+    }
+    length
+}

@@ -1,0 +1,117 @@
+//! The residual of one implicit step and its derivative, at the active nodes:
+//!
+//!   r(u) = M (u − ũ)/(βΔt²) + f_int(u) − f_ext − f_abs(u)   (thesis 2-37)
+//!
+//! with u the nodal displacement increments, M lumped or consistent (no inertia
+//! when quasi-static), f_int the internal force of the relative first
+//! Piola-Kirchhoff stress of the trial state at u on the step-start volumes (the
+//! stresses always recomputed from the step-start state, `Trial`), f_ext the
+//! external force at t + Δt and f_abs the dashpots and springs of absorbing faces
+//! (2-63). At the prescribed components r is the reaction. The consistent
+//! tangent K = ∂r/∂u (2-40) is assembled over the unknowns from the terms of
+//! `assembly`.
+
+use super::assembly::absorbing::absorbing_triplets;
+use super::assembly::fbar::fbar_triplets;
+use super::assembly::mass::{consistent_mass_triplets, lumped_mass_triplets};
+use super::assembly::stiffness::{particle_tangents, relative_pk1, stiffness_triplets};
+use super::assembly::Triplets;
+use super::failure::Failure;
+use super::step::StepSystem;
+use crate::dim::Vector;
+use crate::model::conditions::Constraint;
+use crate::model::particles::Particles;
+use crate::model::Model;
+use crate::physics::transfer::{consistent_mass_product, internal_force};
+use crate::scene::MassMatrix;
+
+/// r(u) at the active nodes; evaluates the particles' trial state at u.
+pub fn residual<const D: usize>(
+    m: &Model<D>,
+    sys: &mut StepSystem<D>,
+    u: &[Vector<D>],
+) -> Result<Vec<Vector<D>>, Failure> {
+    let p = &m.particles;
+    let (st, map) = (&sys.stencils, &sys.map);
+    if let Some(q) = sys.trial.evaluate(p, &m.materials, st, map, u, sys.dt) {
+        return Err(Failure {
+            particle: Some(q),
+            message: "inverted (det F ≤ 0) in a Newton iterate".into(),
+        });
+    }
+    let pk1: Vec<_> = (0..p.len())
+        .map(|q| relative_pk1(&sys.trial.df[q], &sys.trial.stress[q]))
+        .collect();
+    let f_int = internal_force(map, st, &p.volume, &pk1);
+    let w: Vec<Vector<D>> = u.iter().zip(&sys.u_tilde).map(|(a, b)| a - b).collect();
+    let f_inertia = inertial_force(p, sys, &w);
+    let mut r: Vec<Vector<D>> = (0..u.len())
+        .map(|a| f_inertia[a] + f_int[a] - sys.f_ext[a])
+        .collect();
+    // Absorbing faces: − f_boundary(u), dashpots through v_{n+1}(u) (2-63).
+    sys.absorbing.add_residual(map, st, p, u, &mut r);
+    Ok(r)
+}
+
+/// M w / (βΔt²) at the active nodes (lumped or consistent M; zero when
+/// quasi-static).
+pub fn inertial_force<const D: usize>(
+    p: &Particles<D>,
+    sys: &StepSystem<D>,
+    w: &[Vector<D>],
+) -> Vec<Vector<D>> {
+    let inertia = sys.inertia;
+    if inertia == 0.0 {
+        return vec![Vector::<D>::zeros(); sys.mass.len()];
+    }
+    match sys.mass_matrix {
+        MassMatrix::Lumped => w
+            .iter()
+            .zip(&sys.mass)
+            .map(|(w, m)| w * (m * inertia))
+            .collect(),
+        MassMatrix::Consistent => consistent_mass_product(&sys.map, &sys.stencils, p, w, inertia),
+    }
+}
+
+/// The residual at the prescribed components, r = f_int + inertia − f_ext: the
+/// reactions, node by node (zero at free components).
+pub fn reactions<const D: usize>(constraint: &[Constraint<D>], r: &[Vector<D>]) -> Vec<Vector<D>> {
+    constraint
+        .iter()
+        .zip(r)
+        .map(|(c, ra)| Vector::<D>::from_fn(|d, _| if c.fixed[d] { ra[d] } else { 0.0 }))
+        .collect()
+}
+
+/// K = ∂r/∂u at the trial state over the unknowns (2-40): the stiffness of the
+/// particles (2-41, 2-42; with F-bar if on), the absorbing faces' dashpots and
+/// springs, and the inertia; and whether K is symmetric. `numerical` lets
+/// materials without an analytic tangent use a numerical one (Krylov
+/// preconditioners only).
+pub fn tangent<const D: usize>(
+    m: &Model<D>,
+    sys: &StepSystem<D>,
+    numerical: bool,
+) -> Result<(Triplets, bool), Failure> {
+    let p = &m.particles;
+    let (st, map, dofs) = (&sys.stencils, &sys.map, &sys.dofs);
+    let a = particle_tangents(m, &sys.trial, numerical)?;
+    let (mut triplets, symmetric) = match &sys.trial.fbar {
+        None => stiffness_triplets(map, st, dofs, &p.volume, &a),
+        Some(state) => (fbar_triplets(map, st, dofs, &p.volume, state, &a), false),
+    };
+    // Absorbing faces: Σ S_I S_J (γ/(βΔt) C + K), symmetric.
+    absorbing_triplets(&sys.absorbing, map, st, dofs, &mut triplets);
+    if sys.inertia > 0.0 {
+        match sys.mass_matrix {
+            MassMatrix::Lumped => {
+                lumped_mass_triplets::<D>(dofs, &sys.mass, sys.inertia, &mut triplets)
+            }
+            MassMatrix::Consistent => {
+                consistent_mass_triplets(map, st, dofs, &p.mass, sys.inertia, &mut triplets)
+            }
+        }
+    }
+    Ok((triplets, symmetric))
+}

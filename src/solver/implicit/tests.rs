@@ -1,0 +1,320 @@
+//! Tests of the implicit solver as a whole: the assembled tangent against central
+//! differences of the residual (with ties, F-bar and absorbing faces), and the ties
+//! of weakly supported nodes.
+
+use super::residual::{residual, tangent};
+use super::step::StepSystem;
+use super::Implicit;
+use crate::dim::Vector;
+use crate::model::Model;
+use crate::scene::Scene;
+
+/// A 2D block on a 4 × 4 grid, fixed base, gravity and a corner load, Newmark:
+/// the fixture of the implicit solver's tests (here and in `krylov`).
+pub(super) const BLOCK: &str = r#"dimension = 2
+gravity = [0.0, -10.0]
+[grid]
+min = [0.0, 0.0]
+max = [4.0, 4.0]
+cells = [4, 4]
+shape_function = "linear"
+[[material]]
+name = "m"
+model = "hencky"
+density = 1000.0
+youngs_modulus = 1.0e5
+poisson_ratio = 0.3
+[[body]]
+material = "m"
+shape = "rectangle"
+min = [0.5, 0.0]
+max = [3.0, 2.5]
+[[boundary]]
+face = "ymin"
+condition = "fixed"
+[[load]]
+kind = "point"
+region_min = [2.5, 2.0]
+region_max = [3.0, 2.5]
+force = [3.0e3, -1.0e3]
+[solver]
+kind = "implicit"
+integrator = "newmark"
+end_time = 1.0
+dt = 0.01
+"#;
+
+/// Absorbing faces for the tangent check: dashpots and springs (thesis 2-63).
+const ABSORBING: &str = "[[boundary]]\nface = \"xmin\"\ncondition = \"absorbing\"\nspring_distance = 2.0\n[[boundary]]\nface = \"ymin\"\ncondition = \"absorbing\"\nspring_stiffness = [4.0e4, 1.0e4]\n";
+
+/// max |K − K_fd| / max |K| of the assembled tangent against central
+/// differences of the residual (2-37), column by column, at a smooth
+/// finite-strain iterate of the block with these overrides; also the number of
+/// unknowns, of tied nodes and of particles with plastic strain at the iterate.
+fn tangent_error(overrides: &[String], absorbing: bool) -> (f64, usize, usize, usize) {
+    let text = if absorbing {
+        BLOCK.replace("[solver]", &format!("{ABSORBING}[solver]"))
+    } else {
+        BLOCK.to_string()
+    };
+    tangent_error_of::<2>(&text, overrides, absorbing)
+}
+
+/// `tangent_error` of any scene, in D dimensions.
+fn tangent_error_of<const D: usize>(
+    text: &str,
+    overrides: &[String],
+    absorbing: bool,
+) -> (f64, usize, usize, usize) {
+    let scene = Scene::parse("block.toml", text, overrides).unwrap();
+    let m = Model::<D>::build(&scene).unwrap();
+    let mut solver = Implicit::<D>::new(
+        scene.config.grid.shape_function,
+        scene.config.stages()[0],
+        0.0,
+    );
+    solver.prepare(&m, 0.0, 0.01);
+    let sys = &mut solver.system;
+    assert_eq!(sys.absorbing.is_empty(), !absorbing);
+    // A smooth, finite-strain iterate (strains of a few per cent).
+    let nodes: Vec<usize> = sys.map.active.iter().map(|&g| g as usize).collect();
+    let mut u: Vec<Vector<D>> = nodes
+        .iter()
+        .zip(&sys.constraint)
+        .map(|(&g, c)| {
+            let x = m.grid.node_position(m.grid.node_ijk(g));
+            Vector::<D>::from_fn(|d, _| match d {
+                _ if c.fixed[d] => 0.0,
+                0 => 0.03 * (0.7 * x[1]).sin() + 0.01 * x[0],
+                1 => -0.02 * x[0] * x[1] / 4.0,
+                _ => 0.02 * (0.9 * x[0]).cos() * x[2] - 0.01 * x[1],
+            })
+        })
+        .collect();
+    let dofs = sys.dofs.clone();
+    dofs.follow_ties(&mut u);
+    let tied = dofs.ties.iter().filter(|t| t.is_some()).count();
+    let res =
+        |sys: &mut StepSystem<D>, u: &[Vector<D>]| dofs.reduce(&residual(&m, sys, u).unwrap());
+    res(sys, &u);
+    // History of the materials used here: equivalent plastic strain or none.
+    let plastic = sys.trial.history.iter().filter(|&&k| k > 0.0).count();
+    let (triplets, _) = tangent(&m, sys, false).unwrap();
+    let n = dofs.free;
+    let mut k = vec![0.0; n * n];
+    for (r, c, v) in triplets {
+        k[r * n + c] += v;
+    }
+    let kmax = k.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+    let h = 1e-7;
+    let mut worst: f64 = 0.0;
+    for col in 0..n {
+        let (mut up, mut um) = (u.clone(), u.clone());
+        let mut e = vec![0.0; n];
+        e[col] = 1.0;
+        dofs.apply_correction(&mut up, &e, h);
+        dofs.apply_correction(&mut um, &e, -h);
+        let (rp, rm) = (res(sys, &up), res(sys, &um));
+        for row in 0..n {
+            let fd = (rp[row] - rm[row]) / (2.0 * h);
+            worst = worst.max((fd - k[row * n + col]).abs());
+        }
+    }
+    (worst / kmax, n, tied, plastic)
+}
+
+/// The assembled tangent (material + geometric + inertia, 2-40…2-42, and the
+/// dashpots and springs of absorbing faces) against central differences of the
+/// residual (2-37), column by column, at a non-trivial iterate, for every
+/// material, several shape functions and both mass matrices. Two cases tie many
+/// weakly supported nodes (a large `min_node_support`), so the tangent is
+/// checked through the ties too; three have absorbing faces.
+#[test]
+fn global_tangent_matches_finite_differences_of_the_residual() {
+    for (model, shape, mass, support, absorbing) in [
+        ("hencky", "linear", "lumped", 0.0, false),
+        ("hencky", "cpdi", "consistent", 0.01, false),
+        ("neo_hookean", "bspline2", "lumped", 0.01, false),
+        ("linear_elastic", "ugimp", "lumped", 0.01, false),
+        ("neo_hookean", "cpgimp", "consistent", 0.01, false),
+        ("hencky", "bspline2", "consistent", 0.3, false),
+        ("hencky", "ugimp", "lumped", 0.3, false),
+        ("hencky", "linear", "lumped", 0.0, true),
+        ("linear_elastic", "bspline2", "consistent", 0.01, true),
+        ("hencky", "ugimp", "lumped", 0.3, true),
+    ] {
+        let overrides = vec![
+            format!("material.0.model={model}"),
+            format!("grid.shape_function={shape}"),
+            format!("solver.mass={mass}"),
+            format!("solver.min_node_support={support}"),
+        ];
+        let (error, n, tied, _) = tangent_error(&overrides, absorbing);
+        println!(
+            "{model} {shape} {mass} absorbing={absorbing}: {n} unknowns, {tied} tied nodes, \
+             max |K − K_fd| / max|K| = {error:.2e}"
+        );
+        assert!(
+            error < 1e-6,
+            "{model} {shape} {mass}: tangent off by {error:.2e} of its largest entry"
+        );
+    }
+}
+
+/// The F-bar tangent (`assembly::fbar::fbar_triplets`: each particle couples to the
+/// nodes of every particle in its cell) against central differences of the
+/// F-bar residual, with linear and smooth shape functions, through ties, and
+/// with Mohr-Coulomb in a plastic state (c small against the stresses of the
+/// iterate, ψ = 0 and ψ > 0). 2 × 2 particles per cell (as in the slope).
+#[test]
+fn global_tangent_with_fbar_matches_finite_differences_of_the_residual() {
+    let mohr_coulomb = |psi: f64| {
+        vec![
+            "material.0.model=mohr_coulomb".to_string(),
+            "material.0.cohesion=200.0".to_string(),
+            "material.0.friction_angle=20.0".to_string(),
+            format!("material.0.dilation_angle={psi}"),
+        ]
+    };
+    let hencky = vec!["material.0.model=hencky".to_string()];
+    for (name, material, shape, support) in [
+        ("hencky", hencky.clone(), "linear", 0.0),
+        ("hencky", hencky.clone(), "bspline2", 0.01),
+        ("hencky", hencky.clone(), "ugimp", 0.3),
+        ("mohr_coulomb ψ=0", mohr_coulomb(0.0), "linear", 0.0),
+        ("mohr_coulomb ψ=0", mohr_coulomb(0.0), "bspline2", 0.01),
+        ("mohr_coulomb ψ=10", mohr_coulomb(10.0), "ugimp", 0.3),
+    ] {
+        let mut overrides = material;
+        overrides.extend([
+            format!("grid.shape_function={shape}"),
+            format!("solver.min_node_support={support}"),
+            "solver.fbar=true".to_string(),
+            "body.0.particles_per_cell=2".to_string(),
+        ]);
+        let (error, n, tied, plastic) = tangent_error(&overrides, false);
+        println!(
+            "F-bar {name} {shape}: {n} unknowns, {tied} tied nodes, {plastic} plastic \
+             particles, max |K − K_fd| / max|K| = {error:.2e}"
+        );
+        if name.starts_with("mohr") {
+            assert!(plastic > 0, "F-bar {name} {shape}: no plastic particle");
+        }
+        assert!(
+            error < 1e-6,
+            "F-bar {name} {shape}: tangent off by {error:.2e} of its largest entry"
+        );
+    }
+    // 3D: ΔF scaled as a whole (n = 3).
+    for (name, material, shape) in [
+        ("hencky", hencky.clone(), "linear"),
+        ("mohr_coulomb ψ=0", mohr_coulomb(0.0), "bspline2"),
+    ] {
+        let mut overrides = material;
+        overrides.extend([
+            format!("grid.shape_function={shape}"),
+            "solver.fbar=true".to_string(),
+        ]);
+        let (error, n, tied, plastic) = tangent_error_of::<3>(BLOCK_3D, &overrides, false);
+        println!(
+            "F-bar 3D {name} {shape}: {n} unknowns, {tied} tied nodes, {plastic} plastic \
+             particles, max |K − K_fd| / max|K| = {error:.2e}"
+        );
+        assert!(error < 1e-6, "F-bar 3D {name} {shape}: {error:.2e}");
+        if name.starts_with("mohr") {
+            assert!(plastic > 0, "F-bar 3D {name} {shape}: no plastic particle");
+        }
+    }
+}
+
+/// A small 3D block for the F-bar tangent check, 2 × 2 × 2 particles per cell.
+const BLOCK_3D: &str = r#"dimension = 3
+[grid]
+min = [0.0, 0.0, 0.0]
+max = [3.0, 3.0, 3.0]
+cells = [3, 3, 3]
+[[material]]
+name = "m"
+model = "hencky"
+density = 1000.0
+youngs_modulus = 1.0e5
+poisson_ratio = 0.3
+[[body]]
+material = "m"
+shape = "box"
+min = [0.5, 0.0, 0.0]
+max = [2.5, 2.0, 1.5]
+particles_per_cell = 2
+[[boundary]]
+face = "ymin"
+condition = "fixed"
+[solver]
+kind = "implicit"
+integrator = "newmark"
+end_time = 1.0
+dt = 0.01
+"#;
+
+/// Tied nodes follow a linear field exactly, so every particle's gradient of
+/// a linear nodal field is exact (linear consistency survives the ties), and
+/// masters are never tied themselves.
+#[test]
+fn ties_keep_linear_fields_exact() {
+    for shape in ["linear", "ugimp", "cpdi", "bspline2", "bspline3"] {
+        // The block's edges cut the cells anywhere: many weakly supported nodes.
+        let overrides = vec![
+            format!("grid.shape_function={shape}"),
+            "grid.cells=[8,8]".to_string(),
+            "body.0.min=[0.61,0.77]".to_string(),
+            "body.0.max=[3.93,2.38]".to_string(),
+            "body.0.particles_per_cell=2".to_string(),
+            "load.0.region_min=[3.5,2.0]".to_string(),
+            "load.0.region_max=[3.93,2.38]".to_string(),
+            "solver.min_node_support=0.2".to_string(),
+        ];
+        let scene = Scene::parse("block.toml", BLOCK, &overrides).unwrap();
+        let m = Model::<2>::build(&scene).unwrap();
+        let mut solver = Implicit::<2>::new(
+            scene.config.grid.shape_function,
+            scene.config.stages()[0],
+            0.0,
+        );
+        solver.prepare(&m, 0.0, 1.0);
+        let sys = &solver.system;
+        let ties = &sys.dofs.ties;
+        let tied = ties.iter().filter(|t| t.is_some()).count();
+        assert!(tied > 0, "{shape}: no tied node at min_node_support 0.2");
+        for t in ties.iter().flatten() {
+            assert!(ties[t.master[0]].is_none() && ties[t.master[1]].is_none());
+        }
+        let a = crate::dim::Tensor::<2>::new(0.013, -0.021, 0.008, 0.017);
+        let b = Vector::<2>::new(0.3, -0.1);
+        let linear = |g: u32| {
+            let x = m.grid.node_position(m.grid.node_ijk(g as usize));
+            a * x + b
+        };
+        let mut u: Vec<Vector<2>> = sys.map.active.iter().map(|&g| linear(g)).collect();
+        let exact = u.clone();
+        for (ua, t) in u.iter_mut().zip(ties) {
+            if t.is_some() {
+                *ua = Vector::<2>::new(9.0, 9.0); // overwritten by the tie
+            }
+        }
+        sys.dofs.follow_ties(&mut u);
+        let node_error = u
+            .iter()
+            .zip(&exact)
+            .map(|(x, y)| (x - y).norm())
+            .fold(0.0, f64::max);
+        let grad_error = (0..m.particles.len())
+            .map(|q| {
+                (crate::physics::transfer::gradient(&sys.map, &sys.stencils, q, &u) - a).amax()
+            })
+            .fold(0.0, f64::max);
+        println!(
+            "{shape}: {tied} of {} nodes tied; node error {node_error:.1e}, gradient error {grad_error:.1e}",
+            u.len()
+        );
+        assert!(node_error < 1e-14 && grad_error < 1e-12, "{shape}");
+    }
+}
