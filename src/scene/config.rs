@@ -5,6 +5,7 @@
 //! whose length must equal `dimension`.
 
 use super::grid::GridConfig;
+use super::material::MaterialConfig;
 use serde::Deserialize;
 
 #[derive(Clone, Debug, Deserialize)]
@@ -44,77 +45,7 @@ pub struct SceneConfig {
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
-pub enum MaterialModel {
-    /// Hypoelastic, Jaumann rate: youngs_modulus, poisson_ratio.
-    LinearElastic,
-    /// Compressible neo-Hookean: youngs_modulus, poisson_ratio.
-    NeoHookean,
-    /// Hencky (logarithmic strain, Kirchhoff stress): youngs_modulus, poisson_ratio.
-    Hencky,
-    /// Mooney-Rivlin (thesis 3-2): a, b, poisson_ratio; c and d follow (3-8, 3-17).
-    MooneyRivlin,
-    /// Drucker-Prager elastoplasticity (thesis 3-36…3-62) at finite strain:
-    /// youngs_modulus, poisson_ratio, cohesion, friction_angle, dilation_angle,
-    /// mohr_coulomb_fit.
-    DruckerPrager,
-    /// Mohr-Coulomb elastoplasticity (3-34, 3-35) at finite strain: youngs_modulus,
-    /// poisson_ratio, cohesion, friction_angle, dilation_angle; optional softening
-    /// (residual_*, softening_start, softening_end) and tensile_strength.
-    MohrCoulomb,
-    /// Compressible Ogden: mu, alpha (one entry per term), poisson_ratio. No
-    /// analytic tangent: implicit runs need a Krylov linear solver.
-    Ogden,
-}
-
-impl MaterialModel {
-    /// Whether the model supplies the exact derivative of its stress update (the
-    /// direct implicit solver needs it; the Krylov solvers do not).
-    pub fn has_analytic_tangent(&self) -> bool {
-        !matches!(self, MaterialModel::Ogden)
-    }
-}
-
-/// How a Drucker-Prager cone is fitted to the Mohr-Coulomb parameters.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum MohrCoulombFit {
-    /// Through the triaxial-compression vertices (thesis 3-37, 3-38).
-    Outer,
-    /// Through the triaxial-extension vertices (3-39, 3-40).
-    Inner,
-    /// Same plane-strain limit state as Mohr-Coulomb.
-    PlaneStrain,
-}
-
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct MaterialConfig {
-    pub name: String,
-    pub model: MaterialModel,
-    pub density: f64,
-    pub youngs_modulus: Option<f64>,
-    pub poisson_ratio: Option<f64>,
-    pub a: Option<f64>,
-    pub b: Option<f64>,
-    // Plasticity (drucker_prager, mohr_coulomb); angles in degrees.
-    pub cohesion: Option<f64>,
-    pub friction_angle: Option<f64>,
-    pub dilation_angle: Option<f64>,
-    pub mohr_coulomb_fit: Option<MohrCoulombFit>,
-    pub residual_cohesion: Option<f64>,
-    pub residual_friction_angle: Option<f64>,
-    pub residual_dilation_angle: Option<f64>,
-    pub softening_start: Option<f64>,
-    pub softening_end: Option<f64>,
-    pub tensile_strength: Option<f64>,
-    /// Ogden μ_p and α_p, one entry per term.
-    pub mu: Option<Vec<f64>>,
-    pub alpha: Option<Vec<f64>>,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Shape {
+pub enum BodyShape {
     /// 2D, `min` and `max` corners.
     Rectangle,
     /// 3D, `min` and `max` corners.
@@ -133,7 +64,7 @@ pub struct BodyConfig {
     #[serde(default)]
     pub name: Option<String>,
     pub material: String,
-    pub shape: Shape,
+    pub shape: BodyShape,
     pub min: Option<Vec<f64>>,
     pub max: Option<Vec<f64>>,
     pub centre: Option<Vec<f64>>,

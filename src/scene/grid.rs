@@ -70,6 +70,11 @@ impl ShapeFunction {
     }
 }
 
+/// The axis of a component name: "x" 0, "y" 1, "z" 2.
+pub fn axis(name: &str) -> Option<usize> {
+    ["x", "y", "z"].iter().position(|a| *a == name)
+}
+
 /// One face of the grid box: `axis` 0..D, `upper` false for the min face.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Face {

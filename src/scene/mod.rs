@@ -9,12 +9,14 @@ mod config;
 mod error;
 pub mod expr;
 mod grid;
+mod material;
 pub mod overrides;
 pub mod validate;
 
 pub use config::*;
 pub use error::SceneError;
 pub use grid::*;
+pub use material::MaterialConfig;
 
 use std::path::Path;
 

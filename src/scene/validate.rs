@@ -2,7 +2,8 @@
 //! path (`material.0.poisson_ratio`) so the error can point at its line.
 
 use super::config::*;
-use super::grid::{Face, GridConfig};
+use super::grid::{axis, Face, GridConfig};
+use crate::material::Material;
 
 type Check = Result<(), (String, String)>;
 
@@ -49,20 +50,7 @@ pub fn validate(s: &SceneConfig) -> Check {
         vector(g, dim, "gravity")?;
     }
     grid(&s.grid, dim)?;
-    ensure(
-        !s.materials.is_empty(),
-        "material",
-        "the scene defines no [[material]]",
-    )?;
-    for (i, m) in s.materials.iter().enumerate() {
-        material(m, i)?;
-        let dup = s.materials[..i].iter().any(|o| o.name == m.name);
-        ensure(
-            !dup,
-            format!("material.{i}.name"),
-            format!("material name `{}` is used twice", m.name),
-        )?;
-    }
+    let materials = materials(s)?;
     ensure(
         !s.bodies.is_empty(),
         "body",
@@ -84,16 +72,16 @@ pub fn validate(s: &SceneConfig) -> Check {
     for (i, l) in s.loads.iter().enumerate() {
         load(l, i, s)?;
     }
-    needs_krylov(s)?;
+    needs_krylov(s, &materials)?;
     match (&s.solver, s.stages.is_empty()) {
         (Some(solver_config), true) => {
             solver(solver_config, "solver")?;
-            stage_strength_factor(solver_config, "solver", s)?;
+            stage_strength_factor(solver_config, "solver", s, &materials)?;
         }
         (None, false) => {
             for (k, st) in s.stages.iter().enumerate() {
                 solver(st, &format!("stage.{k}"))?;
-                stage_strength_factor(st, &format!("stage.{k}"), s)?;
+                stage_strength_factor(st, &format!("stage.{k}"), s, &materials)?;
             }
         }
         (Some(_), false) => {
@@ -115,10 +103,10 @@ pub fn validate(s: &SceneConfig) -> Check {
         "must be ≥ 0",
     )?;
     if let Some(g) = &s.geostatic {
-        geostatic(g, s)?;
+        geostatic(g, s, &materials)?;
     }
     if let Some(r) = &s.strength_reduction {
-        strength_reduction(r, s)?;
+        strength_reduction(r, s, &materials)?;
     }
     if let Some(b) = &s.bench {
         bench(b, "bench")?;
@@ -200,12 +188,39 @@ pub fn bench(b: &BenchConfig, prefix: &str) -> Check {
     Ok(())
 }
 
+/// The `[[material]]` tables: a positive density, the model's own keys and
+/// checks (`material::registry`), a unique name. Returns the materials as built.
+fn materials(s: &SceneConfig) -> Result<Vec<Box<dyn Material>>, (String, String)> {
+    ensure(
+        !s.materials.is_empty(),
+        "material",
+        "the scene defines no [[material]]",
+    )?;
+    let mut built = Vec::new();
+    for (i, m) in s.materials.iter().enumerate() {
+        ensure(
+            m.density > 0.0 && m.density.is_finite(),
+            format!("material.{i}.density"),
+            "must be a positive number",
+        )?;
+        built.push(m.build(i)?);
+        let dup = s.materials[..i].iter().any(|o| o.name == m.name);
+        ensure(
+            !dup,
+            format!("material.{i}.name"),
+            format!("material name `{}` is used twice", m.name),
+        )?;
+    }
+    Ok(built)
+}
+
 /// A material without an analytic tangent cannot run on an implicit stage with
 /// the direct solver.
-fn needs_krylov(s: &SceneConfig) -> Check {
-    let Some(m) = s.materials.iter().find(|m| !m.model.has_analytic_tangent()) else {
+fn needs_krylov(s: &SceneConfig, materials: &[Box<dyn Material>]) -> Check {
+    let Some(i) = materials.iter().position(|m| !m.has_analytic_tangent()) else {
         return Ok(());
     };
+    let m = &s.materials[i];
     let stages: Vec<(String, &SolverConfig)> = match &s.solver {
         Some(solver) => vec![("solver".into(), solver)],
         None => (s.stages.iter().enumerate())
@@ -225,8 +240,7 @@ fn needs_krylov(s: &SceneConfig) -> Check {
                 "material `{}` (model `{}`) has no analytic tangent, which the direct \
                  implicit solver needs: set linear_solver = \"gmres\" (or \"cg\" for \
                  symmetric problems) in this table",
-                m.name,
-                model_name(m.model)
+                m.name, m.model
             ),
         )?;
     }
@@ -248,248 +262,6 @@ fn grid(g: &GridConfig, dim: usize) -> Check {
     )?;
     let ok = (0..dim).all(|d| g.max[d] > g.min[d]);
     ensure(ok, "grid.max", "must exceed grid.min in every direction")
-}
-
-fn material(m: &MaterialConfig, i: usize) -> Check {
-    let key = |k: &str| format!("material.{i}.{k}");
-    ensure(
-        m.density > 0.0 && m.density.is_finite(),
-        key("density"),
-        "must be a positive number",
-    )?;
-    let what = format!("model `{}`", model_name(m.model));
-    for (k, present) in optional_keys(m) {
-        ensure(
-            !present || model_keys(m.model).contains(&k),
-            key(k),
-            format!("does not apply to {what}"),
-        )?;
-    }
-    match m.model {
-        MaterialModel::MooneyRivlin => {
-            required(&m.a, key("a"), &what)?;
-            required(&m.b, key("b"), &what)?;
-            let g = 2.0 * (m.a.unwrap_or(0.0) + m.b.unwrap_or(0.0));
-            ensure(
-                g > 0.0 && g.is_finite(),
-                key("a"),
-                "a + b (= G/2, thesis 3-16) must be positive",
-            )?;
-        }
-        MaterialModel::Ogden => {
-            required(&m.mu, key("mu"), &what)?;
-            required(&m.alpha, key("alpha"), &what)?;
-            forbidden(&m.youngs_modulus, key("youngs_modulus"), &what)?;
-            forbidden(&m.a, key("a"), &what)?;
-            forbidden(&m.b, key("b"), &what)?;
-            let (mu, alpha) = (m.mu.as_ref().unwrap(), m.alpha.as_ref().unwrap());
-            ensure((1..=6).contains(&mu.len()), key("mu"), "needs 1 to 6 terms")?;
-            ensure(
-                alpha.len() == mu.len(),
-                key("alpha"),
-                format!("needs one entry per term of mu ({})", mu.len()),
-            )?;
-            ensure(
-                mu.iter()
-                    .zip(alpha)
-                    .all(|(m, a)| m * a > 0.0 && (m * a).is_finite()),
-                key("alpha"),
-                "every term needs mu_p * alpha_p > 0 (a positive shear modulus)",
-            )?;
-        }
-        _ => {
-            required(&m.youngs_modulus, key("youngs_modulus"), &what)?;
-            let e = m.youngs_modulus.unwrap_or(0.0);
-            ensure(
-                e > 0.0 && e.is_finite(),
-                key("youngs_modulus"),
-                "must be a positive number",
-            )?;
-        }
-    }
-    required(&m.poisson_ratio, key("poisson_ratio"), &what)?;
-    let nu = m.poisson_ratio.unwrap_or(0.0);
-    ensure(
-        nu > -1.0 && nu < 0.5,
-        key("poisson_ratio"),
-        format!("must lie in (-1, 0.5) for the compressible {what}; got {nu}"),
-    )?;
-    match m.model {
-        MaterialModel::DruckerPrager => {
-            strength(m, i, &what)?;
-            required(&m.mohr_coulomb_fit, key("mohr_coulomb_fit"), &what)
-        }
-        MaterialModel::MohrCoulomb => {
-            strength(m, i, &what)?;
-            softening(m, i)?;
-            if let Some(t) = m.tensile_strength {
-                ensure(
-                    t >= 0.0 && t.is_finite(),
-                    key("tensile_strength"),
-                    format!("must be a number ≥ 0; got {t}"),
-                )?;
-            }
-            Ok(())
-        }
-        _ => Ok(()),
-    }
-}
-
-/// The model-specific optional keys and whether each is given.
-fn optional_keys(m: &MaterialConfig) -> [(&'static str, bool); 15] {
-    [
-        ("youngs_modulus", m.youngs_modulus.is_some()),
-        ("a", m.a.is_some()),
-        ("b", m.b.is_some()),
-        ("mu", m.mu.is_some()),
-        ("alpha", m.alpha.is_some()),
-        ("cohesion", m.cohesion.is_some()),
-        ("friction_angle", m.friction_angle.is_some()),
-        ("dilation_angle", m.dilation_angle.is_some()),
-        ("mohr_coulomb_fit", m.mohr_coulomb_fit.is_some()),
-        ("residual_cohesion", m.residual_cohesion.is_some()),
-        (
-            "residual_friction_angle",
-            m.residual_friction_angle.is_some(),
-        ),
-        (
-            "residual_dilation_angle",
-            m.residual_dilation_angle.is_some(),
-        ),
-        ("softening_start", m.softening_start.is_some()),
-        ("softening_end", m.softening_end.is_some()),
-        ("tensile_strength", m.tensile_strength.is_some()),
-    ]
-}
-
-/// The optional keys a model accepts.
-fn model_keys(model: MaterialModel) -> &'static [&'static str] {
-    match model {
-        MaterialModel::LinearElastic | MaterialModel::NeoHookean | MaterialModel::Hencky => {
-            &["youngs_modulus"]
-        }
-        MaterialModel::MooneyRivlin => &["a", "b"],
-        MaterialModel::Ogden => &["mu", "alpha"],
-        MaterialModel::DruckerPrager => &[
-            "youngs_modulus",
-            "cohesion",
-            "friction_angle",
-            "dilation_angle",
-            "mohr_coulomb_fit",
-        ],
-        MaterialModel::MohrCoulomb => &[
-            "youngs_modulus",
-            "cohesion",
-            "friction_angle",
-            "dilation_angle",
-            "residual_cohesion",
-            "residual_friction_angle",
-            "residual_dilation_angle",
-            "softening_start",
-            "softening_end",
-            "tensile_strength",
-        ],
-    }
-}
-
-/// Cohesion c ≥ 0, friction angle 0 ≤ φ < 90°, dilation angle 0 ≤ ψ ≤ φ (degrees),
-/// and some strength (c > 0 or φ > 0).
-fn strength(m: &MaterialConfig, i: usize, what: &str) -> Check {
-    let key = |k: &str| format!("material.{i}.{k}");
-    required(&m.cohesion, key("cohesion"), what)?;
-    required(&m.friction_angle, key("friction_angle"), what)?;
-    let (c, phi) = (m.cohesion.unwrap(), m.friction_angle.unwrap());
-    let psi = m.dilation_angle.unwrap_or(0.0);
-    ensure(
-        c >= 0.0 && c.is_finite(),
-        key("cohesion"),
-        format!("must be a number ≥ 0 (no negative cohesion); got {c}"),
-    )?;
-    ensure(
-        (0.0..90.0).contains(&phi),
-        key("friction_angle"),
-        format!("must lie in [0, 90) degrees; got {phi}"),
-    )?;
-    ensure(
-        psi >= 0.0 && psi <= phi,
-        key("dilation_angle"),
-        format!("must lie in [0, friction_angle = {phi}] degrees; got {psi}"),
-    )?;
-    ensure(
-        c > 0.0 || phi > 0.0,
-        key("cohesion"),
-        "cohesion and friction_angle are both zero: the material has no strength",
-    )
-}
-
-/// Softening keys (mohr_coulomb): residual values no larger than the peak ones,
-/// 0 ≤ softening_start < softening_end, both given when any softening key is.
-fn softening(m: &MaterialConfig, i: usize) -> Check {
-    let key = |k: &str| format!("material.{i}.{k}");
-    let any = m.residual_cohesion.is_some()
-        || m.residual_friction_angle.is_some()
-        || m.residual_dilation_angle.is_some()
-        || m.softening_start.is_some()
-        || m.softening_end.is_some();
-    if !any {
-        return Ok(());
-    }
-    let what = "strain softening";
-    required(&m.softening_start, key("softening_start"), what)?;
-    required(&m.softening_end, key("softening_end"), what)?;
-    let (start, end) = (m.softening_start.unwrap(), m.softening_end.unwrap());
-    ensure(
-        start >= 0.0 && start.is_finite(),
-        key("softening_start"),
-        format!("must be a plastic strain ≥ 0; got {start}"),
-    )?;
-    ensure(
-        end > start && end.is_finite(),
-        key("softening_end"),
-        format!("must exceed softening_start = {start}; got {end}"),
-    )?;
-    let (c, phi) = (m.cohesion.unwrap(), m.friction_angle.unwrap());
-    let psi = m.dilation_angle.unwrap_or(0.0);
-    let c_r = m.residual_cohesion.unwrap_or(c);
-    let phi_r = m.residual_friction_angle.unwrap_or(phi);
-    let psi_r = m.residual_dilation_angle.unwrap_or(psi.min(phi_r));
-    ensure(
-        c_r >= 0.0 && c_r <= c,
-        key("residual_cohesion"),
-        format!("must lie in [0, cohesion = {c}] (residual no larger than peak); got {c_r}"),
-    )?;
-    ensure(
-        phi_r >= 0.0 && phi_r <= phi,
-        key("residual_friction_angle"),
-        format!("must lie in [0, friction_angle = {phi}] degrees (residual no larger than peak); got {phi_r}"),
-    )?;
-    ensure(
-        phi_r > 0.0 || phi == 0.0,
-        key("residual_friction_angle"),
-        "must be positive when friction_angle is (the pyramid keeps its apex)",
-    )?;
-    ensure(
-        psi_r >= 0.0 && psi_r <= phi_r,
-        key("residual_dilation_angle"),
-        format!("must lie in [0, residual_friction_angle = {phi_r}] degrees; got {psi_r}"),
-    )?;
-    ensure(
-        c_r > 0.0 || phi_r > 0.0,
-        key("residual_cohesion"),
-        "residual cohesion and friction are both zero: no residual strength",
-    )
-}
-
-pub fn model_name(m: MaterialModel) -> &'static str {
-    match m {
-        MaterialModel::Ogden => "ogden",
-        MaterialModel::LinearElastic => "linear_elastic",
-        MaterialModel::NeoHookean => "neo_hookean",
-        MaterialModel::Hencky => "hencky",
-        MaterialModel::MooneyRivlin => "mooney_rivlin",
-        MaterialModel::DruckerPrager => "drucker_prager",
-        MaterialModel::MohrCoulomb => "mohr_coulomb",
-    }
 }
 
 fn body(b: &BodyConfig, i: usize, s: &SceneConfig) -> Check {
@@ -537,7 +309,7 @@ fn body(b: &BodyConfig, i: usize, s: &SceneConfig) -> Check {
 }
 
 /// Bounding box of a body's geometry, checking the keys its shape needs.
-pub fn body_bounds(
+fn body_bounds(
     b: &BodyConfig,
     i: usize,
     dim: usize,
@@ -545,8 +317,8 @@ pub fn body_bounds(
     let key = |k: &str| format!("body.{i}.{k}");
     let what = format!("shape `{:?}`", b.shape).to_lowercase();
     let shape_dim = match b.shape {
-        Shape::Rectangle | Shape::Disk | Shape::Polygon => 2,
-        Shape::Box | Shape::Sphere => 3,
+        BodyShape::Rectangle | BodyShape::Disk | BodyShape::Polygon => 2,
+        BodyShape::Box | BodyShape::Sphere => 3,
     };
     ensure(
         shape_dim == dim,
@@ -554,7 +326,7 @@ pub fn body_bounds(
         format!("{what} is a {shape_dim}D shape but dimension = {dim}"),
     )?;
     match b.shape {
-        Shape::Rectangle | Shape::Box => {
+        BodyShape::Rectangle | BodyShape::Box => {
             required(&b.min, key("min"), &what)?;
             required(&b.max, key("max"), &what)?;
             forbidden(&b.centre, key("centre"), &what)?;
@@ -570,7 +342,7 @@ pub fn body_bounds(
             )?;
             Ok((lo, hi))
         }
-        Shape::Disk | Shape::Sphere => {
+        BodyShape::Disk | BodyShape::Sphere => {
             required(&b.centre, key("centre"), &what)?;
             required(&b.radius, key("radius"), &what)?;
             forbidden(&b.min, key("min"), &what)?;
@@ -589,7 +361,7 @@ pub fn body_bounds(
                 c.iter().map(|x| x + r).collect(),
             ))
         }
-        Shape::Polygon => {
+        BodyShape::Polygon => {
             required(&b.vertices, key("vertices"), &what)?;
             forbidden(&b.min, key("min"), &what)?;
             forbidden(&b.max, key("max"), &what)?;
@@ -755,10 +527,6 @@ fn absorbing(b: &BoundaryConfig, i: usize) -> Check {
     Ok(())
 }
 
-pub fn axis(name: &str) -> Option<usize> {
-    ["x", "y", "z"].iter().position(|a| *a == name)
-}
-
 fn load(l: &LoadConfig, i: usize, s: &SceneConfig) -> Check {
     let dim = s.dimension;
     let key = |k: &str| format!("load.{i}.{k}");
@@ -808,18 +576,18 @@ fn load(l: &LoadConfig, i: usize, s: &SceneConfig) -> Check {
 }
 
 /// Whether the scene has a material whose strength a factor divides.
-fn has_frictional_material(s: &SceneConfig) -> bool {
-    s.materials.iter().any(|m| {
-        matches!(
-            m.model,
-            MaterialModel::DruckerPrager | MaterialModel::MohrCoulomb
-        )
-    })
+fn has_frictional_material(materials: &[Box<dyn Material>]) -> bool {
+    materials.iter().any(|m| m.frictional_strength().is_some())
 }
 
 /// A stage's `strength_reduction_factor`: F > 0, something to reduce, and no
 /// `[strength_reduction]` search (whose trial factor holds for every stage).
-fn stage_strength_factor(st: &SolverConfig, prefix: &str, s: &SceneConfig) -> Check {
+fn stage_strength_factor(
+    st: &SolverConfig,
+    prefix: &str,
+    s: &SceneConfig,
+    materials: &[Box<dyn Material>],
+) -> Check {
     let Some(f) = st.strength_reduction_factor else {
         return Ok(());
     };
@@ -830,7 +598,7 @@ fn stage_strength_factor(st: &SolverConfig, prefix: &str, s: &SceneConfig) -> Ch
         format!("must be a positive number (c and tan φ are divided by it); got {f}"),
     )?;
     ensure(
-        has_frictional_material(s),
+        has_frictional_material(materials),
         key.clone(),
         "needs a drucker_prager or mohr_coulomb material (nothing to reduce)",
     )?;
@@ -1043,16 +811,7 @@ fn linear_solver(s: &SolverConfig, prefix: &str) -> Check {
     )
 }
 
-/// Models whose update integrates from the stored stress (so an initial stress
-/// persists); the hyperelastic ones compute the stress from F alone.
-fn carries_initial_stress(m: MaterialModel) -> bool {
-    matches!(
-        m,
-        MaterialModel::LinearElastic | MaterialModel::DruckerPrager | MaterialModel::MohrCoulomb
-    )
-}
-
-fn geostatic(g: &GeostaticConfig, s: &SceneConfig) -> Check {
+fn geostatic(g: &GeostaticConfig, s: &SceneConfig, materials: &[Box<dyn Material>]) -> Check {
     let gravity = s.gravity.as_deref().unwrap_or(&[]);
     let nonzero = gravity.iter().filter(|&&x| x != 0.0).count();
     ensure(
@@ -1068,18 +827,22 @@ fn geostatic(g: &GeostaticConfig, s: &SceneConfig) -> Check {
         )?;
     }
     for (i, b) in s.bodies.iter().enumerate() {
-        let m = s.materials.iter().find(|m| m.name == b.material).unwrap();
+        let k = s
+            .materials
+            .iter()
+            .position(|m| m.name == b.material)
+            .unwrap();
+        let (m, built) = (&s.materials[k], &materials[k]);
         ensure(
-            carries_initial_stress(m.model),
+            built.integrates_from_stored_stress(),
             format!("body.{i}.material"),
             format!(
                 "[geostatic] needs models that integrate from the stored stress (linear_elastic, drucker_prager, mohr_coulomb); `{}` is {}",
-                m.name,
-                model_name(m.model)
+                m.name, m.model
             ),
         )?;
         ensure(
-            g.k0.is_some() || m.friction_angle.is_some(),
+            g.k0.is_some() || built.frictional_strength().is_some(),
             "geostatic.k0",
             format!(
                 "is required: material `{}` has no friction angle for K0 = 1 − sin φ",
@@ -1090,7 +853,11 @@ fn geostatic(g: &GeostaticConfig, s: &SceneConfig) -> Check {
     Ok(())
 }
 
-fn strength_reduction(r: &StrengthReductionConfig, s: &SceneConfig) -> Check {
+fn strength_reduction(
+    r: &StrengthReductionConfig,
+    s: &SceneConfig,
+    materials: &[Box<dyn Material>],
+) -> Check {
     let p = "strength_reduction";
     ensure(
         r.search.len() == 2
@@ -1122,7 +889,7 @@ fn strength_reduction(r: &StrengthReductionConfig, s: &SceneConfig) -> Check {
         )?;
     }
     ensure(
-        has_frictional_material(s),
+        has_frictional_material(materials),
         p,
         "needs a drucker_prager or mohr_coulomb material (nothing to reduce)",
     )?;
