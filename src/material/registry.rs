@@ -15,12 +15,15 @@ use super::parameters::{FromParameters, KeyError, Parameters};
 use super::Material;
 use std::sync::OnceLock;
 
+/// A model's constructor from its density and parameters.
+type Constructor = fn(f64, &Parameters) -> Result<Box<dyn Material>, KeyError>;
+
 /// One model: its name, its keys and its constructor.
 #[derive(Clone, Copy, Debug)]
 pub struct Entry {
     pub name: &'static str,
     pub keys: &'static [&'static str],
-    construct: fn(f64, &Parameters) -> Result<Box<dyn Material>, KeyError>,
+    construct: Constructor,
 }
 
 impl Entry {

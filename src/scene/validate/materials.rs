@@ -1,0 +1,37 @@
+//! The `[[material]]` tables: a positive density and a unique name here; the
+//! model's own keys and checks are the model's (`material::registry`).
+
+use super::check::{ensure, KeyError};
+use crate::material::Material;
+use crate::scene::SceneConfig;
+
+/// The `[[material]]` tables: a positive density, the model's own keys and
+/// checks (`material::registry`), a unique name. Returns the materials as built.
+pub fn materials(s: &SceneConfig) -> Result<Vec<Box<dyn Material>>, KeyError> {
+    ensure(
+        !s.materials.is_empty(),
+        "material",
+        "the scene defines no [[material]]",
+    )?;
+    let mut built = Vec::new();
+    for (i, m) in s.materials.iter().enumerate() {
+        ensure(
+            m.density > 0.0 && m.density.is_finite(),
+            format!("material.{i}.density"),
+            "must be a positive number",
+        )?;
+        built.push(m.build(i)?);
+        let dup = s.materials[..i].iter().any(|o| o.name == m.name);
+        ensure(
+            !dup,
+            format!("material.{i}.name"),
+            format!("material name `{}` is used twice", m.name),
+        )?;
+    }
+    Ok(built)
+}
+
+/// Whether the scene has a material whose strength a factor divides.
+pub fn has_frictional_material(materials: &[Box<dyn Material>]) -> bool {
+    materials.iter().any(|m| m.frictional_strength().is_some())
+}
