@@ -155,8 +155,8 @@ impl FromParameters for Hencky {
     const KEYS: &'static [&'static str] = &["youngs_modulus", "poisson_ratio"];
 
     fn from_parameters(density: f64, p: &Parameters) -> Result<Self, KeyError> {
-        let youngs_modulus = p.youngs_modulus()?;
-        Ok(Self::new(density, youngs_modulus, p.poisson_ratio()?))
+        // E is checked before ν (arguments are evaluated in order).
+        Ok(Self::new(density, p.youngs_modulus()?, p.poisson_ratio()?))
     }
 }
 

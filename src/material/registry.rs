@@ -4,13 +4,6 @@
 //! into the model, rejecting keys the model does not take; the scene validation
 //! calls it to check a table and `Model::build` to construct the material.
 
-use super::drucker_prager::DruckerPrager;
-use super::hencky::Hencky;
-use super::linear_elastic::LinearElastic;
-use super::mohr_coulomb::MohrCoulomb;
-use super::mooney_rivlin::MooneyRivlin;
-use super::neo_hookean::NeoHookean;
-use super::ogden::Ogden;
 use super::parameters::{FromParameters, KeyError, Parameters};
 use super::Material;
 use std::sync::OnceLock;
@@ -43,15 +36,15 @@ fn construct<M: FromParameters + Material + 'static>(
     Ok(Box::new(M::from_parameters(density, p)?))
 }
 
-/// Every model, in the order docs/scene.md lists them.
+/// Every model, in the order docs/scene.md lists them: one line each.
 pub const MODELS: &[Entry] = &[
-    Entry::of::<LinearElastic>(),
-    Entry::of::<NeoHookean>(),
-    Entry::of::<Hencky>(),
-    Entry::of::<MooneyRivlin>(),
-    Entry::of::<DruckerPrager>(),
-    Entry::of::<MohrCoulomb>(),
-    Entry::of::<Ogden>(),
+    Entry::of::<crate::material::linear_elastic::LinearElastic>(),
+    Entry::of::<crate::material::neo_hookean::NeoHookean>(),
+    Entry::of::<crate::material::hencky::Hencky>(),
+    Entry::of::<crate::material::mooney_rivlin::MooneyRivlin>(),
+    Entry::of::<crate::material::drucker_prager::DruckerPrager>(),
+    Entry::of::<crate::material::mohr_coulomb::MohrCoulomb>(),
+    Entry::of::<crate::material::ogden::Ogden>(),
 ];
 
 /// The model of this name.

@@ -173,77 +173,60 @@ pub struct Scope {
     pub note: &'static str,
 }
 
-const EXPLICIT: &[SolverKind] = &[SolverKind::Explicit];
-const IMPLICIT: &[SolverKind] = &[SolverKind::Implicit];
-const KRYLOV: &[LinearSolver] = &[LinearSolver::Gmres, LinearSolver::Cg];
-const SET_KRYLOV: &str = " (set \"gmres\" or \"cg\")";
-
-const fn scope(key: &'static str, kinds: &'static [SolverKind]) -> Scope {
-    Scope {
-        key,
-        kinds,
-        integrators: &[],
-        linear_solvers: &[],
-        note: "",
+impl Scope {
+    const fn new(
+        key: &'static str,
+        kinds: &'static [SolverKind],
+        integrators: &'static [Integrator],
+        linear_solvers: &'static [LinearSolver],
+        note: &'static str,
+    ) -> Scope {
+        Scope {
+            key,
+            kinds,
+            integrators,
+            linear_solvers,
+            note,
+        }
     }
 }
 
-/// The optional keys that apply to some solvers only (the others apply to all).
+const EXPLICIT: &[SolverKind] = &[SolverKind::Explicit];
+const IMPLICIT: &[SolverKind] = &[SolverKind::Implicit];
+const NEWMARK: &[Integrator] = &[Integrator::Newmark];
+const QUASI_STATIC: &[Integrator] = &[Integrator::QuasiStatic];
+const KRYLOV: &[LinearSolver] = &[LinearSolver::Gmres, LinearSolver::Cg];
+const GMRES: &[LinearSolver] = &[LinearSolver::Gmres];
+// Notes added to "does not apply to …".
+const SET_KRYLOV: &str = " (set \"gmres\" or \"cg\")";
+const RESTART_LENGTH: &str = " (it is the GMRES restart length)";
+const FULL_GRAVITY: &str = " (gravity is always in full)";
+const GIVE_DT: &str = " (give dt)";
+
+/// The optional keys that apply to some solvers only (every other key applies to
+/// all): key, solver kinds, integrators, linear solvers (`&[]`: all), note.
 pub const SCOPES: &[Scope] = &[
-    scope("scheme", EXPLICIT),
-    scope("cfl", EXPLICIT),
-    scope("flip", EXPLICIT),
-    scope("damping", EXPLICIT),
-    scope("integrator", IMPLICIT),
-    Scope {
-        integrators: &[Integrator::Newmark],
-        ..scope("beta", IMPLICIT)
-    },
-    Scope {
-        integrators: &[Integrator::Newmark],
-        ..scope("gamma", IMPLICIT)
-    },
-    Scope {
-        integrators: &[Integrator::Newmark],
-        ..scope("mass", IMPLICIT)
-    },
-    Scope {
-        integrators: &[Integrator::QuasiStatic],
-        note: " (give dt)",
-        ..scope("load_steps", IMPLICIT)
-    },
-    scope("residual_tolerance", IMPLICIT),
-    scope("displacement_tolerance", IMPLICIT),
-    scope("max_iterations", IMPLICIT),
-    scope("line_search", IMPLICIT),
-    scope("max_cutbacks", IMPLICIT),
-    scope("min_node_support", IMPLICIT),
-    scope("linear_solver", IMPLICIT),
-    Scope {
-        linear_solvers: KRYLOV,
-        note: SET_KRYLOV,
-        ..scope("preconditioner", IMPLICIT)
-    },
-    Scope {
-        linear_solvers: KRYLOV,
-        note: SET_KRYLOV,
-        ..scope("krylov_tolerance", IMPLICIT)
-    },
-    Scope {
-        linear_solvers: &[LinearSolver::Gmres],
-        note: " (it is the GMRES restart length)",
-        ..scope("krylov_restart", IMPLICIT)
-    },
-    Scope {
-        linear_solvers: KRYLOV,
-        note: SET_KRYLOV,
-        ..scope("krylov_max_iterations", IMPLICIT)
-    },
-    Scope {
-        integrators: &[Integrator::QuasiStatic],
-        note: " (gravity is always in full)",
-        ..scope("gravity_ramp", IMPLICIT)
-    },
+    Scope::new("scheme", EXPLICIT, &[], &[], ""),
+    Scope::new("cfl", EXPLICIT, &[], &[], ""),
+    Scope::new("flip", EXPLICIT, &[], &[], ""),
+    Scope::new("damping", EXPLICIT, &[], &[], ""),
+    Scope::new("integrator", IMPLICIT, &[], &[], ""),
+    Scope::new("beta", IMPLICIT, NEWMARK, &[], ""),
+    Scope::new("gamma", IMPLICIT, NEWMARK, &[], ""),
+    Scope::new("mass", IMPLICIT, NEWMARK, &[], ""),
+    Scope::new("gravity_ramp", IMPLICIT, QUASI_STATIC, &[], FULL_GRAVITY),
+    Scope::new("load_steps", IMPLICIT, QUASI_STATIC, &[], GIVE_DT),
+    Scope::new("residual_tolerance", IMPLICIT, &[], &[], ""),
+    Scope::new("displacement_tolerance", IMPLICIT, &[], &[], ""),
+    Scope::new("max_iterations", IMPLICIT, &[], &[], ""),
+    Scope::new("line_search", IMPLICIT, &[], &[], ""),
+    Scope::new("max_cutbacks", IMPLICIT, &[], &[], ""),
+    Scope::new("min_node_support", IMPLICIT, &[], &[], ""),
+    Scope::new("linear_solver", IMPLICIT, &[], &[], ""),
+    Scope::new("preconditioner", IMPLICIT, &[], KRYLOV, SET_KRYLOV),
+    Scope::new("krylov_tolerance", IMPLICIT, &[], KRYLOV, SET_KRYLOV),
+    Scope::new("krylov_restart", IMPLICIT, &[], GMRES, RESTART_LENGTH),
+    Scope::new("krylov_max_iterations", IMPLICIT, &[], KRYLOV, SET_KRYLOV),
 ];
 
 impl SolverConfig {
@@ -334,24 +317,30 @@ impl SolverConfig {
         self.krylov_max_iterations.unwrap_or(1000)
     }
 
-    /// The first optional key given where it does not apply (`SCOPES`), with what
-    /// it does not apply to: "the explicit solver", "the Newmark integrator (give
-    /// dt)", "linear_solver = \"direct\" (set \"gmres\" or \"cg\")".
+    /// An optional key given where it does not apply (`SCOPES`), with what it
+    /// does not apply to: "the explicit solver", "the Newmark integrator (give
+    /// dt)", "linear_solver = \"direct\" (set \"gmres\" or \"cg\")". The solver
+    /// kind rules keys out first, then the integrator, then the linear solver;
+    /// within each, the first key in `SCOPES` is named.
     pub fn key_out_of_scope(&self) -> Option<(&'static str, String)> {
         let table = serde_json::to_value(self).expect("a solver table serialises");
-        let given = |key: &str| !table[key].is_null();
-        SCOPES.iter().filter(|s| given(s.key)).find_map(|s| {
-            let (integrator, linear_solver) = (self.integrator(), self.linear_solver());
-            let outside = if !s.kinds.contains(&self.kind) {
-                format!("the {} solver", self.kind.name())
+        let (integrator, linear_solver) = (self.integrator(), self.linear_solver());
+        let ruled_out = |s: &Scope| {
+            if !s.kinds.contains(&self.kind) {
+                Some((0, format!("the {} solver", self.kind.name())))
             } else if !s.integrators.is_empty() && !s.integrators.contains(&integrator) {
-                format!("{}{}", integrator.described(), s.note)
+                Some((1, format!("{}{}", integrator.described(), s.note)))
             } else if !s.linear_solvers.is_empty() && !s.linear_solvers.contains(&linear_solver) {
-                format!("linear_solver = \"{}\"{}", linear_solver.name(), s.note)
+                let name = linear_solver.name();
+                Some((2, format!("linear_solver = \"{name}\"{}", s.note)))
             } else {
-                return None;
-            };
-            Some((s.key, outside))
-        })
+                None
+            }
+        };
+        (SCOPES.iter())
+            .filter(|s| !table[s.key].is_null())
+            .filter_map(|s| ruled_out(s).map(|(by, outside)| (by, s.key, outside)))
+            .min_by_key(|&(by, _, _)| by)
+            .map(|(_, key, outside)| (key, outside))
     }
 }

@@ -2,7 +2,6 @@
 //! `[strength_reduction]` and `[bench]`.
 
 use super::check::{ensure, required, vector, Check};
-use super::materials::has_frictional_material;
 use crate::material::Material;
 use crate::scene::{
     BenchConfig, GeostaticConfig, SceneConfig, SolverKind, StrengthReductionConfig,
@@ -86,7 +85,7 @@ pub fn strength_reduction(
         )?;
     }
     ensure(
-        has_frictional_material(materials),
+        materials.iter().any(|m| m.frictional_strength().is_some()),
         p,
         "needs a drucker_prager or mohr_coulomb material (nothing to reduce)",
     )?;

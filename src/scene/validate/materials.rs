@@ -1,5 +1,5 @@
-//! The `[[material]]` tables: a positive density and a unique name here; the
-//! model's own keys and checks are the model's (`material::registry`).
+//! The `[[material]]` tables. Density and name are checked here, the model's
+//! own keys by the model (`material::registry`).
 
 use super::check::{ensure, KeyError};
 use crate::material::Material;
@@ -29,9 +29,4 @@ pub fn materials(s: &SceneConfig) -> Result<Vec<Box<dyn Material>>, KeyError> {
         )?;
     }
     Ok(built)
-}
-
-/// Whether the scene has a material whose strength a factor divides.
-pub fn has_frictional_material(materials: &[Box<dyn Material>]) -> bool {
-    materials.iter().any(|m| m.frictional_strength().is_some())
 }

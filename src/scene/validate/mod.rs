@@ -23,6 +23,7 @@ use grid_bodies::{body, grid};
 use materials::materials;
 use solver::{needs_krylov, solver, stage_strength_factor};
 
+/// Check a parsed scene, table by table; the first failure names its key.
 pub fn validate(s: &SceneConfig) -> Check {
     let dim = s.dimension;
     ensure(

@@ -3,7 +3,6 @@
 //! analytic tangent only with a Krylov solver, and the stages' strength factors.
 
 use super::check::{ensure, required, Check};
-use super::materials::has_frictional_material;
 use crate::material::Material;
 use crate::scene::{Integrator, LinearSolver, SceneConfig, SolverConfig, SolverKind};
 
@@ -58,7 +57,7 @@ pub fn stage_strength_factor(
         format!("must be a positive number (c and tan φ are divided by it); got {f}"),
     )?;
     ensure(
-        has_frictional_material(materials),
+        materials.iter().any(|m| m.frictional_strength().is_some()),
         key.clone(),
         "needs a drucker_prager or mohr_coulomb material (nothing to reduce)",
     )?;
