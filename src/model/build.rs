@@ -176,7 +176,7 @@ fn fill_body<const D: usize>(
     material: u32,
     model: &dyn Material,
 ) -> Result<usize, (String, String)> {
-    let (lo, hi) = geometry.bounds();
+    let (lo, hi) = b.bounds();
     let spacing = Vector::<D>::from_fn(|d, _| grid.h[d] / b.particles_per_cell.get(d) as f64);
     let volume = spacing.product();
     let mass = model.density() * volume;

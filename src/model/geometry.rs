@@ -1,7 +1,8 @@
 //! The geometry of a body: an axis-aligned box (rectangle in 2D), a ball (disk,
 //! sphere) or a simple polygon (2D), as given by the `[[body]]` keys. The model
-//! fills it with particles (`contains`, `bounds`) and measures the depth of a
-//! particle below its body's top surface for geostatic stresses (`top`).
+//! fills it with particles (`contains`, within `BodyConfig::bounds`, which the
+//! validation also uses) and measures the depth of a particle below its body's
+//! top surface for geostatic stresses (`top`).
 
 use crate::scene::{BodyConfig, BodyShape};
 
@@ -28,26 +29,6 @@ impl Geometry {
                 radius: b.radius.expect("validated"),
             },
             BodyShape::Polygon => Geometry::Polygon(b.vertices.clone().expect("validated")),
-        }
-    }
-
-    /// Corners of the bounding box.
-    pub fn bounds(&self) -> (Vec<f64>, Vec<f64>) {
-        match self {
-            Geometry::Box { min, max } => (min.clone(), max.clone()),
-            Geometry::Ball { centre, radius } => (
-                centre.iter().map(|x| x - radius).collect(),
-                centre.iter().map(|x| x + radius).collect(),
-            ),
-            Geometry::Polygon(v) => {
-                let lo = (0..2)
-                    .map(|d| v.iter().map(|p| p[d]).fold(f64::INFINITY, f64::min))
-                    .collect();
-                let hi = (0..2)
-                    .map(|d| v.iter().map(|p| p[d]).fold(f64::NEG_INFINITY, f64::max))
-                    .collect();
-                (lo, hi)
-            }
         }
     }
 

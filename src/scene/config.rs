@@ -93,6 +93,34 @@ pub struct BodyConfig {
     pub velocity_expr: Option<Vec<String>>,
 }
 
+impl BodyConfig {
+    /// Corners of the bounding box of the body's shape (its keys validated).
+    pub fn bounds(&self) -> (Vec<f64>, Vec<f64>) {
+        match self.shape {
+            BodyShape::Rectangle | BodyShape::Box => {
+                (self.min.clone().unwrap(), self.max.clone().unwrap())
+            }
+            BodyShape::Disk | BodyShape::Sphere => {
+                let (c, r) = (self.centre.as_ref().unwrap(), self.radius.unwrap());
+                (
+                    c.iter().map(|x| x - r).collect(),
+                    c.iter().map(|x| x + r).collect(),
+                )
+            }
+            BodyShape::Polygon => {
+                let v = self.vertices.as_ref().unwrap();
+                let lo = (0..2)
+                    .map(|d| v.iter().map(|p| p[d]).fold(f64::INFINITY, f64::min))
+                    .collect();
+                let hi = (0..2)
+                    .map(|d| v.iter().map(|p| p[d]).fold(f64::NEG_INFINITY, f64::max))
+                    .collect();
+                (lo, hi)
+            }
+        }
+    }
+}
+
 #[derive(Clone, Debug, Deserialize)]
 #[serde(untagged)]
 pub enum PerDirection {

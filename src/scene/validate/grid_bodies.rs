@@ -1,7 +1,7 @@
 //! The `[grid]` and `[[body]]` tables: the grid box and cells; each body's
 //! material, the keys of its shape, and its extent inside the grid.
 
-use super::check::{ensure, forbidden, required, vector, Check, KeyError};
+use super::check::{ensure, forbidden, required, vector, Check};
 use crate::scene::{BodyConfig, BodyShape, GridConfig, PerDirection, SceneConfig};
 
 pub fn grid(g: &GridConfig, dim: usize) -> Check {
@@ -30,7 +30,8 @@ pub fn body(b: &BodyConfig, i: usize, s: &SceneConfig) -> Check {
         key("material"),
         format!("no material is named `{}`", b.material),
     )?;
-    let (lo, hi) = body_bounds(b, i, dim)?;
+    shape_keys(b, i, dim)?;
+    let (lo, hi) = b.bounds();
     let inside = (0..dim).all(|d| lo[d] >= s.grid.min[d] && hi[d] <= s.grid.max[d]);
     ensure(
         inside,
@@ -65,8 +66,8 @@ pub fn body(b: &BodyConfig, i: usize, s: &SceneConfig) -> Check {
     Ok(())
 }
 
-/// Bounding box of a body's geometry, checking the keys its shape needs.
-fn body_bounds(b: &BodyConfig, i: usize, dim: usize) -> Result<(Vec<f64>, Vec<f64>), KeyError> {
+/// The keys a body's shape needs, and no others.
+fn shape_keys(b: &BodyConfig, i: usize, dim: usize) -> Check {
     let key = |k: &str| format!("body.{i}.{k}");
     let what = format!("shape `{}`", b.shape.name());
     let shape_dim = match b.shape {
@@ -92,8 +93,7 @@ fn body_bounds(b: &BodyConfig, i: usize, dim: usize) -> Result<(Vec<f64>, Vec<f6
                 (0..dim).all(|d| hi[d] > lo[d]),
                 key("max"),
                 "must exceed min in every direction",
-            )?;
-            Ok((lo, hi))
+            )
         }
         BodyShape::Disk | BodyShape::Sphere => {
             required(&b.centre, key("centre"), &what)?;
@@ -108,11 +108,7 @@ fn body_bounds(b: &BodyConfig, i: usize, dim: usize) -> Result<(Vec<f64>, Vec<f6
                 r > 0.0 && r.is_finite(),
                 key("radius"),
                 "must be a positive number",
-            )?;
-            Ok((
-                c.iter().map(|x| x - r).collect(),
-                c.iter().map(|x| x + r).collect(),
-            ))
+            )
         }
         BodyShape::Polygon => {
             required(&b.vertices, key("vertices"), &what)?;
@@ -129,13 +125,7 @@ fn body_bounds(b: &BodyConfig, i: usize, dim: usize) -> Result<(Vec<f64>, Vec<f6
             for (k, p) in v.iter().enumerate() {
                 vector(p, 2, &format!("body.{i}.vertices.{k}"))?;
             }
-            let lo = (0..2)
-                .map(|d| v.iter().map(|p| p[d]).fold(f64::INFINITY, f64::min))
-                .collect();
-            let hi = (0..2)
-                .map(|d| v.iter().map(|p| p[d]).fold(f64::NEG_INFINITY, f64::max))
-                .collect();
-            Ok((lo, hi))
+            Ok(())
         }
     }
 }
