@@ -175,18 +175,15 @@ fn read_modules(root: &Path) -> Modules {
         let name = parts.join("::");
         modules.insert(name, strip(&std::fs::read_to_string(&f).unwrap()));
     }
-    // Modules that exist only in tests: `#[cfg(test)] mod x;` in the parent.
+    // Modules that exist only in tests: `#[cfg(test)] mod x;` in the parent, so
+    // the stripped parent does not declare them.
     let test_only: Vec<String> = modules
-        .iter()
-        .flat_map(|(name, _)| {
-            let raw_parent = name.rsplit_once("::").map_or("", |(p, _)| p).to_string();
-            let leaf = name.rsplit("::").next().unwrap().to_string();
-            std::iter::once((name.clone(), raw_parent, leaf))
-        })
-        .filter(|(name, parent, leaf)| {
+        .keys()
+        .filter(|name| {
+            let (parent, leaf) = name.rsplit_once("::").unwrap_or(("", name));
             !name.is_empty() && modules.get(parent).is_some_and(|src| !declares(src, leaf))
         })
-        .map(|(name, _, _)| name)
+        .cloned()
         .collect();
     for name in test_only {
         modules.remove(&name);

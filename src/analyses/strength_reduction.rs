@@ -19,66 +19,119 @@
 //! (the equivalent plastic strain `eps_p` of the last stable and the first failed
 //! trial, in their ParaView frames and the stable one's particles_final.csv).
 
-use crate::output::write_json;
-use crate::run::{run, RunError, RunOptions, RunSummary};
+use crate::output::{write_json, CsvWriter, Field};
+use crate::run::summary::Summary;
+use crate::run::{run, RunError, RunOptions};
 use crate::scene::Scene;
-use serde_json::json;
-use std::io::Write;
-use std::path::{Path, PathBuf};
+use serde::{Deserialize, Serialize};
+use std::path::Path;
 use std::time::Instant;
 
 /// Growth of the search interval while F_low fails or F_high holds.
 const WIDEN: f64 = 1.25;
 
-/// What made a trial fail.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Failure {
+/// How a trial ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TrialStatus {
+    Stable,
     /// Newton did not converge after the cut-backs.
-    Newton,
+    FailedNewton,
     /// The monitored point moved further than `max_displacement`.
-    Displacement,
+    FailedDisplacement,
 }
 
-/// One trial of the search.
-#[derive(Clone, Debug)]
-pub struct Trial {
-    pub factor: f64,
-    pub failure: Option<Failure>,
-    pub steps: u64,
-    pub newton_iterations: u64,
-    pub cutbacks: u64,
-    pub monitor_displacement: Option<f64>,
-    pub wall_seconds: f64,
-    pub dir: PathBuf,
-    pub message: String,
-}
-
-impl Trial {
-    fn csv(&self) -> String {
-        format!(
-            "{},{},{},{},{},{},{},{}",
-            self.factor,
-            match self.failure {
-                None => "stable",
-                Some(Failure::Newton) => "failed_newton",
-                Some(Failure::Displacement) => "failed_displacement",
-            },
-            self.steps,
-            self.newton_iterations,
-            self.cutbacks,
-            self.monitor_displacement
-                .map_or(String::new(), |d| d.to_string()),
-            self.wall_seconds,
-            self.dir.file_name().unwrap().to_string_lossy()
-        )
+impl TrialStatus {
+    pub fn failed(self) -> bool {
+        self != TrialStatus::Stable
     }
 }
 
-const CSV_HEADER: &str =
-    "factor,status,steps,newton_iterations,cutbacks,monitor_displacement,wall_seconds,dir";
+/// One trial of the search: a row of strength_reduction.csv and an entry of
+/// summary.json's `trials`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Trial {
+    pub factor: f64,
+    pub status: TrialStatus,
+    pub steps: usize,
+    pub newton_iterations: usize,
+    pub cutbacks: usize,
+    pub monitor_displacement: Option<f64>,
+    pub wall_seconds: f64,
+    /// Its output directory, relative to the search's (`trials/NN_F…`).
+    pub dir: String,
+    /// Why it failed (empty when stable).
+    pub message: String,
+}
 
-/// Run one trial with the strengths divided by `factor` into `dir`.
-pub fn trial(scene: &Scene, dir: &Path, factor: f64) -> Result<Trial, RunError> {
+/// How the search ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SearchStatus {
+    Completed,
+    /// No [stable F, failed F] bracket within `max_trials`.
+    NoBracket,
+}
+
+/// summary.json of a strength-reduction search.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SearchSummary {
+    pub scene: String,
+    /// Always `strength_reduction`.
+    pub analysis: String,
+    pub failure_criterion: String,
+    pub trials: Vec<Trial>,
+    pub newton_iterations: usize,
+    pub steps: usize,
+    pub wall_seconds: f64,
+    /// Output directories of the last stable and the first failed trial (their
+    /// `eps_p` shows the mechanism).
+    pub mechanism_stable: Option<String>,
+    pub mechanism_failed: Option<String>,
+    pub particles: usize,
+    pub status: SearchStatus,
+    /// The middle of the bracket.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub factor_of_safety: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub factor_of_safety_bracket: Option<[f64; 2]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub message: Option<String>,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum SearchError {
+    #[error(transparent)]
+    Run(#[from] RunError),
+    #[error("cannot write outputs: {0}")]
+    Io(#[from] std::io::Error),
+    /// No bracket was found; the summary (also in summary.json) lists the trials.
+    #[error("{message}")]
+    NoBracket {
+        message: String,
+        summary: Box<SearchSummary>,
+    },
+}
+
+const CSV_COLUMNS: [&str; 8] = [
+    "factor",
+    "status",
+    "steps",
+    "newton_iterations",
+    "cutbacks",
+    "monitor_displacement",
+    "wall_seconds",
+    "dir",
+];
+
+/// Run one trial with the strengths divided by `factor` into `out/dir`; also
+/// returns the run's summary.
+pub fn trial(
+    scene: &Scene,
+    out: &Path,
+    dir: &str,
+    factor: f64,
+) -> Result<(Trial, Summary), RunError> {
     let cfg = scene.config.strength_reduction.as_ref().expect("caller");
     let opts = RunOptions {
         progress: false,
@@ -86,56 +139,68 @@ pub fn trial(scene: &Scene, dir: &Path, factor: f64) -> Result<Trial, RunError> 
         monitor: cfg.monitor.clone(),
     };
     let started = Instant::now();
-    let (json, mut failure, message) = match run(scene, dir, &opts) {
-        Ok(s) => (s.json, None, String::new()),
-        Err(RunError::Diverged(m)) => {
-            let text = std::fs::read_to_string(dir.join("summary.json"))?;
-            let json = serde_json::from_str(&text).map_err(std::io::Error::other)?;
-            (json, Some(Failure::Newton), m)
+    let (summary, mut status, message) = match run(scene, &out.join(dir), &opts) {
+        Ok(s) => (s, TrialStatus::Stable, String::new()),
+        Err(RunError::Diverged { message, summary }) => {
+            (*summary, TrialStatus::FailedNewton, message)
         }
         Err(e) => return Err(e),
     };
-    let monitor_displacement = json["monitor_displacement"].as_f64();
-    if let (None, Some(d), Some(limit)) = (failure, monitor_displacement, cfg.max_displacement) {
+    let moved = summary.monitor_displacement;
+    if let (TrialStatus::Stable, Some(d), Some(limit)) = (status, moved, cfg.max_displacement) {
         if d > limit {
-            failure = Some(Failure::Displacement);
+            status = TrialStatus::FailedDisplacement;
         }
     }
-    Ok(Trial {
+    let trial = Trial {
         factor,
-        failure,
-        steps: json["steps"].as_u64().unwrap_or(0),
-        newton_iterations: json["newton_iterations"].as_u64().unwrap_or(0),
-        cutbacks: json["cutbacks"].as_u64().unwrap_or(0),
-        monitor_displacement,
+        status,
+        steps: summary.steps,
+        newton_iterations: summary.solver.newton_iterations.unwrap_or(0),
+        cutbacks: summary.solver.cutbacks.unwrap_or(0),
+        monitor_displacement: moved,
         wall_seconds: started.elapsed().as_secs_f64(),
-        dir: dir.to_path_buf(),
+        dir: dir.to_string(),
         message,
-    })
+    };
+    Ok((trial, summary))
 }
 
 /// Search for the factor of safety; outputs into `out` (module docs).
-pub fn search(scene: &Scene, out: &Path, opts: &RunOptions) -> Result<RunSummary, RunError> {
+pub fn search(scene: &Scene, out: &Path, opts: &RunOptions) -> Result<SearchSummary, SearchError> {
     let cfg = scene.config.strength_reduction.as_ref().expect("caller");
     let started = Instant::now();
-    let mut csv =
-        std::io::BufWriter::new(std::fs::File::create(out.join("strength_reduction.csv"))?);
-    writeln!(csv, "{CSV_HEADER}")?;
+    std::fs::create_dir_all(out)?;
+    let mut csv = CsvWriter::create(&out.join("strength_reduction.csv"), &CSV_COLUMNS)?;
     let mut trials: Vec<Trial> = Vec::new();
-    let mut run_trial = |factor: f64, trials: &mut Vec<Trial>| -> Result<bool, RunError> {
-        let dir = out
-            .join("trials")
-            .join(format!("{:02}_F{factor:.4}", trials.len()));
-        let t = trial(scene, &dir, factor)?;
-        writeln!(csv, "{}", t.csv())?;
+    let mut particles = 0;
+    let mut run_trial = |factor: f64, trials: &mut Vec<Trial>| -> Result<bool, SearchError> {
+        let dir = format!("trials/{:02}_F{factor:.4}", trials.len());
+        let (t, summary) = trial(scene, out, &dir, factor)?;
+        particles = summary.particles;
+        let name = Path::new(&t.dir)
+            .file_name()
+            .unwrap()
+            .to_string_lossy()
+            .into_owned();
+        csv.row([
+            Field::from(t.factor),
+            Field::Text(status_name(t.status)),
+            t.steps.into(),
+            t.newton_iterations.into(),
+            t.cutbacks.into(),
+            t.monitor_displacement.into(),
+            t.wall_seconds.into(),
+            Field::Text(&name),
+        ])?;
         csv.flush()?;
         if opts.progress {
             eprintln!(
                 "strength reduction: F = {factor:.4} {} ({} steps, {} Newton iterations, {} cut-backs, {:.1} s)",
-                match t.failure {
-                    None => "holds",
-                    Some(Failure::Newton) => "fails (Newton)",
-                    Some(Failure::Displacement) => "fails (displacement)",
+                match t.status {
+                    TrialStatus::Stable => "holds",
+                    TrialStatus::FailedNewton => "fails (Newton)",
+                    TrialStatus::FailedDisplacement => "fails (displacement)",
                 },
                 t.steps,
                 t.newton_iterations,
@@ -143,7 +208,7 @@ pub fn search(scene: &Scene, out: &Path, opts: &RunOptions) -> Result<RunSummary
                 t.wall_seconds
             );
         }
-        let failed = t.failure.is_some();
+        let failed = t.status.failed();
         trials.push(t);
         Ok(failed)
     };
@@ -177,83 +242,61 @@ pub fn search(scene: &Scene, out: &Path, opts: &RunOptions) -> Result<RunSummary
             stable = Some(mid);
         }
     }
-    let wall = started.elapsed().as_secs_f64();
-    let newton: u64 = trials.iter().map(|t| t.newton_iterations).sum();
-    let steps: u64 = trials.iter().map(|t| t.steps).sum();
-    let rel = |t: &Trial| {
-        t.dir
-            .strip_prefix(out)
-            .unwrap_or(&t.dir)
-            .display()
-            .to_string()
-    };
     let find = |f: Option<f64>| {
         f.and_then(|f| trials.iter().find(|t| t.factor == f))
-            .map(rel)
+            .map(|t| t.dir.clone())
     };
-    let mut summary = json!({
-        "scene": scene.file,
-        "analysis": "strength_reduction",
-        "failure_criterion": if cfg.max_displacement.is_some() {
+    let mut summary = SearchSummary {
+        scene: scene.file.clone(),
+        analysis: "strength_reduction".into(),
+        failure_criterion: if cfg.max_displacement.is_some() {
             "Newton non-convergence after cut-backs, or monitored displacement above max_displacement"
         } else {
             "Newton non-convergence after cut-backs"
-        },
-        "trials": trials.iter().map(|t| json!({
-            "factor": t.factor,
-            "status": match t.failure {
-                None => "stable",
-                Some(Failure::Newton) => "failed_newton",
-                Some(Failure::Displacement) => "failed_displacement",
-            },
-            "steps": t.steps,
-            "newton_iterations": t.newton_iterations,
-            "cutbacks": t.cutbacks,
-            "monitor_displacement": t.monitor_displacement,
-            "wall_seconds": t.wall_seconds,
-            "dir": rel(t),
-            "message": t.message,
-        })).collect::<Vec<_>>(),
-        "newton_iterations": newton,
-        "steps": steps,
-        "wall_seconds": wall,
-        "mechanism_stable": find(stable),
-        "mechanism_failed": find(failed),
-    });
-    let particles = trials
-        .first()
-        .and_then(|t| {
-            let text = std::fs::read_to_string(t.dir.join("summary.json")).ok()?;
-            serde_json::from_str::<serde_json::Value>(&text).ok()
-        })
-        .and_then(|j| j["particles"].as_u64())
-        .unwrap_or(0);
-    summary["particles"] = json!(particles);
+        }
+        .into(),
+        newton_iterations: trials.iter().map(|t| t.newton_iterations).sum(),
+        steps: trials.iter().map(|t| t.steps).sum(),
+        wall_seconds: started.elapsed().as_secs_f64(),
+        mechanism_stable: find(stable),
+        mechanism_failed: find(failed),
+        trials,
+        particles,
+        status: SearchStatus::Completed,
+        factor_of_safety: None,
+        factor_of_safety_bracket: None,
+        message: None,
+    };
     match (stable, failed) {
         (Some(s), Some(f)) => {
-            summary["status"] = json!("completed");
-            summary["factor_of_safety"] = json!(0.5 * (s + f));
-            summary["factor_of_safety_bracket"] = json!([s, f]);
+            summary.factor_of_safety = Some(0.5 * (s + f));
+            summary.factor_of_safety_bracket = Some([s, f]);
             write_json(&out.join("summary.json"), &summary)?;
-            Ok(RunSummary {
-                steps: steps as usize,
-                end_time: scene.config.total_time(),
-                particles: particles as usize,
-                wall_seconds: wall,
-                json: summary,
-            })
+            Ok(summary)
         }
         _ => {
-            let msg = format!(
+            let message = format!(
                 "{}: no bracket [stable F, failed F] found in {} trials (stable: {stable:?}, failed: {failed:?}); see {}",
                 scene.file,
-                trials.len(),
+                summary.trials.len(),
                 out.join("strength_reduction.csv").display()
             );
-            summary["status"] = json!("no_bracket");
-            summary["message"] = json!(msg);
+            summary.status = SearchStatus::NoBracket;
+            summary.message = Some(message.clone());
             write_json(&out.join("summary.json"), &summary)?;
-            Err(RunError::Diverged(msg))
+            Err(SearchError::NoBracket {
+                message,
+                summary: Box::new(summary),
+            })
         }
+    }
+}
+
+/// The status as written in strength_reduction.csv and summary.json.
+fn status_name(s: TrialStatus) -> &'static str {
+    match s {
+        TrialStatus::Stable => "stable",
+        TrialStatus::FailedNewton => "failed_newton",
+        TrialStatus::FailedDisplacement => "failed_displacement",
     }
 }

@@ -4,8 +4,9 @@
 
 use clap::{Parser, Subcommand};
 use mpm::analyses::bench::{bench, BenchError, BenchOptions};
-use mpm::analyses::{check, run_scene};
-use mpm::run::{RunError, RunOptions};
+use mpm::analyses::check;
+use mpm::analyses::strength_reduction::{search, SearchError};
+use mpm::run::{run, RunError, RunOptions};
 use mpm::scene::Scene;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -204,14 +205,35 @@ fn main() -> ExitCode {
                     return ExitCode::from(2);
                 }
             };
-            match run_scene(
-                &scene,
-                &out,
-                &RunOptions {
-                    progress: true,
-                    ..Default::default()
-                },
-            ) {
+            let opts = RunOptions {
+                progress: true,
+                ..Default::default()
+            };
+            if scene.config.strength_reduction.is_some() {
+                return match search(&scene, &out, &opts) {
+                    Ok(s) => {
+                        let [lo, hi] = s.factor_of_safety_bracket.unwrap_or([f64::NAN; 2]);
+                        println!(
+                            "{}: factor of safety {:.4} (stable at {lo:.4}, fails at {hi:.4}) after {} trials, {:.2} s wall; outputs in {}",
+                            scene.file,
+                            s.factor_of_safety.unwrap_or(f64::NAN),
+                            s.trials.len(),
+                            s.wall_seconds,
+                            out.display()
+                        );
+                        ExitCode::SUCCESS
+                    }
+                    Err(SearchError::Run(e @ RunError::Scene(_))) => {
+                        eprintln!("error: {e}");
+                        ExitCode::from(2)
+                    }
+                    Err(e) => {
+                        eprintln!("error: {e}");
+                        ExitCode::from(1)
+                    }
+                };
+            }
+            match run(&scene, &out, &opts) {
                 Ok(s) => {
                     println!(
                         "{}: {} steps to t = {:.6e}, {} particles, {:.2} s wall; outputs in {}",
@@ -283,9 +305,9 @@ fn limit(scene: &std::path::Path, out: &std::path::Path, overrides: &[String]) -
             println!(
                 "{}: {} between {:.5} and {:.5}; outputs in {}",
                 scene.file,
-                s["quantity"].as_str().unwrap_or(""),
-                s["lower_bound"].as_f64().unwrap_or(f64::NAN),
-                s["upper_bound"].as_f64().unwrap_or(f64::NAN),
+                s.quantity,
+                s.lower_bound,
+                s.upper_bound,
                 out.display()
             );
             ExitCode::SUCCESS

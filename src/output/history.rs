@@ -1,11 +1,11 @@
 //! `history.csv`: energies and per-body centres of mass over time.
 
-use std::fs::File;
-use std::io::{self, BufWriter, Write};
+use std::io;
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use super::text::{write_f64, AXES};
+use super::csv_file::{CsvWriter, Field};
+use super::text::AXES;
 use crate::dim::Vector;
 use crate::model::particles::Particles;
 
@@ -18,7 +18,7 @@ const AUTO_FLUSH: Duration = Duration::from_secs(1);
 /// Rows are buffered and reach the disk on [`HistoryWriter::flush`], at least once a
 /// second during `write_row`, and on drop, so a run killed midway keeps (almost) all rows.
 pub struct HistoryWriter {
-    w: BufWriter<File>,
+    w: CsvWriter,
     dim: usize,
     n_bodies: usize,
     last_flush: Instant,
@@ -34,8 +34,7 @@ impl HistoryWriter {
                 format!("history: dimension must be 2 or 3, got {dim}"),
             ));
         }
-        let mut w = BufWriter::new(File::create(path)?);
-        w.write_all(header(dim, n_bodies).as_bytes())?;
+        let mut w = CsvWriter::create(path, &header(dim, n_bodies))?;
         w.flush()?;
         Ok(Self {
             w,
@@ -67,19 +66,13 @@ impl HistoryWriter {
                 ),
             ));
         }
-        let w = &mut self.w;
-        write_f64(w, t)?;
-        for x in [kinetic, strain, external_work] {
-            w.write_all(b",")?;
-            write_f64(w, x)?;
-        }
-        for (c, v) in com.iter().zip(com_velocity) {
-            for x in c.iter().chain(v.iter()) {
-                w.write_all(b",")?;
-                write_f64(w, *x)?;
-            }
-        }
-        w.write_all(b"\n")?;
+        let energies = [t, kinetic, strain, external_work];
+        let centres = com
+            .iter()
+            .zip(com_velocity)
+            .flat_map(|(c, v)| c.iter().chain(v.iter()).copied());
+        self.w
+            .row(energies.into_iter().chain(centres).map(Field::Number))?;
         if self.last_flush.elapsed() >= AUTO_FLUSH {
             self.flush()?;
         }
@@ -100,17 +93,18 @@ impl Drop for HistoryWriter {
     }
 }
 
-/// The header line (with newline) of `history.csv`.
-fn header(dim: usize, n_bodies: usize) -> String {
-    let mut h = String::from("t,kinetic,strain,external_work");
+/// The columns of `history.csv`.
+fn header(dim: usize, n_bodies: usize) -> Vec<String> {
+    let mut h: Vec<String> = ["t", "kinetic", "strain", "external_work"]
+        .map(String::from)
+        .into();
     for i in 0..n_bodies {
         for prefix in ["", "v"] {
             for a in &AXES[..dim] {
-                h.push_str(&format!(",body{i}_{prefix}{a}"));
+                h.push(format!("body{i}_{prefix}{a}"));
             }
         }
     }
-    h.push('\n');
     h
 }
 
@@ -182,7 +176,7 @@ mod tests {
 
     #[test]
     fn header_without_bodies() {
-        assert_eq!(header(3, 0), "t,kinetic,strain,external_work\n");
+        assert_eq!(header(3, 0).join(","), "t,kinetic,strain,external_work");
     }
 
     #[test]

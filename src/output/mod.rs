@@ -7,6 +7,7 @@
 //! text files are written with the shortest representation that parses back to the
 //! same `f64`: plain notation for moderate magnitudes, scientific (`1e-7`) otherwise.
 
+pub mod csv_file;
 mod history;
 mod particles_csv;
 mod progress;
@@ -14,10 +15,10 @@ mod table;
 mod text;
 mod vtk;
 
+pub use csv_file::{CsvWriter, Field};
 pub use history::{body_centres, HistoryWriter};
 pub use particles_csv::{write_particles_csv, write_particles_csv_with};
 pub use progress::Progress;
-pub use table::{csv_field, Table};
-pub(crate) use text::f64_string;
+pub use table::Table;
 pub use text::write_json;
 pub use vtk::FrameWriter;

@@ -5,11 +5,11 @@
 //! followed by extra columns only where the run has them (`eps_p`, the equivalent
 //! plastic strain, when a material has one).
 
-use std::fs::File;
-use std::io::{self, BufWriter, Write};
+use std::io;
 use std::path::Path;
 
-use super::text::{write_f64, AXES};
+use super::csv_file::{CsvWriter, Field};
+use super::text::AXES;
 use crate::model::particles::Particles;
 
 /// Stress components written for dimension `dim`, as (column name, row, column) of the
@@ -30,8 +30,8 @@ fn stress_columns(dim: usize) -> &'static [(&'static str, usize, usize)] {
     }
 }
 
-/// The header line (with newline) of `particles_final.csv` for dimension `dim`.
-fn header(dim: usize) -> String {
+/// The contract columns of `particles_final.csv` for dimension `dim`.
+fn header(dim: usize) -> Vec<String> {
     let axes = &AXES[..dim];
     let mut cols: Vec<String> = vec!["id".into(), "body".into()];
     cols.extend(axes.iter().map(|a| format!("{}0", a.to_uppercase())));
@@ -39,9 +39,7 @@ fn header(dim: usize) -> String {
     cols.extend(axes.iter().map(|a| format!("v{a}")));
     cols.extend(stress_columns(dim).iter().map(|c| c.0.to_string()));
     cols.extend(["volume0", "volume", "mass"].map(String::from));
-    let mut h = cols.join(",");
-    h.push('\n');
-    h
+    cols
 }
 
 /// Write every particle of `p` to `path` as CSV (columns in the module docs; `id` is the
@@ -57,36 +55,21 @@ pub fn write_particles_csv_with<const D: usize>(
     p: &Particles<D>,
     extra: &[(&str, &[f64])],
 ) -> io::Result<()> {
-    let mut w = BufWriter::new(File::create(path)?);
     let mut head = header(D);
-    head.pop();
     for (name, values) in extra {
         assert_eq!(values.len(), p.len(), "extra column {name}");
-        head.push(',');
-        head.push_str(name);
+        head.push(name.to_string());
     }
-    head.push('\n');
-    w.write_all(head.as_bytes())?;
+    let mut w = CsvWriter::create(path, &head)?;
     let stress = stress_columns(D);
     for i in 0..p.len() {
-        write!(w, "{},{}", i, p.body[i])?;
-        for x in p.x0[i].iter().chain(p.x[i].iter()).chain(p.v[i].iter()) {
-            w.write_all(b",")?;
-            write_f64(&mut w, *x)?;
-        }
-        for &(_, r, c) in stress {
-            w.write_all(b",")?;
-            write_f64(&mut w, p.stress[i][(r, c)])?;
-        }
-        for x in [p.volume0[i], p.volume[i], p.mass[i]] {
-            w.write_all(b",")?;
-            write_f64(&mut w, x)?;
-        }
-        for (_, values) in extra {
-            w.write_all(b",")?;
-            write_f64(&mut w, values[i])?;
-        }
-        w.write_all(b"\n")?;
+        let ids = [Field::from(i), Field::from(p.body[i])];
+        let kinematics = p.x0[i].iter().chain(p.x[i].iter()).chain(p.v[i].iter());
+        let sigma = stress.iter().map(|&(_, r, c)| p.stress[i][(r, c)]);
+        let sizes = [p.volume0[i], p.volume[i], p.mass[i]];
+        let more = extra.iter().map(|(_, values)| values[i]);
+        let numbers = kinematics.copied().chain(sigma).chain(sizes).chain(more);
+        w.row(ids.into_iter().chain(numbers.map(Field::Number)))?;
     }
     w.flush()
 }

@@ -1,7 +1,7 @@
 //! Reading the CSV outputs back (`particles_final.csv`, `history.csv`,
 //! `newton.csv`, `bench.csv`) by column name, for error measures, the benchmark and
 //! tests. Fields may be quoted (`"a, b"`, with `""` for a quote inside), as
-//! [`csv_field`] writes them.
+//! `CsvWriter` writes them.
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -23,23 +23,39 @@ impl Table {
         Table::parse(&text).map_err(|e| format!("{}: {e}", path.display()))
     }
 
-    /// Parse CSV text whose first line is the header.
+    /// Parse CSV text whose first line is the header (fields trimmed, blank
+    /// lines skipped).
     pub fn parse(text: &str) -> Result<Table, String> {
-        let mut lines = text.lines().filter(|l| !l.trim().is_empty());
-        let header = split_fields(lines.next().ok_or("the file is empty")?);
+        let mut reader = csv::ReaderBuilder::new()
+            .has_headers(false)
+            .flexible(true)
+            .trim(csv::Trim::All)
+            .from_reader(text.as_bytes());
+        let mut records = reader.records().filter(|r| {
+            r.as_ref()
+                .map_or(true, |r| !(r.len() == 1 && r[0].is_empty()))
+        });
+        let header: Vec<String> = match records.next() {
+            None => return Err("the file is empty".into()),
+            Some(r) => r
+                .map_err(|e| e.to_string())?
+                .iter()
+                .map(String::from)
+                .collect(),
+        };
         let mut text_cols: Vec<Vec<String>> = vec![Vec::new(); header.len()];
-        for (i, line) in lines.enumerate() {
-            let fields = split_fields(line);
-            if fields.len() != header.len() {
+        for (i, record) in records.enumerate() {
+            let record = record.map_err(|e| e.to_string())?;
+            if record.len() != header.len() {
                 return Err(format!(
                     "row {} has {} fields, the header has {}",
                     i + 2,
-                    fields.len(),
+                    record.len(),
                     header.len()
                 ));
             }
-            for (col, f) in text_cols.iter_mut().zip(fields) {
-                col.push(f);
+            for (col, f) in text_cols.iter_mut().zip(record.iter()) {
+                col.push(f.to_string());
             }
         }
         let columns = header
@@ -92,36 +108,6 @@ impl Table {
     }
 }
 
-/// Split one CSV line into fields, honouring double quotes.
-fn split_fields(line: &str) -> Vec<String> {
-    let mut fields = Vec::new();
-    let mut field = String::new();
-    let mut quoted = false;
-    let mut chars = line.chars().peekable();
-    while let Some(c) = chars.next() {
-        match (c, quoted) {
-            ('"', true) if chars.peek() == Some(&'"') => {
-                field.push('"');
-                chars.next();
-            }
-            ('"', _) => quoted = !quoted,
-            (',', false) => fields.push(std::mem::take(&mut field).trim().to_string()),
-            _ => field.push(c),
-        }
-    }
-    fields.push(field.trim().to_string());
-    fields
-}
-
-/// A text field for a CSV file: quoted when it holds a comma, a quote or a line break.
-pub fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n']) {
-        format!("\"{}\"", s.replace('"', "\"\"").replace('\n', " "))
-    } else {
-        s.to_string()
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -135,9 +121,13 @@ mod tests {
             "",
             "1.5e-3",
         ];
-        let line: Vec<String> = row.iter().map(|s| csv_field(s)).collect();
-        let text = format!("a,b,c,d,e\n{}\n", line.join(","));
-        let t = Table::parse(&text).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.csv");
+        let mut w = crate::output::CsvWriter::create(&path, &["a", "b", "c", "d", "e"]).unwrap();
+        w.row(row.iter().map(|s| crate::output::Field::Text(s)))
+            .unwrap();
+        w.flush().unwrap();
+        let t = Table::read(&path).unwrap();
         assert_eq!(t.len(), 1);
         for (h, want) in ["a", "b", "c", "d", "e"].iter().zip(row) {
             assert_eq!(t.text_column(h).unwrap()[0], want);

@@ -6,8 +6,8 @@ use std::io::{self, BufWriter, Write};
 use std::path::Path;
 
 /// Write `value` to `path` as pretty-printed JSON followed by a newline (used for
-/// `summary.json`; the caller builds the value).
-pub fn write_json(path: &Path, value: &serde_json::Value) -> io::Result<()> {
+/// `summary.json`).
+pub fn write_json(path: &Path, value: &impl serde::Serialize) -> io::Result<()> {
     let mut w = BufWriter::new(File::create(path)?);
     serde_json::to_writer_pretty(&mut w, value)?;
     w.write_all(b"\n")?;

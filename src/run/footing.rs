@@ -1,45 +1,70 @@
-//! A rigid footing: a velocity condition on a region of a grid face with a
-//! `footing_width`. Its load is the reaction on the nodes it drives; the pressure
-//! is that load over the width (unit thickness in 2D). The run writes the
-//! load–settlement curve to footing.csv and the limit pressure to summary.json.
+//! footing.csv: the load–settlement curve of a rigid footing (a velocity condition
+//! with a `footing_width`, `model::conditions::Footing`) after every step that
+//! computes reactions (implicit steps), and its limit pressure for summary.json.
 
-use serde_json::json;
-use std::io::Write;
+use crate::dim::Vector;
+use crate::model::Model;
+use crate::output::{CsvWriter, Field};
+use crate::run::summary::FootingSummary;
+use std::io;
+use std::path::Path;
 
 /// The load–settlement curve, written to footing.csv as it grows.
 pub struct FootingCurve {
     /// (time, settlement, load, pressure).
     rows: Vec<[f64; 4]>,
-    csv: std::io::BufWriter<std::fs::File>,
+    csv: CsvWriter,
+    /// Settlement so far: the footing's speed into the body times the time.
+    settlement: f64,
 }
 
-pub const FOOTING_CSV_HEADER: &str = "t,settlement,load,pressure";
-
 impl FootingCurve {
-    pub fn create(path: &std::path::Path) -> std::io::Result<Self> {
-        let mut csv = std::io::BufWriter::new(std::fs::File::create(path)?);
-        writeln!(csv, "{FOOTING_CSV_HEADER}")?;
-        Ok(FootingCurve {
+    /// footing.csv with its first point (0, 0, 0, 0).
+    pub fn create(path: &Path) -> io::Result<Self> {
+        let mut curve = FootingCurve {
             rows: Vec::new(),
-            csv,
-        })
+            csv: CsvWriter::create(path, &["t", "settlement", "load", "pressure"])?,
+            settlement: 0.0,
+        };
+        curve.push([0.0; 4])?;
+        Ok(curve)
     }
 
-    pub fn push(&mut self, t: f64, settlement: f64, load: f64, width: f64) -> std::io::Result<()> {
-        let row = [t, settlement, load, load / width];
-        writeln!(self.csv, "{},{},{},{}", row[0], row[1], row[2], row[3])?;
+    /// Add the point (t, settlement, load, pressure).
+    fn push(&mut self, row: [f64; 4]) -> io::Result<()> {
+        self.csv.row(row.map(Field::Number))?;
         self.csv.flush()?;
         self.rows.push(row);
         Ok(())
     }
 
-    /// summary.json fields: the limit pressure is the pressure at the end of the
-    /// run (the plateau, if the run went far enough: `plateau_change` is the
-    /// relative rise of the pressure over the last tenth of the settlement).
-    pub fn summary(&self, cohesion: Option<f64>) -> serde_json::Value {
-        let Some(last) = self.rows.last() else {
-            return json!({});
+    /// After a step of length dt ending at t: the settlement grows; a point is
+    /// added when the step computed reactions.
+    pub fn after_step<const D: usize>(
+        &mut self,
+        m: &Model<D>,
+        t: f64,
+        dt: f64,
+        reaction: Option<&[(u32, Vector<D>)]>,
+    ) -> io::Result<()> {
+        let Some(f) = &m.footing else {
+            return Ok(());
         };
+        self.settlement += f.settlement_rate() * dt;
+        match reaction {
+            Some(r) => {
+                let load = f.load(&m.grid, r);
+                self.push([t, self.settlement, load, load / f.width])
+            }
+            None => Ok(()),
+        }
+    }
+
+    /// The limit pressure is the pressure at the end of the run (the plateau, if
+    /// the run went far enough: `plateau_change` is the relative rise of the
+    /// pressure over the last tenth of the settlement).
+    pub fn summary(&self, cohesion: Option<f64>) -> Option<FootingSummary> {
+        let last = self.rows.last()?;
         let limit = last[3];
         let peak = self
             .rows
@@ -52,15 +77,12 @@ impl FootingCurve {
             .rev()
             .find(|r| r[1] <= 0.9 * last[1])
             .map_or(f64::NAN, |r| r[3]);
-        let mut s = json!({
-            "limit_pressure": limit,
-            "peak_pressure": peak,
-            "settlement": last[1],
-            "plateau_change": (limit - at_90) / limit,
-        });
-        if let Some(c) = cohesion.filter(|c| *c > 0.0) {
-            s["bearing_capacity_factor"] = json!(limit / c);
-        }
-        s
+        Some(FootingSummary {
+            limit_pressure: limit,
+            peak_pressure: peak,
+            settlement: last[1],
+            plateau_change: (limit - at_90) / limit,
+            bearing_capacity_factor: cohesion.filter(|c| *c > 0.0).map(|c| limit / c),
+        })
     }
 }

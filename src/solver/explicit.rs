@@ -281,8 +281,6 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
     }
 
     fn report(&self) -> SolverReport {
-        SolverReport::Explicit {
-            scheme: self.scheme,
-        }
+        SolverReport::explicit(self.scheme)
     }
 }

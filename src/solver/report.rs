@@ -1,7 +1,7 @@
 //! What the solvers report: one row per Newton iteration (newton.csv) and the
 //! solver fields of a stage in summary.json.
 
-use crate::scene::{Integrator, LinearSolver, PreconditionerKind, Scheme};
+use crate::scene::{Integrator, LinearSolver, PreconditionerKind, Scheme, SolverKind};
 use serde::{Deserialize, Serialize};
 
 /// One Newton iteration, as written to newton.csv.
@@ -27,23 +27,24 @@ pub struct NewtonRow {
 }
 
 /// The solver fields of a stage (and of the run, for its last stage) in
-/// summary.json: `"solver": "explicit"` with the scheme, or `"solver": "implicit"`
-/// with the integrator and the iteration counts.
+/// summary.json: the kind, the scheme of an explicit stage, the integrator,
+/// linear solver and iteration counts of an implicit one.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "solver", rename_all = "snake_case")]
-pub enum SolverReport {
-    Explicit { scheme: Scheme },
-    Implicit(ImplicitReport),
-}
-
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct ImplicitReport {
-    pub integrator: Integrator,
-    pub newton_iterations: usize,
-    pub cutbacks: usize,
-    pub linear_solver: LinearSolver,
+pub struct SolverReport {
+    pub solver: SolverKind,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scheme: Option<Scheme>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub integrator: Option<Integrator>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub newton_iterations: Option<usize>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cutbacks: Option<usize>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub linear_solver: Option<LinearSolver>,
     /// Krylov iterations over all Newton corrections (0 with the direct solver).
-    pub krylov_iterations: usize,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub krylov_iterations: Option<usize>,
     /// Krylov solvers only.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub preconditioner: Option<PreconditionerKind>,
@@ -55,4 +56,23 @@ pub struct ImplicitReport {
     pub beta: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gamma: Option<f64>,
+}
+
+impl SolverReport {
+    /// An explicit stage.
+    pub fn explicit(scheme: Scheme) -> SolverReport {
+        SolverReport {
+            solver: SolverKind::Explicit,
+            scheme: Some(scheme),
+            integrator: None,
+            newton_iterations: None,
+            cutbacks: None,
+            linear_solver: None,
+            krylov_iterations: None,
+            preconditioner: None,
+            lagged_factorizations: None,
+            beta: None,
+            gamma: None,
+        }
+    }
 }

@@ -2,8 +2,9 @@
 //! and read its CSV outputs by column name.
 #![allow(dead_code)]
 
-use mpm::analyses::run_scene;
-use mpm::run::{RunError, RunOptions, RunSummary};
+use mpm::analyses::strength_reduction::{search, SearchError, SearchSummary};
+use mpm::run::summary::Summary;
+use mpm::run::{run, RunError, RunOptions};
 use mpm::scene::Scene;
 use std::path::{Path, PathBuf};
 
@@ -17,30 +18,39 @@ pub fn problem(name: &str) -> PathBuf {
 pub fn run_problem(
     name: &str,
     overrides: &[&str],
-) -> (Result<RunSummary, RunError>, tempfile::TempDir) {
+) -> (Result<Summary, RunError>, tempfile::TempDir) {
     let dir = tempfile::tempdir().unwrap();
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     let scene = Scene::load(&problem(name), &overrides).expect("scene loads");
-    let result = run_scene(&scene, dir.path(), &RunOptions::default());
+    let result = run(&scene, dir.path(), &RunOptions::default());
     (result, dir)
 }
 
 #[allow(unused_imports)]
 pub use mpm::analyses::reference::bar::zero_crossings;
+/// Run the strength-reduction search of `problems/NAME` with overrides.
+pub fn search_problem(
+    name: &str,
+    overrides: &[&str],
+) -> (Result<SearchSummary, SearchError>, tempfile::TempDir) {
+    let dir = tempfile::tempdir().unwrap();
+    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    let scene = Scene::load(&problem(name), &overrides).expect("scene loads");
+    let result = search(&scene, dir.path(), &RunOptions::default());
+    (result, dir)
+}
+
 /// CSV outputs by column name, and the zero crossings of a sampled signal: the
 /// library's own (used by the error measures of `mpm bench`).
 #[allow(unused_imports)]
 pub use mpm::output::Table;
 
 /// Run scene text (named `scene.toml` in errors) with overrides.
-pub fn run_text(
-    text: &str,
-    overrides: &[&str],
-) -> (Result<RunSummary, RunError>, tempfile::TempDir) {
+pub fn run_text(text: &str, overrides: &[&str]) -> (Result<Summary, RunError>, tempfile::TempDir) {
     let dir = tempfile::tempdir().unwrap();
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     let scene = Scene::parse("scene.toml", text, &overrides).expect("scene parses");
-    let result = run_scene(&scene, dir.path(), &RunOptions::default());
+    let result = run(&scene, dir.path(), &RunOptions::default());
     (result, dir)
 }
 

@@ -10,11 +10,13 @@ pub mod child;
 pub mod configurations;
 mod plots;
 
+use crate::analyses::strength_reduction::SearchSummary;
 use crate::model::Model;
-use crate::output::{csv_field, Table};
+use crate::output::{CsvWriter, Field, Table};
 use crate::physics::boundary::implicit_node_constraint;
 use crate::physics::shape::Stencils;
 use crate::physics::transfer::NodeMap;
+use crate::run::summary::Summary;
 use crate::scene::overrides;
 use crate::scene::validate;
 use crate::scene::{BenchConfig, Integrator, Scene, SceneConfig, SceneError, SolverKind};
@@ -22,7 +24,6 @@ use crate::solver::explicit::Explicit;
 use crate::solver::implicit::tangent::Dofs;
 use child::{run_child, Exit};
 use configurations::Configuration;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// What the command line gives; `None` fields fall back to the `[bench]` table
@@ -86,9 +87,30 @@ pub struct Row {
     pub run_dir: String,
 }
 
-pub const CSV_HEADER: &str = "configuration,overrides,solver,dt,load_steps,cells,particles,\
-unknowns,error,wall_seconds,run_seconds,peak_mib,steps,newton_iterations,newton_per_step,\
-krylov_iterations,krylov_per_newton,cutbacks,status,note,run_dir";
+/// The columns of bench.csv.
+pub const CSV_HEADER: [&str; 21] = [
+    "configuration",
+    "overrides",
+    "solver",
+    "dt",
+    "load_steps",
+    "cells",
+    "particles",
+    "unknowns",
+    "error",
+    "wall_seconds",
+    "run_seconds",
+    "peak_mib",
+    "steps",
+    "newton_iterations",
+    "newton_per_step",
+    "krylov_iterations",
+    "krylov_per_newton",
+    "cutbacks",
+    "status",
+    "note",
+    "run_dir",
+];
 
 impl Row {
     pub fn newton_per_step(&self) -> Option<f64> {
@@ -103,34 +125,31 @@ impl Row {
         self.status == "ok"
     }
 
-    fn csv(&self) -> String {
-        let num = |x: Option<f64>| x.map(crate::output::f64_string).unwrap_or_default();
-        let int = |x: Option<u64>| x.map(|v| v.to_string()).unwrap_or_default();
-        let size = |x: Option<usize>| int(x.map(|v| v as u64));
+    /// The fields of this row in the order of `CSV_HEADER`.
+    fn fields(&self) -> [Field<'_>; 21] {
         [
-            csv_field(&self.configuration),
-            csv_field(&self.overrides),
-            self.solver.clone(),
-            num(self.dt),
-            size(self.load_steps),
-            self.cells.clone(),
-            size(self.particles),
-            size(self.unknowns),
-            num(self.error),
-            num(self.wall_seconds),
-            num(self.run_seconds),
-            num(self.peak_mib),
-            int(self.steps),
-            int(self.newton_iterations),
-            num(self.newton_per_step()),
-            int(self.krylov_iterations),
-            num(self.krylov_per_newton()),
-            int(self.cutbacks),
-            csv_field(&self.status),
-            csv_field(&self.note),
-            csv_field(&self.run_dir),
+            Field::from(&self.configuration),
+            Field::from(&self.overrides),
+            Field::from(&self.solver),
+            self.dt.into(),
+            self.load_steps.into(),
+            Field::from(&self.cells),
+            self.particles.into(),
+            self.unknowns.into(),
+            self.error.into(),
+            self.wall_seconds.into(),
+            self.run_seconds.into(),
+            self.peak_mib.into(),
+            self.steps.into(),
+            self.newton_iterations.into(),
+            self.newton_per_step().into(),
+            self.krylov_iterations.into(),
+            self.krylov_per_newton().into(),
+            self.cutbacks.into(),
+            Field::from(&self.status),
+            Field::from(&self.note),
+            Field::from(&self.run_dir),
         ]
-        .join(",")
     }
 }
 
@@ -179,11 +198,10 @@ pub fn bench(opts: &BenchOptions) -> Result<BenchReport, BenchError> {
 
     std::fs::create_dir_all(opts.out.join("runs"))?;
     let csv_path = opts.out.join("bench.csv");
-    let mut csv = std::io::BufWriter::new(std::fs::File::create(&csv_path)?);
-    writeln!(csv, "{CSV_HEADER}")?;
+    let mut csv = CsvWriter::create(&csv_path, &CSV_HEADER)?;
     let mut rows = Vec::new();
     let mut emit = |row: Row, rows: &mut Vec<Row>| -> std::io::Result<()> {
-        writeln!(csv, "{}", row.csv())?;
+        csv.row(row.fields())?;
         csv.flush()?;
         println!("{}", progress_line(&row));
         rows.push(row);
@@ -527,23 +545,40 @@ fn solver_label(cfg: &SceneConfig) -> &'static str {
 /// Counts from summary.json and newton.csv (also after a divergence: both are
 /// written up to the failure).
 fn read_outputs(row: &mut Row, dir: &Path) {
-    let summary: Option<serde_json::Value> = std::fs::read_to_string(dir.join("summary.json"))
-        .ok()
-        .and_then(|t| serde_json::from_str(&t).ok());
-    if let Some(s) = &summary {
-        row.steps = s["steps"].as_u64();
-        row.run_seconds = s["wall_seconds"].as_f64();
-        row.newton_iterations = s["newton_iterations"].as_u64();
-        row.cutbacks = s["cutbacks"].as_u64();
-        if row.dt.is_none() {
-            // Explicit runs: the mean step (the last one is cut to the end time).
-            let steps = row.steps.filter(|&n| n > 0);
-            row.dt = steps.and_then(|n| Some(s["end_time"].as_f64()? / n as f64));
+    match read_summary(dir) {
+        Some(ChildSummary::Run(s)) => {
+            row.steps = Some(s.steps as u64);
+            row.run_seconds = Some(s.wall_seconds);
+            row.newton_iterations = s.solver.newton_iterations.map(|n| n as u64);
+            row.cutbacks = s.solver.cutbacks.map(|n| n as u64);
+            if row.dt.is_none() && s.steps > 0 {
+                // Explicit runs: the mean step (the last one is cut to the end time).
+                row.dt = Some(s.end_time / s.steps as f64);
+            }
         }
+        Some(ChildSummary::Search(s)) => {
+            row.steps = Some(s.steps as u64);
+            row.run_seconds = Some(s.wall_seconds);
+            row.newton_iterations = Some(s.newton_iterations as u64);
+        }
+        None => {}
     }
     if let Ok(newton) = Table::read(&dir.join("newton.csv")) {
         row.krylov_iterations = krylov_total(&newton);
     }
+}
+
+/// A child's summary.json: a run's, or a strength-reduction search's.
+#[derive(serde::Deserialize)]
+#[serde(untagged)]
+enum ChildSummary {
+    Run(Box<Summary>),
+    Search(Box<SearchSummary>),
+}
+
+fn read_summary(dir: &Path) -> Option<ChildSummary> {
+    let text = std::fs::read_to_string(dir.join("summary.json")).ok()?;
+    serde_json::from_str(&text).ok()
 }
 
 /// Krylov iterations summed over newton.csv: the first column whose name starts with
@@ -566,11 +601,12 @@ fn status(exit: Exit, dir: &Path, timeout: f64) -> String {
         .trim_start_matches("error: ")
         .to_string();
     let message = || -> String {
-        std::fs::read_to_string(dir.join("summary.json"))
-            .ok()
-            .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
-            .and_then(|s| s["message"].as_str().map(str::to_string))
-            .unwrap_or_else(|| last.clone())
+        match read_summary(dir) {
+            Some(ChildSummary::Run(s)) => s.divergence.map(|d| d.message),
+            Some(ChildSummary::Search(s)) => s.message,
+            None => None,
+        }
+        .unwrap_or_else(|| last.clone())
     };
     match exit {
         Exit::Code(0) => "ok".into(),

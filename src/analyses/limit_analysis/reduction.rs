@@ -12,7 +12,7 @@ use super::model::Model;
 use super::Bound;
 
 /// One evaluation α(F).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Trial {
     pub factor: f64,
     pub multiplier: f64,

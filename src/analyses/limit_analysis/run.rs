@@ -9,11 +9,12 @@
 use super::config::{LimitScene, Problem};
 use super::lower_bound::lower_bound;
 use super::model::Model;
+use super::reduction::Trial;
 use super::reduction::{factor_of_safety, FactorOfSafety, ReductionError};
 use super::upper_bound::upper_bound;
 use super::Bound;
-use serde_json::{json, Value};
-use std::io::Write;
+use crate::output::{write_json, CsvWriter, Field};
+use serde::{Deserialize, Serialize};
 use std::path::Path;
 use std::time::Instant;
 
@@ -105,70 +106,151 @@ fn solve_level(scene: &LimitScene, refinements: u32) -> Result<Level, LimitError
     }
 }
 
-fn level_json(scene: &LimitScene, l: &Level) -> Value {
-    let mut v = json!({
-        "refinements": l.refinements,
-        "elements": l.elements,
-        "lower_bound": l.lower,
-        "upper_bound": l.upper,
-        "relative_gap": l.relative_gap(),
-        "lower_seconds": l.lower_seconds,
-        "upper_seconds": l.upper_seconds,
-    });
+/// summary.json of `mpm limit`: the bounds of the finest level (the headline)
+/// and every level.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LimitSummary {
+    pub scene: String,
+    /// `footing` or `slope`.
+    pub problem: String,
+    /// What is bounded: `limit_pressure` or `factor_of_safety`.
+    pub quantity: String,
+    pub lower_bound: f64,
+    pub upper_bound: f64,
+    pub relative_gap: f64,
+    pub elements: usize,
+    #[serde(flatten)]
+    pub headline: Headline,
+    pub levels: Vec<LevelSummary>,
+    pub wall_seconds: f64,
+}
+
+/// The bounds of the finest level in the units of the problem.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Headline {
+    /// Footing: q/c.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bearing_capacity_factor_lower: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bearing_capacity_factor_upper: Option<f64>,
+    /// Slope: the factors of safety and the brackets of their searches.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub factor_of_safety_lower: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub factor_of_safety_upper: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub factor_of_safety_lower_bracket: Option<[f64; 2]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub factor_of_safety_upper_bracket: Option<[f64; 2]>,
+}
+
+/// One refinement level in summary.json.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LevelSummary {
+    pub refinements: u32,
+    pub elements: usize,
+    pub lower_bound: f64,
+    pub upper_bound: f64,
+    pub relative_gap: f64,
+    pub lower_seconds: f64,
+    pub upper_seconds: f64,
+    #[serde(flatten)]
+    pub headline: Headline,
+    /// Footing: the sizes of the two cone programs and their iterations.
+    #[serde(flatten, default, skip_serializing_if = "Option::is_none")]
+    pub programs: Option<Programs>,
+    /// Slope: the trials of the two factor-of-safety searches.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lower_trials: Option<Vec<Trial>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub upper_trials: Option<Vec<Trial>>,
+}
+
+/// The two cone programs of a footing level.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Programs {
+    pub lower_iterations: u32,
+    pub upper_iterations: u32,
+    pub variables: usize,
+    pub lower_equalities: usize,
+    pub upper_equalities: usize,
+    pub cones: usize,
+}
+
+fn level_summary(scene: &LimitScene, l: &Level) -> LevelSummary {
+    let mut headline = Headline::default();
+    let mut programs = None;
     if let Some([lb, ub]) = &l.solves {
         let c = scene.config.soil.cohesion;
-        v["bearing_capacity_factor_lower"] = json!(lb.multiplier / c);
-        v["bearing_capacity_factor_upper"] = json!(ub.multiplier / c);
-        v["lower_iterations"] = json!(lb.iterations);
-        v["upper_iterations"] = json!(ub.iterations);
-        v["variables"] = json!(lb.variables);
-        v["lower_equalities"] = json!(lb.equalities);
-        v["upper_equalities"] = json!(ub.equalities);
-        v["cones"] = json!(lb.cones);
+        headline.bearing_capacity_factor_lower = Some(lb.multiplier / c);
+        headline.bearing_capacity_factor_upper = Some(ub.multiplier / c);
+        programs = Some(Programs {
+            lower_iterations: lb.iterations,
+            upper_iterations: ub.iterations,
+            variables: lb.variables,
+            lower_equalities: lb.equalities,
+            upper_equalities: ub.equalities,
+            cones: lb.cones,
+        });
     }
-    if let Some(searches) = &l.searches {
-        for (name, s) in ["lower", "upper"].iter().zip(searches) {
-            v[format!("factor_of_safety_{name}")] = json!(s.factor);
-            v[format!("factor_of_safety_{name}_bracket")] = json!(s.bracket);
-            v[format!("{name}_trials")] = json!(s
-                .trials
-                .iter()
-                .map(|t| json!({"factor": t.factor, "multiplier": t.multiplier, "seconds": t.seconds}))
-                .collect::<Vec<_>>());
-        }
+    let searches = l.searches.as_ref();
+    if let Some([lb, ub]) = searches {
+        headline.factor_of_safety_lower = Some(lb.factor);
+        headline.factor_of_safety_upper = Some(ub.factor);
+        headline.factor_of_safety_lower_bracket = Some(lb.bracket);
+        headline.factor_of_safety_upper_bracket = Some(ub.bracket);
     }
-    v
+    LevelSummary {
+        refinements: l.refinements,
+        elements: l.elements,
+        lower_bound: l.lower,
+        upper_bound: l.upper,
+        relative_gap: l.relative_gap(),
+        lower_seconds: l.lower_seconds,
+        upper_seconds: l.upper_seconds,
+        headline,
+        programs,
+        lower_trials: searches.map(|[lb, _]| lb.trials.clone()),
+        upper_trials: searches.map(|[_, ub]| ub.trials.clone()),
+    }
 }
 
 /// Solve every refinement level and write summary.json (the last level is the
 /// headline) and refinement.csv into `out`. `progress` prints one line per level.
-pub fn run_limit(scene: &LimitScene, out: &Path, progress: bool) -> Result<Value, LimitError> {
+pub fn run_limit(
+    scene: &LimitScene,
+    out: &Path,
+    progress: bool,
+) -> Result<LimitSummary, LimitError> {
     std::fs::create_dir_all(out).map_err(io(out))?;
     let start = Instant::now();
     let mut levels = Vec::new();
     let csv_path = out.join("refinement.csv");
-    let mut csv = std::fs::File::create(&csv_path).map_err(io(&csv_path))?;
-    writeln!(
-        csv,
-        "refinements,elements,lower_bound,upper_bound,relative_gap,lower_seconds,upper_seconds"
-    )
-    .map_err(io(&csv_path))?;
+    let columns = [
+        "refinements",
+        "elements",
+        "lower_bound",
+        "upper_bound",
+        "relative_gap",
+        "lower_seconds",
+        "upper_seconds",
+    ];
+    let mut csv = CsvWriter::create(&csv_path, &columns).map_err(io(&csv_path))?;
     let mut refinements = scene.config.mesh.refinements.clone();
     refinements.sort_unstable();
     refinements.dedup();
     for r in refinements {
         let l = solve_level(scene, r)?;
-        writeln!(
-            csv,
-            "{},{},{:.8e},{:.8e},{:.6e},{:.3},{:.3}",
-            l.refinements,
-            l.elements,
-            l.lower,
-            l.upper,
-            l.relative_gap(),
-            l.lower_seconds,
-            l.upper_seconds
-        )
+        csv.row([
+            Field::from(l.refinements),
+            l.elements.into(),
+            l.lower.into(),
+            l.upper.into(),
+            l.relative_gap().into(),
+            l.lower_seconds.into(),
+            l.upper_seconds.into(),
+        ])
+        .and_then(|_| csv.flush())
         .map_err(io(&csv_path))?;
         if progress {
             println!(
@@ -189,31 +271,23 @@ pub fn run_limit(scene: &LimitScene, out: &Path, progress: bool) -> Result<Value
         levels.push(l);
     }
     let last = levels.last().expect("at least one level");
-    let mut summary = json!({
-        "scene": scene.file,
-        "problem": match scene.config.problem { Problem::Footing => "footing", Problem::Slope => "slope" },
-        "quantity": match scene.config.problem { Problem::Footing => "limit_pressure", Problem::Slope => "factor_of_safety" },
-        "lower_bound": last.lower,
-        "upper_bound": last.upper,
-        "relative_gap": last.relative_gap(),
-        "elements": last.elements,
-        "levels": levels.iter().map(|l| level_json(scene, l)).collect::<Vec<_>>(),
-        "wall_seconds": start.elapsed().as_secs_f64(),
-    });
-    let headline = level_json(scene, last);
-    for key in [
-        "bearing_capacity_factor_lower",
-        "bearing_capacity_factor_upper",
-        "factor_of_safety_lower",
-        "factor_of_safety_upper",
-        "factor_of_safety_lower_bracket",
-        "factor_of_safety_upper_bracket",
-    ] {
-        if let Some(v) = headline.get(key) {
-            summary[key] = v.clone();
-        }
-    }
+    let (problem, quantity) = match scene.config.problem {
+        Problem::Footing => ("footing", "limit_pressure"),
+        Problem::Slope => ("slope", "factor_of_safety"),
+    };
+    let summary = LimitSummary {
+        scene: scene.file.clone(),
+        problem: problem.into(),
+        quantity: quantity.into(),
+        lower_bound: last.lower,
+        upper_bound: last.upper,
+        relative_gap: last.relative_gap(),
+        elements: last.elements,
+        headline: level_summary(scene, last).headline,
+        levels: levels.iter().map(|l| level_summary(scene, l)).collect(),
+        wall_seconds: start.elapsed().as_secs_f64(),
+    };
     let path = out.join("summary.json");
-    std::fs::write(&path, serde_json::to_string_pretty(&summary).unwrap()).map_err(io(&path))?;
+    write_json(&path, &summary).map_err(io(&path))?;
     Ok(summary)
 }

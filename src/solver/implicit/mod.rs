@@ -29,11 +29,11 @@ use crate::physics::shape::{ShapeFunction, Stencils};
 use crate::physics::transfer::{
     applied_force, external_force, interpolate, mass_momentum, nodal_force, NodeMap,
 };
-use crate::scene::{Integrator, LinearSolver, MassMatrix, SolverConfig};
+use crate::scene::{Integrator, LinearSolver, MassMatrix, SolverConfig, SolverKind};
 use crate::solver::divergence::{check_state, Divergence};
-use crate::solver::report::{ImplicitReport, NewtonRow, SolverReport};
-use crate::solver::stepper::Stepper;
 use crate::solver::linear::direct::{DirectSolver, Structure};
+use crate::solver::report::{NewtonRow, SolverReport};
+use crate::solver::stepper::Stepper;
 use newmark::Newmark;
 use rayon::prelude::*;
 use std::time::Instant;
@@ -803,17 +803,19 @@ impl<const D: usize> Stepper<D> for Implicit<D> {
     fn report(&self) -> SolverReport {
         let krylov = self.krylov.as_ref().map(|k| k.config);
         let newmark = self.integrator == Integrator::Newmark;
-        SolverReport::Implicit(ImplicitReport {
-            integrator: self.integrator,
-            newton_iterations: self.newton_iterations,
-            cutbacks: self.cutbacks,
-            linear_solver: krylov.map_or(LinearSolver::Direct, |k| k.method),
-            krylov_iterations: self.krylov_iterations,
+        SolverReport {
+            solver: SolverKind::Implicit,
+            scheme: None,
+            integrator: Some(self.integrator),
+            newton_iterations: Some(self.newton_iterations),
+            cutbacks: Some(self.cutbacks),
+            linear_solver: Some(krylov.map_or(LinearSolver::Direct, |k| k.method)),
+            krylov_iterations: Some(self.krylov_iterations),
             preconditioner: krylov.map(|k| k.preconditioner),
             lagged_factorizations: krylov.map(|_| self.lagged_factorizations()),
             beta: newmark.then_some(self.newmark.beta),
             gamma: newmark.then_some(self.newmark.gamma),
-        })
+        }
     }
 }
 

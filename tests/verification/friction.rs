@@ -11,8 +11,8 @@
 //! FLIP 0.99: pure FLIP with a one-sided wall gains energy slowly (the block
 //! hops on its base); a touch of PIC removes that.
 
-mod common;
-use common::{run_problem, Table};
+use crate::common::{run_problem, Table};
+use mpm::run::summary::Status;
 
 const G: f64 = 9.81;
 
@@ -27,7 +27,7 @@ fn slide(theta_deg: f64, mu: f64, damping: f64) -> (f64, f64) {
         &[&gravity, &mu, &damping, "solver.flip=0.99"],
     );
     let summary = result.unwrap();
-    assert_eq!(summary.json["status"], "completed");
+    assert_eq!(summary.status, Status::Completed);
     let h = Table::read(&dir.path().join("history.csv")).unwrap();
     let (t, x) = (h.col("t"), h.col("body0_x"));
     (*t.last().unwrap(), x.last().unwrap() - x[0])
@@ -110,20 +110,20 @@ fn friction_face_is_fixed_in_implicit_steps() {
             "{f} differs: friction base vs fixed base"
         );
     }
-    assert!(rough.json["limit_pressure"].as_f64().unwrap() > 0.0);
+    assert!(rough.footing.unwrap().limit_pressure > 0.0);
 
     // A block on a base tilted by 30° with μ = 0.3 < tan 30° slides in the
     // explicit solver (sliding_block_follows_the_closed_form); in a quasi-static
     // implicit step the base holds it: only the elastic shear of the block moves
     // its centre, by about ρ g sin θ H² / (3G) = 1.1e-4 m in 1D simple shear
     // (measured 1.3e-4 m; the slide would be 0.29 m in 0.5 s).
-    let text = std::fs::read_to_string(common::problem("sliding_block.toml"))
+    let text = std::fs::read_to_string(crate::common::problem("sliding_block.toml"))
         .unwrap()
         .replace(
             "kind = \"explicit\"\nend_time = 0.5\ncfl = 0.5",
             "kind = \"implicit\"\nintegrator = \"quasi_static\"\nend_time = 1.0\nload_steps = 2",
         );
-    let (result, dir) = common::run_text(&text, &[]);
+    let (result, dir) = crate::common::run_text(&text, &[]);
     result.unwrap();
     let h = Table::read(&dir.path().join("history.csv")).unwrap();
     let x = h.col("body0_x");

@@ -26,9 +26,9 @@
 //! - The stage factor is not cumulative: each stage starts from the scene's
 //!   strengths.
 
-mod common;
-use common::{problem, read_output, run_problem, Table};
+use crate::common::{problem, read_output, run_problem, Table};
 use mpm::model::Model;
+use mpm::run::summary::{Status, Summary};
 use mpm::scene::Scene;
 use std::sync::OnceLock;
 
@@ -41,17 +41,13 @@ fn coarse(extra: &[&str]) -> Vec<String> {
 
 /// Run the coarse scene with overrides; particles_final.csv, history.csv and
 /// summary.json.
-fn run(extra: &[&str]) -> (Table, Table, serde_json::Value) {
+fn run(extra: &[&str]) -> (Table, Table, Summary) {
     let overrides = coarse(extra);
     let refs: Vec<&str> = overrides.iter().map(String::as_str).collect();
     let (result, dir) = run_problem(SCENE, &refs);
     let summary = result.unwrap_or_else(|e| panic!("{e}"));
     let read = |f: &str| Table::read(&dir.path().join(f)).unwrap();
-    (
-        read("particles_final.csv"),
-        read("history.csv"),
-        summary.json,
-    )
+    (read("particles_final.csv"), read("history.csv"), summary)
 }
 
 fn max_of(v: &[f64]) -> f64 {
@@ -74,8 +70,8 @@ fn hand_off(factor: f64, mu: f64) -> (f64, f64) {
 }
 
 /// The failing coarse run (F = 2, as shipped), run once and shared by the tests.
-fn failing_run() -> &'static (Table, Table, serde_json::Value) {
-    static RUN: OnceLock<(Table, Table, serde_json::Value)> = OnceLock::new();
+fn failing_run() -> &'static (Table, Table, Summary) {
+    static RUN: OnceLock<(Table, Table, Summary)> = OnceLock::new();
     RUN.get_or_init(|| run(&[]))
 }
 
@@ -105,11 +101,11 @@ fn the_implicit_equilibrium_carries_over_to_the_explicit_stage() {
 #[test]
 fn the_reduced_slope_fails_runs_out_and_comes_to_rest() {
     let (p, h, summary) = failing_run();
-    assert_eq!(summary["status"], "completed");
-    let stages = summary["stages"].as_array().unwrap();
+    assert_eq!(summary.status, Status::Completed);
+    let stages = &summary.stages;
     assert_eq!(stages.len(), 2);
-    assert_eq!(stages[1]["strength_reduction_factor"], 2.0);
-    let newton = stages[0]["newton_iterations"].as_u64().unwrap();
+    assert_eq!(stages[1].strength_reduction_factor, Some(2.0));
+    let newton = stages[0].solver.newton_iterations.unwrap();
     assert!(
         newton <= 10,
         "gravity stage took {newton} Newton iterations"
@@ -180,7 +176,7 @@ fn gravity_work_is_the_lost_potential_energy_and_is_dissipated() {
 #[test]
 fn one_and_two_threads_give_identical_runout() {
     let run_cli = |threads: usize| {
-        let dir = common::run_cli(SCENE, threads, &coarse(&["stage.1.end_time=1.5"]));
+        let dir = crate::common::run_cli(SCENE, threads, &coarse(&["stage.1.end_time=1.5"]));
         (
             read_output(&dir, "particles_final.csv"),
             read_output(&dir, "history.csv"),

@@ -4,8 +4,7 @@
 //! (the grid-velocity contact and the hypoelastic stored-energy measure) and returns
 //! to within 1 % of E0 after the rebound with USF and MUSL; USL keeps a loss of ~6 %.
 
-mod common;
-use common::{run_problem, Table};
+use crate::common::{run_problem, Table};
 
 struct Collision {
     e0: f64,

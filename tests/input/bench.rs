@@ -6,8 +6,7 @@
 //! `diverged` row; the four plots are PNG files. Bad bench input stops with the
 //! file, key, line and column.
 
-mod common;
-use common::{problem, Table};
+use crate::common::{problem, Table};
 use std::path::Path;
 use std::process::Command;
 

@@ -10,9 +10,7 @@
 //! is the reflected energy. The ratio E_left / W is ≤ 5 % with dashpots and close
 //! to 1 with a fixed base.
 
-mod common;
-
-use common::{problem, run_problem, run_text, Table};
+use crate::common::{problem, run_problem, run_text, Table};
 use mpm::dim::Vector;
 use mpm::model::Model;
 use mpm::run::{kinetic_energy, strain_energy};

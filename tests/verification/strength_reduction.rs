@@ -14,8 +14,8 @@
 //!   upper bound and ten times further from 1.40, and checks the search itself,
 //!   the runaway of the crest near the bracket and the mechanism.
 
-mod common;
-use common::{problem, run_problem, run_text, Table};
+use crate::common::{problem, run_text, search_problem, Table};
+use mpm::analyses::strength_reduction::TrialStatus;
 use mpm::model::Model;
 use mpm::scene::Scene;
 
@@ -139,20 +139,15 @@ fn k0_depth_is_measured_below_the_slope_face() {
 
 #[test]
 fn griffiths_lane_slope_factor_of_safety_coarse() {
-    let (locked, _) = run_problem(
+    let (locked, _) = search_problem(
         "slope_griffiths_lane.toml",
         &["grid.cells=[40,12]", "solver.fbar=false"],
     );
-    let f_locked = locked.unwrap().json["factor_of_safety"].as_f64().unwrap();
-    let (result, dir) = run_problem("slope_griffiths_lane.toml", &["grid.cells=[40,12]"]);
-    let s = result.unwrap().json;
-    let fos = s["factor_of_safety"].as_f64().unwrap();
-    let bracket: Vec<f64> = s["factor_of_safety_bracket"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_f64().unwrap())
-        .collect();
+    let f_locked = locked.unwrap().factor_of_safety.unwrap();
+    let (result, dir) = search_problem("slope_griffiths_lane.toml", &["grid.cells=[40,12]"]);
+    let s = result.unwrap();
+    let fos = s.factor_of_safety.unwrap();
+    let bracket = s.factor_of_safety_bracket.unwrap();
     eprintln!(
         "coarse Griffiths & Lane slope: F = {fos:.4} in {bracket:?} with F-bar, {f_locked:.4} without"
     );
@@ -171,15 +166,18 @@ fn griffiths_lane_slope_factor_of_safety_coarse() {
          ten times further from 1.40 than {fos}"
     );
     // Every stable trial lies below every failed one.
-    let trials = s["trials"].as_array().unwrap();
-    let factors = |status: &str| -> Vec<f64> {
+    let trials = &s.trials;
+    let factors = |status: TrialStatus| -> Vec<f64> {
         trials
             .iter()
-            .filter(|t| t["status"] == status)
-            .map(|t| t["factor"].as_f64().unwrap())
+            .filter(|t| t.status == status)
+            .map(|t| t.factor)
             .collect()
     };
-    let (stable, failed) = (factors("stable"), factors("failed_newton"));
+    let (stable, failed) = (
+        factors(TrialStatus::Stable),
+        factors(TrialStatus::FailedNewton),
+    );
     assert!(stable.iter().all(|s| failed.iter().all(|f| s < f)));
     assert_eq!(stable.len() + failed.len(), trials.len());
     // The crest runs away as F approaches the bracket: its displacement at the
@@ -187,9 +185,9 @@ fn griffiths_lane_slope_factor_of_safety_coarse() {
     let crest = |f: f64| {
         trials
             .iter()
-            .find(|t| t["factor"].as_f64() == Some(f))
-            .unwrap()["monitor_displacement"]
-            .as_f64()
+            .find(|t| t.factor == f)
+            .unwrap()
+            .monitor_displacement
             .unwrap()
     };
     let lowest = stable.iter().cloned().fold(f64::INFINITY, f64::min);
@@ -202,7 +200,7 @@ fn griffiths_lane_slope_factor_of_safety_coarse() {
     // The mechanism: in the last stable trial the plastic strain concentrates in a
     // band that runs out at the toe (x ≈ 35, y ≈ 0), not at the back or the base
     // behind the crest.
-    let dir_stable = dir.path().join(s["mechanism_stable"].as_str().unwrap());
+    let dir_stable = dir.path().join(s.mechanism_stable.as_ref().unwrap());
     let p = Table::read(&dir_stable.join("particles_final.csv")).unwrap();
     let (x, y, e) = (p.col("X0"), p.col("Y0"), p.col("eps_p"));
     let peak = e.iter().cloned().fold(0.0, f64::max);

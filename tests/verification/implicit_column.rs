@@ -5,8 +5,7 @@
 //! volume) e = √(Σ V0 (σ_yy − σ_a)²) / (ρ g l0 √(Σ V0)), computed by
 //! `mpm::analyses::reference::column` (also the error of `mpm bench` for this scene).
 
-mod common;
-use common::{run_problem, Table};
+use crate::common::{run_problem, Table};
 use mpm::analyses::reference::column::Column;
 
 const RHO_G: f64 = 80.0 * 10.0;

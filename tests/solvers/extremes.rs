@@ -3,8 +3,7 @@
 //! 1000× stiffness contrast. (Time steps at and beyond the critical one are in
 //! `stability.rs`.)
 
-mod common;
-use common::{run_problem, run_text, Table};
+use crate::common::{run_problem, run_text, Table};
 
 /// A free block translating at v = (1.0, 0.5) across 12 cells: every shape function
 /// reproduces a uniform velocity field, so the block must stay unstressed and keep

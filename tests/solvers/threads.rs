@@ -1,9 +1,7 @@
 //! Results do not depend on the number of threads: the same scene run with 1 and
 //! 2 threads gives byte-identical outputs.
 
-mod common;
-
-use common::{read_output, run_cli};
+use crate::common::{read_output, run_cli};
 
 fn run(threads: usize, shape: &str, fbar: bool) -> (Vec<u8>, Vec<u8>) {
     let overrides = [

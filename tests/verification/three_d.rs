@@ -1,8 +1,7 @@
 //! The same code path in 3D: the vibrating bar as a one-cell square prism with
 //! rollers on the four long faces, with each material model; output columns in 3D.
 
-mod common;
-use common::{run_text, zero_crossings, Table};
+use crate::common::{run_text, zero_crossings, Table};
 
 fn bar_3d(label: &str, material: &str, shape_function: &str) -> (f64, Table) {
     let text = format!(

@@ -6,26 +6,27 @@
 //! the quadrature change when the explicit step evaluates the shape functions at
 //! the moved particles.
 
-mod common;
-use common::{run_problem, Table};
+use crate::common::{run_problem, Table};
+use mpm::scene::{Integrator, SolverKind};
 
 #[test]
 fn quasi_static_then_explicit_then_newmark() {
     let (result, dir) = run_problem("column_staged.toml", &[]);
     let s = result.unwrap();
-    let stages = s.json["stages"].as_array().unwrap();
-    let kinds: Vec<&str> = stages
-        .iter()
-        .map(|st| st["solver"].as_str().unwrap())
-        .collect();
-    assert_eq!(kinds, ["implicit", "explicit", "implicit"]);
-    let ends: Vec<f64> = stages
-        .iter()
-        .map(|st| st["end_time"].as_f64().unwrap())
-        .collect();
+    let stages = &s.stages;
+    let kinds: Vec<SolverKind> = stages.iter().map(|st| st.solver.solver).collect();
+    assert_eq!(
+        kinds,
+        [
+            SolverKind::Implicit,
+            SolverKind::Explicit,
+            SolverKind::Implicit
+        ]
+    );
+    let ends: Vec<f64> = stages.iter().map(|st| st.end_time).collect();
     assert_eq!(ends, [1.0, 3.0, 5.0], "stage durations add up on one clock");
-    assert_eq!(stages[0]["integrator"], "quasi_static");
-    assert_eq!(stages[2]["integrator"], "newmark");
+    assert_eq!(stages[0].solver.integrator, Some(Integrator::QuasiStatic));
+    assert_eq!(stages[2].solver.integrator, Some(Integrator::Newmark));
 
     let h = Table::read(&dir.path().join("history.csv")).unwrap();
     let t = h.col("t");
@@ -69,7 +70,7 @@ fn quasi_static_then_explicit_then_newmark() {
 
 #[test]
 fn solver_and_stages_are_exclusive() {
-    let text = std::fs::read_to_string(common::problem("column_staged.toml")).unwrap()
+    let text = std::fs::read_to_string(crate::common::problem("column_staged.toml")).unwrap()
         + "\n[solver]\nkind = \"explicit\"\nend_time = 1.0\n";
     let e = mpm::scene::Scene::parse("staged.toml", &text, &[])
         .unwrap_err()
@@ -81,7 +82,7 @@ fn solver_and_stages_are_exclusive() {
     assert!(e.contains("unknown field `stagex`"), "{e}");
     let e = mpm::scene::Scene::parse(
         "staged.toml",
-        &std::fs::read_to_string(common::problem("column_staged.toml"))
+        &std::fs::read_to_string(crate::common::problem("column_staged.toml"))
             .unwrap()
             .replace("scheme = \"musl\"", "scheme = \"musl\"\nbeta = 0.3"),
         &[],

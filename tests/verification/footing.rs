@@ -5,8 +5,7 @@
 //! for Mohr–Coulomb; quadratic Newton convergence in the plastic steps; the keys
 //! of a footing (a velocity condition on a region of a face).
 
-mod common;
-use common::{newton_order, run_problem, step_residuals, Table};
+use crate::common::{newton_order, run_problem, step_residuals, Table};
 use mpm::model::Model;
 use mpm::scene::Scene;
 
@@ -27,19 +26,20 @@ fn prandtl_nc(phi_deg: f64) -> f64 {
 /// Returns the relative error of N_c.
 fn footing(scene: &str, overrides: &[&str], phi: f64, tol: f64, max_iterations: usize) -> f64 {
     let (result, dir) = run_problem(scene, overrides);
-    let summary = result.unwrap_or_else(|e| panic!("{scene}: {e}")).json;
-    let nc = summary["bearing_capacity_factor"].as_f64().unwrap();
-    let limit = summary["limit_pressure"].as_f64().unwrap();
-    let plateau = summary["plateau_change"].as_f64().unwrap();
+    let summary = result.unwrap_or_else(|e| panic!("{scene}: {e}"));
+    let footing = summary.footing.clone().unwrap();
+    let nc = footing.bearing_capacity_factor.unwrap();
+    let limit = footing.limit_pressure;
+    let plateau = footing.plateau_change;
     let exact = prandtl_nc(phi);
     let error = (nc - exact) / exact;
     eprintln!(
         "{scene}: limit pressure {limit:.5e}, N_c = {nc:.4} (Prandtl {exact:.4}), error {:+.2} %, plateau change {:.2e}, {} Newton iterations in {} steps, {:.1} s",
         100.0 * error,
         plateau,
-        summary["newton_iterations"],
-        summary["steps"],
-        summary["wall_seconds"].as_f64().unwrap()
+        summary.solver.newton_iterations.unwrap(),
+        summary.steps,
+        summary.wall_seconds
     );
     assert!(
         error.abs() < tol,
@@ -50,7 +50,7 @@ fn footing(scene: &str, overrides: &[&str], phi: f64, tol: f64, max_iterations: 
     let curve = Table::read(&dir.path().join("footing.csv")).unwrap();
     let p = curve.col("pressure");
     assert_eq!(p[0], 0.0);
-    assert!(p.len() == summary["steps"].as_u64().unwrap() as usize + 1);
+    assert!(p.len() == summary.steps + 1);
     assert_eq!(*p.last().unwrap(), limit);
     // Newton in the last steps (on the plateau, plastic zone fully developed).
     let newton = Table::read(&dir.path().join("newton.csv")).unwrap();
@@ -108,8 +108,11 @@ fn tresca_footing_with_linear_shapes_locks_and_fbar_cures_it() {
         "footing_tresca.toml",
         &linear("grid.cells=[20,12]", "solver.fbar=false"),
     );
-    let nc = result.unwrap().json["bearing_capacity_factor"]
-        .as_f64()
+    let nc = result
+        .unwrap()
+        .footing
+        .unwrap()
+        .bearing_capacity_factor
         .unwrap();
     let locked = nc / prandtl_nc(0.0) - 1.0;
     let rate = (coarse / fine).log2();
@@ -138,7 +141,7 @@ fn mohr_coulomb_footing_reaches_prandtl() {
 
 /// A footing scene whose `[[boundary]]` table of the footing is replaced by `footing`.
 fn with_footing(footing: &str) -> String {
-    let text = std::fs::read_to_string(common::problem("footing_tresca.toml")).unwrap();
+    let text = std::fs::read_to_string(crate::common::problem("footing_tresca.toml")).unwrap();
     let start = text.find("[[boundary]]\nface = \"ymax\"").unwrap();
     let end = text.find("[solver]").unwrap();
     format!("{}{footing}\n{}", &text[..start], &text[end..])
@@ -215,7 +218,7 @@ fn bad_footing_keys_are_named_with_their_line() {
 #[test]
 fn region_selects_the_face_nodes_in_the_box() {
     let scene = Scene::load(
-        &common::problem("footing_tresca.toml"),
+        &crate::common::problem("footing_tresca.toml"),
         &["grid.shape_function=linear".into()],
     )
     .unwrap();

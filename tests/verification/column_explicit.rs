@@ -5,8 +5,7 @@
 //! it holds at finite strain too. Error (normalised L2 over the reference volume):
 //! e = √(Σ V0_p (σ_yy,p − σ_a(Y_p))²) / (ρ g l0 √(Σ V0_p)) (`mpm::analyses::reference::column`).
 
-mod common;
-use common::{run_problem, Table};
+use crate::common::{run_problem, Table};
 use mpm::analyses::reference::column::Column;
 
 fn column_error(shape: &str, cells: usize, extra: &[&str]) -> f64 {

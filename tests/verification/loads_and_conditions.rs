@@ -1,8 +1,7 @@
 //! Loads, prescribed velocities and the energy balance with gravity, each against
 //! a closed-form static or energy result.
 
-mod common;
-use common::{run_problem, run_text, Table};
+use crate::common::{run_problem, run_text, Table};
 
 /// A bar [0,10]×[0,1] fixed at x = 0, loaded at its free end, relaxed dynamically
 /// (PIC + local damping). E = 10⁴, ν = 0, so a end load of 10 N per unit width gives

@@ -17,8 +17,8 @@
 //! shifted by the half particle spacing, so that the initial column measures
 //! d0 × h0); "final" is kinetic energy below 1 % of its peak.
 
-mod common;
-use common::{run_problem, Table};
+use crate::common::{run_problem, Table};
+use mpm::run::summary::Status;
 
 const D0: f64 = 0.2;
 
@@ -41,7 +41,7 @@ fn collapse(a: f64, end_time: f64, length: f64) -> Heap {
     ];
     let o: Vec<&str> = overrides.iter().map(|s| s.as_str()).collect();
     let (result, dir) = run_problem("collapse.toml", &o);
-    assert_eq!(result.unwrap().json["status"], "completed");
+    assert_eq!(result.unwrap().status, Status::Completed);
     let p = Table::read(&dir.path().join("particles_final.csv")).unwrap();
     let h = Table::read(&dir.path().join("history.csv")).unwrap();
     let (x, y, mass) = (p.col("x"), p.col("y"), p.col("mass"));

@@ -3,8 +3,7 @@
 //! recovery, and a clean stop when cut-backs are not allowed), and results that do
 //! not depend on the number of threads.
 
-mod common;
-use common::{run_problem, Table};
+use crate::common::{run_problem, Table};
 
 fn syy_errors(dir: &std::path::Path, l0: f64) -> Vec<(f64, f64)> {
     let p = Table::read(&dir.join("particles_final.csv")).unwrap();
@@ -33,7 +32,7 @@ fn stiffness_contrast_of_a_million() {
             .filter(|(_, y)| (y - 5.0).abs() > 1.0)
             .map(|x| x.0)
             .fold(0.0, f64::max);
-        println!("{shape}: max error {worst:.0} Pa, beyond 1 m of the interface {far:.0} Pa, {} Newton iterations", s.json["newton_iterations"]);
+        println!("{shape}: max error {worst:.0} Pa, beyond 1 m of the interface {far:.0} Pa, {} Newton iterations", s.solver.newton_iterations.unwrap());
         if shape == "bspline2" {
             assert!(
                 far < 400.0,
@@ -43,9 +42,9 @@ fn stiffness_contrast_of_a_million() {
             assert!(worst < 120.0, "{shape}: max error {worst:.0} Pa");
         }
         assert!(
-            s.json["newton_iterations"].as_u64().unwrap() <= 40,
+            s.solver.newton_iterations.unwrap() <= 40,
             "{shape}: {} Newton iterations for 10 steps",
-            s.json["newton_iterations"]
+            s.solver.newton_iterations.unwrap()
         );
     }
 }
@@ -73,7 +72,7 @@ fn nearly_incompressible_column() {
             .iter()
             .map(|x| x.0)
             .fold(0.0, f64::max);
-        (worst, s.json["newton_iterations"].as_u64().unwrap())
+        (worst, s.solver.newton_iterations.unwrap())
     };
     let (w0, n0) = run("0.0");
     let (w49, n49) = run("0.49");
@@ -101,12 +100,12 @@ fn newton_failure_cuts_the_step_and_recovers() {
     ];
     let (result, dir) = run_problem("column.toml", &base);
     let s = result.unwrap();
-    let cutbacks = s.json["cutbacks"].as_u64().unwrap();
+    let cutbacks = s.solver.cutbacks.unwrap();
     let e = syy_errors(dir.path(), 50.0);
     let l2 = (e.iter().map(|x| x.0 * x.0).sum::<f64>() / e.len() as f64).sqrt() / 40000.0;
     println!(
         "one load step: {cutbacks} cut-backs, {} Newton iterations, stress error {l2:.3e}",
-        s.json["newton_iterations"]
+        s.solver.newton_iterations.unwrap()
     );
     assert!(cutbacks >= 1, "the full step should need a cut-back");
     assert!(l2 < 1e-2, "stress error after recovery {l2:.3e}");
@@ -123,7 +122,7 @@ fn newton_failure_cuts_the_step_and_recovers() {
     no_cut.push("solver.max_cutbacks=0");
     let (result, dir) = run_problem("column.toml", &no_cut);
     match result {
-        Err(mpm::run::RunError::Diverged(m)) => assert!(
+        Err(mpm::run::RunError::Diverged { message: m, .. }) => assert!(
             m.contains("diverged at step 1") && m.contains("Newton iterate"),
             "{m}"
         ),
@@ -149,8 +148,8 @@ fn implicit_results_do_not_depend_on_threads() {
         ("vibrating_bar_implicit.toml", "solver.end_time=5"),
     ] {
         let run = |threads: usize| {
-            let dir = common::run_cli(scene, threads, &[extra, "output.frames=0"]);
-            common::read_output(&dir, "particles_final.csv")
+            let dir = crate::common::run_cli(scene, threads, &[extra, "output.frames=0"]);
+            crate::common::read_output(&dir, "particles_final.csv")
         };
         assert!(
             run(1) == run(2),
@@ -182,8 +181,8 @@ fn line_search_saves_newton_iterations() {
             .col("y")
             .to_vec();
         (
-            s.json["newton_iterations"].as_u64().unwrap(),
-            s.json["cutbacks"].as_u64().unwrap(),
+            s.solver.newton_iterations.unwrap(),
+            s.solver.cutbacks.unwrap(),
             y,
         )
     };

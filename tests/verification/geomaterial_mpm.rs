@@ -7,8 +7,8 @@
 //! strain) once the block has been compressed three times its yield strain.
 //! The quasi-static runs also check the Newton iterations of the plastic steps.
 
-mod common;
-use common::{newton_order, problem, read_newton, run_text, step_residuals, Table};
+use crate::common::{newton_order, problem, read_newton, run_text, step_residuals, Table};
+use mpm::run::summary::Status;
 
 const C: f64 = 1.0e4;
 
@@ -56,7 +56,7 @@ struct Result {
 fn run(text: &str, overrides: &[&str]) -> (Result, tempfile::TempDir) {
     let (result, dir) = run_text(text, overrides);
     let summary = result.unwrap_or_else(|e| panic!("{overrides:?}: {e}"));
-    assert_eq!(summary.json["status"], "completed");
+    assert_eq!(summary.status, Status::Completed);
     let p = Table::read(&dir.path().join("particles_final.csv")).unwrap();
     let n = p.col("syy").len() as f64;
     let syy = p.col("syy").iter().sum::<f64>() / n;

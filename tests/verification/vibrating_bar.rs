@@ -3,8 +3,7 @@
 //! The period comes from the zero crossings of the bar's mean velocity, the energy
 //! from history.csv (kinetic + strain; no external work).
 
-mod common;
-use common::{run_problem, zero_crossings, Table};
+use crate::common::{run_problem, zero_crossings, Table};
 
 struct Bar {
     period: f64,

@@ -22,13 +22,12 @@
 //! move as the tip of a cantilever of length a (the rest is unloaded), so the
 //! reference is the elastica of length a at k_a = P a²/EI.
 
-mod common;
 // The finite-element reference (examples/cantilever_fe): the same continuum on Q9
 // elements, total Lagrangian, the project's Hencky law.
 #[allow(dead_code)]
-#[path = "../examples/cantilever_fe/fe.rs"]
+#[path = "../../examples/cantilever_fe/fe.rs"]
 mod fe;
-use common::{run_problem, Table};
+use crate::common::{run_problem, Table};
 use mpm::analyses::reference::elastica::elastica;
 
 const L: f64 = 10.0;

@@ -7,8 +7,8 @@
 //! while USL needs a step below h/c. A run past the limit stops with a message
 //! naming the step and the particle and keeps what it wrote.
 
-mod common;
-use common::{run_problem, Table};
+use crate::common::{run_problem, Table};
+use mpm::run::summary::Status;
 use mpm::run::RunError;
 
 fn runs(scheme: &str, factor: f64, end_time: f64) -> bool {
@@ -24,7 +24,7 @@ fn runs(scheme: &str, factor: f64, end_time: f64) -> bool {
     );
     match result {
         Ok(_) => true,
-        Err(RunError::Diverged(_)) => false,
+        Err(RunError::Diverged { .. }) => false,
         Err(e) => panic!("{e}"),
     }
 }
@@ -55,7 +55,7 @@ fn critical_step_is_h_over_c() {
         &["solver.end_time=0.05", "output.frames=0"],
     );
     let s = result.unwrap();
-    let dt_cr = s.json["dt_critical"].as_f64().unwrap();
+    let dt_cr = s.dt_critical;
     // min over particles of h / (c + |v|), |v| ≤ 0.1: between 1/10.1 and 1/10.
     assert!(
         dt_cr > 1.0 / 10.1 - 1e-12 && dt_cr <= 0.1,
@@ -90,7 +90,7 @@ fn runs_at_nine_tenths_of_the_critical_step() {
                 &format!("solver.scheme={scheme}"),
             ],
         );
-        assert_eq!(result.unwrap().json["status"], "completed");
+        assert_eq!(result.unwrap().status, Status::Completed);
         let h = Table::read(&dir.path().join("history.csv")).unwrap();
         let e: Vec<f64> = h
             .col("kinetic")
@@ -113,7 +113,7 @@ fn diverges_at_twice_the_critical_step_and_stops_cleanly() {
         &["solver.dt=0.2", "solver.end_time=300", "output.frames=300"],
     );
     let msg = match result {
-        Err(RunError::Diverged(m)) => m,
+        Err(RunError::Diverged { message: m, .. }) => m,
         other => panic!("expected a divergence, got {other:?}"),
     };
     assert!(

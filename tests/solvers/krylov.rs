@@ -4,24 +4,22 @@
 //! Eisenstat–Walker forcing terms; a material without an analytic tangent; a
 //! Krylov failure handled like a Newton failure.
 
-mod common;
-use common::{problem, read_newton, read_output, run_cli, run_problem, run_text, Table};
+use crate::common::{problem, read_newton, read_output, run_cli, run_problem, run_text, Table};
+use mpm::run::summary::Summary;
 use mpm::run::RunError;
 
 /// One run: final particles, Newton rows and summary.
 struct Run {
     particles: Table,
     newton: Table,
-    summary: serde_json::Value,
+    summary: Summary,
 }
 
 fn run(scene: &str, overrides: &[&str]) -> Run {
     let mut args: Vec<&str> = vec!["output.frames=0"];
     args.extend_from_slice(overrides);
     let (result, dir) = run_problem(scene, &args);
-    let summary = result
-        .unwrap_or_else(|e| panic!("{scene} {overrides:?}: {e}"))
-        .json;
+    let summary = result.unwrap_or_else(|e| panic!("{scene} {overrides:?}: {e}"));
     Run {
         particles: Table::read(&dir.path().join("particles_final.csv")).unwrap(),
         newton: read_newton(&dir.path().join("newton.csv")),
@@ -60,7 +58,8 @@ fn assert_same_state(direct: &Run, krylov: &Run, length: f64, fields: &[&str], t
 fn counts(r: &Run) -> String {
     format!(
         "{} Newton, {} Krylov iterations",
-        r.summary["newton_iterations"], r.summary["krylov_iterations"]
+        r.summary.solver.newton_iterations.unwrap(),
+        r.summary.solver.krylov_iterations.unwrap()
     )
 }
 
@@ -97,7 +96,7 @@ fn column_same_state_as_direct() {
             counts(&k),
             counts(&direct)
         );
-        assert!(k.summary["krylov_iterations"].as_u64().unwrap() > 0);
+        assert!(k.summary.solver.krylov_iterations.unwrap() > 0);
     }
 }
 
@@ -240,8 +239,8 @@ fn newton_stays_superlinear_with_forcing_terms() {
     );
     assert!(!superlinear(&contractions(&fixed.newton)));
     let (n_direct, n_ew) = (
-        direct.summary["newton_iterations"].as_u64().unwrap(),
-        ew.summary["newton_iterations"].as_u64().unwrap(),
+        direct.summary.solver.newton_iterations.unwrap(),
+        ew.summary.solver.newton_iterations.unwrap(),
     );
     assert!(
         n_ew <= 2 * n_direct,
@@ -291,7 +290,7 @@ fn material_without_tangent_runs_on_the_krylov_path() {
         let ds = max_abs(a.col("syy").iter().zip(b.col("syy")).map(|(p, q)| p - q)) / stress;
         println!(
             "ogden {config:?}: settlement {settlement:.3} m, differences {dy:.1e} / {ds:.1e}; {} Newton, {} Krylov (neo-Hookean direct: {} Newton)",
-            krylov.json["newton_iterations"], krylov.json["krylov_iterations"], direct.json["newton_iterations"]
+            krylov.solver.newton_iterations.unwrap(), krylov.solver.krylov_iterations.unwrap(), direct.solver.newton_iterations.unwrap()
         );
         assert!(
             settlement > 10.0,
@@ -325,7 +324,7 @@ fn krylov_failure_cuts_back_then_stops_cleanly() {
     ];
     let (result, dir) = run_problem("cantilever.toml", &args);
     match result {
-        Err(RunError::Diverged(m)) => assert!(
+        Err(RunError::Diverged { message: m, .. }) => assert!(
             m.contains("GMRES")
                 && m.contains("krylov_max_iterations = 3")
                 && m.contains("after 2 cut-backs"),

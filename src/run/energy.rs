@@ -1,0 +1,19 @@
+//! Energies of the particle state (history.csv, tests of energy balance).
+
+use crate::model::Model;
+use crate::parallel::deterministic_sum;
+
+/// Kinetic energy Σ ½ m |v|².
+pub fn kinetic_energy<const D: usize>(m: &Model<D>) -> f64 {
+    let p = &m.particles;
+    deterministic_sum(p.len(), |q| 0.5 * p.mass[q] * p.v[q].norm_squared())
+}
+
+/// Stored energy Σ V_p w_p.
+pub fn strain_energy<const D: usize>(m: &Model<D>) -> f64 {
+    let p = &m.particles;
+    deterministic_sum(p.len(), |q| {
+        let mat = &m.materials[p.material[q] as usize];
+        p.volume[q] * mat.strain_energy_density(&p.f[q], &p.stress[q], p.history.get(q))
+    })
+}

@@ -1,0 +1,9 @@
+//! Input handling: bad scene files and command lines give an error naming the
+//! file, the key and the line and column, never a panic; `mpm bench` on good and
+//! bad settings.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod bench;
+mod scene_errors;

@@ -1,0 +1,13 @@
+//! The solvers at their limits: matrix-free Newton–Krylov against the direct
+//! path, time steps at and beyond the critical one, nearly incompressible
+//! materials, stiffness contrasts, cut-backs, and results that do not depend on
+//! the number of threads.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod extremes;
+mod implicit_extremes;
+mod krylov;
+mod stability;
+mod threads;

@@ -1,0 +1,25 @@
+//! Verification against analytical and published solutions: each module runs
+//! a scene (or a single material point) and compares with its reference, with
+//! the tolerance stated at the assertion.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod absorbing;
+mod cantilever;
+mod collapse;
+mod column_explicit;
+mod disks;
+mod footing;
+mod friction;
+mod geomaterial_driver;
+mod geomaterial_mpm;
+mod implicit_bar;
+mod implicit_column;
+mod limit_analysis;
+mod loads_and_conditions;
+mod slope_runout;
+mod stages;
+mod strength_reduction;
+mod three_d;
+mod vibrating_bar;
