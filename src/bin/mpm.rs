@@ -164,11 +164,7 @@ fn main() -> ExitCode {
         Command::Check { scene, overrides } => match load(&scene, &overrides) {
             Ok(s) => {
                 let c = &s.config;
-                let stages: Vec<String> = c
-                    .stages()
-                    .iter()
-                    .map(|st| format!("{:?}", st.kind).to_lowercase())
-                    .collect();
+                let stages: Vec<&str> = c.stages().iter().map(|st| st.kind.name()).collect();
                 println!(
                     "{}: ok ({}D, {} material(s), {} body(ies), {} boundary condition(s), {} load(s), shape function {}, solver stages: {})",
                     s.file,

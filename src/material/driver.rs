@@ -275,7 +275,7 @@ mod tests {
     #[test]
     fn run_applies_multiplicative_increments() {
         // A trivial "material" whose stress is F_new − I: the driver must rebuild F_k.
-        #[derive(Debug)]
+        #[derive(Clone, Debug)]
         struct Probe;
         impl Material for Probe {
             fn model(&self) -> &'static str {

@@ -34,13 +34,20 @@
 //! at the apex it is zero (the stress is fixed).
 //!
 //! History: one slot, the equivalent plastic strain ε̄p.
+//!
+//! Scene keys: youngs_modulus, poisson_ratio, cohesion, friction_angle,
+//! dilation_angle (degrees) and mohr_coulomb_fit.
 
-use super::return_mapping::{self, Elasticity, Principal, PrincipalTangent, Return, ReturnMapping};
-use super::{Increment, Material, StressDerivative};
-use crate::dim::Mat3;
+use super::parameters::{FromParameters, KeyError, Parameters};
+use super::return_mapping::{
+    Elasticity, Frictional, Principal, PrincipalTangent, Return, ReturnMapping,
+};
+use super::{reduced_angle, Strength};
+use serde::Deserialize;
 
 /// How the cone is matched to the Mohr–Coulomb parameters (module documentation).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum MohrCoulombFit {
     Outer,
     Inner,
@@ -119,6 +126,35 @@ impl DruckerPrager {
     }
 }
 
+impl FromParameters for DruckerPrager {
+    const NAME: &'static str = "drucker_prager";
+    const KEYS: &'static [&'static str] = &[
+        "youngs_modulus",
+        "poisson_ratio",
+        "cohesion",
+        "friction_angle",
+        "dilation_angle",
+        "mohr_coulomb_fit",
+    ];
+
+    /// Angles in degrees in the scene, radians here.
+    fn from_parameters(density: f64, p: &Parameters) -> Result<Self, KeyError> {
+        let youngs_modulus = p.youngs_modulus()?;
+        let poisson_ratio = p.poisson_ratio()?;
+        let (cohesion, phi, psi) = p.mohr_coulomb_strength()?;
+        let fit = p.required("mohr_coulomb_fit")?;
+        Ok(DruckerPrager {
+            density,
+            youngs_modulus,
+            poisson_ratio,
+            cohesion,
+            friction_angle: phi.to_radians(),
+            dilation_angle: psi.to_radians(),
+            fit,
+        })
+    }
+}
+
 /// q = √(3/2) |s| of a principal deviator.
 fn equivalent(s: &Principal) -> f64 {
     (1.5 * s.norm_squared()).sqrt()
@@ -180,54 +216,36 @@ impl ReturnMapping for DruckerPrager {
     }
 }
 
-impl Material for DruckerPrager {
-    fn model(&self) -> &'static str {
-        "drucker_prager"
-    }
-
-    fn density(&self) -> f64 {
+/// Its `Material` implementation is the one of `return_mapping::Frictional`.
+impl Frictional for DruckerPrager {
+    fn reference_density(&self) -> f64 {
         self.density
     }
 
-    fn n_history(&self) -> usize {
-        1
+    fn peak_strength(&self) -> Strength {
+        Strength {
+            cohesion: self.cohesion,
+            friction_angle: self.friction_angle,
+            dilation_angle: self.dilation_angle,
+        }
     }
 
-    fn with_reduced_strength(&self, factor: f64) -> Option<Box<dyn Material>> {
-        Some(Box::new(DruckerPrager {
+    fn reduced(&self, factor: f64) -> Self {
+        DruckerPrager {
             cohesion: self.cohesion / factor,
-            friction_angle: super::reduced_angle(self.friction_angle, factor),
-            dilation_angle: super::reduced_angle(self.dilation_angle, factor),
+            friction_angle: reduced_angle(self.friction_angle, factor),
+            dilation_angle: reduced_angle(self.dilation_angle, factor),
             ..*self
-        }))
-    }
-
-    fn equivalent_plastic_strain(&self, history: &[f64]) -> Option<f64> {
-        history.first().copied()
-    }
-
-    fn update(&self, inc: &Increment, history_new: &mut [f64]) -> Mat3 {
-        return_mapping::update(self, inc, history_new)
-    }
-
-    fn p_wave_modulus(&self) -> f64 {
-        let el = self.elastic();
-        el.lambda + 2.0 * el.mu
-    }
-
-    fn strain_energy_density(&self, f: &Mat3, stress: &Mat3, _history: &[f64]) -> f64 {
-        return_mapping::stored_energy_density(&self.elastic(), f, stress)
-    }
-
-    fn stress_derivative(&self, inc: &Increment) -> Option<StressDerivative> {
-        return_mapping::stress_derivative(self, inc)
+        }
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::material::driver;
+    use crate::dim::Mat3;
+    use crate::material::testing::{increment, rotated};
+    use crate::material::{driver, Increment, Material};
     use nalgebra::Vector3;
 
     const C: f64 = 1.0e4;
@@ -318,22 +336,6 @@ mod tests {
         (f_old, s)
     }
 
-    fn inc<'a>(f_old: Mat3, stress_old: Mat3, df: Mat3, history: &'a [f64]) -> Increment<'a> {
-        Increment {
-            f_old,
-            df,
-            dt: 0.0,
-            stress_old,
-            history_old: history,
-        }
-    }
-
-    fn rotated(d: [f64; 3]) -> Mat3 {
-        let axis = nalgebra::Unit::new_normalize(Vector3::new(0.3, -0.5, 0.8));
-        let r = *nalgebra::Rotation3::from_axis_angle(&axis, 0.3).matrix();
-        r * Mat3::from_diagonal(&Vector3::from(d))
-    }
-
     /// Which part of the surface the update ended on: elastic, cone or apex.
     fn state(m: &DruckerPrager, i: &Increment) -> &'static str {
         let mut h = [0.0];
@@ -373,7 +375,7 @@ mod tests {
                     m.cohesion = 5.0 * C; // the start state lies inside
                 }
                 for (expect, d) in cases {
-                    let i = inc(f_old, s_old, rotated(d), &history);
+                    let i = increment(f_old, rotated(d), s_old, &history);
                     let got = state(&m, &i);
                     if phi == 0.0 && expect == "apex" {
                         assert_eq!(got, "cone", "von Mises has no apex");

@@ -37,6 +37,7 @@
 //! are accurate to a few ulp, so there is no tolerance-dependent switch between an
 //! approximate limit and the exact quotient.
 
+use super::parameters::{FromParameters, KeyError, Parameters};
 use super::{lame, Increment, Material, StressDerivative};
 use crate::dim::Mat3;
 use nalgebra::{SymmetricEigen, Vector3};
@@ -149,9 +150,19 @@ impl Hencky {
     }
 }
 
+impl FromParameters for Hencky {
+    const NAME: &'static str = "hencky";
+    const KEYS: &'static [&'static str] = &["youngs_modulus", "poisson_ratio"];
+
+    fn from_parameters(density: f64, p: &Parameters) -> Result<Self, KeyError> {
+        // E is checked before ν (arguments are evaluated in order).
+        Ok(Self::new(density, p.youngs_modulus()?, p.poisson_ratio()?))
+    }
+}
+
 impl Material for Hencky {
     fn model(&self) -> &'static str {
-        "hencky"
+        Self::NAME
     }
 
     fn density(&self) -> f64 {
@@ -210,33 +221,10 @@ impl Material for Hencky {
 mod tests {
     use super::*;
     use crate::material::driver;
+    use crate::material::testing::{general_f, prestressed, rel, rotation};
 
     fn model() -> Hencky {
         Hencky::new(1100.0, 3.0e6, 0.35)
-    }
-
-    fn inc<'a>(f_old: Mat3, df: Mat3) -> Increment<'a> {
-        let stress_old = Mat3::new(1.0e5, 2.0e4, 0.0, 2.0e4, -3.0e4, 1.0e4, 0.0, 1.0e4, 5.0e4);
-        Increment {
-            f_old,
-            df,
-            dt: 1e-3,
-            stress_old,
-            history_old: &[],
-        }
-    }
-
-    fn rel(a: &Mat3, b: &Mat3) -> f64 {
-        (a - b).norm() / b.norm()
-    }
-
-    fn general_f() -> Mat3 {
-        Mat3::new(1.2, 0.3, -0.1, 0.05, 0.9, 0.15, 0.02, -0.1, 1.1)
-    }
-
-    fn general_rotation() -> Mat3 {
-        let axis = nalgebra::Unit::new_normalize(nalgebra::Vector3::new(0.3, -0.5, 0.8));
-        *nalgebra::Rotation3::from_axis_angle(&axis, 0.8).matrix()
     }
 
     fn diag(a: f64, b: f64, c: f64) -> Mat3 {
@@ -250,7 +238,7 @@ mod tests {
     #[test]
     fn zero_stress_at_identity() {
         let m = model();
-        let s = m.update(&inc(Mat3::identity(), Mat3::identity()), &mut []);
+        let s = m.update(&prestressed(Mat3::identity(), Mat3::identity()), &mut []);
         assert!(s.norm() == 0.0, "σ(I) = 0 exactly");
         assert!(
             m.strain_energy_density(&Mat3::identity(), &Mat3::zeros(), &[]) == 0.0,
@@ -267,7 +255,10 @@ mod tests {
         let (lambda, mu) = m.lame();
         for (scale, tol) in [(1e-7, 1e-6), (1e-6, 1e-5)] {
             let h = Mat3::new(1.0, 0.4, -0.3, 0.4, -0.6, 0.2, -0.3, 0.2, 0.5) * scale;
-            let s = m.update(&inc(Mat3::identity(), Mat3::identity() + h), &mut []);
+            let s = m.update(
+                &prestressed(Mat3::identity(), Mat3::identity() + h),
+                &mut [],
+            );
             let e = rel(&s, &hooke(lambda, mu, &h));
             eprintln!("Hooke at strain {scale:e}: {e:e}");
             assert!(
@@ -279,7 +270,7 @@ mod tests {
 
     #[test]
     fn stress_is_symmetric() {
-        let s = model().update(&inc(general_f(), driver::rotation_z(0.3)), &mut []);
+        let s = model().update(&prestressed(general_f(), driver::rotation_z(0.3)), &mut []);
         assert!(
             (s - s.transpose()).norm() <= 1e-14 * s.norm(),
             "symmetric to 1e-14"
@@ -357,7 +348,7 @@ mod tests {
     #[test]
     fn superposed_rotation_rotates_stress() {
         let m = model();
-        let r = general_rotation();
+        let r = rotation(0.8);
         for f in [general_f(), diag(1.3, 1.0, 1.0), Mat3::identity() * 0.8] {
             let s = m.cauchy(&f);
             let sr = m.cauchy(&(r * f));
@@ -366,8 +357,8 @@ mod tests {
         }
         let f_old = general_f();
         let df = Mat3::new(1.03, 0.02, 0.0, -0.01, 0.98, 0.01, 0.0, 0.0, 1.0);
-        let s = m.update(&inc(f_old, df), &mut []);
-        let sr = m.update(&inc(f_old, r * df), &mut []);
+        let s = m.update(&prestressed(f_old, df), &mut []);
+        let sr = m.update(&prestressed(f_old, r * df), &mut []);
         assert!(
             rel(&sr, &(r * s * r.transpose())) < 1e-12,
             "update: σ(Q ΔF F_old) = QσQᵀ to 1e-12"
@@ -387,7 +378,7 @@ mod tests {
     fn energy_derivative_is_first_piola() {
         for nu in [0.0, 0.35, 0.49] {
             let m = Hencky::new(1100.0, 3.0e6, nu);
-            for f in [general_f(), general_rotation() * diag(1.3, 1.0, 1.0)] {
+            for f in [general_f(), rotation(0.8) * diag(1.3, 1.0, 1.0)] {
                 let h = 1e-6;
                 let w =
                     |f: &Mat3| f.determinant() * m.strain_energy_density(f, &Mat3::zeros(), &[]);
@@ -446,7 +437,7 @@ mod tests {
         let m = model();
         let (lambda, mu) = m.lame();
         let d = m
-            .stress_derivative(&inc(Mat3::identity(), Mat3::identity()))
+            .stress_derivative(&prestressed(Mat3::identity(), Mat3::identity()))
             .unwrap();
         let delta = |a: usize, b: usize| if a == b { 1.0 } else { 0.0 };
         let c = StressDerivative::from_fn(|r, c| {
@@ -463,7 +454,7 @@ mod tests {
 
     /// Relative error of the exact tangent against central differences of `update`.
     fn tangent_error(m: &Hencky, f_old: Mat3, df: Mat3) -> f64 {
-        let i = inc(f_old, df);
+        let i = prestressed(f_old, df);
         let exact = m.stress_derivative(&i).unwrap();
         // ΔF entries are O(1): an absolute step 1e-6 balances the O(h²) truncation
         // against the O(ulp/h) round-off, both ~1e-10 relative here.
@@ -474,7 +465,7 @@ mod tests {
 
     #[test]
     fn stress_derivative_matches_finite_differences() {
-        let r = general_rotation();
+        let r = rotation(0.8);
         let id = Mat3::identity();
         let generic_df = driver::rotation_z(0.15)
             * Mat3::new(1.02, 0.03, 0.01, -0.01, 0.99, 0.02, 0.0, 0.01, 1.01);

@@ -12,6 +12,7 @@
 //! a rigid rotation would produce a spurious strain sym(R − I) = O(θ²).) Under
 //! simple shear both choices coincide.
 
+use super::parameters::{FromParameters, KeyError, Parameters};
 use super::{lame, Increment, Material, StressDerivative};
 use crate::dim::Mat3;
 
@@ -69,9 +70,19 @@ impl LinearElastic {
     }
 }
 
+impl FromParameters for LinearElastic {
+    const NAME: &'static str = "linear_elastic";
+    const KEYS: &'static [&'static str] = &["youngs_modulus", "poisson_ratio"];
+
+    fn from_parameters(density: f64, p: &Parameters) -> Result<Self, KeyError> {
+        // E is checked before ν (arguments are evaluated in order).
+        Ok(Self::new(density, p.youngs_modulus()?, p.poisson_ratio()?))
+    }
+}
+
 impl Material for LinearElastic {
     fn model(&self) -> &'static str {
-        "linear_elastic"
+        Self::NAME
     }
 
     fn density(&self) -> f64 {
@@ -88,6 +99,11 @@ impl Material for LinearElastic {
     fn p_wave_modulus(&self) -> f64 {
         let (lambda, g) = self.lame();
         lambda + 2.0 * g
+    }
+
+    /// The Jaumann rate integrates from σ_old.
+    fn integrates_from_stored_stress(&self) -> bool {
+        true
     }
 
     /// Complementary energy ½ σ : C⁻¹ : σ = [(1 + ν) σ:σ − ν (tr σ)²] / (2E).
@@ -125,23 +141,10 @@ impl Material for LinearElastic {
 mod tests {
     use super::*;
     use crate::material::driver;
+    use crate::material::testing::{increment, rel, rotation};
 
     fn model() -> LinearElastic {
         LinearElastic::new(2500.0, 2.0e9, 0.3)
-    }
-
-    fn inc<'a>(f_old: Mat3, df: Mat3, stress_old: Mat3) -> Increment<'a> {
-        Increment {
-            f_old,
-            df,
-            dt: 1e-3,
-            stress_old,
-            history_old: &[],
-        }
-    }
-
-    fn rel(a: &Mat3, b: &Mat3) -> f64 {
-        (a - b).norm() / b.norm()
     }
 
     fn prestress() -> Mat3 {
@@ -154,12 +157,15 @@ mod tests {
     fn zero_increment_keeps_stress_and_identity_gives_zero() {
         let m = model();
         let s = m.update(
-            &inc(Mat3::identity(), Mat3::identity(), Mat3::zeros()),
+            &increment(Mat3::identity(), Mat3::identity(), Mat3::zeros(), &[]),
             &mut [],
         );
         assert_eq!(s, Mat3::zeros(), "zero stress at F = I exactly");
         let p = prestress();
-        let s = m.update(&inc(Mat3::identity(), Mat3::identity(), p), &mut []);
+        let s = m.update(
+            &increment(Mat3::identity(), Mat3::identity(), p, &[]),
+            &mut [],
+        );
         assert!(rel(&s, &p) < 1e-15, "ΔF = I keeps the stress to 1e-15");
     }
 
@@ -170,7 +176,7 @@ mod tests {
         for scale in [1e-7, 1e-6] {
             let h = Mat3::new(1.0, 0.4, -0.3, 0.4, -0.6, 0.2, -0.3, 0.2, 0.5) * scale;
             let s = m.update(
-                &inc(Mat3::identity(), Mat3::identity() + h, Mat3::zeros()),
+                &increment(Mat3::identity(), Mat3::identity() + h, Mat3::zeros(), &[]),
                 &mut [],
             );
             let hooke = Mat3::identity() * (lambda * h.trace()) + h * (2.0 * g);
@@ -190,7 +196,7 @@ mod tests {
         let m = model();
         let df = driver::rotation_z(0.2)
             * Mat3::new(1.05, 0.1, 0.02, -0.03, 0.97, 0.04, 0.01, -0.02, 1.01);
-        let s = m.update(&inc(Mat3::identity(), df, prestress()), &mut []);
+        let s = m.update(&increment(Mat3::identity(), df, prestress(), &[]), &mut []);
         assert!(
             (s - s.transpose()).norm() <= 1e-14 * s.norm(),
             "symmetric to 1e-14"
@@ -203,7 +209,7 @@ mod tests {
         let f_old = Mat3::new(1.1, 0.2, 0.0, 0.05, 0.95, 0.0, 0.0, 0.0, 1.02);
         let df = driver::rotation_z(0.15)
             * Mat3::new(1.02, 0.03, 0.01, -0.01, 0.99, 0.02, 0.0, 0.01, 1.01);
-        let i = inc(f_old, df, prestress());
+        let i = increment(f_old, df, prestress(), &[]);
         let exact = m.stress_derivative(&i).unwrap();
         let fd = driver::numerical_stress_derivative(&m, &i, 1e-5);
         let err = (exact - fd).norm() / exact.norm();
@@ -219,9 +225,8 @@ mod tests {
         let p = prestress();
         for angle in [0.1, 1.0, 2.5] {
             // A general rotation (about a skew axis), not only about z.
-            let axis = nalgebra::Unit::new_normalize(nalgebra::Vector3::new(0.3, -0.5, 0.8));
-            let r = *nalgebra::Rotation3::from_axis_angle(&axis, angle).matrix();
-            let s = m.update(&inc(Mat3::identity(), r, p), &mut []);
+            let r = rotation(angle);
+            let s = m.update(&increment(Mat3::identity(), r, p, &[]), &mut []);
             let expect = r * p * r.transpose();
             assert!(
                 rel(&s, &expect) < 1e-12,
@@ -236,9 +241,9 @@ mod tests {
         // (the second half of `driver::rotation`): the rotation step must map σ to RσRᵀ.
         let m = model();
         let u = Mat3::new(1.01, 0.004, 0.0, 0.004, 0.995, 0.0, 0.0, 0.0, 1.0);
-        let s1 = m.update(&inc(Mat3::identity(), u, prestress()), &mut []);
+        let s1 = m.update(&increment(Mat3::identity(), u, prestress(), &[]), &mut []);
         let r = driver::rotation_z(0.7);
-        let s2 = m.update(&inc(u, r, s1), &mut []);
+        let s2 = m.update(&increment(u, r, s1, &[]), &mut []);
         assert!(
             rel(&s2, &(r * s1 * r.transpose())) < 1e-13,
             "rotation after stretch rotates σ to 1e-13"

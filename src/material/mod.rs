@@ -6,6 +6,12 @@
 //! implicit solver can call it at every Newton iterate without drift, and it can ask
 //! for the derivative of the updated stress with respect to ΔF (the consistent
 //! tangent of the update).
+//!
+//! Each model is one file that also says how a scene builds it
+//! (`parameters::FromParameters`: its name, its keys, their checks and its
+//! constructor); `registry` lists the models a scene may name. A new model is a
+//! new file, its `pub mod` line here, one line in `registry::MODELS` and its keys
+//! in docs/scene.md.
 
 pub mod driver;
 pub mod drucker_prager;
@@ -15,7 +21,11 @@ pub mod mohr_coulomb;
 pub mod mooney_rivlin;
 pub mod neo_hookean;
 pub mod ogden;
+pub mod parameters;
+pub mod registry;
 pub mod return_mapping;
+#[cfg(test)]
+mod testing;
 
 use crate::dim::Mat3;
 use nalgebra::SMatrix;
@@ -38,7 +48,28 @@ pub struct Increment<'a> {
     pub history_old: &'a [f64],
 }
 
-pub trait Material: Send + Sync + std::fmt::Debug {
+impl Increment<'_> {
+    /// An increment ΔF from the undeformed, unstressed state.
+    pub fn at_rest(df: Mat3, history_old: &[f64]) -> Increment<'_> {
+        Increment {
+            f_old: Mat3::identity(),
+            df,
+            dt: 0.0,
+            stress_old: Mat3::zeros(),
+            history_old,
+        }
+    }
+}
+
+/// Cohesion, friction angle and dilation angle (radians), or their derivatives.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Strength {
+    pub cohesion: f64,
+    pub friction_angle: f64,
+    pub dilation_angle: f64,
+}
+
+pub trait Material: CloneMaterial + Send + Sync + std::fmt::Debug {
     /// Model name as written in scene files.
     fn model(&self) -> &'static str;
 
@@ -66,6 +97,27 @@ pub trait Material: Send + Sync + std::fmt::Debug {
         None
     }
 
+    /// Whether the model supplies `stress_derivative` (asked at rest), which the
+    /// direct implicit solver needs; the Krylov solvers do not.
+    fn has_analytic_tangent(&self) -> bool {
+        let history = vec![0.0; self.n_history()];
+        let at_rest = Increment::at_rest(Mat3::identity(), &history);
+        self.stress_derivative(&at_rest).is_some()
+    }
+
+    /// Whether the update integrates from the stored stress (rate and
+    /// return-mapping models), so that a prescribed initial stress (geostatic)
+    /// persists; hyperelastic models compute the stress from F alone.
+    fn integrates_from_stored_stress(&self) -> bool {
+        false
+    }
+
+    /// The peak frictional strength c, φ, ψ (radians; for Jáky's K0 = 1 − sin φ
+    /// and the footing's cohesion), `None` for a model without one.
+    fn frictional_strength(&self) -> Option<Strength> {
+        None
+    }
+
     /// The same model with its shear strength reduced by the factor F (strength
     /// reduction, Griffiths & Lane 1999): c/F, tan φ/F and tan ψ/F, residual values
     /// included. `None`: the model has no frictional strength to reduce.
@@ -81,6 +133,24 @@ pub trait Material: Send + Sync + std::fmt::Debug {
     /// Wave speed c = √(M/ρ) at the current Jacobian J (ρ = ρ0/J).
     fn wave_speed(&self, j: f64) -> f64 {
         (self.p_wave_modulus() * j / self.density()).sqrt()
+    }
+}
+
+/// A copy of a material behind `Box<dyn Material>` (the model keeps the
+/// materials as built to reduce their strength from them again).
+pub trait CloneMaterial {
+    fn clone_material(&self) -> Box<dyn Material>;
+}
+
+impl<T: Material + Clone + 'static> CloneMaterial for T {
+    fn clone_material(&self) -> Box<dyn Material> {
+        Box::new(self.clone())
+    }
+}
+
+impl Clone for Box<dyn Material> {
+    fn clone(&self) -> Self {
+        self.clone_material()
     }
 }
 
@@ -123,13 +193,7 @@ pub fn lame(youngs_modulus: f64, poisson_ratio: f64) -> (f64, f64) {
 /// stress update when it has none. For isotropic elasticity this is G.
 pub fn shear_modulus(m: &dyn Material) -> f64 {
     let history = vec![0.0; m.n_history()];
-    let at_rest = |df| Increment {
-        f_old: Mat3::identity(),
-        df,
-        dt: 0.0,
-        stress_old: Mat3::zeros(),
-        history_old: &history,
-    };
+    let at_rest = |df| Increment::at_rest(df, &history);
     if let Some(d) = m.stress_derivative(&at_rest(Mat3::identity())) {
         return d[(1, 1)];
     }

@@ -38,10 +38,17 @@
 //! dτ = D^e (dε^tr − Σ n_j dΔγ_j − Σ Δγ_j n_j' dκ).
 //!
 //! History: one slot, the equivalent plastic strain ε̄p.
+//!
+//! Scene keys: youngs_modulus, poisson_ratio, cohesion, friction_angle,
+//! dilation_angle (degrees); optional softening (residual_cohesion,
+//! residual_friction_angle, residual_dilation_angle, softening_start,
+//! softening_end) and tensile_strength.
 
-use super::return_mapping::{self, Elasticity, Principal, PrincipalTangent, Return, ReturnMapping};
-use super::{Increment, Material, StressDerivative};
-use crate::dim::Mat3;
+use super::parameters::{FromParameters, KeyError, Parameters};
+use super::return_mapping::{
+    Elasticity, Frictional, Principal, PrincipalTangent, Return, ReturnMapping,
+};
+use super::{reduced_angle, Strength};
 use nalgebra::{DMatrix, DVector};
 
 /// Linear strain softening from the peak to the residual strength parameters.
@@ -56,14 +63,6 @@ pub struct Softening {
     pub start: f64,
     /// … and at which the residual values are reached (> start).
     pub end: f64,
-}
-
-/// Cohesion, friction angle and dilation angle (radians), or their derivatives.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Strength {
-    pub cohesion: f64,
-    pub friction_angle: f64,
-    pub dilation_angle: f64,
 }
 
 /// Mohr–Coulomb solid: Hencky elasticity, Mohr–Coulomb pyramid.
@@ -451,25 +450,131 @@ impl ReturnMapping for MohrCoulomb {
     }
 }
 
-impl Material for MohrCoulomb {
-    fn model(&self) -> &'static str {
-        "mohr_coulomb"
-    }
+impl FromParameters for MohrCoulomb {
+    const NAME: &'static str = "mohr_coulomb";
+    const KEYS: &'static [&'static str] = &[
+        "youngs_modulus",
+        "poisson_ratio",
+        "cohesion",
+        "friction_angle",
+        "dilation_angle",
+        "residual_cohesion",
+        "residual_friction_angle",
+        "residual_dilation_angle",
+        "softening_start",
+        "softening_end",
+        "tensile_strength",
+    ];
 
-    fn density(&self) -> f64 {
+    /// Angles in degrees in the scene, radians here.
+    fn from_parameters(density: f64, p: &Parameters) -> Result<Self, KeyError> {
+        let youngs_modulus = p.youngs_modulus()?;
+        let poisson_ratio = p.poisson_ratio()?;
+        let (c, phi, psi) = p.mohr_coulomb_strength()?;
+        let softening = softening(p, c, phi, psi)?;
+        let tensile_strength: Option<f64> = p.get("tensile_strength")?;
+        if let Some(t) = tensile_strength {
+            p.ensure(
+                t >= 0.0 && t.is_finite(),
+                "tensile_strength",
+                format!("must be a number ≥ 0; got {t}"),
+            )?;
+        }
+        Ok(MohrCoulomb {
+            density,
+            youngs_modulus,
+            poisson_ratio,
+            peak: Strength {
+                cohesion: c,
+                friction_angle: phi.to_radians(),
+                dilation_angle: psi.to_radians(),
+            },
+            softening,
+            tensile_strength,
+        })
+    }
+}
+
+/// The softening keys, given peak c, φ, ψ (degrees): residual values no larger
+/// than the peak ones (defaults c, φ and min(ψ, φ_r)), 0 ≤ softening_start <
+/// softening_end, both required when any softening key is given.
+fn softening(p: &Parameters, c: f64, phi: f64, psi: f64) -> Result<Option<Softening>, KeyError> {
+    let keys = [
+        "residual_cohesion",
+        "residual_friction_angle",
+        "residual_dilation_angle",
+        "softening_start",
+        "softening_end",
+    ];
+    if !keys.iter().any(|k| p.given(k)) {
+        return Ok(None);
+    }
+    let what = "strain softening";
+    let start: f64 = p.required_for("softening_start", what)?;
+    let end: f64 = p.required_for("softening_end", what)?;
+    p.ensure(
+        start >= 0.0 && start.is_finite(),
+        "softening_start",
+        format!("must be a plastic strain ≥ 0; got {start}"),
+    )?;
+    p.ensure(
+        end > start && end.is_finite(),
+        "softening_end",
+        format!("must exceed softening_start = {start}; got {end}"),
+    )?;
+    let c_r = p.get("residual_cohesion")?.unwrap_or(c);
+    let phi_r = p.get("residual_friction_angle")?.unwrap_or(phi);
+    let psi_r = p.get("residual_dilation_angle")?.unwrap_or(psi.min(phi_r));
+    p.ensure(
+        c_r >= 0.0 && c_r <= c,
+        "residual_cohesion",
+        format!("must lie in [0, cohesion = {c}] (residual no larger than peak); got {c_r}"),
+    )?;
+    p.ensure(
+        phi_r >= 0.0 && phi_r <= phi,
+        "residual_friction_angle",
+        format!("must lie in [0, friction_angle = {phi}] degrees (residual no larger than peak); got {phi_r}"),
+    )?;
+    p.ensure(
+        phi_r > 0.0 || phi == 0.0,
+        "residual_friction_angle",
+        "must be positive when friction_angle is (the pyramid keeps its apex)",
+    )?;
+    p.ensure(
+        psi_r >= 0.0 && psi_r <= phi_r,
+        "residual_dilation_angle",
+        format!("must lie in [0, residual_friction_angle = {phi_r}] degrees; got {psi_r}"),
+    )?;
+    p.ensure(
+        c_r > 0.0 || phi_r > 0.0,
+        "residual_cohesion",
+        "residual cohesion and friction are both zero: no residual strength",
+    )?;
+    Ok(Some(Softening {
+        residual_cohesion: c_r,
+        residual_friction_angle: phi_r.to_radians(),
+        residual_dilation_angle: psi_r.to_radians(),
+        start,
+        end,
+    }))
+}
+
+/// Its `Material` implementation is the one of `return_mapping::Frictional`.
+impl Frictional for MohrCoulomb {
+    fn reference_density(&self) -> f64 {
         self.density
     }
 
-    fn n_history(&self) -> usize {
-        1
+    fn peak_strength(&self) -> Strength {
+        self.peak
     }
 
     /// Peak and residual strengths are reduced alike; the tension cut-off is kept.
-    fn with_reduced_strength(&self, factor: f64) -> Option<Box<dyn Material>> {
+    fn reduced(&self, factor: f64) -> Self {
         let reduce = |s: Strength| Strength {
             cohesion: s.cohesion / factor,
-            friction_angle: super::reduced_angle(s.friction_angle, factor),
-            dilation_angle: super::reduced_angle(s.dilation_angle, factor),
+            friction_angle: reduced_angle(s.friction_angle, factor),
+            dilation_angle: reduced_angle(s.dilation_angle, factor),
         };
         let softening = self.softening.map(|s| {
             let residual = reduce(Strength {
@@ -484,39 +589,20 @@ impl Material for MohrCoulomb {
                 ..s
             }
         });
-        Some(Box::new(MohrCoulomb {
+        MohrCoulomb {
             peak: reduce(self.peak),
             softening,
             ..*self
-        }))
-    }
-
-    fn equivalent_plastic_strain(&self, history: &[f64]) -> Option<f64> {
-        history.first().copied()
-    }
-
-    fn update(&self, inc: &Increment, history_new: &mut [f64]) -> Mat3 {
-        return_mapping::update(self, inc, history_new)
-    }
-
-    fn p_wave_modulus(&self) -> f64 {
-        let el = self.elastic();
-        el.lambda + 2.0 * el.mu
-    }
-
-    fn strain_energy_density(&self, f: &Mat3, stress: &Mat3, _history: &[f64]) -> f64 {
-        return_mapping::stored_energy_density(&self.elastic(), f, stress)
-    }
-
-    fn stress_derivative(&self, inc: &Increment) -> Option<StressDerivative> {
-        return_mapping::stress_derivative(self, inc)
+        }
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::material::driver;
+    use crate::dim::Mat3;
+    use crate::material::testing::{increment, rotated};
+    use crate::material::{driver, Increment, Material};
     use nalgebra::Vector3;
     use std::collections::BTreeSet;
 
@@ -549,12 +635,6 @@ mod tests {
             start: 0.0,
             end: 0.05,
         }
-    }
-
-    fn rotated(d: [f64; 3]) -> Mat3 {
-        let axis = nalgebra::Unit::new_normalize(Vector3::new(0.3, -0.5, 0.8));
-        let r = *nalgebra::Rotation3::from_axis_angle(&axis, 0.3).matrix();
-        r * Mat3::from_diagonal(&Vector3::from(d))
     }
 
     fn start(confinement: f64) -> (Mat3, Mat3) {
@@ -614,13 +694,7 @@ mod tests {
         let history = [kappa];
         let mut seen = BTreeSet::new();
         for d in trials {
-            let i = Increment {
-                f_old,
-                df: rotated(*d),
-                dt: 0.0,
-                stress_old: s_old,
-                history_old: &history,
-            };
+            let i = increment(f_old, rotated(*d), s_old, &history);
             let st = state(m, &i);
             let e = driver::tangent_error(m, &i, 1e-7);
             eprintln!("MC {name:<28} {st:<22}: tangent vs FD {e:.2e}");

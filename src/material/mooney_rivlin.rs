@@ -14,6 +14,7 @@
 //! change (for a = 4b, ν = 0.3: peak mean stress ≈ 0.054 G at J ≈ 1.05). The model is
 //! meant for nearly incompressible rubber (ν → 0.5).
 
+use super::parameters::{FromParameters, KeyError, Parameters};
 use super::{Increment, Material, StressDerivative};
 use crate::dim::Mat3;
 use nalgebra::SMatrix;
@@ -134,9 +135,26 @@ impl MooneyRivlin {
     }
 }
 
+impl FromParameters for MooneyRivlin {
+    const NAME: &'static str = "mooney_rivlin";
+    const KEYS: &'static [&'static str] = &["a", "b", "poisson_ratio"];
+
+    fn from_parameters(density: f64, p: &Parameters) -> Result<Self, KeyError> {
+        let a: f64 = p.required("a")?;
+        let b: f64 = p.required("b")?;
+        let g = 2.0 * (a + b);
+        p.ensure(
+            g > 0.0 && g.is_finite(),
+            "a",
+            "a + b (= G/2, thesis 3-16) must be positive",
+        )?;
+        Ok(Self::from_thesis(density, a, b, p.poisson_ratio()?))
+    }
+}
+
 impl Material for MooneyRivlin {
     fn model(&self) -> &'static str {
-        "mooney_rivlin"
+        Self::NAME
     }
 
     fn density(&self) -> f64 {
@@ -198,27 +216,13 @@ impl Material for MooneyRivlin {
 mod tests {
     use super::*;
     use crate::material::driver;
+    use crate::material::testing::{prestressed, rel};
 
     const A: f64 = 0.4e6;
     const B: f64 = 0.1e6;
 
     fn model(nu: f64) -> MooneyRivlin {
         MooneyRivlin::from_thesis(1200.0, A, B, nu)
-    }
-
-    fn inc<'a>(f_old: Mat3, df: Mat3) -> Increment<'a> {
-        let stress_old = Mat3::new(1.0e5, 2.0e4, 0.0, 2.0e4, -3.0e4, 1.0e4, 0.0, 1.0e4, 5.0e4);
-        Increment {
-            f_old,
-            df,
-            dt: 1e-3,
-            stress_old,
-            history_old: &[],
-        }
-    }
-
-    fn rel(a: &Mat3, b: &Mat3) -> f64 {
-        (a - b).norm() / b.norm()
     }
 
     fn general_f() -> Mat3 {
@@ -237,7 +241,7 @@ mod tests {
     fn zero_stress_at_identity() {
         for nu in [0.0, 0.3, 0.45, 0.499] {
             let m = model(nu);
-            let s = m.update(&inc(Mat3::identity(), Mat3::identity()), &mut []);
+            let s = m.update(&prestressed(Mat3::identity(), Mat3::identity()), &mut []);
             assert!(
                 s.norm() < 1e-9 * (A + B),
                 "σ(I) = 0 via 3-8 to 1e-9·G (ν = {nu}): {s}"
@@ -267,8 +271,14 @@ mod tests {
             let shape = Mat3::new(1.0, 0.4, -0.3, 0.4, -0.6, 0.2, -0.3, 0.2, 0.5);
             for scale in [1e-7, 1e-6] {
                 let h = shape * scale;
-                let sp = m.update(&inc(Mat3::identity(), Mat3::identity() + h), &mut []);
-                let sm = m.update(&inc(Mat3::identity(), Mat3::identity() - h), &mut []);
+                let sp = m.update(
+                    &prestressed(Mat3::identity(), Mat3::identity() + h),
+                    &mut [],
+                );
+                let sm = m.update(
+                    &prestressed(Mat3::identity(), Mat3::identity() - h),
+                    &mut [],
+                );
                 let hooke = Mat3::identity() * (lambda * h.trace()) + h * (2.0 * g);
                 // Odd part ½(σ(h) − σ(−h)): the linear response, O(h²) relative error.
                 let e_lin = rel(&((sp - sm) * 0.5), &hooke);
@@ -292,7 +302,10 @@ mod tests {
     }
 
     fn sym_err(m: &MooneyRivlin, h: Mat3) -> f64 {
-        let s = m.update(&inc(Mat3::identity(), Mat3::identity() + h), &mut []);
+        let s = m.update(
+            &prestressed(Mat3::identity(), Mat3::identity() + h),
+            &mut [],
+        );
         (s - s.transpose()).norm() / s.norm()
     }
 
@@ -325,7 +338,7 @@ mod tests {
 
     #[test]
     fn stress_is_symmetric() {
-        let s = model(0.45).update(&inc(general_f(), driver::rotation_z(0.3)), &mut []);
+        let s = model(0.45).update(&prestressed(general_f(), driver::rotation_z(0.3)), &mut []);
         assert!(
             (s - s.transpose()).norm() <= 1e-12 * s.norm(),
             "symmetric to 1e-12"
@@ -339,7 +352,7 @@ mod tests {
             let f_old = Mat3::new(1.1, 0.2, 0.0, 0.05, 0.95, 0.0, 0.0, 0.0, 1.02);
             let df = driver::rotation_z(0.15)
                 * Mat3::new(1.02, 0.03, 0.01, -0.01, 0.99, 0.02, 0.0, 0.01, 1.01);
-            let i = inc(f_old, df);
+            let i = prestressed(f_old, df);
             let exact = m.stress_derivative(&i).unwrap();
             let fd = driver::numerical_stress_derivative(&m, &i, 1e-6);
             let err = (exact - fd).norm() / exact.norm();
@@ -357,8 +370,8 @@ mod tests {
         let df = Mat3::new(1.03, 0.02, 0.0, -0.01, 0.98, 0.01, 0.0, 0.0, 1.0);
         let axis = nalgebra::Unit::new_normalize(nalgebra::Vector3::new(0.3, -0.5, 0.8));
         let r = *nalgebra::Rotation3::from_axis_angle(&axis, 0.8).matrix();
-        let s = m.update(&inc(f_old, df), &mut []);
-        let sr = m.update(&inc(f_old, r * df), &mut []);
+        let s = m.update(&prestressed(f_old, df), &mut []);
+        let sr = m.update(&prestressed(f_old, r * df), &mut []);
         assert!(
             rel(&sr, &(r * s * r.transpose())) < 1e-12,
             "σ(RF) = RσRᵀ to 1e-12"

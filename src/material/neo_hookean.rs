@@ -4,6 +4,7 @@
 //! gives the Cauchy stress σ = (μ/J)(b − I) + (λ ln J / J) I with b = F Fᵀ, J = det F.
 //! The stress depends only on F_new = ΔF F_old (no history, path independent).
 
+use super::parameters::{FromParameters, KeyError, Parameters};
 use super::{lame, Increment, Material, StressDerivative};
 use crate::dim::Mat3;
 
@@ -43,9 +44,19 @@ impl NeoHookean {
     }
 }
 
+impl FromParameters for NeoHookean {
+    const NAME: &'static str = "neo_hookean";
+    const KEYS: &'static [&'static str] = &["youngs_modulus", "poisson_ratio"];
+
+    fn from_parameters(density: f64, p: &Parameters) -> Result<Self, KeyError> {
+        // E is checked before ν (arguments are evaluated in order).
+        Ok(Self::new(density, p.youngs_modulus()?, p.poisson_ratio()?))
+    }
+}
+
 impl Material for NeoHookean {
     fn model(&self) -> &'static str {
-        "neo_hookean"
+        Self::NAME
     }
 
     fn density(&self) -> f64 {
@@ -100,33 +111,15 @@ impl Material for NeoHookean {
 mod tests {
     use super::*;
     use crate::material::driver;
+    use crate::material::testing::{general_f, prestressed, rel};
 
     fn model() -> NeoHookean {
         NeoHookean::new(1100.0, 3.0e6, 0.35)
     }
 
-    fn inc<'a>(f_old: Mat3, df: Mat3) -> Increment<'a> {
-        let stress_old = Mat3::new(1.0e5, 2.0e4, 0.0, 2.0e4, -3.0e4, 1.0e4, 0.0, 1.0e4, 5.0e4);
-        Increment {
-            f_old,
-            df,
-            dt: 1e-3,
-            stress_old,
-            history_old: &[],
-        }
-    }
-
-    fn rel(a: &Mat3, b: &Mat3) -> f64 {
-        (a - b).norm() / b.norm()
-    }
-
-    fn general_f() -> Mat3 {
-        Mat3::new(1.2, 0.3, -0.1, 0.05, 0.9, 0.15, 0.02, -0.1, 1.1)
-    }
-
     #[test]
     fn zero_stress_at_identity() {
-        let s = model().update(&inc(Mat3::identity(), Mat3::identity()), &mut []);
+        let s = model().update(&prestressed(Mat3::identity(), Mat3::identity()), &mut []);
         assert!(s.norm() == 0.0, "σ(I) = 0 exactly");
     }
 
@@ -136,7 +129,10 @@ mod tests {
         let (lambda, mu) = m.lame();
         for (scale, tol) in [(1e-7, 1e-6), (1e-6, 1e-5)] {
             let h = Mat3::new(1.0, 0.4, -0.3, 0.4, -0.6, 0.2, -0.3, 0.2, 0.5) * scale;
-            let s = m.update(&inc(Mat3::identity(), Mat3::identity() + h), &mut []);
+            let s = m.update(
+                &prestressed(Mat3::identity(), Mat3::identity() + h),
+                &mut [],
+            );
             let hooke = Mat3::identity() * (lambda * h.trace()) + h * (2.0 * mu);
             let e = rel(&s, &hooke);
             assert!(
@@ -148,7 +144,7 @@ mod tests {
 
     #[test]
     fn stress_is_symmetric() {
-        let s = model().update(&inc(general_f(), driver::rotation_z(0.3)), &mut []);
+        let s = model().update(&prestressed(general_f(), driver::rotation_z(0.3)), &mut []);
         assert!(
             (s - s.transpose()).norm() <= 1e-14 * s.norm(),
             "symmetric to 1e-14"
@@ -161,7 +157,7 @@ mod tests {
         let f_old = Mat3::new(1.1, 0.2, 0.0, 0.05, 0.95, 0.0, 0.0, 0.0, 1.02);
         let df = driver::rotation_z(0.15)
             * Mat3::new(1.02, 0.03, 0.01, -0.01, 0.99, 0.02, 0.0, 0.01, 1.01);
-        let i = inc(f_old, df);
+        let i = prestressed(f_old, df);
         let exact = m.stress_derivative(&i).unwrap();
         let fd = driver::numerical_stress_derivative(&m, &i, 1e-5);
         let err = (exact - fd).norm() / exact.norm();
@@ -178,8 +174,8 @@ mod tests {
         let df = Mat3::new(1.03, 0.02, 0.0, -0.01, 0.98, 0.01, 0.0, 0.0, 1.0);
         let axis = nalgebra::Unit::new_normalize(nalgebra::Vector3::new(0.3, -0.5, 0.8));
         let r = *nalgebra::Rotation3::from_axis_angle(&axis, 0.8).matrix();
-        let s = m.update(&inc(f_old, df), &mut []);
-        let sr = m.update(&inc(f_old, r * df), &mut []);
+        let s = m.update(&prestressed(f_old, df), &mut []);
+        let sr = m.update(&prestressed(f_old, r * df), &mut []);
         assert!(
             rel(&sr, &(r * s * r.transpose())) < 1e-14,
             "σ(RF) = RσRᵀ to 1e-14"

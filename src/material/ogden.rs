@@ -15,6 +15,7 @@
 //! neo-Hookean model of `neo_hookean.rs` (τ = μ (b − I) + λ ln J I).
 
 use super::hencky::Spectral;
+use super::parameters::{FromParameters, KeyError, Parameters};
 use super::{Increment, Material};
 use crate::dim::Mat3;
 use nalgebra::Vector3;
@@ -74,9 +75,33 @@ impl Ogden {
     }
 }
 
+impl FromParameters for Ogden {
+    const NAME: &'static str = "ogden";
+    const KEYS: &'static [&'static str] = &["mu", "alpha", "poisson_ratio"];
+
+    fn from_parameters(density: f64, p: &Parameters) -> Result<Self, KeyError> {
+        let mu: Vec<f64> = p.required("mu")?;
+        let alpha: Vec<f64> = p.required("alpha")?;
+        p.ensure((1..=6).contains(&mu.len()), "mu", "needs 1 to 6 terms")?;
+        p.ensure(
+            alpha.len() == mu.len(),
+            "alpha",
+            format!("needs one entry per term of mu ({})", mu.len()),
+        )?;
+        p.ensure(
+            mu.iter()
+                .zip(&alpha)
+                .all(|(m, a)| m * a > 0.0 && (m * a).is_finite()),
+            "alpha",
+            "every term needs mu_p * alpha_p > 0 (a positive shear modulus)",
+        )?;
+        Ok(Self::new(density, mu, alpha, p.poisson_ratio()?))
+    }
+}
+
 impl Material for Ogden {
     fn model(&self) -> &'static str {
-        "ogden"
+        Self::NAME
     }
 
     fn density(&self) -> f64 {
@@ -113,20 +138,7 @@ mod tests {
     use super::*;
     use crate::material::driver;
     use crate::material::neo_hookean::NeoHookean;
-
-    fn general_f() -> Mat3 {
-        Mat3::new(1.2, 0.3, -0.1, 0.05, 0.9, 0.15, 0.02, -0.1, 1.1)
-    }
-
-    fn inc<'a>(f: Mat3) -> Increment<'a> {
-        Increment {
-            f_old: Mat3::identity(),
-            df: f,
-            dt: 0.0,
-            stress_old: Mat3::zeros(),
-            history_old: &[],
-        }
-    }
+    use crate::material::testing::general_f;
 
     /// One term with α = 2 and μ_1 = μ is neo-Hookean, at finite strain.
     #[test]
@@ -148,7 +160,9 @@ mod tests {
             );
             assert!((wa - wb).abs() <= 1e-9 * wb.abs().max(1.0), "{wa} vs {wb}");
         }
-        assert!(ogden.stress_derivative(&inc(general_f())).is_none());
+        assert!(ogden
+            .stress_derivative(&Increment::at_rest(general_f(), &[]))
+            .is_none());
     }
 
     /// The stress is the derivative of the stored energy: for dF, J σ : (dF F⁻¹) =

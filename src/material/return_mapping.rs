@@ -30,9 +30,16 @@
 //! (`hencky::log_divided_difference`) and Q_ab = (τ_a − τ_b)/(ε_a − ε_b), which for
 //! coincident strains tends to ½(D_aa − D_ab − D_ba + D_bb). For dΔF = E_kl:
 //! db = E_kl b_e,old ΔFᵀ + (…)ᵀ and d ln J = (ΔF⁻¹)_lk, dσ = dτ / J − σ d ln J.
+//!
+//! # Frictional models
+//!
+//! Drucker–Prager and Mohr–Coulomb differ only in their return mapping, their
+//! strength and how a factor reduces it (`Frictional`); their `Material`
+//! implementation is the one at the end of this file.
 
 use super::hencky::log_divided_difference;
-use super::{lame, Increment, StressDerivative};
+use super::parameters::FromParameters;
+use super::{lame, Increment, Material, Strength, StressDerivative};
 use crate::dim::Mat3;
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 
@@ -204,14 +211,78 @@ pub fn stored_energy_density(el: &Elasticity, f: &Mat3, stress: &Mat3) -> f64 {
     0.5 * stress.component_mul(&eps).sum()
 }
 
+/// A frictional elastoplastic model on these kinematics, with one history value,
+/// the equivalent plastic strain ε̄p.
+pub trait Frictional:
+    ReturnMapping + FromParameters + Clone + std::fmt::Debug + Send + Sync + 'static
+{
+    /// Reference mass density ρ0.
+    fn reference_density(&self) -> f64;
+
+    /// Peak cohesion, friction and dilation angles (radians).
+    fn peak_strength(&self) -> Strength;
+
+    /// The model with c/F, tan φ/F and tan ψ/F (strength reduction, Griffiths &
+    /// Lane 1999).
+    fn reduced(&self, factor: f64) -> Self;
+}
+
+impl<M: Frictional> Material for M {
+    fn model(&self) -> &'static str {
+        M::NAME
+    }
+
+    fn density(&self) -> f64 {
+        self.reference_density()
+    }
+
+    fn n_history(&self) -> usize {
+        1
+    }
+
+    fn update(&self, inc: &Increment, history_new: &mut [f64]) -> Mat3 {
+        update(self, inc, history_new)
+    }
+
+    fn p_wave_modulus(&self) -> f64 {
+        let el = self.elasticity();
+        el.lambda + 2.0 * el.mu
+    }
+
+    fn strain_energy_density(&self, f: &Mat3, stress: &Mat3, _history: &[f64]) -> f64 {
+        stored_energy_density(&self.elasticity(), f, stress)
+    }
+
+    fn stress_derivative(&self, inc: &Increment) -> Option<StressDerivative> {
+        stress_derivative(self, inc)
+    }
+
+    fn integrates_from_stored_stress(&self) -> bool {
+        true
+    }
+
+    fn frictional_strength(&self) -> Option<Strength> {
+        Some(self.peak_strength())
+    }
+
+    fn with_reduced_strength(&self, factor: f64) -> Option<Box<dyn Material>> {
+        Some(Box::new(self.reduced(factor)))
+    }
+
+    fn equivalent_plastic_strain(&self, history: &[f64]) -> Option<f64> {
+        history.first().copied()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::material::hencky::Hencky;
+    use crate::material::testing::{general_f, increment};
     use crate::material::{driver, Material};
 
     /// The purely elastic return: the framework must reproduce the Hencky model.
-    #[derive(Debug)]
+    #[derive(Clone, Debug)]
     struct Elastic(Elasticity, Hencky);
 
     impl ReturnMapping for Elastic {
@@ -249,16 +320,6 @@ mod tests {
 
     fn elastic() -> Elastic {
         Elastic(Elasticity::new(3.0e6, 0.3), Hencky::new(1.0, 3.0e6, 0.3))
-    }
-
-    fn inc<'a>(f_old: Mat3, stress_old: Mat3, df: Mat3) -> Increment<'a> {
-        Increment {
-            f_old,
-            df,
-            dt: 0.0,
-            stress_old,
-            history_old: &[],
-        }
     }
 
     #[test]
@@ -300,7 +361,7 @@ mod tests {
     #[test]
     fn elastic_return_tangent_matches_hencky_and_finite_differences() {
         let m = elastic();
-        let f_old = Mat3::new(1.2, 0.3, -0.1, 0.05, 0.9, 0.15, 0.02, -0.1, 1.1);
+        let f_old = general_f();
         let s_old = m.1.cauchy(&f_old);
         let r = driver::rotation_z(0.2);
         let cases = [
@@ -325,9 +386,9 @@ mod tests {
             ),
         ];
         for (name, f, s, df) in cases {
-            let i = inc(f, s, df);
+            let i = increment(f, df, s, &[]);
             let exact = m.stress_derivative(&i).unwrap();
-            let hencky = m.1.stress_derivative(&inc(f, s, df)).unwrap();
+            let hencky = m.1.stress_derivative(&increment(f, df, s, &[])).unwrap();
             let e_h = (exact - hencky).norm() / hencky.norm();
             let fd = driver::numerical_stress_derivative(&m, &i, 1e-6);
             let e_fd = (exact - fd).norm() / exact.norm();

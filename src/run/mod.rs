@@ -78,10 +78,10 @@ fn run_dim<const D: usize>(
     // set its own (validation keeps the two apart).
     let mut strength_factor = opts.strength_factor.unwrap_or(1.0);
     if strength_factor != 1.0 {
-        model.reduce_strength(&cfg.materials, strength_factor);
+        model.reduce_strength(strength_factor);
     }
-    if cfg.geostatic.is_some() {
-        crate::physics::geostatic::initialise(&mut model, cfg);
+    if let Some(g) = &cfg.geostatic {
+        crate::physics::geostatic::initialise(&mut model, g);
     }
     let monitor = opts
         .monitor
@@ -110,7 +110,7 @@ fn run_dim<const D: usize>(
             .strength_reduction_factor
             .filter(|&f| f != strength_factor)
         {
-            model.reduce_strength(&cfg.materials, f);
+            model.reduce_strength(f);
             strength_factor = f;
         }
         let mut stepper = crate::solver::stepper::<D>(cfg.grid.shape_function, sc, clock.t);

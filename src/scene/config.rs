@@ -1,11 +1,16 @@
 //! The scene file's structure. Field names are the TOML keys; `docs/scene.md`
 //! documents each one. Every section is a plain struct with `deny_unknown_fields`
 //! (so TOML errors point at the offending key); which optional keys a given
-//! `model`, `shape` or `kind` needs is checked in `validate`. Vectors are arrays
-//! whose length must equal `dimension`.
+//! `shape` or `condition` needs is checked in `validate`, the keys of a material
+//! model by the model (`material.rs`), those of a solver in `solver.rs`. Vectors
+//! are arrays whose length must equal `dimension`. Enumerated values are read
+//! (serde) and named (strum, `name()`) in snake_case.
 
 use super::grid::GridConfig;
+use super::material::MaterialConfig;
+use super::solver::SolverConfig;
 use serde::Deserialize;
+use strum::{EnumIter, IntoStaticStr};
 
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -42,79 +47,10 @@ pub struct SceneConfig {
     pub bench: Option<BenchConfig>,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, IntoStaticStr, EnumIter)]
 #[serde(rename_all = "snake_case")]
-pub enum MaterialModel {
-    /// Hypoelastic, Jaumann rate: youngs_modulus, poisson_ratio.
-    LinearElastic,
-    /// Compressible neo-Hookean: youngs_modulus, poisson_ratio.
-    NeoHookean,
-    /// Hencky (logarithmic strain, Kirchhoff stress): youngs_modulus, poisson_ratio.
-    Hencky,
-    /// Mooney-Rivlin (thesis 3-2): a, b, poisson_ratio; c and d follow (3-8, 3-17).
-    MooneyRivlin,
-    /// Drucker-Prager elastoplasticity (thesis 3-36…3-62) at finite strain:
-    /// youngs_modulus, poisson_ratio, cohesion, friction_angle, dilation_angle,
-    /// mohr_coulomb_fit.
-    DruckerPrager,
-    /// Mohr-Coulomb elastoplasticity (3-34, 3-35) at finite strain: youngs_modulus,
-    /// poisson_ratio, cohesion, friction_angle, dilation_angle; optional softening
-    /// (residual_*, softening_start, softening_end) and tensile_strength.
-    MohrCoulomb,
-    /// Compressible Ogden: mu, alpha (one entry per term), poisson_ratio. No
-    /// analytic tangent: implicit runs need a Krylov linear solver.
-    Ogden,
-}
-
-impl MaterialModel {
-    /// Whether the model supplies the exact derivative of its stress update (the
-    /// direct implicit solver needs it; the Krylov solvers do not).
-    pub fn has_analytic_tangent(&self) -> bool {
-        !matches!(self, MaterialModel::Ogden)
-    }
-}
-
-/// How a Drucker-Prager cone is fitted to the Mohr-Coulomb parameters.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum MohrCoulombFit {
-    /// Through the triaxial-compression vertices (thesis 3-37, 3-38).
-    Outer,
-    /// Through the triaxial-extension vertices (3-39, 3-40).
-    Inner,
-    /// Same plane-strain limit state as Mohr-Coulomb.
-    PlaneStrain,
-}
-
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct MaterialConfig {
-    pub name: String,
-    pub model: MaterialModel,
-    pub density: f64,
-    pub youngs_modulus: Option<f64>,
-    pub poisson_ratio: Option<f64>,
-    pub a: Option<f64>,
-    pub b: Option<f64>,
-    // Plasticity (drucker_prager, mohr_coulomb); angles in degrees.
-    pub cohesion: Option<f64>,
-    pub friction_angle: Option<f64>,
-    pub dilation_angle: Option<f64>,
-    pub mohr_coulomb_fit: Option<MohrCoulombFit>,
-    pub residual_cohesion: Option<f64>,
-    pub residual_friction_angle: Option<f64>,
-    pub residual_dilation_angle: Option<f64>,
-    pub softening_start: Option<f64>,
-    pub softening_end: Option<f64>,
-    pub tensile_strength: Option<f64>,
-    /// Ogden μ_p and α_p, one entry per term.
-    pub mu: Option<Vec<f64>>,
-    pub alpha: Option<Vec<f64>>,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Shape {
+#[strum(serialize_all = "snake_case")]
+pub enum BodyShape {
     /// 2D, `min` and `max` corners.
     Rectangle,
     /// 3D, `min` and `max` corners.
@@ -127,13 +63,19 @@ pub enum Shape {
     Polygon,
 }
 
+impl BodyShape {
+    pub fn name(&self) -> &'static str {
+        self.into()
+    }
+}
+
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BodyConfig {
     #[serde(default)]
     pub name: Option<String>,
     pub material: String,
-    pub shape: Shape,
+    pub shape: BodyShape,
     pub min: Option<Vec<f64>>,
     pub max: Option<Vec<f64>>,
     pub centre: Option<Vec<f64>>,
@@ -149,6 +91,34 @@ pub struct BodyConfig {
     /// pi, sin, cos, exp, sqrt, abs), one per component; added to `velocity`.
     #[serde(default)]
     pub velocity_expr: Option<Vec<String>>,
+}
+
+impl BodyConfig {
+    /// Corners of the bounding box of the body's shape (its keys validated).
+    pub fn bounds(&self) -> (Vec<f64>, Vec<f64>) {
+        match self.shape {
+            BodyShape::Rectangle | BodyShape::Box => {
+                (self.min.clone().unwrap(), self.max.clone().unwrap())
+            }
+            BodyShape::Disk | BodyShape::Sphere => {
+                let (c, r) = (self.centre.as_ref().unwrap(), self.radius.unwrap());
+                (
+                    c.iter().map(|x| x - r).collect(),
+                    c.iter().map(|x| x + r).collect(),
+                )
+            }
+            BodyShape::Polygon => {
+                let v = self.vertices.as_ref().unwrap();
+                let lo = (0..2)
+                    .map(|d| v.iter().map(|p| p[d]).fold(f64::INFINITY, f64::min))
+                    .collect();
+                let hi = (0..2)
+                    .map(|d| v.iter().map(|p| p[d]).fold(f64::NEG_INFINITY, f64::max))
+                    .collect();
+                (lo, hi)
+            }
+        }
+    }
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -171,8 +141,9 @@ fn default_ppc() -> PerDirection {
     PerDirection::Same(2)
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, IntoStaticStr, EnumIter)]
 #[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
 pub enum Condition {
     /// All velocity components zero.
     Fixed,
@@ -186,6 +157,12 @@ pub enum Condition {
     /// Rigid rough wall: no penetration, Coulomb friction with
     /// `friction_coefficient` (explicit solver; fixed in implicit steps).
     Friction,
+}
+
+impl Condition {
+    pub fn name(&self) -> &'static str {
+        self.into()
+    }
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -215,14 +192,21 @@ pub struct BoundaryConfig {
     pub footing_width: Option<f64>,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, IntoStaticStr, EnumIter)]
 #[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
 pub enum LoadKind {
     /// `force`: a total force shared equally by the selected particles.
     Point,
     /// `traction` on the `face` side of each selected particle: force per unit area
     /// of its reference face (unit thickness in 2D).
     Traction,
+}
+
+impl LoadKind {
+    pub fn name(&self) -> &'static str {
+        self.into()
+    }
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -280,141 +264,6 @@ impl StrengthReductionConfig {
     }
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum SolverKind {
-    Explicit,
-    Implicit,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Scheme {
-    Usf,
-    Usl,
-    Musl,
-}
-
-impl Scheme {
-    pub fn name(&self) -> &'static str {
-        match self {
-            Scheme::Usf => "usf",
-            Scheme::Usl => "usl",
-            Scheme::Musl => "musl",
-        }
-    }
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Integrator {
-    /// Newmark with Newton-Raphson (thesis 2-33…2-38).
-    Newmark,
-    /// No inertia: gravity and loads scaled by the load factor t / end_time.
-    QuasiStatic,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum MassMatrix {
-    Lumped,
-    Consistent,
-}
-
-/// How the implicit solver solves each Newton correction (thesis 2-38).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum LinearSolver {
-    /// Assembled consistent tangent, sparse Cholesky / LU (needs an analytic tangent).
-    Direct,
-    /// Matrix-free restarted GMRES with finite-difference products (2-39).
-    Gmres,
-    /// Matrix-free conjugate gradients (symmetric positive definite tangents).
-    Cg,
-}
-
-impl LinearSolver {
-    pub fn name(&self) -> &'static str {
-        match self {
-            LinearSolver::Direct => "direct",
-            LinearSolver::Gmres => "gmres",
-            LinearSolver::Cg => "cg",
-        }
-    }
-}
-
-/// Preconditioner of the Krylov solvers.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum PreconditionerKind {
-    None,
-    /// Inverse of the tangent's diagonal, built particle by particle.
-    Jacobi,
-    /// Inverse of each node's D×D diagonal block, built particle by particle.
-    BlockJacobi,
-    /// The assembled tangent of an earlier iteration, factorized once and reused.
-    LaggedDirect,
-}
-
-impl PreconditionerKind {
-    pub fn name(&self) -> &'static str {
-        match self {
-            PreconditionerKind::None => "none",
-            PreconditionerKind::Jacobi => "jacobi",
-            PreconditionerKind::BlockJacobi => "block_jacobi",
-            PreconditionerKind::LaggedDirect => "lagged_direct",
-        }
-    }
-}
-
-/// The `[solver]` table. Keys that belong to the other kind are rejected by
-/// `validate`; the accessors give the documented defaults.
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SolverConfig {
-    /// Stage name (for `[[stage]]` tables; optional).
-    pub name: Option<String>,
-    /// From this stage on, c, tan φ and tan ψ of the frictional materials are the
-    /// scene's values divided by this factor (default: the previous stage's, 1 at
-    /// the start). docs/strength_reduction.md.
-    pub strength_reduction_factor: Option<f64>,
-    pub kind: SolverKind,
-    /// Duration of the run or stage (implicit quasi-static: the pseudo-time over
-    /// which the loads rise to full value).
-    pub end_time: f64,
-    /// Explicit: fixed step instead of the CFL rule. Implicit: the step (required
-    /// for Newmark; quasi-static may give `load_steps` instead).
-    pub dt: Option<f64>,
-    // Explicit keys.
-    pub scheme: Option<Scheme>,
-    pub cfl: Option<f64>,
-    pub flip: Option<f64>,
-    pub damping: Option<f64>,
-    // Implicit keys.
-    pub integrator: Option<Integrator>,
-    pub beta: Option<f64>,
-    pub gamma: Option<f64>,
-    pub mass: Option<MassMatrix>,
-    pub load_steps: Option<usize>,
-    pub residual_tolerance: Option<f64>,
-    pub displacement_tolerance: Option<f64>,
-    pub max_iterations: Option<usize>,
-    pub line_search: Option<bool>,
-    pub max_cutbacks: Option<usize>,
-    pub min_node_support: Option<f64>,
-    // Linear solver of the Newton corrections (implicit).
-    pub linear_solver: Option<LinearSolver>,
-    pub preconditioner: Option<PreconditionerKind>,
-    pub krylov_tolerance: Option<f64>,
-    pub krylov_restart: Option<usize>,
-    pub krylov_max_iterations: Option<usize>,
-    /// Quasi-static: ramp gravity from zero over the stage (default true); false
-    /// applies it in full from the first step (after a geostatic initialisation).
-    pub gravity_ramp: Option<bool>,
-    /// F-bar against volumetric locking (explicit and implicit; default false).
-    pub fbar: Option<bool>,
-}
-
 impl SceneConfig {
     /// The stages of the run: the `[solver]` table alone, or the `[[stage]]` tables.
     pub fn stages(&self) -> Vec<&SolverConfig> {
@@ -427,95 +276,6 @@ impl SceneConfig {
     /// Total simulated time: the sum of the stage durations.
     pub fn total_time(&self) -> f64 {
         self.stages().iter().map(|s| s.end_time).sum()
-    }
-}
-
-impl SolverConfig {
-    pub fn scheme(&self) -> Scheme {
-        self.scheme.unwrap_or(Scheme::Musl)
-    }
-    /// Fraction of the CFL limit (2-45); default 0.5.
-    pub fn cfl(&self) -> f64 {
-        self.cfl.unwrap_or(0.5)
-    }
-    /// FLIP fraction: 1 = FLIP (default), 0 = PIC.
-    pub fn flip(&self) -> f64 {
-        self.flip.unwrap_or(1.0)
-    }
-    /// Local damping α (default 0).
-    pub fn damping(&self) -> f64 {
-        self.damping.unwrap_or(0.0)
-    }
-    pub fn integrator(&self) -> Integrator {
-        self.integrator.unwrap_or(Integrator::Newmark)
-    }
-    /// Newmark β (default 1/4, trapezoidal).
-    pub fn beta(&self) -> f64 {
-        self.beta.unwrap_or(0.25)
-    }
-    /// Newmark γ (default 1/2).
-    pub fn gamma(&self) -> f64 {
-        self.gamma.unwrap_or(0.5)
-    }
-    pub fn mass(&self) -> MassMatrix {
-        self.mass.unwrap_or(MassMatrix::Lumped)
-    }
-    /// Implicit step: `dt`, or end_time / load_steps.
-    pub fn implicit_dt(&self) -> f64 {
-        self.dt
-            .unwrap_or_else(|| self.end_time / self.load_steps.unwrap_or(1) as f64)
-    }
-    /// Newton converges when ‖R‖ ≤ this × the reference force (default 1e-9).
-    pub fn residual_tolerance(&self) -> f64 {
-        self.residual_tolerance.unwrap_or(1e-9)
-    }
-    /// … and ‖δu‖ ≤ this × ‖u‖ (default 1e-9).
-    pub fn displacement_tolerance(&self) -> f64 {
-        self.displacement_tolerance.unwrap_or(1e-9)
-    }
-    /// Newton iteration cap per attempt (default 25).
-    pub fn max_iterations(&self) -> usize {
-        self.max_iterations.unwrap_or(25)
-    }
-    /// Backtracking line search on the residual norm (default off).
-    pub fn line_search(&self) -> bool {
-        self.line_search.unwrap_or(false)
-    }
-    /// Times a failing step may be halved before the run stops (default 5).
-    pub fn max_cutbacks(&self) -> usize {
-        self.max_cutbacks.unwrap_or(5)
-    }
-    /// Quasi-static gravity ramps from zero over the stage (default true).
-    pub fn gravity_ramp(&self) -> bool {
-        self.gravity_ramp.unwrap_or(true)
-    }
-    /// Nodes whose particle support Σ_p V_p S_Ip is below this fraction of a cell
-    /// volume are tied to two neighbours by linear extrapolation (default 1e-2;
-    /// 0 turns it off). See `implicit::support`.
-    pub fn min_node_support(&self) -> f64 {
-        self.min_node_support.unwrap_or(1e-2)
-    }
-    /// F-bar: per background cell, the particles' volume change is the cell
-    /// average (default false). See `fbar`.
-    pub fn fbar(&self) -> bool {
-        self.fbar.unwrap_or(false)
-    }
-    /// Linear solver of the Newton corrections (default direct).
-    pub fn linear_solver(&self) -> LinearSolver {
-        self.linear_solver.unwrap_or(LinearSolver::Direct)
-    }
-    /// Krylov preconditioner (default block_jacobi).
-    pub fn preconditioner(&self) -> PreconditionerKind {
-        self.preconditioner
-            .unwrap_or(PreconditionerKind::BlockJacobi)
-    }
-    /// GMRES restart length (default 30).
-    pub fn krylov_restart(&self) -> usize {
-        self.krylov_restart.unwrap_or(30)
-    }
-    /// Krylov iterations allowed per Newton correction (default 1000).
-    pub fn krylov_max_iterations(&self) -> usize {
-        self.krylov_max_iterations.unwrap_or(1000)
     }
 }
 
@@ -543,8 +303,9 @@ impl Default for OutputConfig {
     }
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, IntoStaticStr, EnumIter)]
 #[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
 pub enum ReferenceKind {
     /// Column under self-weight: σ along gravity against −ρ g (l0 − Y).
     Column,
@@ -554,13 +315,26 @@ pub enum ReferenceKind {
     Cantilever,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+impl ReferenceKind {
+    pub fn name(&self) -> &'static str {
+        self.into()
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, IntoStaticStr, EnumIter)]
 #[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
 pub enum Beam {
     /// The elastica with extension and shear (the beam model of a 2D continuum).
     Reissner,
     /// The classical inextensible elastica.
     Elastica,
+}
+
+impl Beam {
+    pub fn name(&self) -> &'static str {
+        self.into()
+    }
 }
 
 /// The `[reference]` table: which analytical solution the scene has

@@ -3,6 +3,7 @@
 //! and tractions refer to.
 
 use serde::Deserialize;
+use strum::{EnumIter, IntoStaticStr};
 
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -18,8 +19,11 @@ fn default_shape() -> ShapeFunction {
     ShapeFunction::Linear
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Deserialize, serde::Serialize, IntoStaticStr, EnumIter,
+)]
 #[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
 pub enum ShapeFunction {
     /// Standard MPM: piecewise-linear (bilinear, trilinear) hat functions.
     Linear,
@@ -38,14 +42,7 @@ pub enum ShapeFunction {
 
 impl ShapeFunction {
     pub fn name(&self) -> &'static str {
-        match self {
-            ShapeFunction::Linear => "linear",
-            ShapeFunction::Ugimp => "ugimp",
-            ShapeFunction::Cpgimp => "cpgimp",
-            ShapeFunction::Cpdi => "cpdi",
-            ShapeFunction::Bspline2 => "bspline2",
-            ShapeFunction::Bspline3 => "bspline3",
-        }
+        self.into()
     }
 
     /// Polynomial degree of the underlying grid basis (sets the node layout).
@@ -68,6 +65,11 @@ impl ShapeFunction {
         };
         per_dir.pow(dim as u32)
     }
+}
+
+/// The axis of a component name: "x" 0, "y" 1, "z" 2.
+pub fn axis(name: &str) -> Option<usize> {
+    ["x", "y", "z"].iter().position(|a| *a == name)
 }
 
 /// One face of the grid box: `axis` 0..D, `upper` false for the min face.

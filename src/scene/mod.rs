@@ -9,12 +9,16 @@ mod config;
 mod error;
 pub mod expr;
 mod grid;
+mod material;
 pub mod overrides;
+mod solver;
 pub mod validate;
 
 pub use config::*;
 pub use error::SceneError;
 pub use grid::*;
+pub use material::MaterialConfig;
+pub use solver::*;
 
 use std::path::Path;
 
@@ -48,5 +52,50 @@ impl Scene {
             config,
             text,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde::de::{value::StrDeserializer, DeserializeOwned, IntoDeserializer};
+    use strum::IntoEnumIterator;
+
+    /// Every value's `name()` (strum) is the name serde reads for it.
+    fn names_agree<T>()
+    where
+        T: IntoEnumIterator + DeserializeOwned + PartialEq + std::fmt::Debug + Copy,
+        &'static str: From<T>,
+    {
+        for v in T::iter() {
+            let name: &'static str = v.into();
+            let d: StrDeserializer<serde::de::value::Error> = name.into_deserializer();
+            assert_eq!(T::deserialize(d), Ok(v), "`{name}`");
+        }
+    }
+
+    #[test]
+    fn enum_names_are_the_scene_names() {
+        names_agree::<ShapeFunction>();
+        names_agree::<BodyShape>();
+        names_agree::<Condition>();
+        names_agree::<LoadKind>();
+        names_agree::<SolverKind>();
+        names_agree::<Scheme>();
+        names_agree::<Integrator>();
+        names_agree::<MassMatrix>();
+        names_agree::<LinearSolver>();
+        names_agree::<PreconditionerKind>();
+        names_agree::<ReferenceKind>();
+        names_agree::<Beam>();
+    }
+
+    #[test]
+    fn every_scoped_key_is_a_solver_key() {
+        let s: SolverConfig = toml::from_str("kind = \"implicit\"\nend_time = 1.0").unwrap();
+        let table = serde_json::to_value(&s).unwrap();
+        for scope in SCOPES {
+            assert!(table.get(scope.key).is_some(), "`{}`", scope.key);
+        }
     }
 }

@@ -15,9 +15,10 @@ use mpm::material::driver::{run_mixed, MixedResponse, StressControl};
 use mpm::material::drucker_prager::DruckerPrager;
 use mpm::material::drucker_prager::{Cone, MohrCoulombFit};
 use mpm::material::mohr_coulomb::MohrCoulomb;
-use mpm::material::mohr_coulomb::{Softening, Strength};
+use mpm::material::mohr_coulomb::Softening;
 use mpm::material::return_mapping::Elasticity;
 use mpm::material::Material;
+use mpm::material::Strength;
 
 const E: f64 = 5.0e7;
 const NU: f64 = 0.3;

@@ -194,16 +194,15 @@ fn one_and_two_threads_give_identical_runout() {
 #[test]
 fn the_stage_factor_starts_from_the_scene_strengths() {
     let scene = Scene::load(&problem(SCENE), &[]).unwrap();
-    let materials = &scene.config.materials;
     let describe = |m: &Model<2>| format!("{:?}", m.materials);
     let mut model = Model::<2>::build(&scene).unwrap();
     let given = describe(&model);
-    model.reduce_strength(materials, 2.0);
+    model.reduce_strength(2.0);
     let once = describe(&model);
     assert_ne!(once, given, "F = 2 changed nothing");
-    model.reduce_strength(materials, 2.0);
+    model.reduce_strength(2.0);
     assert_eq!(describe(&model), once, "a second F = 2 reduced again");
-    model.reduce_strength(materials, 1.0);
+    model.reduce_strength(1.0);
     assert_eq!(
         describe(&model),
         given,

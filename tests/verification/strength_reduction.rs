@@ -121,7 +121,8 @@ fn k0_state_of_level_ground_is_in_equilibrium() {
 fn k0_depth_is_measured_below_the_slope_face() {
     let scene = Scene::load(&problem("slope_griffiths_lane.toml"), &[]).unwrap();
     let mut model = Model::<2>::build(&scene).unwrap();
-    mpm::physics::geostatic::initialise(&mut model, &scene.config);
+    let geostatic = scene.config.geostatic.as_ref().unwrap();
+    mpm::physics::geostatic::initialise(&mut model, geostatic);
     let k0 = 1.0 - 20f64.to_radians().sin();
     let p = &model.particles;
     for q in 0..p.len() {

@@ -11,7 +11,7 @@ pub mod cantilever;
 pub mod column;
 pub mod elastica;
 
-use crate::scene::{ReferenceKind, SceneConfig, Shape};
+use crate::scene::{BodyShape, ReferenceKind, SceneConfig};
 use std::path::Path;
 
 /// An error measure of one scene against its analytical reference.
@@ -52,7 +52,7 @@ fn body0_box(s: &SceneConfig) -> Result<(Vec<f64>, Vec<f64>), KeyError> {
         .first()
         .ok_or(("body".to_string(), "no body".to_string()))?;
     match (b.shape, &b.min, &b.max) {
-        (Shape::Rectangle | Shape::Box, Some(lo), Some(hi)) => Ok((lo.clone(), hi.clone())),
+        (BodyShape::Rectangle | BodyShape::Box, Some(lo), Some(hi)) => Ok((lo.clone(), hi.clone())),
         _ => Err((
             "body.0.shape".into(),
             "the [reference] needs body 0 to be a rectangle or box".into(),
@@ -72,9 +72,11 @@ fn body0_material(s: &SceneConfig) -> Result<(f64, f64, f64), KeyError> {
             "body.0.material".to_string(),
             "unknown material".to_string(),
         ))?;
-    let e = m.youngs_modulus.ok_or((
-        format!("material.{i}.youngs_modulus"),
+    let table = format!("material.{i}");
+    let p = m.parameters(&table);
+    let e = p.get("youngs_modulus")?.ok_or((
+        p.key("youngs_modulus"),
         "the [reference] needs the Young's modulus of body 0's material".to_string(),
     ))?;
-    Ok((m.density, e, m.poisson_ratio.unwrap_or(0.0)))
+    Ok((m.density, e, p.get("poisson_ratio")?.unwrap_or(0.0)))
 }

@@ -1,0 +1,128 @@
+//! The models a scene may name: the one list a new model is added to.
+//!
+//! `build` turns a material table (its model's name, density and other keys)
+//! into the model, rejecting keys the model does not take; the scene validation
+//! calls it to check a table and `Model::build` to construct the material.
+
+use super::parameters::{FromParameters, KeyError, Parameters};
+use super::Material;
+use std::sync::OnceLock;
+
+/// A model's constructor from its density and parameters.
+type Constructor = fn(f64, &Parameters) -> Result<Box<dyn Material>, KeyError>;
+
+/// One model: its name, its keys and its constructor.
+#[derive(Clone, Copy, Debug)]
+pub struct Entry {
+    pub name: &'static str,
+    pub keys: &'static [&'static str],
+    construct: Constructor,
+}
+
+impl Entry {
+    const fn of<M: FromParameters + Material + 'static>() -> Entry {
+        Entry {
+            name: M::NAME,
+            keys: M::KEYS,
+            construct: construct::<M>,
+        }
+    }
+}
+
+fn construct<M: FromParameters + Material + 'static>(
+    density: f64,
+    p: &Parameters,
+) -> Result<Box<dyn Material>, KeyError> {
+    Ok(Box::new(M::from_parameters(density, p)?))
+}
+
+/// Every model, in the order docs/scene.md lists them: one line each.
+pub const MODELS: &[Entry] = &[
+    Entry::of::<crate::material::linear_elastic::LinearElastic>(),
+    Entry::of::<crate::material::neo_hookean::NeoHookean>(),
+    Entry::of::<crate::material::hencky::Hencky>(),
+    Entry::of::<crate::material::mooney_rivlin::MooneyRivlin>(),
+    Entry::of::<crate::material::drucker_prager::DruckerPrager>(),
+    Entry::of::<crate::material::mohr_coulomb::MohrCoulomb>(),
+    Entry::of::<crate::material::ogden::Ogden>(),
+];
+
+/// The model of this name.
+pub fn find(name: &str) -> Option<&'static Entry> {
+    MODELS.iter().find(|m| m.name == name)
+}
+
+/// The names of the models.
+pub fn names() -> &'static [&'static str] {
+    static NAMES: OnceLock<Vec<&'static str>> = OnceLock::new();
+    NAMES.get_or_init(|| MODELS.iter().map(|m| m.name).collect())
+}
+
+/// Every key some model takes (a key outside this list is unknown to all).
+pub fn all_keys() -> &'static [&'static str] {
+    static KEYS: OnceLock<Vec<&'static str>> = OnceLock::new();
+    KEYS.get_or_init(|| {
+        let mut keys: Vec<&'static str> = Vec::new();
+        for k in MODELS.iter().flat_map(|m| m.keys) {
+            if !keys.contains(k) {
+                keys.push(k);
+            }
+        }
+        keys
+    })
+}
+
+/// The material of the table at `table` (`material.0`): model `model` with this
+/// density and these other keys. An error names the key.
+pub fn build(
+    table: &str,
+    model: &str,
+    density: f64,
+    values: &toml::Table,
+) -> Result<Box<dyn Material>, KeyError> {
+    let entry = find(model).ok_or_else(|| {
+        (
+            format!("{table}.model"),
+            format!(
+                "unknown model `{model}`; the models are {}",
+                names().join(", ")
+            ),
+        )
+    })?;
+    if let Some(k) = values.keys().find(|k| !entry.keys.contains(&k.as_str())) {
+        return Err((
+            format!("{table}.{k}"),
+            format!("does not apply to model `{}`", entry.name),
+        ));
+    }
+    (entry.construct)(density, &Parameters::new(table, entry.name, values))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_and_model_names_agree() {
+        let mut seen = Vec::new();
+        for m in MODELS {
+            assert!(!seen.contains(&m.name), "`{}` registered twice", m.name);
+            seen.push(m.name);
+        }
+        let table: toml::Table = toml::from_str(
+            "youngs_modulus = 1.0e6\npoisson_ratio = 0.3\na = 1.0e5\nb = 1.0e5\n\
+             cohesion = 1.0e3\nfriction_angle = 30.0\nmohr_coulomb_fit = \"outer\"\n\
+             mu = [1.0e5]\nalpha = [2.0]",
+        )
+        .unwrap();
+        for m in MODELS {
+            let values = table
+                .iter()
+                .filter(|(k, _)| m.keys.contains(&k.as_str()))
+                .map(|(k, v)| (k.clone(), v.clone()))
+                .collect();
+            let built = build("material.0", m.name, 1000.0, &values).unwrap();
+            assert_eq!(built.model(), m.name, "Material::model of `{}`", m.name);
+        }
+    }
+}

@@ -1,0 +1,227 @@
+//! `Model::build`: from a validated scene to the model. The materials come from
+//! `material::registry`, the bodies are filled with particles on a lattice aligned
+//! with the grid, and the conditions and loads are put on grid faces and
+//! particles. What only the built model can tell (a region without grid nodes, a
+//! load region without particles, an absorbing face without material next to it)
+//! is reported here, at the scene key.
+
+use crate::dim::Vector;
+use crate::material::Material;
+use crate::model::conditions::{Absorbing, Constraint, FaceCondition, Footing, FrictionFace};
+use crate::model::geometry::Geometry;
+use crate::model::grid::Grid;
+use crate::model::loads::Loads;
+use crate::model::particles::Particles;
+use crate::model::Model;
+use crate::scene::{axis, expr, BodyConfig, BoundaryConfig, Condition, Face, Scene, SceneError};
+
+impl<const D: usize> Model<D> {
+    pub fn build(scene: &Scene) -> Result<Model<D>, SceneError> {
+        let c = &scene.config;
+        assert_eq!(c.dimension, D, "caller dispatches on the scene dimension");
+        let err =
+            |(key, msg): (String, String)| SceneError::at_key(&scene.file, &scene.text, &key, msg);
+        let vec = |v: &[f64]| Vector::<D>::from_fn(|d, _| v[d]);
+        let cells = std::array::from_fn(|d| c.grid.cells[d]);
+        let grid = Grid::new(
+            vec(&c.grid.min),
+            vec(&c.grid.max),
+            cells,
+            c.grid.shape_function.degree(),
+        );
+        let base_materials = (c.materials.iter().enumerate())
+            .map(|(i, m)| m.build(i))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(err)?;
+        let bodies: Vec<Geometry> = c.bodies.iter().map(Geometry::of).collect();
+        let mut particles = Particles::default();
+        for (i, b) in c.bodies.iter().enumerate() {
+            let m = c
+                .materials
+                .iter()
+                .position(|m| m.name == b.material)
+                .expect("validated");
+            let material = base_materials[m].as_ref();
+            let added = fill_body(&mut particles, &grid, b, &bodies[i], i, m as u32, material)
+                .map_err(err)?;
+            if added == 0 {
+                return Err(err((format!("body.{i}.shape"), "the body holds no particle centre: refine the grid or raise particles_per_cell".into())));
+            }
+        }
+        let faces: Vec<FaceCondition<D>> = c
+            .boundaries
+            .iter()
+            .filter(|b| !matches!(b.condition, Condition::Absorbing | Condition::Friction))
+            .map(|b| face_condition(b, &vec))
+            .collect();
+        let friction = c
+            .boundaries
+            .iter()
+            .filter(|b| b.condition == Condition::Friction)
+            .map(|b| FrictionFace {
+                face: Face::parse(&b.face, D).unwrap(),
+                coefficient: b.friction_coefficient.unwrap(),
+            })
+            .collect();
+        // A region must hold at least one node of its face.
+        let velocity_conditions =
+            c.boundaries.iter().enumerate().filter(|(_, b)| {
+                !matches!(b.condition, Condition::Absorbing | Condition::Friction)
+            });
+        for ((i, _), fc) in velocity_conditions.zip(&faces) {
+            if !(0..grid.node_count()).any(|g| fc.acts_on(&grid, grid.node_ijk(g))) {
+                return Err(err((
+                    format!("boundary.{i}.region_min"),
+                    "the region holds no grid node of the face".into(),
+                )));
+            }
+        }
+        let footing = footing(&c.boundaries, &faces, &grid, &particles, &base_materials);
+        let absorbing = Absorbing::new(&c.boundaries, &base_materials);
+        absorbing
+            .check_adjacent(&grid, &particles)
+            .map_err(|(i, msg)| err((format!("boundary.{i}.face"), msg)))?;
+        let gravity = c.gravity.as_deref().map_or(Vector::<D>::zeros(), vec);
+        let loads = Loads::apply(c, &mut particles).map_err(err)?;
+        Ok(Model {
+            grid,
+            particles,
+            materials: base_materials.clone(),
+            base_materials,
+            bodies,
+            faces,
+            friction,
+            footing,
+            absorbing,
+            gravity,
+            load_ramps: loads.ramps,
+            load_ramp_of: loads.ramp_of,
+        })
+    }
+}
+
+fn face_condition<const D: usize>(
+    b: &BoundaryConfig,
+    vec: &impl Fn(&[f64]) -> Vector<D>,
+) -> FaceCondition<D> {
+    let face = Face::parse(&b.face, D).unwrap();
+    let mut constraint = Constraint::<D>::free();
+    match b.condition {
+        Condition::Fixed => (0..D).for_each(|d| constraint.set(d, 0.0)),
+        Condition::Roller => constraint.set(face.axis, 0.0),
+        Condition::Absorbing | Condition::Friction => {
+            unreachable!("absorbing and friction faces are not velocity conditions")
+        }
+        Condition::Velocity => {
+            let v = vec(b.velocity.as_ref().unwrap());
+            let comps: Vec<usize> = match &b.components {
+                Some(c) => c.iter().map(|a| axis(a).unwrap()).collect(),
+                None => (0..D).collect(),
+            };
+            comps.into_iter().for_each(|d| constraint.set(d, v[d]));
+        }
+    }
+    let region = b
+        .region_min
+        .as_ref()
+        .zip(b.region_max.as_ref())
+        .map(|(lo, hi)| (vec(lo), vec(hi)));
+    FaceCondition {
+        face,
+        constraint,
+        region,
+    }
+}
+
+/// The footing (the velocity condition with a `footing_width`), with the cohesion
+/// of the material of the particle nearest to the centre of its region.
+fn footing<const D: usize>(
+    boundaries: &[BoundaryConfig],
+    faces: &[FaceCondition<D>],
+    grid: &Grid<D>,
+    particles: &Particles<D>,
+    materials: &[Box<dyn Material>],
+) -> Option<Footing<D>> {
+    let (b, condition) = boundaries
+        .iter()
+        .filter(|b| !matches!(b.condition, Condition::Absorbing | Condition::Friction))
+        .zip(faces)
+        .find(|(b, _)| b.footing_width.is_some())?;
+    let nodes: Vec<Vector<D>> = (0..grid.node_count())
+        .map(|g| grid.node_ijk(g))
+        .filter(|&ijk| condition.acts_on(grid, ijk))
+        .map(|ijk| grid.node_position(ijk))
+        .collect();
+    let centre = nodes.iter().sum::<Vector<D>>() / nodes.len() as f64;
+    let nearest = (0..particles.len()).min_by(|&a, &b| {
+        let (da, db) = (particles.x[a] - centre, particles.x[b] - centre);
+        da.norm_squared().total_cmp(&db.norm_squared())
+    });
+    let strength = |q: usize| materials[particles.material[q] as usize].frictional_strength();
+    Some(Footing {
+        condition: *condition,
+        width: b.footing_width.unwrap(),
+        cohesion: nearest.and_then(strength).map(|s| s.cohesion),
+    })
+}
+
+/// Put particles on the lattice of `particles_per_cell` points per cell direction
+/// (aligned with the grid) wherever the lattice point lies inside the body.
+fn fill_body<const D: usize>(
+    particles: &mut Particles<D>,
+    grid: &Grid<D>,
+    b: &BodyConfig,
+    geometry: &Geometry,
+    i: usize,
+    material: u32,
+    model: &dyn Material,
+) -> Result<usize, (String, String)> {
+    let (lo, hi) = b.bounds();
+    let spacing = Vector::<D>::from_fn(|d, _| grid.h[d] / b.particles_per_cell.get(d) as f64);
+    let volume = spacing.product();
+    let mass = model.density() * volume;
+    // Lattice index range covering the bounding box.
+    let first: [usize; D] =
+        std::array::from_fn(|d| (((lo[d] - grid.min[d]) / spacing[d]).floor().max(0.0)) as usize);
+    let last: [usize; D] =
+        std::array::from_fn(|d| ((hi[d] - grid.min[d]) / spacing[d]).ceil() as usize);
+    let counts: Vec<usize> = (0..D).map(|d| last[d].saturating_sub(first[d])).collect();
+    let total: usize = counts.iter().product();
+    let uniform = b
+        .velocity
+        .as_deref()
+        .map_or(Vector::<D>::zeros(), |v| Vector::<D>::from_fn(|d, _| v[d]));
+    let mut added = 0;
+    for flat in 0..total {
+        let mut rem = flat;
+        let x = Vector::<D>::from_fn(|d, _| {
+            let k = first[d] + rem % counts[d];
+            rem /= counts[d];
+            grid.min[d] + (k as f64 + 0.5) * spacing[d]
+        });
+        if !geometry.contains(x.as_slice()) {
+            continue;
+        }
+        let mut v = uniform;
+        if let Some(exprs) = &b.velocity_expr {
+            let mut pos = [0.0; 3];
+            (0..D).for_each(|d| pos[d] = x[d]);
+            for (d, e) in exprs.iter().enumerate() {
+                v[d] +=
+                    expr::eval(e, &pos).map_err(|m| (format!("body.{i}.velocity_expr.{d}"), m))?;
+            }
+        }
+        particles.push(
+            x,
+            v,
+            mass,
+            volume,
+            spacing / 2.0,
+            i as u32,
+            material,
+            model.n_history(),
+        );
+        added += 1;
+    }
+    Ok(added)
+}

@@ -1,0 +1,121 @@
+//! Loads on particles: a point force shared by the particles of a region, or a
+//! traction on one face of each particle, with its time history (a ramp or a
+//! pulse). The force at full value is stored on the particles (`Particles::load`);
+//! a solver scales it by the factor of the particle's history at time t
+//! (`load_factor`).
+
+use crate::dim::Vector;
+use crate::model::particles::Particles;
+use crate::scene::{Face, LoadConfig, LoadKind, SceneConfig};
+
+/// How a load varies in time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LoadTime {
+    /// min(t / ramp_time, 1); at once when the ramp time is 0.
+    Ramp(f64),
+    /// A smooth pulse of duration T: sin²(π t / T) for t ≤ T, then 0.
+    Pulse(f64),
+}
+
+impl LoadTime {
+    pub fn of(l: &LoadConfig) -> LoadTime {
+        match l.pulse_duration {
+            Some(t) => LoadTime::Pulse(t),
+            None => LoadTime::Ramp(l.ramp_time),
+        }
+    }
+
+    pub fn factor(&self, t: f64) -> f64 {
+        match *self {
+            LoadTime::Ramp(r) if r > 0.0 => (t / r).min(1.0),
+            LoadTime::Ramp(_) => 1.0,
+            LoadTime::Pulse(d) if t >= 0.0 && t <= d => {
+                (std::f64::consts::PI * t / d).sin().powi(2)
+            }
+            LoadTime::Pulse(_) => 0.0,
+        }
+    }
+}
+
+/// Load factor of particle q from its ramp (`Model::load_ramp_of`) and the factor
+/// of each ramp (0: the particle carries no load).
+pub fn load_factor(ramp_of: &[u32], q: usize, scales: &[f64]) -> f64 {
+    match ramp_of[q] {
+        u32::MAX => 0.0,
+        r => scales[r as usize],
+    }
+}
+
+/// The loads of a scene, put on the particles at full value.
+pub struct Loads {
+    /// The distinct time histories.
+    pub ramps: Vec<LoadTime>,
+    /// For each particle, the index into `ramps` of its load (u32::MAX: none).
+    pub ramp_of: Vec<u32>,
+}
+
+impl Loads {
+    /// Add each `[[load]]` to the particles it selects. An error names the key: a
+    /// region that selects no particle, or a particle given two time histories.
+    pub fn apply<const D: usize>(
+        c: &SceneConfig,
+        particles: &mut Particles<D>,
+    ) -> Result<Loads, (String, String)> {
+        let vec = |v: &[f64]| Vector::<D>::from_fn(|d, _| v[d]);
+        let mut ramp_of = vec![u32::MAX; particles.len()];
+        let mut ramps = Vec::new();
+        for (i, l) in c.loads.iter().enumerate() {
+            let body = l.body.as_ref().map(|n| {
+                c.bodies
+                    .iter()
+                    .position(|b| b.name.as_deref() == Some(n))
+                    .unwrap() as u32
+            });
+            let (lo, hi) = (vec(&l.region_min), vec(&l.region_max));
+            let selected: Vec<usize> = (0..particles.len())
+                .filter(|&p| body.is_none_or(|b| particles.body[p] == b))
+                .filter(|&p| {
+                    (0..D).all(|d| particles.x0[p][d] >= lo[d] && particles.x0[p][d] <= hi[d])
+                })
+                .collect();
+            if selected.is_empty() {
+                return Err((
+                    format!("load.{i}.region_min"),
+                    "the load region selects no particle".into(),
+                ));
+            }
+            let time = LoadTime::of(l);
+            let ramp = ramps.iter().position(|&r| r == time).unwrap_or_else(|| {
+                ramps.push(time);
+                ramps.len() - 1
+            });
+            for &p in &selected {
+                if ramp_of[p] != u32::MAX && ramp_of[p] != ramp as u32 {
+                    let key = if l.pulse_duration.is_some() {
+                        "pulse_duration"
+                    } else {
+                        "ramp_time"
+                    };
+                    return Err((
+                        format!("load.{i}.{key}"),
+                        format!("particle {p} already carries a load with another time history (ramp_time or pulse_duration)"),
+                    ));
+                }
+                ramp_of[p] = ramp as u32;
+                particles.load[p] += match l.kind {
+                    LoadKind::Point => vec(l.force.as_ref().unwrap()) / selected.len() as f64,
+                    LoadKind::Traction => {
+                        let face = Face::parse(l.face.as_ref().unwrap(), D).unwrap();
+                        let half = particles.half_length0[p];
+                        let area: f64 = (0..D)
+                            .filter(|&d| d != face.axis)
+                            .map(|d| 2.0 * half[d])
+                            .product();
+                        vec(l.traction.as_ref().unwrap()) * area
+                    }
+                };
+            }
+        }
+        Ok(Loads { ramps, ramp_of })
+    }
+}

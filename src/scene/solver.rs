@@ -1,0 +1,346 @@
+//! The `[solver]` table (and each `[[stage]]`): the solver kind and its settings,
+//! their defaults, and where each optional key applies (`SCOPES`), which the
+//! validation checks with one loop: a key given where it does not apply is an
+//! error "does not apply to …".
+
+use serde::{Deserialize, Serialize};
+use strum::{EnumIter, IntoStaticStr};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize, IntoStaticStr, EnumIter)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum SolverKind {
+    Explicit,
+    Implicit,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize, IntoStaticStr, EnumIter)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum Scheme {
+    Usf,
+    Usl,
+    Musl,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize, IntoStaticStr, EnumIter)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum Integrator {
+    /// Newmark with Newton-Raphson (thesis 2-33…2-38).
+    Newmark,
+    /// No inertia: gravity and loads scaled by the load factor t / end_time.
+    QuasiStatic,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize, IntoStaticStr, EnumIter)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum MassMatrix {
+    Lumped,
+    Consistent,
+}
+
+/// How the implicit solver solves each Newton correction (thesis 2-38).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize, IntoStaticStr, EnumIter)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum LinearSolver {
+    /// Assembled consistent tangent, sparse Cholesky / LU (needs an analytic tangent).
+    Direct,
+    /// Matrix-free restarted GMRES with finite-difference products (2-39).
+    Gmres,
+    /// Matrix-free conjugate gradients (symmetric positive definite tangents).
+    Cg,
+}
+
+/// Preconditioner of the Krylov solvers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize, IntoStaticStr, EnumIter)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum PreconditionerKind {
+    None,
+    /// Inverse of the tangent's diagonal, built particle by particle.
+    Jacobi,
+    /// Inverse of each node's D×D diagonal block, built particle by particle.
+    BlockJacobi,
+    /// The assembled tangent of an earlier iteration, factorized once and reused.
+    LaggedDirect,
+}
+
+/// The `[solver]` table (or a `[[stage]]`). The accessors give the documented
+/// defaults; `SCOPES` says where each optional key applies.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolverConfig {
+    /// Stage name (for `[[stage]]` tables; optional).
+    pub name: Option<String>,
+    /// From this stage on, c, tan φ and tan ψ of the frictional materials are the
+    /// scene's values divided by this factor (default: the previous stage's, 1 at
+    /// the start). docs/strength_reduction.md.
+    pub strength_reduction_factor: Option<f64>,
+    pub kind: SolverKind,
+    /// Duration of the run or stage (implicit quasi-static: the pseudo-time over
+    /// which the loads rise to full value).
+    pub end_time: f64,
+    /// Explicit: fixed step instead of the CFL rule. Implicit: the step (required
+    /// for Newmark; quasi-static may give `load_steps` instead).
+    pub dt: Option<f64>,
+    // Explicit keys.
+    pub scheme: Option<Scheme>,
+    pub cfl: Option<f64>,
+    pub flip: Option<f64>,
+    pub damping: Option<f64>,
+    // Implicit keys.
+    pub integrator: Option<Integrator>,
+    pub beta: Option<f64>,
+    pub gamma: Option<f64>,
+    pub mass: Option<MassMatrix>,
+    pub load_steps: Option<usize>,
+    pub residual_tolerance: Option<f64>,
+    pub displacement_tolerance: Option<f64>,
+    pub max_iterations: Option<usize>,
+    pub line_search: Option<bool>,
+    pub max_cutbacks: Option<usize>,
+    pub min_node_support: Option<f64>,
+    // Linear solver of the Newton corrections (implicit).
+    pub linear_solver: Option<LinearSolver>,
+    pub preconditioner: Option<PreconditionerKind>,
+    pub krylov_tolerance: Option<f64>,
+    pub krylov_restart: Option<usize>,
+    pub krylov_max_iterations: Option<usize>,
+    /// Quasi-static: ramp gravity from zero over the stage (default true); false
+    /// applies it in full from the first step (after a geostatic initialisation).
+    pub gravity_ramp: Option<bool>,
+    /// F-bar against volumetric locking (explicit and implicit; default false).
+    pub fbar: Option<bool>,
+}
+
+impl SolverKind {
+    pub fn name(&self) -> &'static str {
+        self.into()
+    }
+}
+
+impl Scheme {
+    pub fn name(&self) -> &'static str {
+        self.into()
+    }
+}
+
+impl Integrator {
+    pub fn name(&self) -> &'static str {
+        self.into()
+    }
+
+    /// How messages name it.
+    fn described(&self) -> &'static str {
+        match self {
+            Integrator::Newmark => "the Newmark integrator",
+            Integrator::QuasiStatic => "the quasi-static integrator",
+        }
+    }
+}
+
+impl MassMatrix {
+    pub fn name(&self) -> &'static str {
+        self.into()
+    }
+}
+
+impl LinearSolver {
+    pub fn name(&self) -> &'static str {
+        self.into()
+    }
+}
+
+impl PreconditionerKind {
+    pub fn name(&self) -> &'static str {
+        self.into()
+    }
+}
+
+/// Where an optional key of the solver table applies: to these solver kinds
+/// and, for the implicit solver, to these integrators and linear solvers (empty:
+/// all of them).
+#[derive(Clone, Copy, Debug)]
+pub struct Scope {
+    pub key: &'static str,
+    pub kinds: &'static [SolverKind],
+    pub integrators: &'static [Integrator],
+    pub linear_solvers: &'static [LinearSolver],
+    /// Added to the error where an integrator or a linear solver rules the key out.
+    pub note: &'static str,
+}
+
+impl Scope {
+    const fn new(
+        key: &'static str,
+        kinds: &'static [SolverKind],
+        integrators: &'static [Integrator],
+        linear_solvers: &'static [LinearSolver],
+        note: &'static str,
+    ) -> Scope {
+        Scope {
+            key,
+            kinds,
+            integrators,
+            linear_solvers,
+            note,
+        }
+    }
+}
+
+const EXPLICIT: &[SolverKind] = &[SolverKind::Explicit];
+const IMPLICIT: &[SolverKind] = &[SolverKind::Implicit];
+const NEWMARK: &[Integrator] = &[Integrator::Newmark];
+const QUASI_STATIC: &[Integrator] = &[Integrator::QuasiStatic];
+const KRYLOV: &[LinearSolver] = &[LinearSolver::Gmres, LinearSolver::Cg];
+const GMRES: &[LinearSolver] = &[LinearSolver::Gmres];
+// Notes added to "does not apply to …".
+const SET_KRYLOV: &str = " (set \"gmres\" or \"cg\")";
+const RESTART_LENGTH: &str = " (it is the GMRES restart length)";
+const FULL_GRAVITY: &str = " (gravity is always in full)";
+const GIVE_DT: &str = " (give dt)";
+
+/// The optional keys that apply to some solvers only (every other key applies to
+/// all): key, solver kinds, integrators, linear solvers (`&[]`: all), note.
+pub const SCOPES: &[Scope] = &[
+    Scope::new("scheme", EXPLICIT, &[], &[], ""),
+    Scope::new("cfl", EXPLICIT, &[], &[], ""),
+    Scope::new("flip", EXPLICIT, &[], &[], ""),
+    Scope::new("damping", EXPLICIT, &[], &[], ""),
+    Scope::new("integrator", IMPLICIT, &[], &[], ""),
+    Scope::new("beta", IMPLICIT, NEWMARK, &[], ""),
+    Scope::new("gamma", IMPLICIT, NEWMARK, &[], ""),
+    Scope::new("mass", IMPLICIT, NEWMARK, &[], ""),
+    Scope::new("gravity_ramp", IMPLICIT, QUASI_STATIC, &[], FULL_GRAVITY),
+    Scope::new("load_steps", IMPLICIT, QUASI_STATIC, &[], GIVE_DT),
+    Scope::new("residual_tolerance", IMPLICIT, &[], &[], ""),
+    Scope::new("displacement_tolerance", IMPLICIT, &[], &[], ""),
+    Scope::new("max_iterations", IMPLICIT, &[], &[], ""),
+    Scope::new("line_search", IMPLICIT, &[], &[], ""),
+    Scope::new("max_cutbacks", IMPLICIT, &[], &[], ""),
+    Scope::new("min_node_support", IMPLICIT, &[], &[], ""),
+    Scope::new("linear_solver", IMPLICIT, &[], &[], ""),
+    Scope::new("preconditioner", IMPLICIT, &[], KRYLOV, SET_KRYLOV),
+    Scope::new("krylov_tolerance", IMPLICIT, &[], KRYLOV, SET_KRYLOV),
+    Scope::new("krylov_restart", IMPLICIT, &[], GMRES, RESTART_LENGTH),
+    Scope::new("krylov_max_iterations", IMPLICIT, &[], KRYLOV, SET_KRYLOV),
+];
+
+impl SolverConfig {
+    pub fn scheme(&self) -> Scheme {
+        self.scheme.unwrap_or(Scheme::Musl)
+    }
+    /// Fraction of the CFL limit (2-45); default 0.5.
+    pub fn cfl(&self) -> f64 {
+        self.cfl.unwrap_or(0.5)
+    }
+    /// FLIP fraction: 1 = FLIP (default), 0 = PIC.
+    pub fn flip(&self) -> f64 {
+        self.flip.unwrap_or(1.0)
+    }
+    /// Local damping α (default 0).
+    pub fn damping(&self) -> f64 {
+        self.damping.unwrap_or(0.0)
+    }
+    pub fn integrator(&self) -> Integrator {
+        self.integrator.unwrap_or(Integrator::Newmark)
+    }
+    /// Newmark β (default 1/4, trapezoidal).
+    pub fn beta(&self) -> f64 {
+        self.beta.unwrap_or(0.25)
+    }
+    /// Newmark γ (default 1/2).
+    pub fn gamma(&self) -> f64 {
+        self.gamma.unwrap_or(0.5)
+    }
+    pub fn mass(&self) -> MassMatrix {
+        self.mass.unwrap_or(MassMatrix::Lumped)
+    }
+    /// Implicit step: `dt`, or end_time / load_steps.
+    pub fn implicit_dt(&self) -> f64 {
+        self.dt
+            .unwrap_or_else(|| self.end_time / self.load_steps.unwrap_or(1) as f64)
+    }
+    /// Newton converges when ‖R‖ ≤ this × the reference force (default 1e-9).
+    pub fn residual_tolerance(&self) -> f64 {
+        self.residual_tolerance.unwrap_or(1e-9)
+    }
+    /// … and ‖δu‖ ≤ this × ‖u‖ (default 1e-9).
+    pub fn displacement_tolerance(&self) -> f64 {
+        self.displacement_tolerance.unwrap_or(1e-9)
+    }
+    /// Newton iteration cap per attempt (default 25).
+    pub fn max_iterations(&self) -> usize {
+        self.max_iterations.unwrap_or(25)
+    }
+    /// Backtracking line search on the residual norm (default off).
+    pub fn line_search(&self) -> bool {
+        self.line_search.unwrap_or(false)
+    }
+    /// Times a failing step may be halved before the run stops (default 5).
+    pub fn max_cutbacks(&self) -> usize {
+        self.max_cutbacks.unwrap_or(5)
+    }
+    /// Quasi-static gravity ramps from zero over the stage (default true).
+    pub fn gravity_ramp(&self) -> bool {
+        self.gravity_ramp.unwrap_or(true)
+    }
+    /// Nodes whose particle support Σ_p V_p S_Ip is below this fraction of a cell
+    /// volume are tied to two neighbours by linear extrapolation (default 1e-2;
+    /// 0 turns it off). See `implicit::support`.
+    pub fn min_node_support(&self) -> f64 {
+        self.min_node_support.unwrap_or(1e-2)
+    }
+    /// F-bar: per background cell, the particles' volume change is the cell
+    /// average (default false). See `fbar`.
+    pub fn fbar(&self) -> bool {
+        self.fbar.unwrap_or(false)
+    }
+    /// Linear solver of the Newton corrections (default direct).
+    pub fn linear_solver(&self) -> LinearSolver {
+        self.linear_solver.unwrap_or(LinearSolver::Direct)
+    }
+    /// Krylov preconditioner (default block_jacobi).
+    pub fn preconditioner(&self) -> PreconditionerKind {
+        self.preconditioner
+            .unwrap_or(PreconditionerKind::BlockJacobi)
+    }
+    /// GMRES restart length (default 30).
+    pub fn krylov_restart(&self) -> usize {
+        self.krylov_restart.unwrap_or(30)
+    }
+    /// Krylov iterations allowed per Newton correction (default 1000).
+    pub fn krylov_max_iterations(&self) -> usize {
+        self.krylov_max_iterations.unwrap_or(1000)
+    }
+
+    /// An optional key given where it does not apply (`SCOPES`), with what it
+    /// does not apply to: "the explicit solver", "the Newmark integrator (give
+    /// dt)", "linear_solver = \"direct\" (set \"gmres\" or \"cg\")". The solver
+    /// kind rules keys out first, then the integrator, then the linear solver;
+    /// within each, the first key in `SCOPES` is named.
+    pub fn key_out_of_scope(&self) -> Option<(&'static str, String)> {
+        let table = serde_json::to_value(self).expect("a solver table serialises");
+        let (integrator, linear_solver) = (self.integrator(), self.linear_solver());
+        let ruled_out = |s: &Scope| {
+            if !s.kinds.contains(&self.kind) {
+                Some((0, format!("the {} solver", self.kind.name())))
+            } else if !s.integrators.is_empty() && !s.integrators.contains(&integrator) {
+                Some((1, format!("{}{}", integrator.described(), s.note)))
+            } else if !s.linear_solvers.is_empty() && !s.linear_solvers.contains(&linear_solver) {
+                let name = linear_solver.name();
+                Some((2, format!("linear_solver = \"{name}\"{}", s.note)))
+            } else {
+                None
+            }
+        };
+        (SCOPES.iter())
+            .filter(|s| !table[s.key].is_null())
+            .filter_map(|s| ruled_out(s).map(|(by, outside)| (by, s.key, outside)))
+            .min_by_key(|&(by, _, _)| by)
+            .map(|(_, key, outside)| (key, outside))
+    }
+}

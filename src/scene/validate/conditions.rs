@@ -1,0 +1,193 @@
+//! The `[[boundary]]` and `[[load]]` tables: faces, which keys each condition
+//! and load kind takes, regions.
+
+use super::check::{ensure, forbidden, required, vector, Check};
+use crate::scene::{axis, BoundaryConfig, Condition, Face, LoadConfig, LoadKind, SceneConfig};
+
+pub fn boundary(b: &BoundaryConfig, i: usize, dim: usize) -> Check {
+    let key = |k: &str| format!("boundary.{i}.{k}");
+    let face_names = if dim == 2 {
+        "xmin, xmax, ymin, ymax"
+    } else {
+        "xmin, xmax, ymin, ymax, zmin, zmax"
+    };
+    ensure(
+        Face::parse(&b.face, dim).is_some(),
+        key("face"),
+        format!("must be one of {face_names}"),
+    )?;
+    if b.condition != Condition::Absorbing {
+        let what = "a fixed, roller, velocity or friction condition (only to absorbing)";
+        forbidden(&b.spring_distance, key("spring_distance"), what)?;
+        forbidden(&b.spring_stiffness, key("spring_stiffness"), what)?;
+    }
+    if b.condition != Condition::Friction {
+        let what = "a fixed, roller, velocity or absorbing condition (only to friction)";
+        forbidden(&b.friction_coefficient, key("friction_coefficient"), what)?;
+    }
+    region(b, i, dim)?;
+    if b.condition != Condition::Velocity {
+        forbidden(
+            &b.footing_width,
+            key("footing_width"),
+            "a velocity condition",
+        )?;
+    }
+    if let Some(w) = b.footing_width {
+        ensure(
+            w > 0.0 && w.is_finite(),
+            key("footing_width"),
+            format!("must be a positive width; got {w}"),
+        )?;
+    }
+    match b.condition {
+        Condition::Friction => friction(b, i),
+        Condition::Fixed | Condition::Roller => {
+            forbidden(&b.velocity, key("velocity"), "fixed or roller conditions")?;
+            forbidden(
+                &b.components,
+                key("components"),
+                "fixed or roller conditions",
+            )
+        }
+        Condition::Absorbing => absorbing(b, i),
+        Condition::Velocity => {
+            required(&b.velocity, key("velocity"), "a velocity condition")?;
+            vector(b.velocity.as_ref().unwrap(), dim, &key("velocity"))?;
+            for (k, c) in b.components.iter().flatten().enumerate() {
+                let ok = axis(c).is_some_and(|a| a < dim);
+                ensure(
+                    ok,
+                    format!("boundary.{i}.components.{k}"),
+                    "must be \"x\", \"y\" or (3D) \"z\"",
+                )?;
+            }
+            Ok(())
+        }
+    }
+}
+
+/// Keys of a friction face: a coefficient μ ≥ 0 and no velocity.
+fn friction(b: &BoundaryConfig, i: usize) -> Check {
+    let key = |k: &str| format!("boundary.{i}.{k}");
+    let what = "a friction condition (the wall is at rest)";
+    forbidden(&b.velocity, key("velocity"), what)?;
+    forbidden(&b.components, key("components"), what)?;
+    required(
+        &b.friction_coefficient,
+        key("friction_coefficient"),
+        "a friction condition",
+    )?;
+    let mu = b.friction_coefficient.unwrap();
+    ensure(
+        mu >= 0.0 && mu.is_finite(),
+        key("friction_coefficient"),
+        format!("must be a finite number ≥ 0; got {mu}"),
+    )
+}
+
+/// A region of a face: both corners or neither, each with `dim` components, min ≤ max;
+/// not on absorbing faces.
+fn region(b: &BoundaryConfig, i: usize, dim: usize) -> Check {
+    let key = |k: &str| format!("boundary.{i}.{k}");
+    if matches!(b.condition, Condition::Absorbing | Condition::Friction) {
+        let what = "a fixed, roller or velocity condition (not to absorbing or friction)";
+        forbidden(&b.region_min, key("region_min"), what)?;
+        return forbidden(&b.region_max, key("region_max"), what);
+    }
+    match (&b.region_min, &b.region_max) {
+        (None, None) => Ok(()),
+        (Some(_), None) => required(&b.region_max, key("region_max"), "a face with region_min"),
+        (None, Some(_)) => required(&b.region_min, key("region_min"), "a face with region_max"),
+        (Some(lo), Some(hi)) => {
+            vector(lo, dim, &key("region_min"))?;
+            vector(hi, dim, &key("region_max"))?;
+            ensure(
+                lo.iter().zip(hi).all(|(a, b)| a <= b),
+                key("region_max"),
+                "must be ≥ region_min in every component",
+            )
+        }
+    }
+}
+
+/// Keys of an absorbing face: no velocity, at most one way of giving springs.
+fn absorbing(b: &BoundaryConfig, i: usize) -> Check {
+    let key = |k: &str| format!("boundary.{i}.{k}");
+    let what = "an absorbing condition";
+    forbidden(&b.velocity, key("velocity"), what)?;
+    forbidden(&b.components, key("components"), what)?;
+    if let Some(r) = b.spring_distance {
+        ensure(
+            r > 0.0 && r.is_finite(),
+            key("spring_distance"),
+            format!("must be a positive distance (from the wave source to the face); got {r}"),
+        )?;
+        forbidden(
+            &b.spring_stiffness,
+            key("spring_stiffness"),
+            "a face that sets spring_distance (give one of the two)",
+        )?;
+    }
+    if let Some(k) = &b.spring_stiffness {
+        ensure(
+            k.len() == 2,
+            key("spring_stiffness"),
+            format!("needs 2 entries [normal, tangential], has {}", k.len()),
+        )?;
+        ensure(
+            k.iter().all(|k| *k >= 0.0 && k.is_finite()),
+            key("spring_stiffness"),
+            "stiffnesses per unit area must be finite and ≥ 0",
+        )?;
+    }
+    Ok(())
+}
+
+pub fn load(l: &LoadConfig, i: usize, s: &SceneConfig) -> Check {
+    let dim = s.dimension;
+    let key = |k: &str| format!("load.{i}.{k}");
+    vector(&l.region_min, dim, &key("region_min"))?;
+    vector(&l.region_max, dim, &key("region_max"))?;
+    if let Some(b) = &l.body {
+        let known = s.bodies.iter().any(|x| x.name.as_deref() == Some(b));
+        ensure(known, key("body"), format!("no body is named `{b}`"))?;
+    }
+    ensure(
+        l.ramp_time >= 0.0 && l.ramp_time.is_finite(),
+        key("ramp_time"),
+        "must be ≥ 0",
+    )?;
+    if let Some(t) = l.pulse_duration {
+        ensure(
+            t > 0.0 && t.is_finite(),
+            key("pulse_duration"),
+            "must be a positive number",
+        )?;
+        ensure(
+            l.ramp_time == 0.0,
+            key("pulse_duration"),
+            "a load is either ramped (ramp_time) or a pulse (pulse_duration), not both",
+        )?;
+    }
+    match l.kind {
+        LoadKind::Point => {
+            required(&l.force, key("force"), "a point load")?;
+            forbidden(&l.traction, key("traction"), "a point load")?;
+            forbidden(&l.face, key("face"), "a point load")?;
+            vector(l.force.as_ref().unwrap(), dim, &key("force"))
+        }
+        LoadKind::Traction => {
+            required(&l.traction, key("traction"), "a traction")?;
+            required(&l.face, key("face"), "a traction")?;
+            forbidden(&l.force, key("force"), "a traction")?;
+            vector(l.traction.as_ref().unwrap(), dim, &key("traction"))?;
+            let ok = Face::parse(l.face.as_ref().unwrap(), dim).is_some();
+            ensure(
+                ok,
+                key("face"),
+                "must name a particle face: xmin, xmax, ymin, ymax (zmin, zmax)",
+            )
+        }
+    }
+}

@@ -1,0 +1,131 @@
+//! The `[grid]` and `[[body]]` tables: the grid box and cells; each body's
+//! material, the keys of its shape, and its extent inside the grid.
+
+use super::check::{ensure, forbidden, required, vector, Check};
+use crate::scene::{BodyConfig, BodyShape, GridConfig, PerDirection, SceneConfig};
+
+pub fn grid(g: &GridConfig, dim: usize) -> Check {
+    vector(&g.min, dim, "grid.min")?;
+    vector(&g.max, dim, "grid.max")?;
+    ensure(
+        g.cells.len() == dim,
+        "grid.cells",
+        format!("needs {dim} entries"),
+    )?;
+    ensure(
+        g.cells.iter().all(|&c| c >= 1),
+        "grid.cells",
+        "every direction needs at least one cell",
+    )?;
+    let ok = (0..dim).all(|d| g.max[d] > g.min[d]);
+    ensure(ok, "grid.max", "must exceed grid.min in every direction")
+}
+
+pub fn body(b: &BodyConfig, i: usize, s: &SceneConfig) -> Check {
+    let dim = s.dimension;
+    let key = |k: &str| format!("body.{i}.{k}");
+    let known = s.materials.iter().any(|m| m.name == b.material);
+    ensure(
+        known,
+        key("material"),
+        format!("no material is named `{}`", b.material),
+    )?;
+    shape_keys(b, i, dim)?;
+    let (lo, hi) = b.bounds();
+    let inside = (0..dim).all(|d| lo[d] >= s.grid.min[d] && hi[d] <= s.grid.max[d]);
+    ensure(
+        inside,
+        key("shape"),
+        format!(
+            "the body spans {lo:?}..{hi:?}, outside the grid {:?}..{:?}",
+            s.grid.min, s.grid.max
+        ),
+    )?;
+    match &b.particles_per_cell {
+        PerDirection::Same(n) => ensure(*n >= 1, key("particles_per_cell"), "must be at least 1")?,
+        PerDirection::Each(v) => ensure(
+            v.len() == dim && v.iter().all(|&n| n >= 1),
+            key("particles_per_cell"),
+            format!("needs {dim} entries, each at least 1"),
+        )?,
+    }
+    if let Some(v) = &b.velocity {
+        vector(v, dim, &key("velocity"))?;
+    }
+    if let Some(exprs) = &b.velocity_expr {
+        ensure(
+            exprs.len() == dim,
+            key("velocity_expr"),
+            format!("needs {dim} expressions"),
+        )?;
+        for (c, e) in exprs.iter().enumerate() {
+            crate::scene::expr::eval(e, &[0.0; 3])
+                .map_err(|m| (format!("body.{i}.velocity_expr.{c}"), m))?;
+        }
+    }
+    Ok(())
+}
+
+/// The keys a body's shape needs, and no others.
+fn shape_keys(b: &BodyConfig, i: usize, dim: usize) -> Check {
+    let key = |k: &str| format!("body.{i}.{k}");
+    let what = format!("shape `{}`", b.shape.name());
+    let shape_dim = match b.shape {
+        BodyShape::Rectangle | BodyShape::Disk | BodyShape::Polygon => 2,
+        BodyShape::Box | BodyShape::Sphere => 3,
+    };
+    ensure(
+        shape_dim == dim,
+        key("shape"),
+        format!("{what} is a {shape_dim}D shape but dimension = {dim}"),
+    )?;
+    match b.shape {
+        BodyShape::Rectangle | BodyShape::Box => {
+            required(&b.min, key("min"), &what)?;
+            required(&b.max, key("max"), &what)?;
+            forbidden(&b.centre, key("centre"), &what)?;
+            forbidden(&b.radius, key("radius"), &what)?;
+            forbidden(&b.vertices, key("vertices"), &what)?;
+            let (lo, hi) = (b.min.clone().unwrap(), b.max.clone().unwrap());
+            vector(&lo, dim, &key("min"))?;
+            vector(&hi, dim, &key("max"))?;
+            ensure(
+                (0..dim).all(|d| hi[d] > lo[d]),
+                key("max"),
+                "must exceed min in every direction",
+            )
+        }
+        BodyShape::Disk | BodyShape::Sphere => {
+            required(&b.centre, key("centre"), &what)?;
+            required(&b.radius, key("radius"), &what)?;
+            forbidden(&b.min, key("min"), &what)?;
+            forbidden(&b.max, key("max"), &what)?;
+            forbidden(&b.vertices, key("vertices"), &what)?;
+            let c = b.centre.clone().unwrap();
+            vector(&c, dim, &key("centre"))?;
+            let r = b.radius.unwrap();
+            ensure(
+                r > 0.0 && r.is_finite(),
+                key("radius"),
+                "must be a positive number",
+            )
+        }
+        BodyShape::Polygon => {
+            required(&b.vertices, key("vertices"), &what)?;
+            forbidden(&b.min, key("min"), &what)?;
+            forbidden(&b.max, key("max"), &what)?;
+            forbidden(&b.centre, key("centre"), &what)?;
+            forbidden(&b.radius, key("radius"), &what)?;
+            let v = b.vertices.as_ref().unwrap();
+            ensure(
+                v.len() >= 3,
+                key("vertices"),
+                "a polygon needs at least 3 vertices",
+            )?;
+            for (k, p) in v.iter().enumerate() {
+                vector(p, 2, &format!("body.{i}.vertices.{k}"))?;
+            }
+            Ok(())
+        }
+    }
+}

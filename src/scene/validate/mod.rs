@@ -1,0 +1,100 @@
+//! Physical and structural checks after parsing. Each failure names the dotted key
+//! path (`material.0.poisson_ratio`) so the error can point at its line.
+//!
+//! One file per group of tables: `grid_bodies`, `conditions` (boundaries and
+//! loads), `materials`, `solver` (solver and stages) and `analyses` (geostatic,
+//! strength reduction, bench); `check` holds the checks they share.
+
+mod analyses;
+mod check;
+mod conditions;
+mod grid_bodies;
+mod materials;
+mod solver;
+
+pub use analyses::bench;
+pub use check::{Check, KeyError};
+
+use crate::scene::SceneConfig;
+use analyses::{geostatic, strength_reduction};
+use check::{ensure, vector};
+use conditions::{boundary, load};
+use grid_bodies::{body, grid};
+use materials::materials;
+use solver::{needs_krylov, solver, stage_strength_factor};
+
+/// Check a parsed scene, table by table; the first failure names its key.
+pub fn validate(s: &SceneConfig) -> Check {
+    let dim = s.dimension;
+    ensure(
+        dim == 2 || dim == 3,
+        "dimension",
+        "must be 2 (plane strain) or 3",
+    )?;
+    if let Some(g) = &s.gravity {
+        vector(g, dim, "gravity")?;
+    }
+    grid(&s.grid, dim)?;
+    let materials = materials(s)?;
+    ensure(
+        !s.bodies.is_empty(),
+        "body",
+        "the scene defines no [[body]]",
+    )?;
+    for (i, b) in s.bodies.iter().enumerate() {
+        body(b, i, s)?;
+    }
+    for (i, b) in s.boundaries.iter().enumerate() {
+        boundary(b, i, dim)?;
+        let earlier = s.boundaries[..i].iter().any(|b| b.footing_width.is_some());
+        if b.footing_width.is_some() && earlier {
+            return Err((
+                format!("boundary.{i}.footing_width"),
+                "only one boundary may be a footing".into(),
+            ));
+        }
+    }
+    for (i, l) in s.loads.iter().enumerate() {
+        load(l, i, s)?;
+    }
+    needs_krylov(s, &materials)?;
+    match (&s.solver, s.stages.is_empty()) {
+        (Some(solver_config), true) => {
+            solver(solver_config, "solver")?;
+            stage_strength_factor(solver_config, "solver", s, &materials)?;
+        }
+        (None, false) => {
+            for (k, st) in s.stages.iter().enumerate() {
+                solver(st, &format!("stage.{k}"))?;
+                stage_strength_factor(st, &format!("stage.{k}"), s, &materials)?;
+            }
+        }
+        (Some(_), false) => {
+            return Err((
+                "stage".into(),
+                "give either [solver] or [[stage]] tables, not both".into(),
+            ))
+        }
+        (None, true) => {
+            return Err((
+                "solver".into(),
+                "the scene needs a [solver] table or [[stage]] tables".into(),
+            ))
+        }
+    }
+    ensure(
+        s.output.history_interval >= 0.0,
+        "output.history_interval",
+        "must be ≥ 0",
+    )?;
+    if let Some(g) = &s.geostatic {
+        geostatic(g, s, &materials)?;
+    }
+    if let Some(r) = &s.strength_reduction {
+        strength_reduction(r, s, &materials)?;
+    }
+    if let Some(b) = &s.bench {
+        bench(b, "bench")?;
+    }
+    Ok(())
+}

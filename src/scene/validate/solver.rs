@@ -1,0 +1,193 @@
+//! The `[solver]` table or the `[[stage]]` tables: ranges of the settings and
+//! which optional keys apply (`scene::solver::SCOPES`), a material without an
+//! analytic tangent only with a Krylov solver, and the stages' strength factors.
+
+use super::check::{ensure, required, Check};
+use crate::material::Material;
+use crate::scene::{Integrator, LinearSolver, SceneConfig, SolverConfig, SolverKind};
+
+/// A material without an analytic tangent cannot run on an implicit stage with
+/// the direct solver.
+pub fn needs_krylov(s: &SceneConfig, materials: &[Box<dyn Material>]) -> Check {
+    let Some(i) = materials.iter().position(|m| !m.has_analytic_tangent()) else {
+        return Ok(());
+    };
+    let m = &s.materials[i];
+    let stages: Vec<(String, &SolverConfig)> = match &s.solver {
+        Some(solver) => vec![("solver".into(), solver)],
+        None => (s.stages.iter().enumerate())
+            .map(|(k, st)| (format!("stage.{k}"), st))
+            .collect(),
+    };
+    for (prefix, st) in stages {
+        let direct = st.kind == SolverKind::Implicit && st.linear_solver() == LinearSolver::Direct;
+        let key = match st.linear_solver {
+            Some(_) => format!("{prefix}.linear_solver"),
+            None => format!("{prefix}.kind"),
+        };
+        ensure(
+            !direct,
+            key,
+            format!(
+                "material `{}` (model `{}`) has no analytic tangent, which the direct \
+                 implicit solver needs: set linear_solver = \"gmres\" (or \"cg\" for \
+                 symmetric problems) in this table",
+                m.name, m.model
+            ),
+        )?;
+    }
+    Ok(())
+}
+
+/// A stage's `strength_reduction_factor`: F > 0, something to reduce, and no
+/// `[strength_reduction]` search (whose trial factor holds for every stage).
+pub fn stage_strength_factor(
+    st: &SolverConfig,
+    prefix: &str,
+    s: &SceneConfig,
+    materials: &[Box<dyn Material>],
+) -> Check {
+    let Some(f) = st.strength_reduction_factor else {
+        return Ok(());
+    };
+    let key = format!("{prefix}.strength_reduction_factor");
+    ensure(
+        f > 0.0 && f.is_finite(),
+        key.clone(),
+        format!("must be a positive number (c and tan φ are divided by it); got {f}"),
+    )?;
+    ensure(
+        materials.iter().any(|m| m.frictional_strength().is_some()),
+        key.clone(),
+        "needs a drucker_prager or mohr_coulomb material (nothing to reduce)",
+    )?;
+    ensure(
+        s.strength_reduction.is_none(),
+        key,
+        "cannot be combined with a [strength_reduction] search: each trial divides the \
+         strengths by its own factor in every stage; remove one of the two",
+    )
+}
+
+pub fn solver(s: &SolverConfig, prefix: &str) -> Check {
+    let key = |k: &str| format!("{prefix}.{k}");
+    ensure(
+        s.end_time > 0.0 && s.end_time.is_finite(),
+        key("end_time"),
+        "must be a positive number",
+    )?;
+    if let Some(dt) = s.dt {
+        ensure(
+            dt > 0.0 && dt.is_finite(),
+            key("dt"),
+            "must be a positive number",
+        )?;
+    }
+    if let Some((k, outside)) = s.key_out_of_scope() {
+        return Err((key(k), format!("does not apply to {outside}")));
+    }
+    match s.kind {
+        SolverKind::Explicit => explicit(s, prefix),
+        SolverKind::Implicit => implicit(s, prefix),
+    }
+}
+
+fn explicit(s: &SolverConfig, prefix: &str) -> Check {
+    let cfl = s.cfl();
+    ensure(
+        cfl > 0.0 && cfl <= 1.0,
+        format!("{prefix}.cfl"),
+        format!("must lie in (0, 1]: the explicit step is cfl × the critical step; got {cfl}"),
+    )?;
+    ensure(
+        (0.0..=1.0).contains(&s.flip()),
+        format!("{prefix}.flip"),
+        "must lie in [0, 1] (1 = FLIP, 0 = PIC)",
+    )?;
+    ensure(
+        (0.0..1.0).contains(&s.damping()),
+        format!("{prefix}.damping"),
+        "must lie in [0, 1)",
+    )
+}
+
+fn implicit(s: &SolverConfig, prefix: &str) -> Check {
+    match s.integrator() {
+        Integrator::Newmark => {
+            required(&s.dt, format!("{prefix}.dt"), "the Newmark integrator")?;
+            ensure(
+                s.beta() > 0.0 && s.beta() <= 1.0,
+                format!("{prefix}.beta"),
+                "must lie in (0, 1]",
+            )?;
+            ensure(
+                s.gamma() >= 0.0 && s.gamma() <= 1.5,
+                format!("{prefix}.gamma"),
+                "must lie in [0, 1.5]",
+            )?;
+        }
+        Integrator::QuasiStatic => {
+            ensure(
+                s.dt.is_some() != s.load_steps.is_some(),
+                format!("{prefix}.load_steps"),
+                "give either load_steps or dt",
+            )?;
+            if let Some(n) = s.load_steps {
+                ensure(n >= 1, format!("{prefix}.load_steps"), "must be at least 1")?;
+            }
+        }
+    }
+    for (key, v) in [
+        ("residual_tolerance", s.residual_tolerance()),
+        ("displacement_tolerance", s.displacement_tolerance()),
+    ] {
+        ensure(
+            v > 0.0 && v < 1.0,
+            format!("{prefix}.{key}"),
+            "must lie in (0, 1)",
+        )?;
+    }
+    let support = s.min_node_support();
+    ensure(
+        (0.0..0.5).contains(&support),
+        format!("{prefix}.min_node_support"),
+        format!("must lie in [0, 0.5) (a fraction of one cell volume); got {support}"),
+    )?;
+    ensure(
+        s.max_iterations() >= 1,
+        format!("{prefix}.max_iterations"),
+        "must be at least 1",
+    )?;
+    linear_solver(s, prefix)
+}
+
+/// Ranges of the Krylov keys; CG cannot solve the unsymmetric F-bar tangent.
+fn linear_solver(s: &SolverConfig, prefix: &str) -> Check {
+    let key = |k: &str| format!("{prefix}.{k}");
+    match s.linear_solver() {
+        LinearSolver::Direct => return Ok(()),
+        LinearSolver::Cg => ensure(
+            !s.fbar(),
+            key("fbar"),
+            "F-bar makes the tangent unsymmetric, which linear_solver = \"cg\" cannot \
+             solve: use linear_solver = \"gmres\" or \"direct\"",
+        )?,
+        LinearSolver::Gmres => ensure(
+            s.krylov_restart() >= 1,
+            key("krylov_restart"),
+            "must be at least 1",
+        )?,
+    }
+    if let Some(eta) = s.krylov_tolerance {
+        ensure(
+            eta > 0.0 && eta < 1.0,
+            key("krylov_tolerance"),
+            format!("must lie in (0, 1) (a relative residual of the linear solve); got {eta}"),
+        )?;
+    }
+    ensure(
+        s.krylov_max_iterations() >= 1,
+        key("krylov_max_iterations"),
+        "must be at least 1",
+    )
+}
