@@ -36,6 +36,15 @@ fn err(text: &str) -> String {
         .to_string()
 }
 
+/// The scene is rejected with an error that contains every one of `parts` (the
+/// position, the key, the words of the message).
+fn rejected(text: &str, parts: &[&str]) {
+    let e = err(text);
+    for part in parts {
+        assert!(e.contains(part), "`{part}` not in: {e}");
+    }
+}
+
 #[test]
 fn the_reference_scene_is_valid() {
     Scene::parse("scene.toml", GOOD, &[]).unwrap();
@@ -52,101 +61,88 @@ fn malformed_toml_gives_line_and_column() {
 
 #[test]
 fn unknown_key_is_named_with_its_line() {
-    let e = err(&GOOD.replace("cfl = 0.5", "cfl = 0.5\nend_tme = 2.0"));
-    assert!(
-        e.contains("scene.toml:25:1") && e.contains("unknown field `end_tme`"),
-        "{e}"
+    rejected(
+        &GOOD.replace("cfl = 0.5", "cfl = 0.5\nend_tme = 2.0"),
+        &["scene.toml:25:1", "unknown field `end_tme`"],
     );
 }
 
 #[test]
 fn mistyped_value_points_at_the_value() {
-    let e = err(&GOOD.replace("density = 1.0", "density = \"heavy\""));
-    assert!(
-        e.contains("scene.toml:11:11") && e.contains("expected f64"),
-        "{e}"
+    rejected(
+        &GOOD.replace("density = 1.0", "density = \"heavy\""),
+        &["scene.toml:11:11", "expected f64"],
     );
 }
 
 #[test]
 fn unknown_model_is_named() {
-    let e = err(&GOOD.replace("\"linear_elastic\"", "\"linear_elastc\""));
-    assert!(
-        e.contains("scene.toml:10:9") && e.contains("unknown variant `linear_elastc`"),
-        "{e}"
+    rejected(
+        &GOOD.replace("\"linear_elastic\"", "\"linear_elastc\""),
+        &["scene.toml:10:9", "unknown variant `linear_elastc`"],
     );
 }
 
 #[test]
 fn negative_density() {
-    let e = err(&GOOD.replace("density = 1.0", "density = -1.0"));
-    assert!(
-        e.contains("scene.toml:11:11") && e.contains("key `material.0.density`"),
-        "{e}"
+    rejected(
+        &GOOD.replace("density = 1.0", "density = -1.0"),
+        &["scene.toml:11:11", "key `material.0.density`"],
     );
 }
 
 #[test]
 fn negative_modulus() {
-    let e = err(&GOOD.replace("youngs_modulus = 100.0", "youngs_modulus = -5.0"));
-    assert!(
-        e.contains("scene.toml:12:18") && e.contains("key `material.0.youngs_modulus`"),
-        "{e}"
+    rejected(
+        &GOOD.replace("youngs_modulus = 100.0", "youngs_modulus = -5.0"),
+        &["scene.toml:12:18", "key `material.0.youngs_modulus`"],
     );
 }
 
 #[test]
 fn poisson_ratio_at_one_half_for_a_compressible_model() {
-    let e = err(&GOOD.replace("poisson_ratio = 0.3", "poisson_ratio = 0.5"));
-    assert!(
-        e.contains("scene.toml:13:17") && e.contains("poisson_ratio") && e.contains("compressible"),
-        "{e}"
+    rejected(
+        &GOOD.replace("poisson_ratio = 0.3", "poisson_ratio = 0.5"),
+        &["scene.toml:13:17", "poisson_ratio", "compressible"],
     );
 }
 
 #[test]
 fn body_outside_the_grid() {
-    let e = err(&GOOD.replace("max = [2.0, 1.0]", "max = [5.0, 1.0]"));
-    assert!(
-        e.contains("key `body.0.shape`")
-            && e.contains("outside the grid")
-            && e.contains("scene.toml:17:9"),
-        "{e}"
+    rejected(
+        &GOOD.replace("max = [2.0, 1.0]", "max = [5.0, 1.0]"),
+        &["key `body.0.shape`", "outside the grid", "scene.toml:17:9"],
     );
 }
 
 #[test]
 fn cfl_above_one() {
-    let e = err(&GOOD.replace("cfl = 0.5", "cfl = 1.2"));
-    assert!(
-        e.contains("scene.toml:24:7") && e.contains("key `solver.cfl`"),
-        "{e}"
+    rejected(
+        &GOOD.replace("cfl = 0.5", "cfl = 1.2"),
+        &["scene.toml:24:7", "key `solver.cfl`"],
     );
 }
 
 #[test]
 fn wrong_vector_length_and_missing_material() {
-    let e = err(&GOOD.replace(
-        "min = [0.0, 0.0]\nmax = [2.0, 1.0]",
-        "min = [0.0, 0.0, 0.0]\nmax = [2.0, 1.0]",
-    ));
-    assert!(
-        e.contains("key `body.0.min`") && e.contains("needs 2 components"),
-        "{e}"
+    rejected(
+        &GOOD.replace(
+            "min = [0.0, 0.0]\nmax = [2.0, 1.0]",
+            "min = [0.0, 0.0, 0.0]\nmax = [2.0, 1.0]",
+        ),
+        &["key `body.0.min`", "needs 2 components"],
     );
-    let e = err(&GOOD.replace("material = \"m\"", "material = \"steel\""));
-    assert!(
-        e.contains("key `body.0.material`") && e.contains("no material is named `steel`"),
-        "{e}"
+    rejected(
+        &GOOD.replace("material = \"m\"", "material = \"steel\""),
+        &["key `body.0.material`", "no material is named `steel`"],
     );
 }
 
 #[test]
 fn keys_of_another_shape_are_rejected() {
-    let e = err(&GOOD.replace("max = [2.0, 1.0]", "max = [2.0, 1.0]\nradius = 0.3"));
-    assert!(
-        e.contains("key `body.0.radius`") && e.contains("does not apply"),
-        "{e}"
+    rejected(
+        &GOOD.replace("max = [2.0, 1.0]", "max = [2.0, 1.0]\nradius = 0.3"),
+        &["key `body.0.radius`", "does not apply"],
     );
 }
 
@@ -185,38 +181,33 @@ fn linear_solver_keys_are_checked() {
         &[],
     )
     .unwrap();
-    let e = err(&implicit("preconditioner = \"jacobi\""));
-    assert!(
-        e.contains("scene.toml:25:18")
-            && e.contains("key `solver.preconditioner`")
-            && e.contains("linear_solver = \"direct\""),
-        "{e}"
+    rejected(
+        &implicit("preconditioner = \"jacobi\""),
+        &[
+            "scene.toml:25:18",
+            "key `solver.preconditioner`",
+            "linear_solver = \"direct\"",
+        ],
     );
-    let e = err(&implicit("linear_solver = \"cg\"\nkrylov_restart = 10"));
-    assert!(
-        e.contains("scene.toml:26:18") && e.contains("key `solver.krylov_restart`"),
-        "{e}"
+    rejected(
+        &implicit("linear_solver = \"cg\"\nkrylov_restart = 10"),
+        &["scene.toml:26:18", "key `solver.krylov_restart`"],
     );
-    let e = err(&implicit(
-        "linear_solver = \"gmres\"\nkrylov_tolerance = 1.5",
-    ));
-    assert!(
-        e.contains("scene.toml:26:20") && e.contains("must lie in (0, 1)"),
-        "{e}"
+    rejected(
+        &implicit("linear_solver = \"gmres\"\nkrylov_tolerance = 1.5"),
+        &["scene.toml:26:20", "must lie in (0, 1)"],
     );
-    let e = err(&implicit(
-        "linear_solver = \"gmres\"\nkrylov_max_iterations = 0",
-    ));
-    assert!(e.contains("key `solver.krylov_max_iterations`"), "{e}");
-    let e = err(&implicit("linear_solver = \"bicgstab\""));
-    assert!(
-        e.contains("scene.toml:25:17") && e.contains("unknown variant `bicgstab`"),
-        "{e}"
+    rejected(
+        &implicit("linear_solver = \"gmres\"\nkrylov_max_iterations = 0"),
+        &["key `solver.krylov_max_iterations`"],
     );
-    let e = err(&GOOD.replace("cfl = 0.5", "cfl = 0.5\nlinear_solver = \"gmres\""));
-    assert!(
-        e.contains("key `solver.linear_solver`") && e.contains("explicit"),
-        "{e}"
+    rejected(
+        &implicit("linear_solver = \"bicgstab\""),
+        &["scene.toml:25:17", "unknown variant `bicgstab`"],
+    );
+    rejected(
+        &GOOD.replace("cfl = 0.5", "cfl = 0.5\nlinear_solver = \"gmres\""),
+        &["key `solver.linear_solver`", "explicit"],
     );
 }
 
@@ -231,13 +222,11 @@ fn fbar_is_checked() {
         Scene::parse("scene.toml", &text, &[]).unwrap();
     }
     // CG cannot solve the unsymmetric F-bar tangent.
-    let e = err(&implicit("linear_solver = \"cg\"\nfbar = true"));
-    assert!(
-        e.contains("scene.toml:26:8") && e.contains("key `solver.fbar`") && e.contains("gmres"),
-        "{e}"
+    rejected(
+        &implicit("linear_solver = \"cg\"\nfbar = true"),
+        &["scene.toml:26:8", "key `solver.fbar`", "gmres"],
     );
-    let e = err(&implicit("fbar = 1"));
-    assert!(e.contains("scene.toml:25:8") && e.contains("bool"), "{e}");
+    rejected(&implicit("fbar = 1"), &["scene.toml:25:8", "bool"]);
 }
 
 #[test]
@@ -249,22 +238,18 @@ fn a_model_without_tangent_needs_a_krylov_solver() {
         )
     };
     Scene::parse("scene.toml", &ogden("linear_solver = \"cg\""), &[]).unwrap();
-    let e = err(&ogden("linear_solver = \"direct\""));
-    assert!(
-        e.contains("scene.toml:26:17")
-            && e.contains("material `m` (model `ogden`) has no analytic tangent")
-            && e.contains("gmres"),
-        "{e}"
+    rejected(
+        &ogden("linear_solver = \"direct\""),
+        &[
+            "scene.toml:26:17",
+            "material `m` (model `ogden`) has no analytic tangent",
+            "gmres",
+        ],
     );
-    let e = err(&ogden(""));
-    assert!(
-        e.contains("key `solver.kind`") && e.contains("no analytic tangent"),
-        "{e}"
-    );
-    let e = err(&ogden("linear_solver = \"cg\"").replace("alpha = [2.0, -1.0]", "alpha = [2.0]"));
-    assert!(
-        e.contains("key `material.0.alpha`") && e.contains("one entry per term"),
-        "{e}"
+    rejected(&ogden(""), &["key `solver.kind`", "no analytic tangent"]);
+    rejected(
+        &ogden("linear_solver = \"cg\"").replace("alpha = [2.0, -1.0]", "alpha = [2.0]"),
+        &["key `material.0.alpha`", "one entry per term"],
     );
     let e =
         err(&ogden("linear_solver = \"cg\"").replace("alpha = [2.0, -1.0]", "alpha = [2.0, 1.0]"));
@@ -431,46 +416,45 @@ fn geomaterial_parameters_out_of_range() {
         ),
     ];
     for (from, to, at, key, msg) in cases {
-        let e = err(&GEO.replacen(from, to, 1));
-        assert!(
-            e.contains(at) && e.contains(&format!("key `{key}`")) && e.contains(msg),
-            "{e}"
+        rejected(
+            &GEO.replacen(from, to, 1),
+            &[at, &format!("key `{key}`"), msg],
         );
     }
 }
 
 #[test]
 fn geomaterial_keys_of_the_other_model_and_missing_keys() {
-    let e = err(&GEO.replace(
-        "mohr_coulomb_fit = \"plane_strain\"",
-        "mohr_coulomb_fit = \"plane_strain\"\ntensile_strength = 0.0",
-    ));
-    assert!(
-        e.contains("scene.toml:32:20")
-            && e.contains("key `material.1.tensile_strength`")
-            && e.contains("does not apply to model `drucker_prager`"),
-        "{e}"
+    rejected(
+        &GEO.replace(
+            "mohr_coulomb_fit = \"plane_strain\"",
+            "mohr_coulomb_fit = \"plane_strain\"\ntensile_strength = 0.0",
+        ),
+        &[
+            "scene.toml:32:20",
+            "key `material.1.tensile_strength`",
+            "does not apply to model `drucker_prager`",
+        ],
     );
-    let e = err(&GEO.replace("mohr_coulomb_fit = \"plane_strain\"\n", ""));
-    assert!(
-        e.contains("key `material.1.mohr_coulomb_fit`") && e.contains("is required"),
-        "{e}"
+    rejected(
+        &GEO.replace("mohr_coulomb_fit = \"plane_strain\"\n", ""),
+        &["key `material.1.mohr_coulomb_fit`", "is required"],
     );
-    let e = err(&GEO.replace("\"plane_strain\"", "\"planestrain\""));
-    assert!(
-        e.contains("scene.toml:31:20") && e.contains("unknown variant `planestrain`"),
-        "{e}"
+    rejected(
+        &GEO.replace("\"plane_strain\"", "\"planestrain\""),
+        &["scene.toml:31:20", "unknown variant `planestrain`"],
     );
-    let e = err(&GEO.replace("softening_start = 0.0\n", ""));
-    assert!(
-        e.contains("key `material.0.softening_start`") && e.contains("strain softening"),
-        "{e}"
+    rejected(
+        &GEO.replace("softening_start = 0.0\n", ""),
+        &["key `material.0.softening_start`", "strain softening"],
     );
-    let e = err(&GEO.replace(
-        "cohesion = 1.0e4\nfriction_angle = 30.0\ndilation_angle = 10.0",
-        "cohesion = 0.0\nfriction_angle = 0.0\ndilation_angle = 0.0",
-    ));
-    assert!(e.contains("no strength"), "{e}");
+    rejected(
+        &GEO.replace(
+            "cohesion = 1.0e4\nfriction_angle = 30.0\ndilation_angle = 10.0",
+            "cohesion = 0.0\nfriction_angle = 0.0\ndilation_angle = 0.0",
+        ),
+        &["no strength"],
+    );
 }
 
 #[test]
@@ -483,10 +467,14 @@ fn friction_face_needs_a_valid_coefficient() {
         e.starts_with("scene.toml:") && e.contains("boundary.0.friction_coefficient"),
         "{e}"
     );
-    let e = err(&with("friction_coefficient = -0.1"));
-    assert!(e.contains("scene.toml:25:24") && e.contains("≥ 0"), "{e}");
-    let e = err(&with("friction_coefficient = 0.4\nvelocity = [0.0, 0.0]"));
-    assert!(e.contains("boundary.0.velocity"), "{e}");
+    rejected(
+        &with("friction_coefficient = -0.1"),
+        &["scene.toml:25:24", "≥ 0"],
+    );
+    rejected(
+        &with("friction_coefficient = 0.4\nvelocity = [0.0, 0.0]"),
+        &["boundary.0.velocity"],
+    );
 }
 
 #[test]
@@ -495,10 +483,9 @@ fn friction_coefficient_only_on_friction_faces() {
         "[solver]",
         "[[boundary]]\nface = \"ymin\"\ncondition = \"roller\"\nfriction_coefficient = 0.4\n\n[solver]",
     );
-    let e = err(&text);
-    assert!(
-        e.contains("boundary.0.friction_coefficient") && e.contains("only to friction"),
-        "{e}"
+    rejected(
+        &text,
+        &["boundary.0.friction_coefficient", "only to friction"],
     );
 }
 
@@ -549,10 +536,9 @@ fn stage_strength_reduction_factor_is_checked() {
             "{bad}: {e}"
         );
     }
-    let e = err(&staged_geo("strength_reduction_factor = \"2\""));
-    assert!(
-        e.contains("scene.toml:48:29") && e.contains("expected f64"),
-        "{e}"
+    rejected(
+        &staged_geo("strength_reduction_factor = \"2\""),
+        &["scene.toml:48:29", "expected f64"],
     );
     // Overrides are checked like the file.
     let e = Scene::parse(
@@ -569,27 +555,26 @@ fn stage_strength_reduction_factor_is_checked() {
 fn stage_strength_reduction_factor_in_the_wrong_place() {
     // Nothing to reduce: only elastic materials.
     let text = GOOD.replace("cfl = 0.5", "cfl = 0.5\nstrength_reduction_factor = 2.0");
-    let e = err(&text);
-    assert!(
-        e.contains("scene.toml:25:29") && e.contains("nothing to reduce"),
-        "{e}"
-    );
+    rejected(&text, &["scene.toml:25:29", "nothing to reduce"]);
     // A material key it is not.
-    let e = err(&GEO.replace(
-        "tensile_strength = 1.0e3",
-        "tensile_strength = 1.0e3\nstrength_reduction_factor = 2.0",
-    ));
-    assert!(
-        e.contains("scene.toml:22:1") && e.contains("unknown field `strength_reduction_factor`"),
-        "{e}"
+    rejected(
+        &GEO.replace(
+            "tensile_strength = 1.0e3",
+            "tensile_strength = 1.0e3\nstrength_reduction_factor = 2.0",
+        ),
+        &[
+            "scene.toml:22:1",
+            "unknown field `strength_reduction_factor`",
+        ],
     );
     // With a [strength_reduction] search, whose trial factor holds in every stage.
     let search = "strength_reduction_factor = 2.0\n\n[strength_reduction]\nsearch = [1.0, 2.0]";
-    let e = err(&staged_geo(search));
-    assert!(
-        e.contains("scene.toml:48:29")
-            && e.contains("stage.1.strength_reduction_factor")
-            && e.contains("[strength_reduction] search"),
-        "{e}"
+    rejected(
+        &staged_geo(search),
+        &[
+            "scene.toml:48:29",
+            "stage.1.strength_reduction_factor",
+            "[strength_reduction] search",
+        ],
     );
 }
