@@ -31,8 +31,9 @@ use std::time::Instant;
 const WIDEN: f64 = 1.25;
 
 /// How a trial ended.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, strum::IntoStaticStr)]
 #[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
 pub enum TrialStatus {
     Stable,
     /// Newton did not converge after the cut-backs.
@@ -185,7 +186,7 @@ pub fn search(scene: &Scene, out: &Path, opts: &RunOptions) -> Result<SearchSumm
             .into_owned();
         csv.row([
             Field::from(t.factor),
-            Field::Text(status_name(t.status)),
+            Field::Text(t.status.into()),
             t.steps.into(),
             t.newton_iterations.into(),
             t.cutbacks.into(),
@@ -289,14 +290,5 @@ pub fn search(scene: &Scene, out: &Path, opts: &RunOptions) -> Result<SearchSumm
                 summary: Box::new(summary),
             })
         }
-    }
-}
-
-/// The status as written in strength_reduction.csv and summary.json.
-fn status_name(s: TrialStatus) -> &'static str {
-    match s {
-        TrialStatus::Stable => "stable",
-        TrialStatus::FailedNewton => "failed_newton",
-        TrialStatus::FailedDisplacement => "failed_displacement",
     }
 }

@@ -11,11 +11,16 @@
 //! with Δt = 10 × the explicit critical step at t = 0. In a staged scene the
 //! implicit configurations act on every implicit stage.
 
-use crate::scene::{Integrator, SceneConfig, SolverKind};
+use crate::scene::{Integrator, LinearSolver, PreconditionerKind, SceneConfig, SolverKind};
+use strum::IntoEnumIterator;
 use toml_edit::DocumentMut;
 
-pub const KRYLOV: [&str; 2] = ["gmres", "cg"];
-pub const PRECONDITIONERS: [&str; 4] = ["none", "jacobi", "block_jacobi", "lagged_direct"];
+/// The matrix-free linear solvers (every one but the direct solver), by name.
+fn krylov_names() -> impl Iterator<Item = &'static str> {
+    LinearSolver::iter()
+        .filter(|&s| s != LinearSolver::Direct)
+        .map(|s| s.name())
+}
 
 /// Solver-table keys kept when a configuration switches between explicit and
 /// implicit; every other key of the table is removed.
@@ -43,8 +48,8 @@ impl Configuration {
 /// Names of the built-in configurations.
 pub fn builtin_names() -> Vec<String> {
     let mut names = vec!["explicit".to_string(), "direct".to_string()];
-    for k in KRYLOV {
-        names.extend(PRECONDITIONERS.iter().map(|p| format!("{k}_{p}")));
+    for k in krylov_names() {
+        names.extend(PreconditionerKind::iter().map(|p| format!("{k}_{}", p.name())));
     }
     names
 }
@@ -118,7 +123,7 @@ pub fn builtin(
     }
     for p in prefixes {
         match name.split_once('_') {
-            Some((krylov, pre)) if KRYLOV.contains(&krylov) => {
+            Some((krylov, pre)) if krylov_names().any(|k| k == krylov) => {
                 c.set.push(format!("{p}.linear_solver=\"{krylov}\""));
                 c.set.push(format!("{p}.preconditioner=\"{pre}\""));
             }

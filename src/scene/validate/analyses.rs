@@ -33,7 +33,7 @@ pub fn geostatic(g: &GeostaticConfig, s: &SceneConfig, materials: &[Box<dyn Mate
             built.integrates_from_stored_stress(),
             format!("body.{i}.material"),
             format!(
-                "[geostatic] needs models that integrate from the stored stress (linear_elastic, drucker_prager, mohr_coulomb); `{}` is {}",
+                "[geostatic] needs models whose stress update starts from the stored stress, so that the K0 stresses persist (hyperelastic models compute the stress from F alone); `{}` is {}",
                 m.name, m.model
             ),
         )?;
@@ -87,7 +87,7 @@ pub fn strength_reduction(
     ensure(
         materials.iter().any(|m| m.frictional_strength().is_some()),
         p,
-        "needs a drucker_prager or mohr_coulomb material (nothing to reduce)",
+        "needs a material with a frictional strength, c and φ (nothing to reduce)",
     )?;
     ensure(
         s.stages().iter().any(|st| st.kind == SolverKind::Implicit),

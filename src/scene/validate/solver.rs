@@ -59,7 +59,7 @@ pub fn stage_strength_factor(
     ensure(
         materials.iter().any(|m| m.frictional_strength().is_some()),
         key.clone(),
-        "needs a drucker_prager or mohr_coulomb material (nothing to reduce)",
+        "needs a material with a frictional strength, c and φ (nothing to reduce)",
     )?;
     ensure(
         s.strength_reduction.is_none(),

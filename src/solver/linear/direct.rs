@@ -39,7 +39,8 @@ pub enum Structure {
 }
 
 /// Factorization that was used by the last successful [`DirectSolver::factorize`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, strum::IntoStaticStr)]
+#[strum(serialize_all = "snake_case")]
 pub enum Method {
     /// Sparse Cholesky `LLᵀ` (symmetric positive definite).
     Llt,
@@ -52,11 +53,7 @@ pub enum Method {
 impl Method {
     /// Short name for logs (newton.csv).
     pub fn name(&self) -> &'static str {
-        match self {
-            Method::Llt => "llt",
-            Method::Ldlt => "ldlt",
-            Method::Lu => "lu",
-        }
+        self.into()
     }
 }
 
