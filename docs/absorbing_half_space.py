@@ -5,7 +5,7 @@ grid from which no reflection reaches the probes in time (docs/absorbing.md).
 Regenerate (python3, standard library only):
 
     MPM_HALF_SPACE_CSV=docs/absorbing_half_space.csv \\
-        cargo test --release --test absorbing -- --nocapture half_space
+        cargo test --release --test verification -- --nocapture absorbing::half_space
     python3 docs/absorbing_half_space.py
 
 prints the markdown tables of docs/absorbing.md and writes

@@ -1,7 +1,7 @@
 //! Total-Lagrangian finite elements for the plane-strain Hencky cantilever of
 //! problems/cantilever.toml: an independent discretisation of the same continuum,
 //! written to verify the MPM result (not a product feature; no particles, no grid
-//! transfer). Shared by `examples/cantilever_fe/main.rs` and tests/cantilever.rs.
+//! transfer). Shared by `examples/cantilever_fe/main.rs` and tests/verification/cantilever.rs.
 //!
 //! - Mesh: nx × ny 9-node Lagrange quadrilaterals (biquadratic) on the reference
 //!   rectangle [0, L] × [0, d], 3 × 3 Gauss points.

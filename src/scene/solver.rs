@@ -290,7 +290,7 @@ impl SolverConfig {
     }
     /// Nodes whose particle support Σ_p V_p S_Ip is below this fraction of a cell
     /// volume are tied to two neighbours by linear extrapolation (default 1e-2;
-    /// 0 turns it off). See `implicit::support`.
+    /// 0 turns it off). See `solver::implicit::ties`.
     pub fn min_node_support(&self) -> f64 {
         self.min_node_support.unwrap_or(1e-2)
     }

@@ -4,7 +4,7 @@
 //! rigid base (friction face: fixed in the implicit stage, Coulomb in the
 //! explicit one). All runs use h = 1 m (`grid.cells = [60, 12]`, 1000 particles;
 //! the scene ships h = 0.5 m), where the factor of safety of this slope is about
-//! 1.75 (tests/strength_reduction.rs).
+//! 1.75 (tests/verification/strength_reduction.rs).
 //!
 //! - Hand-off: at F = 1.1 (well below the factor of safety) the explicit stage
 //!   must stay where the implicit equilibrium left it: every particle moves

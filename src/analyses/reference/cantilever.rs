@@ -5,7 +5,7 @@
 //! thickness). By default the beam is Reissner's (the elastica with extension
 //! P/EA and shear P/(κGA), κ = 5/6), the beam model of a 2D continuum;
 //! `beam = "elastica"` gives the classical inextensible elastica. Error
-//! |v / v_ref − 1|. Details: tests/cantilever.rs, papers/cantilever_elastica/.
+//! |v / v_ref − 1|. Details: tests/verification/cantilever.rs, papers/cantilever_elastica/.
 
 use super::elastica::elastica;
 use super::{body0_box, body0_material, ErrorMeasure, KeyError};

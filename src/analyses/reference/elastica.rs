@@ -2,7 +2,7 @@
 //! EI θ'' = −P cos θ, θ(0) = 0, θ'(L) = 0 (Mattiasson 1981), optionally with
 //! extension and shear (Reissner's beam), solved by shooting on θ'(0) with RK4 and
 //! bisection. Lengths are in units of the beam length; k = P L²/EI.
-//! Checked against Mattiasson's table in tests/cantilever.rs.
+//! Checked against Mattiasson's table in tests/verification/cantilever.rs.
 
 /// Integrate θ'' = −k x'(θ) over s ∈ [0, 1] from θ(0) = 0, θ'(0) = kappa0, with
 /// x' = cos θ + (a_e − a_s) sin θ cos θ and v' = sin θ + a_e sin²θ + a_s cos²θ
