@@ -103,6 +103,7 @@ pub(crate) mod tests {
     //! families through the `ShapeFunction` dispatch.
 
     use super::*;
+    use strum::IntoEnumIterator;
 
     /// Small deterministic generator (SplitMix64), so tests need no extra crate.
     pub(crate) struct Rng(u64);
@@ -301,15 +302,6 @@ pub(crate) mod tests {
         }
     }
 
-    const FAMILIES: [ShapeFunction; 6] = [
-        ShapeFunction::Linear,
-        ShapeFunction::Ugimp,
-        ShapeFunction::Cpgimp,
-        ShapeFunction::Cpdi,
-        ShapeFunction::Bspline2,
-        ShapeFunction::Bspline3,
-    ];
-
     /// A deformation gradient with rotation, shear and stretch, scaled so that the
     /// CPDI domain r = F diag(h/4) reaches at most `reach` cell sizes from the
     /// particle along each axis (Σ_i |r_di| ≤ reach h_d).
@@ -343,7 +335,7 @@ pub(crate) mod tests {
     /// stretched until they reach one cell size from the particle.
     fn all_families_respect_max_support<const D: usize>() {
         let mut rng = Rng::new(77);
-        for shape in FAMILIES {
+        for shape in ShapeFunction::iter() {
             let g = test_grid::<D>(shape.degree());
             let cap = shape.max_support(D);
             for x in sample_points(&g, 400) {
