@@ -4,7 +4,7 @@
 
 use clap::{Parser, Subcommand};
 use mpm::analyses::bench::{bench, BenchError, BenchOptions};
-use mpm::analyses::check;
+use mpm::analyses::reference;
 use mpm::analyses::strength_reduction::{search, SearchError};
 use mpm::run::{run, RunError, RunOptions};
 use mpm::scene::Scene;
@@ -262,9 +262,7 @@ fn main() -> ExitCode {
 /// A scene for `mpm run` and `mpm check`: parsed, validated, and its analysis
 /// tables checked.
 fn load(path: &std::path::Path, overrides: &[String]) -> Result<Scene, mpm::scene::SceneError> {
-    let scene = Scene::load(path, overrides)?;
-    check(&scene)?;
-    Ok(scene)
+    reference::checked(Scene::load(path, overrides)?)
 }
 
 /// A hint when a scene that `run`/`check` rejects is a limit-analysis file (top-level

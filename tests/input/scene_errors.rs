@@ -578,3 +578,34 @@ fn stage_strength_reduction_factor_in_the_wrong_place() {
         ],
     );
 }
+
+/// A `[reference]` that does not fit its scene is rejected with its key by every
+/// command that loads scenes (`mpm check`, `mpm run`, `mpm bench`), before any run.
+#[test]
+fn a_reference_that_does_not_fit_is_rejected() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bad.toml");
+    let text = format!("{GOOD}\n[reference]\nkind = \"column\"\nbeam = \"reissner\"\n");
+    std::fs::write(&path, text).unwrap();
+    let out = dir.path().join("o");
+    for args in [
+        vec!["check"],
+        vec!["run", "--out", out.to_str().unwrap()],
+        vec!["bench", "--out", out.to_str().unwrap()],
+    ] {
+        let result = Command::new(env!("CARGO_BIN_EXE_mpm"))
+            .args(&args)
+            .arg(&path)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&result.stderr);
+        assert_eq!(result.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(
+            stderr.contains("bad.toml:28:8")
+                && stderr.contains("key `reference.beam`")
+                && stderr.contains("cantilever"),
+            "{args:?}: {stderr}"
+        );
+    }
+    assert!(!out.join("bench.csv").exists(), "bench stopped before running");
+}

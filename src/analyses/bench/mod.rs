@@ -10,6 +10,7 @@ pub mod child;
 pub mod configurations;
 mod plots;
 
+use crate::analyses::reference;
 use crate::analyses::strength_reduction::SearchSummary;
 use crate::model::Model;
 use crate::output::{CsvWriter, Field, Table};
@@ -180,7 +181,7 @@ pub fn bench(opts: &BenchOptions) -> Result<BenchReport, BenchError> {
     let file = opts.scene.display().to_string();
     let text = std::fs::read_to_string(&opts.scene)
         .map_err(|e| SceneError::plain(&file, format!("cannot read the scene file: {e}")))?;
-    let first = Scene::parse(&file, &text, &opts.overrides)?;
+    let first = reference::checked(Scene::parse(&file, &text, &opts.overrides)?)?;
     let (settings, names_source) = settings(opts, &first)?;
     // Every run: no ParaView frames (they would dominate small runs), the [bench]
     // overrides, then the command line's.
@@ -188,7 +189,7 @@ pub fn bench(opts: &BenchOptions) -> Result<BenchReport, BenchError> {
     base_set.extend(settings.set.iter().cloned());
     base_set.extend(opts.overrides.iter().cloned());
     let base_text = overrides::apply(&file, &text, &base_set)?;
-    let base = Scene::parse(&file, &base_text, &[])?;
+    let base = reference::checked(Scene::parse(&file, &base_text, &[])?)?;
     let dt_critical = critical_dt(&base)?;
     let configs = resolve(&settings, &base, &base_text, dt_critical, names_source)?;
     let grids = grid_points(&base.config.grid.cells, &settings);
@@ -222,7 +223,7 @@ pub fn bench(opts: &BenchOptions) -> Result<BenchReport, BenchError> {
             .and_then(|t| {
                 std::fs::write(&configured_path, &t)
                     .map_err(|e| SceneError::plain(&label, format!("cannot write: {e}")))?;
-                Scene::parse(&label, &t, &[])
+                reference::checked(Scene::parse(&label, &t, &[])?)
             });
         let scene_c = match configured {
             Ok(s) => s,
@@ -475,7 +476,7 @@ fn run_point(
     let text =
         overrides::unset(file, base_text, &unset).and_then(|t| overrides::apply(file, &t, &set))?;
     std::fs::write(&scene_path, &text)?;
-    let scene = match Scene::parse(&label, &text, &[]) {
+    let scene = match Scene::parse(&label, &text, &[]).and_then(reference::checked) {
         Ok(s) => s,
         Err(e) => {
             row.status = format!("skipped: {e}");
@@ -517,7 +518,7 @@ fn run_point(
     read_outputs(&mut row, &run_dir);
     row.status = status(child.exit, &run_dir, timeout);
     if row.is_ok() {
-        match crate::analyses::reference::from_scene(cfg) {
+        match reference::from_scene(cfg) {
             Ok(Some(measure)) => match measure.error(&run_dir) {
                 Ok(e) => row.error = Some(e),
                 Err(m) => row.note = format!("no error: {m}"),

@@ -11,7 +11,7 @@ pub mod cantilever;
 pub mod column;
 pub mod elastica;
 
-use crate::scene::{BodyShape, ReferenceKind, SceneConfig};
+use crate::scene::{BodyShape, ReferenceKind, Scene, SceneConfig, SceneError};
 use std::path::Path;
 
 /// An error measure of one scene against its analytical reference.
@@ -42,6 +42,16 @@ pub fn from_scene(s: &SceneConfig) -> Result<Option<Box<dyn ErrorMeasure>>, KeyE
         ReferenceKind::VibratingBar => Box::new(bar::BarPeriod::from_scene(s)?),
         ReferenceKind::Cantilever => Box::new(cantilever::CantileverTip::from_scene(s)?),
     }))
+}
+
+/// A parsed scene whose `[reference]`, if any, fits it (the check that the scene
+/// validation cannot make: it needs the reference kinds of this layer). `mpm run`,
+/// `mpm check` and `mpm bench` load scenes through it.
+pub fn checked(scene: Scene) -> Result<Scene, SceneError> {
+    match from_scene(&scene.config) {
+        Ok(_) => Ok(scene),
+        Err((key, m)) => Err(SceneError::at_key(&scene.file, &scene.text, &key, m)),
+    }
 }
 
 /// Corners of body 0, which must be a rectangle or box (the references are about a
