@@ -1,5 +1,5 @@
 //! Drucker–Prager elastoplasticity at finite strain (thesis §3.2, 3-36…3-62),
-//! perfectly plastic, on the Hencky kinematics of `principal.rs`.
+//! perfectly plastic, on the Hencky kinematics of `return_mapping.rs`.
 //!
 //! Yield function and plastic potential on the Kirchhoff stress τ (tension
 //! positive), with q = √(3/2 s:s) and σ_m = tr τ / 3:
@@ -136,6 +136,7 @@ impl FromParameters for DruckerPrager {
         "dilation_angle",
         "mohr_coulomb_fit",
     ];
+    const EXAMPLE: &'static str = "youngs_modulus = 1.0e6\npoisson_ratio = 0.3\ncohesion = 1.0e3\nfriction_angle = 30.0\nmohr_coulomb_fit = \"outer\"";
 
     /// Angles in degrees in the scene, radians here.
     fn from_parameters(density: f64, p: &Parameters) -> Result<Self, KeyError> {

@@ -153,6 +153,7 @@ impl Hencky {
 impl FromParameters for Hencky {
     const NAME: &'static str = "hencky";
     const KEYS: &'static [&'static str] = &["youngs_modulus", "poisson_ratio"];
+    const EXAMPLE: &'static str = "youngs_modulus = 1.0e6\npoisson_ratio = 0.3";
 
     fn from_parameters(density: f64, p: &Parameters) -> Result<Self, KeyError> {
         // E is checked before ν (arguments are evaluated in order).

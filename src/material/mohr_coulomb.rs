@@ -1,6 +1,6 @@
 //! Mohr–Coulomb elastoplasticity at finite strain (thesis 3-34, 3-35) with
 //! non-associated flow, a tension cut-off and strain softening, on the Hencky
-//! kinematics of `principal.rs`.
+//! kinematics of `return_mapping.rs`.
 //!
 //! In ordered principal Kirchhoff stresses τ_1 ≥ τ_2 ≥ τ_3 (tension positive) the
 //! yield function is (3-35)
@@ -465,6 +465,7 @@ impl FromParameters for MohrCoulomb {
         "softening_end",
         "tensile_strength",
     ];
+    const EXAMPLE: &'static str = "youngs_modulus = 1.0e6\npoisson_ratio = 0.3\ncohesion = 1.0e3\nfriction_angle = 30.0\ndilation_angle = 10.0";
 
     /// Angles in degrees in the scene, radians here.
     fn from_parameters(density: f64, p: &Parameters) -> Result<Self, KeyError> {

@@ -138,6 +138,7 @@ impl MooneyRivlin {
 impl FromParameters for MooneyRivlin {
     const NAME: &'static str = "mooney_rivlin";
     const KEYS: &'static [&'static str] = &["a", "b", "poisson_ratio"];
+    const EXAMPLE: &'static str = "a = 1.0e5\nb = 1.0e5\npoisson_ratio = 0.3";
 
     fn from_parameters(density: f64, p: &Parameters) -> Result<Self, KeyError> {
         let a: f64 = p.required("a")?;

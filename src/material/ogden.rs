@@ -78,6 +78,7 @@ impl Ogden {
 impl FromParameters for Ogden {
     const NAME: &'static str = "ogden";
     const KEYS: &'static [&'static str] = &["mu", "alpha", "poisson_ratio"];
+    const EXAMPLE: &'static str = "mu = [1.0e5]\nalpha = [2.0]\npoisson_ratio = 0.3";
 
     fn from_parameters(density: f64, p: &Parameters) -> Result<Self, KeyError> {
         let mu: Vec<f64> = p.required("mu")?;

@@ -20,6 +20,9 @@ pub trait FromParameters: Sized {
     /// The keys the model takes besides name, model and density; any other key of
     /// the table "does not apply" to it.
     const KEYS: &'static [&'static str];
+    /// A valid parameter table (TOML, the keys besides name, model and density):
+    /// an example for readers, and what the registry's test builds the model from.
+    const EXAMPLE: &'static str;
     /// The model from its density and parameters, their ranges checked.
     fn from_parameters(density: f64, p: &Parameters) -> Result<Self, KeyError>;
 }

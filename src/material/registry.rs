@@ -11,11 +11,13 @@ use std::sync::OnceLock;
 /// A model's constructor from its density and parameters.
 type Constructor = fn(f64, &Parameters) -> Result<Box<dyn Material>, KeyError>;
 
-/// One model: its name, its keys and its constructor.
+/// One model: its name, its keys, an example of its parameters and its
+/// constructor.
 #[derive(Clone, Copy, Debug)]
 pub struct Entry {
     pub name: &'static str,
     pub keys: &'static [&'static str],
+    pub example: &'static str,
     construct: Constructor,
 }
 
@@ -24,6 +26,7 @@ impl Entry {
         Entry {
             name: M::NAME,
             keys: M::KEYS,
+            example: M::EXAMPLE,
             construct: construct::<M>,
         }
     }
@@ -109,18 +112,8 @@ mod tests {
             assert!(!seen.contains(&m.name), "`{}` registered twice", m.name);
             seen.push(m.name);
         }
-        let table: toml::Table = toml::from_str(
-            "youngs_modulus = 1.0e6\npoisson_ratio = 0.3\na = 1.0e5\nb = 1.0e5\n\
-             cohesion = 1.0e3\nfriction_angle = 30.0\nmohr_coulomb_fit = \"outer\"\n\
-             mu = [1.0e5]\nalpha = [2.0]",
-        )
-        .unwrap();
         for m in MODELS {
-            let values = table
-                .iter()
-                .filter(|(k, _)| m.keys.contains(&k.as_str()))
-                .map(|(k, v)| (k.clone(), v.clone()))
-                .collect();
+            let values: toml::Table = toml::from_str(m.example).unwrap();
             let built = build("material.0", m.name, 1000.0, &values).unwrap();
             assert_eq!(built.model(), m.name, "Material::model of `{}`", m.name);
         }

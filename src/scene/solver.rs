@@ -70,7 +70,7 @@ pub enum PreconditionerKind {
 
 /// The `[solver]` table (or a `[[stage]]`). The accessors give the documented
 /// defaults; `SCOPES` says where each optional key applies.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SolverConfig {
     /// Stage name (for `[[stage]]` tables; optional).
@@ -166,6 +166,8 @@ impl PreconditionerKind {
 #[derive(Clone, Copy, Debug)]
 pub struct Scope {
     pub key: &'static str,
+    /// Whether the table gives the key.
+    pub given: fn(&SolverConfig) -> bool,
     pub kinds: &'static [SolverKind],
     pub integrators: &'static [Integrator],
     pub linear_solvers: &'static [LinearSolver],
@@ -176,6 +178,7 @@ pub struct Scope {
 impl Scope {
     const fn new(
         key: &'static str,
+        given: fn(&SolverConfig) -> bool,
         kinds: &'static [SolverKind],
         integrators: &'static [Integrator],
         linear_solvers: &'static [LinearSolver],
@@ -183,6 +186,7 @@ impl Scope {
     ) -> Scope {
         Scope {
             key,
+            given,
             kinds,
             integrators,
             linear_solvers,
@@ -203,30 +207,39 @@ const RESTART_LENGTH: &str = " (it is the GMRES restart length)";
 const FULL_GRAVITY: &str = " (gravity is always in full)";
 const GIVE_DT: &str = " (give dt)";
 
+/// The `Scope` of the optional key `key`, a field of `SolverConfig` named as in
+/// the table.
+macro_rules! scope {
+    ($key:ident, $($where:expr),*) => {
+        Scope::new(stringify!($key), |s| s.$key.is_some(), $($where),*)
+    };
+}
+
 /// The optional keys that apply to some solvers only (every other key applies to
-/// all): key, solver kinds, integrators, linear solvers (`&[]`: all), note.
+/// all): key, whether it is given, solver kinds, integrators, linear solvers
+/// (`&[]`: all), note.
 pub const SCOPES: &[Scope] = &[
-    Scope::new("scheme", EXPLICIT, &[], &[], ""),
-    Scope::new("cfl", EXPLICIT, &[], &[], ""),
-    Scope::new("flip", EXPLICIT, &[], &[], ""),
-    Scope::new("damping", EXPLICIT, &[], &[], ""),
-    Scope::new("integrator", IMPLICIT, &[], &[], ""),
-    Scope::new("beta", IMPLICIT, NEWMARK, &[], ""),
-    Scope::new("gamma", IMPLICIT, NEWMARK, &[], ""),
-    Scope::new("mass", IMPLICIT, NEWMARK, &[], ""),
-    Scope::new("gravity_ramp", IMPLICIT, QUASI_STATIC, &[], FULL_GRAVITY),
-    Scope::new("load_steps", IMPLICIT, QUASI_STATIC, &[], GIVE_DT),
-    Scope::new("residual_tolerance", IMPLICIT, &[], &[], ""),
-    Scope::new("displacement_tolerance", IMPLICIT, &[], &[], ""),
-    Scope::new("max_iterations", IMPLICIT, &[], &[], ""),
-    Scope::new("line_search", IMPLICIT, &[], &[], ""),
-    Scope::new("max_cutbacks", IMPLICIT, &[], &[], ""),
-    Scope::new("min_node_support", IMPLICIT, &[], &[], ""),
-    Scope::new("linear_solver", IMPLICIT, &[], &[], ""),
-    Scope::new("preconditioner", IMPLICIT, &[], KRYLOV, SET_KRYLOV),
-    Scope::new("krylov_tolerance", IMPLICIT, &[], KRYLOV, SET_KRYLOV),
-    Scope::new("krylov_restart", IMPLICIT, &[], GMRES, RESTART_LENGTH),
-    Scope::new("krylov_max_iterations", IMPLICIT, &[], KRYLOV, SET_KRYLOV),
+    scope!(scheme, EXPLICIT, &[], &[], ""),
+    scope!(cfl, EXPLICIT, &[], &[], ""),
+    scope!(flip, EXPLICIT, &[], &[], ""),
+    scope!(damping, EXPLICIT, &[], &[], ""),
+    scope!(integrator, IMPLICIT, &[], &[], ""),
+    scope!(beta, IMPLICIT, NEWMARK, &[], ""),
+    scope!(gamma, IMPLICIT, NEWMARK, &[], ""),
+    scope!(mass, IMPLICIT, NEWMARK, &[], ""),
+    scope!(gravity_ramp, IMPLICIT, QUASI_STATIC, &[], FULL_GRAVITY),
+    scope!(load_steps, IMPLICIT, QUASI_STATIC, &[], GIVE_DT),
+    scope!(residual_tolerance, IMPLICIT, &[], &[], ""),
+    scope!(displacement_tolerance, IMPLICIT, &[], &[], ""),
+    scope!(max_iterations, IMPLICIT, &[], &[], ""),
+    scope!(line_search, IMPLICIT, &[], &[], ""),
+    scope!(max_cutbacks, IMPLICIT, &[], &[], ""),
+    scope!(min_node_support, IMPLICIT, &[], &[], ""),
+    scope!(linear_solver, IMPLICIT, &[], &[], ""),
+    scope!(preconditioner, IMPLICIT, &[], KRYLOV, SET_KRYLOV),
+    scope!(krylov_tolerance, IMPLICIT, &[], KRYLOV, SET_KRYLOV),
+    scope!(krylov_restart, IMPLICIT, &[], GMRES, RESTART_LENGTH),
+    scope!(krylov_max_iterations, IMPLICIT, &[], KRYLOV, SET_KRYLOV),
 ];
 
 impl SolverConfig {
@@ -323,7 +336,6 @@ impl SolverConfig {
     /// kind rules keys out first, then the integrator, then the linear solver;
     /// within each, the first key in `SCOPES` is named.
     pub fn key_out_of_scope(&self) -> Option<(&'static str, String)> {
-        let table = serde_json::to_value(self).expect("a solver table serialises");
         let (integrator, linear_solver) = (self.integrator(), self.linear_solver());
         let ruled_out = |s: &Scope| {
             if !s.kinds.contains(&self.kind) {
@@ -338,7 +350,7 @@ impl SolverConfig {
             }
         };
         (SCOPES.iter())
-            .filter(|s| !table[s.key].is_null())
+            .filter(|s| (s.given)(self))
             .filter_map(|s| ruled_out(s).map(|(by, outside)| (by, s.key, outside)))
             .min_by_key(|&(by, _, _)| by)
             .map(|(_, key, outside)| (key, outside))

@@ -26,8 +26,6 @@ pub fn run_problem(
     (result, dir)
 }
 
-#[allow(unused_imports)]
-pub use mpm::analyses::reference::bar::zero_crossings;
 /// Run the strength-reduction search of `problems/NAME` with overrides.
 pub fn search_problem(
     name: &str,
@@ -42,6 +40,8 @@ pub fn search_problem(
 
 /// CSV outputs by column name, and the zero crossings of a sampled signal: the
 /// library's own (used by the error measures of `mpm bench`).
+#[allow(unused_imports)]
+pub use mpm::analyses::reference::bar::zero_crossings;
 #[allow(unused_imports)]
 pub use mpm::output::Table;
 

@@ -607,5 +607,8 @@ fn a_reference_that_does_not_fit_is_rejected() {
             "{args:?}: {stderr}"
         );
     }
-    assert!(!out.join("bench.csv").exists(), "bench stopped before running");
+    assert!(
+        !out.join("bench.csv").exists(),
+        "bench stopped before running"
+    );
 }

@@ -530,14 +530,12 @@ fn run_point(
     Ok(row)
 }
 
+/// explicit, newmark, quasi_static (the integrator's name) or staged.
 fn solver_label(cfg: &SceneConfig) -> &'static str {
     match &cfg.solver {
         None => "staged",
-        Some(s) => match (s.kind, s.integrator()) {
-            (SolverKind::Explicit, _) => "explicit",
-            (SolverKind::Implicit, Integrator::Newmark) => "newmark",
-            (SolverKind::Implicit, Integrator::QuasiStatic) => "quasi_static",
-        },
+        Some(s) if s.kind == SolverKind::Explicit => s.kind.name(),
+        Some(s) => s.integrator().name(),
     }
 }
 

@@ -8,7 +8,7 @@ use crate::scene::SceneError;
 use serde::Deserialize;
 use std::path::Path;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Problem {
     Footing,

@@ -111,8 +111,7 @@ fn solve_level(scene: &LimitScene, refinements: u32) -> Result<Level, LimitError
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LimitSummary {
     pub scene: String,
-    /// `footing` or `slope`.
-    pub problem: String,
+    pub problem: Problem,
     /// What is bounded: `limit_pressure` or `factor_of_safety`.
     pub quantity: String,
     pub lower_bound: f64,
@@ -271,13 +270,13 @@ pub fn run_limit(
         levels.push(l);
     }
     let last = levels.last().expect("at least one level");
-    let (problem, quantity) = match scene.config.problem {
-        Problem::Footing => ("footing", "limit_pressure"),
-        Problem::Slope => ("slope", "factor_of_safety"),
+    let quantity = match scene.config.problem {
+        Problem::Footing => "limit_pressure",
+        Problem::Slope => "factor_of_safety",
     };
     let summary = LimitSummary {
         scene: scene.file.clone(),
-        problem: problem.into(),
+        problem: scene.config.problem,
         quantity: quantity.into(),
         lower_bound: last.lower,
         upper_bound: last.upper,

@@ -23,7 +23,7 @@ pub trait ErrorMeasure {
 }
 
 /// A scene-validation failure: dotted key path and message.
-pub type KeyError = (String, String);
+pub use crate::material::parameters::KeyError;
 
 /// The error measure the scene declares, if any; an error names the scene key that
 /// makes the reference inapplicable.

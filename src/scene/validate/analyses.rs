@@ -84,8 +84,11 @@ pub fn strength_reduction(
             "must be a positive length",
         )?;
     }
+    // Something a factor divides, as strength reduction does it.
     ensure(
-        materials.iter().any(|m| m.frictional_strength().is_some()),
+        materials
+            .iter()
+            .any(|m| m.with_reduced_strength(1.0).is_some()),
         p,
         "needs a material with a frictional strength, c and φ (nothing to reduce)",
     )?;

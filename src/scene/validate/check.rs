@@ -1,8 +1,7 @@
 //! The checks every table uses: a condition at a key, vectors of the scene's
 //! dimension, required and ruled-out optional keys.
 
-/// A failed check: the dotted key path and the message.
-pub type KeyError = (String, String);
+pub use crate::material::parameters::KeyError;
 pub type Check = Result<(), KeyError>;
 
 pub fn ensure(ok: bool, path: impl Into<String>, msg: impl Into<String>) -> Check {

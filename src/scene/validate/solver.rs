@@ -56,8 +56,11 @@ pub fn stage_strength_factor(
         key.clone(),
         format!("must be a positive number (c and tan φ are divided by it); got {f}"),
     )?;
+    // Something a factor divides, as strength reduction does it.
     ensure(
-        materials.iter().any(|m| m.frictional_strength().is_some()),
+        materials
+            .iter()
+            .any(|m| m.with_reduced_strength(1.0).is_some()),
         key.clone(),
         "needs a material with a frictional strength, c and φ (nothing to reduce)",
     )?;

@@ -270,7 +270,8 @@ impl KrylovState {
         };
         let outcome: Outcome = match config.method {
             LinearSolver::Cg => cg(product, pre, &b, &mut du, &settings),
-            _ => gmres(product, pre, &b, &mut du, &settings),
+            LinearSolver::Gmres => gmres(product, pre, &b, &mut du, &settings),
+            LinearSolver::Direct => unreachable!("KrylovConfig::of is None for the direct solver"),
         }?;
         self.iterations += outcome.iterations;
         if !outcome.converged || outcome.iterations > LAGGED_REFRESH_ITERATIONS {
