@@ -4,7 +4,8 @@
 //! Every `.rs` file under `src/` (but `src/bin/`) is a module; a folder's `mod.rs`
 //! is the folder's module. The test reads each module's non-test code (comments,
 //! string literals and `#[cfg(test)]` items removed), collects the paths it names
-//! (`use crate::…`, `use super::…`, `use child::…` and inline `crate::a::b::f`),
+//! (`use crate::…`, `use super::…`, `use child::…`, and in code `crate::a::f`,
+//! `super::a::f`, `child::f`),
 //! resolves each to the module that defines it, and checks that
 //! 1. an import either stays inside its top-level module or points to a lower layer
 //!    (`LAYERS`), and
@@ -239,28 +240,58 @@ fn expand(tree: &str) -> Vec<String> {
 /// The paths a module names: its `use` trees and inline `crate::…` paths.
 fn named_paths(src: &str) -> Vec<String> {
     let mut out = Vec::new();
+    // The code without its `use` statements, for the paths written inline.
+    let mut code = String::new();
+    let mut last = 0;
     for (k, _) in src.match_indices("use ") {
         let before = src[..k].chars().last();
-        if before.is_some_and(|c| c.is_alphanumeric() || c == '_') {
+        if k < last || before.is_some_and(|c| c.is_alphanumeric() || c == '_') {
             continue;
         }
         let rest = &src[k + 4..];
         if let Some(end) = rest.find(';') {
             out.extend(expand(&rest[..end]));
+            code.push_str(&src[last..k]);
+            last = k + 4 + end + 1;
         }
     }
-    let b = src.as_bytes();
-    for (k, _) in src.match_indices("crate::") {
-        if k > 0 && (b[k - 1].is_ascii_alphanumeric() || b[k - 1] == b'_' || b[k - 1] == b':') {
-            continue;
-        }
-        let path: String = src[k..]
-            .chars()
-            .take_while(|c| c.is_alphanumeric() || *c == '_' || *c == ':')
-            .collect();
-        out.push(path.trim_end_matches(':').to_string());
-    }
+    code.push_str(&src[last..]);
+    out.extend(inline_paths(&code, "crate::"));
+    out.extend(inline_paths(&code, "super::"));
     out
+}
+
+/// Paths in code that start with `start` (`crate::a::b::f`, `super::x::g`), not
+/// inside a longer path.
+fn inline_paths(src: &str, start: &str) -> Vec<String> {
+    let b = src.as_bytes();
+    src.match_indices(start)
+        .filter(|&(k, _)| {
+            k == 0 || !(b[k - 1].is_ascii_alphanumeric() || b[k - 1] == b'_' || b[k - 1] == b':')
+        })
+        .map(|(k, _)| {
+            let path: String = src[k..]
+                .chars()
+                .take_while(|c| c.is_alphanumeric() || *c == '_' || *c == ':')
+                .collect();
+            path.trim_end_matches(':').to_string()
+        })
+        .collect()
+}
+
+/// The child modules of `name` that its code names inline (`child::f(…)`).
+fn children_named(name: &str, src: &str, modules: &Modules) -> Vec<String> {
+    let prefix = if name.is_empty() {
+        String::new()
+    } else {
+        format!("{name}::")
+    };
+    modules
+        .keys()
+        .filter_map(|m| m.strip_prefix(&prefix).filter(|c| !c.contains("::")))
+        .filter(|c| !c.is_empty() && !inline_paths(src, &format!("{c}::")).is_empty())
+        .map(|c| format!("{prefix}{c}"))
+        .collect()
 }
 
 /// The module a path points into, seen from module `from`; None for other crates.
@@ -300,16 +331,85 @@ fn resolve(path: &str, from: &str, modules: &Modules) -> Option<String> {
     // The longest prefix that names a module.
     let mut best = base.join("::");
     let mut cur = base;
+    let mut used = 0;
     for s in rest {
         cur.push(s.to_string());
         let name = cur.join("::");
         if modules.contains_key(&name) {
             best = name;
+            used += 1;
         } else {
             break;
         }
     }
-    Some(best)
+    // An item the module only re-exports (`pub use x::Item`, `pub use x::*`)
+    // belongs to the module that defines it.
+    match rest.get(used) {
+        Some(item) => Some(origin(&best, item, modules, 0)),
+        None => Some(best),
+    }
+}
+
+/// The module that defines `item` as seen from module `m`: `m` itself, or, when
+/// `m` re-exports it (`pub use x::Item`, `pub use x::*`), the module it comes from.
+fn origin(m: &str, item: &str, modules: &Modules, depth: usize) -> String {
+    let Some(src) = modules.get(m) else {
+        return m.to_string();
+    };
+    if depth >= 8 || defines(src, item) {
+        return m.to_string();
+    }
+    for path in pub_use_paths(src) {
+        match path.strip_suffix("::*") {
+            Some(glob) => {
+                let Some(target) = resolve(glob, m, modules) else {
+                    continue;
+                };
+                let found = origin(&target, item, modules, depth + 1);
+                if modules.get(&found).is_some_and(|s| defines(s, item)) {
+                    return found;
+                }
+            }
+            None if path.rsplit("::").next() == Some(item) => {
+                if let Some(found) = resolve(&path, m, modules) {
+                    return found;
+                }
+            }
+            None => {}
+        }
+    }
+    m.to_string()
+}
+
+/// Does this (stripped) source define `item` (a type, trait, function, constant
+/// or module of that name)?
+fn defines(src: &str, item: &str) -> bool {
+    [
+        "struct", "enum", "fn", "type", "trait", "const", "static", "mod", "union",
+    ]
+    .iter()
+    .any(|kw| {
+        src.match_indices(&format!("{kw} {item}")).any(|(k, m)| {
+            let after = src[k + m.len()..].chars().next();
+            let before = src[..k].chars().last();
+            !after.is_some_and(|c| c.is_alphanumeric() || c == '_')
+                && !before.is_some_and(|c| c.is_alphanumeric() || c == '_')
+        })
+    })
+}
+
+/// The paths of a module's `pub use` and `pub(crate) use` trees.
+fn pub_use_paths(src: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    for start in ["pub use ", "pub(crate) use "] {
+        for (k, _) in src.match_indices(start) {
+            let rest = &src[k + start.len()..];
+            if let Some(end) = rest.find(';') {
+                out.extend(expand(&rest[..end]));
+            }
+        }
+    }
+    out
 }
 
 /// Module → the modules it imports (itself excluded).
@@ -320,6 +420,7 @@ fn graph(modules: &Modules) -> BTreeMap<String, BTreeSet<String>> {
             let targets = named_paths(src)
                 .iter()
                 .filter_map(|p| resolve(p, name, modules))
+                .chain(children_named(name, src, modules))
                 .filter(|t| t != name && !t.is_empty())
                 .collect();
             (name.clone(), targets)
@@ -500,7 +601,7 @@ fn the_checker_finds_what_it_should() {
     add(
         &mut m,
         "model",
-        "pub mod grid;\nuse crate::physics::shape::Stencils; // up!",
+        "pub mod grid;\nuse crate::physics::shape::Stencils; // up!\nfn f() { grid::g(); }",
     );
     add(
         &mut m,
@@ -516,9 +617,14 @@ fn the_checker_finds_what_it_should() {
     add(&mut m, "solver", "pub mod a; pub mod b; use a::X;");
     add(&mut m, "solver::a", "fn f() { crate::solver::b::g(); }");
     add(&mut m, "solver::b", "use super::a::Y;");
-    add(&mut m, "solver::c", "pub mod d;");
-    add(&mut m, "solver::c::d", "use crate::solver::e::Z;");
-    add(&mut m, "solver::e", "use super::c::W;");
+    add(&mut m, "solver::c", "pub mod d;\npub use d::*;");
+    add(&mut m, "solver::f", "use crate::solver::c::Thing;");
+    add(
+        &mut m,
+        "solver::c::d",
+        "use crate::solver::e::Z;\npub struct Thing;",
+    );
+    add(&mut m, "solver::e", "fn h() { super::c::w(); }");
     let g = graph(&m);
     assert_eq!(
         g["physics::shape"],
@@ -526,6 +632,10 @@ fn the_checker_finds_what_it_should() {
     );
     assert!(g["model::grid"].is_empty(), "{:?}", g["model::grid"]);
     assert_eq!(g["solver"], BTreeSet::from(["solver::a".to_string()]));
+    assert!(g["model"].contains("model::grid"), "{:?}", g["model"]);
+    // Through a re-export, to the module that defines the item.
+    assert_eq!(g["solver::f"], BTreeSet::from(["solver::c::d".to_string()]));
+    assert_eq!(g["solver::e"], BTreeSet::from(["solver::c".to_string()]));
     let bad = upward(&g);
     assert_eq!(bad.len(), 1, "{bad:?}");
     assert!(
@@ -537,6 +647,12 @@ fn the_checker_finds_what_it_should() {
         found,
         vec![
             vec!["solver::a".to_string(), "solver::b".to_string()],
+            // c re-exports d, d imports e, e calls into c.
+            vec![
+                "solver::c".to_string(),
+                "solver::c::d".to_string(),
+                "solver::e".to_string(),
+            ],
             // Seen with folders as one module: the upward import closes a cycle.
             vec!["model".to_string(), "physics".to_string()],
             vec!["solver::c".to_string(), "solver::e".to_string()],

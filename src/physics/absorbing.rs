@@ -114,27 +114,21 @@ pub fn layer<const D: usize>(
 }
 
 /// out_I += sign · Σ_p S_Ip f_p over the layer particles, with f_p = −(C v_p + K u_p),
-/// v_p = Σ_I S_Ip v_I and u_p = x_p − X_p (+ Σ_I S_Ip u_I within an implicit step,
-/// `u`). Scatters in particle order, so the sum does not depend on the number of
+/// v_p = Σ_I S_Ip v_I and u_p the particle's displacement (`displacement(q)`).
+/// Scatters in particle order, so the sum does not depend on the number of
 /// threads.
-#[allow(clippy::too_many_arguments)]
 fn add_layer_forces<const D: usize>(
     layer: &[LayerParticle<D>],
     map: &NodeMap,
     st: &Stencils<D>,
-    p: &Particles<D>,
     v: &[Vector<D>],
-    u: Option<&[Vector<D>]>,
+    displacement: impl Fn(usize) -> Vector<D>,
     sign: f64,
     out: &mut [Vector<D>],
 ) {
     for lp in layer {
         let q = lp.q;
-        let mut u_p = p.x[q] - p.x0[q];
-        if let Some(u) = u {
-            u_p += interpolate(map, st, q, u);
-        }
-        let f = lp.force(&interpolate(map, st, q, v), &u_p);
+        let f = lp.force(&interpolate(map, st, q, v), &displacement(q));
         for e in st.range(q) {
             out[map.local_of(st, e)] += f * (st.weight[e] * sign);
         }
@@ -153,7 +147,9 @@ pub fn add_force<const D: usize>(
     force: &mut [Vector<D>],
 ) {
     let layer = layer(absorbing, grid, p);
-    add_layer_forces(&layer, map, st, p, v, None, 1.0, force);
+    // u_p = x_p − X_p.
+    let displacement = |q: usize| p.x[q] - p.x0[q];
+    add_layer_forces(&layer, map, st, v, displacement, 1.0, force);
 }
 
 /// The absorbing boundary within one implicit step: the layer at the step start
@@ -190,7 +186,9 @@ impl<const D: usize> AbsorbingStep<D> {
         let v: Vec<Vector<D>> = (0..u.len())
             .map(|a| self.velocity_offset[a] + u[a] * self.rate)
             .collect();
-        add_layer_forces(&self.layer, map, st, p, &v, Some(u), -1.0, r);
+        // u_p = x_p − X_p + Σ_I S_Ip u_I: the displacement at the end of the step.
+        let displacement = |q: usize| p.x[q] - p.x0[q] + interpolate(map, st, q, u);
+        add_layer_forces(&self.layer, map, st, &v, displacement, -1.0, r);
     }
 }
 

@@ -13,7 +13,7 @@ pub use energy::{kinetic_energy, strain_energy};
 
 use crate::model::Model;
 use crate::output::{write_particles_csv_with, Progress};
-use crate::scene::{Scene, SceneError, SolverConfig};
+use crate::scene::{Scene, SceneError, SolverKind};
 use crate::solver::divergence::{check_state, Divergence};
 use crate::solver::explicit::Explicit;
 use crate::solver::report::SolverReport;
@@ -60,11 +60,58 @@ pub fn run(scene: &Scene, out: &Path, opts: &RunOptions) -> Result<Summary, RunE
     }
 }
 
-/// Where the run is: time, step and the work done so far.
-struct Clock {
+/// The run's course: where it is (time, step, the work done so far) and what it
+/// writes as it goes.
+struct Timeline {
     t: f64,
     step: usize,
     external_work: f64,
+    /// The run's total time (the time tolerance is relative to it).
+    total_time: f64,
+    recorders: Recorders,
+    progress: Option<Progress>,
+}
+
+impl Timeline {
+    fn moment<'a, const D: usize>(&self, model: &'a Model<D>) -> Moment<'a, D> {
+        Moment {
+            model,
+            t: self.t,
+            external_work: self.external_work,
+        }
+    }
+
+    /// Advance one stage of length `duration`: step, record, repeat. Returns how
+    /// the stage ended and its last step; the outer error is an output failure.
+    fn stage<const D: usize>(
+        &mut self,
+        model: &mut Model<D>,
+        stepper: &mut dyn Stepper<D>,
+        duration: f64,
+    ) -> std::io::Result<(Result<(), Divergence>, f64)> {
+        let end = self.t + duration;
+        let mut last_dt = 0.0;
+        while self.t < end - 1e-12 * self.total_time {
+            let dt = stepper.dt(model).min(end - self.t);
+            last_dt = dt;
+            let result = stepper.step(model, self.t, dt, self.step);
+            self.recorders.newton(&stepper.take_newton_rows())?;
+            match result {
+                Ok(work) => self.external_work += work,
+                Err(d) => return Ok((Err(d), last_dt)),
+            }
+            self.t += dt;
+            self.step += 1;
+            self.recorders
+                .footing(model, self.t, dt, stepper.reaction())?;
+            self.recorders.state(&self.moment(model), false)?;
+            if let Some(p) = &self.progress {
+                p.set(self.t, self.step);
+            }
+        }
+        self.t = end;
+        Ok((Ok(()), last_dt))
+    }
 }
 
 fn run_dim<const D: usize>(
@@ -87,18 +134,19 @@ fn run_dim<const D: usize>(
         .monitor
         .as_deref()
         .and_then(|x| model.nearest_particle(x));
-    let mut recorders = Recorders::create(out, cfg, &model)?;
-    let progress = opts.progress.then(|| Progress::new(cfg.total_time()));
-    let dt_critical = Explicit::critical_dt(&model);
-    let started = Instant::now();
-    let mut clock = Clock {
+    let mut line = Timeline {
         t: 0.0,
         step: 0,
         external_work: 0.0,
+        total_time: cfg.total_time(),
+        recorders: Recorders::create(out, cfg, &model)?,
+        progress: opts.progress.then(|| Progress::new(cfg.total_time())),
     };
+    let dt_critical = Explicit::critical_dt(&model);
+    let started = Instant::now();
     let mut outcome = check_state(&model, 0, 0.0);
     if outcome.is_ok() {
-        recorders.state(&moment(&model, &clock), true)?;
+        line.recorders.state(&line.moment(&model), true)?;
     }
     let mut stages = Vec::new();
     let mut last: Option<(SolverReport, f64, usize)> = None;
@@ -113,24 +161,16 @@ fn run_dim<const D: usize>(
             model.reduce_strength(f);
             strength_factor = f;
         }
-        let mut stepper = crate::solver::stepper::<D>(cfg.grid.shape_function, sc, clock.t);
-        let (start, steps_before, stage_clock) = (clock.t, clock.step, Instant::now());
-        let (result, dt) = run_stage(
-            &mut model,
-            stepper.as_mut(),
-            sc,
-            cfg.total_time(),
-            &mut clock,
-            &mut recorders,
-            progress.as_ref(),
-        )?;
+        let mut stepper = crate::solver::stepper::<D>(cfg.grid.shape_function, sc, line.t);
+        let (start, steps_before, stage_clock) = (line.t, line.step, Instant::now());
+        let (result, dt) = line.stage(&mut model, stepper.as_mut(), sc.end_time)?;
         outcome = result;
         let report = stepper.report();
         stages.push(StageSummary {
             name: sc.name.clone().unwrap_or_else(|| format!("stage{k}")),
             start_time: start,
-            end_time: clock.t,
-            steps: clock.step - steps_before,
+            end_time: line.t,
+            steps: line.step - steps_before,
             dt,
             wall_seconds: stage_clock.elapsed().as_secs_f64(),
             active_nodes_last_step: stepper.active_nodes(),
@@ -139,33 +179,35 @@ fn run_dim<const D: usize>(
         });
         last = Some((report, dt, stepper.active_nodes()));
     }
-    if let Some(p) = &progress {
+    if let Some(p) = &line.progress {
         p.finish();
     }
     let wall = started.elapsed().as_secs_f64();
     let particles = model.particles.len();
+    // A run that stopped before its first step reports its first stage's solver.
     let (solver, dt, active_nodes) = last.unwrap_or_else(|| {
         let first = cfg.stages()[0];
         let report = crate::solver::stepper::<D>(cfg.grid.shape_function, first, 0.0).report();
         (report, 0.0, 0)
     });
+    let implicit = cfg.stages().iter().any(|s| s.kind == SolverKind::Implicit);
     let mut summary = Summary {
         scene: scene.file.clone(),
         dimension: D,
         shape_function: cfg.grid.shape_function,
         particles,
-        steps: clock.step,
+        steps: line.step,
         dt,
         dt_critical,
-        end_time: clock.t,
+        end_time: line.t,
         wall_seconds: wall,
-        particle_steps_per_second: (particles * clock.step) as f64 / wall.max(1e-9),
+        particle_steps_per_second: (particles * line.step) as f64 / wall.max(1e-9),
         active_nodes_last_step: active_nodes,
         status: Status::Completed,
         divergence: None,
-        solver: run_totals(solver, &stages, recorders.has_newton()),
+        solver: run_totals(solver, &stages, implicit),
         stages,
-        footing: recorders.footing_summary(&model),
+        footing: line.recorders.footing_summary(&model),
         monitor_particle: monitor,
         monitor_displacement: monitor
             .map(|q| (model.particles.x[q] - model.particles.x0[q]).norm()),
@@ -188,55 +230,12 @@ fn run_dim<const D: usize>(
             summary: Box::new(summary),
         });
     }
-    recorders.state(&moment(&model, &clock), true)?;
+    line.recorders.state(&line.moment(&model), true)?;
     let eps_p = model.plastic_strain();
     let extra: Vec<(&str, &[f64])> = eps_p.iter().map(|e| ("eps_p", e.as_slice())).collect();
     write_particles_csv_with(&out.join("particles_final.csv"), &model.particles, &extra)?;
     summary.write(&out.join("summary.json"))?;
     Ok(summary)
-}
-
-fn moment<'a, const D: usize>(model: &'a Model<D>, clock: &Clock) -> Moment<'a, D> {
-    Moment {
-        model,
-        t: clock.t,
-        external_work: clock.external_work,
-    }
-}
-
-/// Advance one stage to its end time: step, record, repeat. Returns how the stage
-/// ended and its last step; the outer error is an output failure.
-#[allow(clippy::too_many_arguments)]
-fn run_stage<const D: usize>(
-    model: &mut Model<D>,
-    stepper: &mut dyn Stepper<D>,
-    sc: &SolverConfig,
-    total_time: f64,
-    clock: &mut Clock,
-    recorders: &mut Recorders,
-    progress: Option<&Progress>,
-) -> Result<(Result<(), Divergence>, f64), RunError> {
-    let end = clock.t + sc.end_time;
-    let mut last_dt = 0.0;
-    while clock.t < end - 1e-12 * total_time {
-        let dt = stepper.dt(model).min(end - clock.t);
-        last_dt = dt;
-        let result = stepper.step(model, clock.t, dt, clock.step);
-        recorders.newton(&stepper.take_newton_rows())?;
-        match result {
-            Ok(work) => clock.external_work += work,
-            Err(d) => return Ok((Err(d), last_dt)),
-        }
-        clock.t += dt;
-        clock.step += 1;
-        recorders.footing(model, clock.t, dt, stepper.reaction())?;
-        recorders.state(&moment(model, clock), false)?;
-        if let Some(p) = progress {
-            p.set(clock.t, clock.step);
-        }
-    }
-    clock.t = end;
-    Ok((Ok(()), last_dt))
 }
 
 /// The run's solver fields: the last stage's, with the Newton, cut-back and

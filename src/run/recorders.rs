@@ -154,11 +154,6 @@ impl Recorders {
         }
     }
 
-    /// Whether the run writes newton.csv (it has an implicit stage).
-    pub fn has_newton(&self) -> bool {
-        self.newton.is_some()
-    }
-
     /// The footing's limit pressure and its neighbours, for summary.json.
     pub fn footing_summary<const D: usize>(&self, m: &Model<D>) -> Option<FootingSummary> {
         let f = m.footing.as_ref()?;

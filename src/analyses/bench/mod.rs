@@ -9,11 +9,12 @@
 pub mod child;
 pub mod configurations;
 mod plots;
+pub mod row;
 
 use crate::analyses::reference;
 use crate::analyses::strength_reduction::SearchSummary;
 use crate::model::Model;
-use crate::output::{CsvWriter, Field, Table};
+use crate::output::{CsvWriter, Table};
 use crate::physics::shape::Stencils;
 use crate::physics::transfer::NodeMap;
 use crate::run::summary::Summary;
@@ -23,6 +24,7 @@ use crate::scene::{BenchConfig, Integrator, Scene, SceneConfig, SceneError, Solv
 use crate::solver::explicit::Explicit;
 use child::{run_child, Exit};
 use configurations::Configuration;
+pub use row::{Row, CSV_HEADER};
 use std::path::{Path, PathBuf};
 
 /// What the command line gives; `None` fields fall back to the `[bench]` table
@@ -59,105 +61,6 @@ pub enum BenchError {
 
 /// Default time limit of one run (seconds).
 pub const DEFAULT_TIMEOUT: f64 = 3600.0;
-
-/// One row of bench.csv.
-#[derive(Clone, Debug, Default)]
-pub struct Row {
-    pub configuration: String,
-    pub overrides: String,
-    /// explicit, newmark, quasi_static or staged.
-    pub solver: String,
-    pub dt: Option<f64>,
-    pub load_steps: Option<usize>,
-    pub cells: String,
-    pub particles: Option<usize>,
-    pub unknowns: Option<usize>,
-    pub error: Option<f64>,
-    pub wall_seconds: Option<f64>,
-    pub run_seconds: Option<f64>,
-    pub peak_mib: Option<f64>,
-    pub steps: Option<u64>,
-    pub newton_iterations: Option<u64>,
-    pub krylov_iterations: Option<u64>,
-    pub cutbacks: Option<u64>,
-    pub status: String,
-    pub note: String,
-    /// The run's directory, relative to DIR.
-    pub run_dir: String,
-}
-
-/// The columns of bench.csv.
-pub const CSV_HEADER: [&str; 21] = [
-    "configuration",
-    "overrides",
-    "solver",
-    "dt",
-    "load_steps",
-    "cells",
-    "particles",
-    "unknowns",
-    "error",
-    "wall_seconds",
-    "run_seconds",
-    "peak_mib",
-    "steps",
-    "newton_iterations",
-    "newton_per_step",
-    "krylov_iterations",
-    "krylov_per_newton",
-    "cutbacks",
-    "status",
-    "note",
-    "run_dir",
-];
-
-impl Row {
-    pub fn newton_per_step(&self) -> Option<f64> {
-        ratio(self.newton_iterations, self.steps)
-    }
-
-    pub fn krylov_per_newton(&self) -> Option<f64> {
-        ratio(self.krylov_iterations, self.newton_iterations)
-    }
-
-    pub fn is_ok(&self) -> bool {
-        self.status == "ok"
-    }
-
-    /// The fields of this row in the order of `CSV_HEADER`.
-    fn fields(&self) -> [Field<'_>; 21] {
-        [
-            Field::from(&self.configuration),
-            Field::from(&self.overrides),
-            Field::from(&self.solver),
-            self.dt.into(),
-            self.load_steps.into(),
-            Field::from(&self.cells),
-            self.particles.into(),
-            self.unknowns.into(),
-            self.error.into(),
-            self.wall_seconds.into(),
-            self.run_seconds.into(),
-            self.peak_mib.into(),
-            self.steps.into(),
-            self.newton_iterations.into(),
-            self.newton_per_step().into(),
-            self.krylov_iterations.into(),
-            self.krylov_per_newton().into(),
-            self.cutbacks.into(),
-            Field::from(&self.status),
-            Field::from(&self.note),
-            Field::from(&self.run_dir),
-        ]
-    }
-}
-
-fn ratio(a: Option<u64>, b: Option<u64>) -> Option<f64> {
-    match (a, b) {
-        (Some(a), Some(b)) if b > 0 => Some(a as f64 / b as f64),
-        _ => None,
-    }
-}
 
 /// A point of the time sweep.
 #[derive(Clone, Copy, Debug, PartialEq)]

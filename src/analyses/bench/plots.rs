@@ -12,7 +12,7 @@
 //!
 //! A plot without data still gets written, with a note saying why it is empty.
 
-use super::Row;
+use super::row::Row;
 use crate::output::Table;
 use plotters::coord::Shift;
 use plotters::prelude::*;

@@ -4,7 +4,7 @@
 //! measured period comes from the zero crossings of the body's mean velocity in
 //! history.csv; the error is |T_h / T − 1|.
 
-use super::{body0_box, body0_material, ErrorMeasure, KeyError};
+use super::measure::{body0_box, body0_material, ErrorMeasure, KeyError};
 use crate::output::Table;
 use crate::scene::SceneConfig;
 use std::path::Path;

@@ -8,7 +8,7 @@
 //! |v / v_ref − 1|. Details: tests/verification/cantilever.rs, papers/cantilever_elastica/.
 
 use super::elastica::elastica;
-use super::{body0_box, body0_material, ErrorMeasure, KeyError};
+use super::measure::{body0_box, body0_material, ErrorMeasure, KeyError};
 use crate::output::Table;
 use crate::scene::{Beam, LoadKind, SceneConfig};
 use std::path::Path;

@@ -4,7 +4,7 @@
 //! normalised L2 over the reference volume,
 //! e = √(Σ V0 (σ_yy − σ_a)² / Σ V0) / (ρ g l0).
 
-use super::{body0_box, body0_material, ErrorMeasure, KeyError};
+use super::measure::{body0_box, body0_material, ErrorMeasure, KeyError};
 use crate::output::Table;
 use crate::scene::SceneConfig;
 use std::path::Path;

@@ -10,20 +10,11 @@ pub mod bar;
 pub mod cantilever;
 pub mod column;
 pub mod elastica;
+pub mod measure;
 
-use crate::scene::{BodyShape, ReferenceKind, Scene, SceneConfig, SceneError};
-use std::path::Path;
+pub use measure::{ErrorMeasure, KeyError};
 
-/// An error measure of one scene against its analytical reference.
-pub trait ErrorMeasure {
-    /// What is compared with what, in one line.
-    fn description(&self) -> String;
-    /// The (non-negative) error of the run whose outputs are in `out`.
-    fn error(&self, out: &Path) -> Result<f64, String>;
-}
-
-/// A scene-validation failure: dotted key path and message.
-pub use crate::material::parameters::KeyError;
+use crate::scene::{ReferenceKind, Scene, SceneConfig, SceneError};
 
 /// The error measure the scene declares, if any; an error names the scene key that
 /// makes the reference inapplicable.
@@ -52,41 +43,4 @@ pub fn checked(scene: Scene) -> Result<Scene, SceneError> {
         Ok(_) => Ok(scene),
         Err((key, m)) => Err(SceneError::at_key(&scene.file, &scene.text, &key, m)),
     }
-}
-
-/// Corners of body 0, which must be a rectangle or box (the references are about a
-/// prismatic body).
-fn body0_box(s: &SceneConfig) -> Result<(Vec<f64>, Vec<f64>), KeyError> {
-    let b = s
-        .bodies
-        .first()
-        .ok_or(("body".to_string(), "no body".to_string()))?;
-    match (b.shape, &b.min, &b.max) {
-        (BodyShape::Rectangle | BodyShape::Box, Some(lo), Some(hi)) => Ok((lo.clone(), hi.clone())),
-        _ => Err((
-            "body.0.shape".into(),
-            "the [reference] needs body 0 to be a rectangle or box".into(),
-        )),
-    }
-}
-
-/// Density, Young's modulus and Poisson's ratio of body 0's material.
-fn body0_material(s: &SceneConfig) -> Result<(f64, f64, f64), KeyError> {
-    let name = &s.bodies[0].material;
-    let (i, m) = s
-        .materials
-        .iter()
-        .enumerate()
-        .find(|(_, m)| &m.name == name)
-        .ok_or((
-            "body.0.material".to_string(),
-            "unknown material".to_string(),
-        ))?;
-    let table = format!("material.{i}");
-    let p = m.parameters(&table);
-    let e = p.get("youngs_modulus")?.ok_or((
-        p.key("youngs_modulus"),
-        "the [reference] needs the Young's modulus of body 0's material".to_string(),
-    ))?;
-    Ok((m.density, e, p.get("poisson_ratio")?.unwrap_or(0.0)))
 }
