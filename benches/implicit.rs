@@ -42,6 +42,7 @@ use mpm::solver::implicit::assembly::Dofs;
 use mpm::solver::implicit::step::number_unknowns;
 use mpm::solver::implicit::Implicit;
 use mpm::solver::linear::direct::{DirectSolver, Structure};
+use mpm::solver::stepper::Stepper;
 use rayon::prelude::*;
 use std::hint::black_box;
 
@@ -101,7 +102,7 @@ impl Problem {
         let mut solver = Implicit::<2>::new(self.shape, self.scene.config.stages()[0], 0.0);
         for step in 0..steps {
             solver
-                .advance(&mut self.model, step as f64 * self.dt, self.dt, step)
+                .step(&mut self.model, step as f64 * self.dt, self.dt, step)
                 .expect("converged");
         }
         self.name = format!("{}_step{}", self.name, steps + 1);
@@ -175,11 +176,7 @@ fn assemble(p: &Problem, w: &mut Workspace) -> (Dofs, Vec<(usize, usize, f64)>, 
     let a = pk1_derivatives(p, w);
     let (triplets, symmetric) =
         stiffness_triplets(&w.map, &w.stencils, &dofs, &p.model.particles.volume, &a);
-    let structure = if symmetric {
-        Structure::Symmetric
-    } else {
-        Structure::General
-    };
+    let structure = Structure::of(symmetric);
     (dofs, triplets, structure)
 }
 
@@ -191,15 +188,7 @@ fn rhs(p: &Problem, w: &Workspace, dofs: &Dofs) -> Vec<f64> {
     let m = &p.model;
     let g = m.gravity / p.load_steps as f64;
     let f = external_force(&w.map, &w.stencils, &m.particles, &g, &|_| 0.0);
-    let mut out = vec![0.0; dofs.free];
-    for (a, fa) in f.iter().enumerate() {
-        for d in 0..2 {
-            if let Some(i) = dofs.of(a, d, 2) {
-                out[i] = fa[d];
-            }
-        }
-    }
-    out
+    dofs.reduce(&f)
 }
 
 /// The lower triangle of K in CSC form, as the direct solver builds it from the

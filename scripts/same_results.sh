@@ -55,16 +55,15 @@ diff_all() {
   python3 - "$1" "$2" <<'EOF'
 import csv, io, json, os, sys
 a_root, b_root = sys.argv[1], sys.argv[2]
-TIMING_KEYS = {"seconds", "wall_seconds", "particle_steps_per_second", "solver_seconds",
-               "lower_seconds", "upper_seconds", "setup_seconds"}
-TIMING_COLUMNS = TIMING_KEYS | {"lower_solver_seconds", "upper_solver_seconds"}
+# Wall-clock fields (and every field or column whose name ends in _seconds).
+TIMING = {"seconds", "particle_steps_per_second"}
 BYTES = ("particles_final.csv", "history.csv")
-TABLES = ("footing.csv", "newton.csv", "strength_reduction.csv", "refinement.csv", "trials.csv")
+TABLES = ("footing.csv", "newton.csv", "strength_reduction.csv", "refinement.csv")
 
 def strip(v, root):
     """Without wall-clock fields, and with the output directory in messages as OUT."""
     if isinstance(v, dict):
-        return {k: strip(x, root) for k, x in v.items() if k not in TIMING_KEYS and not k.endswith("_seconds")}
+        return {k: strip(x, root) for k, x in v.items() if k not in TIMING and not k.endswith("_seconds")}
     if isinstance(v, list):
         return [strip(x, root) for x in v]
     if isinstance(v, str):
@@ -83,7 +82,7 @@ def table(path):
     rows = list(csv.reader(open(path, newline="")))
     if not rows:
         return rows
-    keep = [i for i, h in enumerate(rows[0]) if h not in TIMING_COLUMNS and not h.endswith("_seconds")]
+    keep = [i for i, h in enumerate(rows[0]) if h not in TIMING and not h.endswith("_seconds")]
     return [rows[0]] + [[value(r[i]) for i in keep if i < len(r)] for r in rows[1:]]
 
 def files(root):

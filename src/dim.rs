@@ -8,17 +8,6 @@ pub type Vector<const D: usize> = SVector<f64, D>;
 pub type Tensor<const D: usize> = SMatrix<f64, D, D>;
 pub type Mat3 = Matrix3<f64>;
 
-/// Embed a D×D tensor into the upper-left block of a 3×3 tensor (zeros elsewhere).
-pub fn embed<const D: usize>(a: &Tensor<D>) -> Mat3 {
-    let mut m = Mat3::zeros();
-    for i in 0..D {
-        for j in 0..D {
-            m[(i, j)] = a[(i, j)];
-        }
-    }
-    m
-}
-
 /// The upper-left D×D block of a 3×3 tensor.
 pub fn restrict<const D: usize>(m: &Mat3) -> Tensor<D> {
     Tensor::<D>::from_fn(|i, j| m[(i, j)])

@@ -4,7 +4,7 @@
 //! maps a particle to a slice of a flat buffer, and a scene of elastic bodies has an
 //! empty buffer.
 
-use crate::dim::{Mat3, Tensor, Vector};
+use crate::dim::{Mat3, Vector};
 
 #[derive(Clone, Debug, Default)]
 pub struct Particles<const D: usize> {
@@ -48,12 +48,6 @@ impl History {
             Self::NONE => &[],
             o => &self.data[o as usize..o as usize + self.len[p] as usize],
         }
-    }
-
-    /// One mutable slice per particle (empty for particles without history), for
-    /// updating all particles in parallel.
-    pub fn split_mut(&mut self) -> Vec<&mut [f64]> {
-        split_slots(&self.len, &mut self.data)
     }
 
     /// The per-particle mutable slices of another buffer laid out like `data`.
@@ -134,11 +128,5 @@ impl<const D: usize> Particles<D> {
         self.material.push(material);
         self.load.push(Vector::<D>::zeros());
         self.history.push(n_history);
-    }
-
-    /// Current CPDI domain vectors r_i = F r_i⁰ as the columns of a D×D matrix.
-    pub fn domain_vectors(&self, p: usize) -> Tensor<D> {
-        let f = crate::dim::restrict::<D>(&self.f[p]);
-        f * Tensor::<D>::from_diagonal(&self.half_length0[p])
     }
 }

@@ -54,11 +54,6 @@ impl<const D: usize> Explicit<D> {
         }
     }
 
-    /// Number of active nodes in the last step.
-    pub fn active_nodes(&self) -> usize {
-        self.map.len()
-    }
-
     /// Critical time step min_p h / (c_p + |v_p|) (2-45).
     pub fn critical_dt(m: &Model<D>) -> f64 {
         let p = &m.particles;
@@ -72,22 +67,18 @@ impl<const D: usize> Explicit<D> {
             })
             .reduce(|| f64::INFINITY, f64::min)
     }
+}
 
+impl<const D: usize> Stepper<D> for Explicit<D> {
     /// The step to take now: the fixed one, or cfl × the critical one.
-    pub fn dt(&self, m: &Model<D>) -> f64 {
+    fn dt(&self, m: &Model<D>) -> f64 {
         self.fixed_dt
             .unwrap_or_else(|| self.cfl * Self::critical_dt(m))
     }
 
     /// Advance the model from t to t + dt. Returns the work done by gravity and
     /// applied loads over the step.
-    pub fn step(
-        &mut self,
-        m: &mut Model<D>,
-        t: f64,
-        dt: f64,
-        step: usize,
-    ) -> Result<f64, Divergence> {
+    fn step(&mut self, m: &mut Model<D>, t: f64, dt: f64, step: usize) -> Result<f64, Divergence> {
         let p = &m.particles;
         crate::physics::transfer::stencils_and_nodes(
             m,
@@ -184,6 +175,14 @@ impl<const D: usize> Explicit<D> {
         check_state(m, step + 1, t + dt)?;
         Ok(work)
     }
+
+    fn active_nodes(&self) -> usize {
+        self.map.len()
+    }
+
+    fn report(&self) -> SolverReport {
+        SolverReport::explicit(self.scheme)
+    }
 }
 
 /// Local (non-viscous) damping of a nodal force: f − α |f| sign(v), component by
@@ -265,22 +264,4 @@ fn update_stress<const D: usize>(
     }
     trial.commit(&mut m.particles);
     Ok(())
-}
-
-impl<const D: usize> Stepper<D> for Explicit<D> {
-    fn dt(&self, m: &Model<D>) -> f64 {
-        Explicit::dt(self, m)
-    }
-
-    fn step(&mut self, m: &mut Model<D>, t: f64, dt: f64, step: usize) -> Result<f64, Divergence> {
-        Explicit::step(self, m, t, dt, step)
-    }
-
-    fn active_nodes(&self) -> usize {
-        Explicit::active_nodes(self)
-    }
-
-    fn report(&self) -> SolverReport {
-        SolverReport::explicit(self.scheme)
-    }
 }

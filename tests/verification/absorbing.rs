@@ -16,6 +16,7 @@ use mpm::model::Model;
 use mpm::run::{kinetic_energy, strain_energy};
 use mpm::scene::Scene;
 use mpm::solver::explicit::Explicit;
+use mpm::solver::stepper::Stepper;
 
 /// (incident work W, energy left at the end) from a finished run's history.csv.
 fn energies(dir: &std::path::Path) -> (f64, f64) {

@@ -250,16 +250,6 @@ impl Model {
             ..self.clone()
         }
     }
-
-    /// Total length of boundary edges of a kind.
-    pub fn boundary_length(&self, kind: BoundaryKind) -> f64 {
-        self.edges
-            .iter()
-            .zip(&self.boundary)
-            .filter(|(_, k)| **k == Some(kind))
-            .map(|(e, _)| edge_geometry(&self.mesh, e.nodes).2)
-            .sum()
-    }
 }
 
 /// Slope geometry (physical lengths).

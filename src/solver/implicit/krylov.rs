@@ -376,11 +376,7 @@ impl KrylovState {
         }
         // The lagged preconditioner accepts a numerical tangent.
         let (triplets, symmetric) = tangent(m, sys, true)?;
-        let structure = if symmetric {
-            Structure::Symmetric
-        } else {
-            Structure::General
-        };
+        let structure = Structure::of(symmetric);
         self.lagged
             .factorize(sys.dofs.free, &triplets, structure)
             .map_err(|e| Failure {

@@ -71,32 +71,13 @@ impl<const D: usize> Implicit<D> {
         }
     }
 
-    /// Newton rows logged since the last call.
-    pub fn take_log(&mut self) -> Vec<NewtonRow> {
-        std::mem::take(&mut self.newton.log)
-    }
-
-    pub fn active_nodes(&self) -> usize {
-        self.system.map.len()
-    }
-
     /// Factorizations of the lagged_direct preconditioner so far (0 otherwise).
     pub fn lagged_factorizations(&self) -> usize {
         self.newton.krylov().map_or(0, |k| k.factorizations)
     }
 
-    /// Advance from t to t + dt, halving the step on Newton failure. Returns the
-    /// work of gravity and applied loads.
-    pub fn advance(
-        &mut self,
-        m: &mut Model<D>,
-        t: f64,
-        dt: f64,
-        step: usize,
-    ) -> Result<f64, Divergence> {
-        self.advance_level(m, t, dt, step, 0)
-    }
-
+    /// Advance from t to t + dt at cut-back `level`, halving the step on Newton
+    /// failure. Returns the work of gravity and applied loads.
     fn advance_level(
         &mut self,
         m: &mut Model<D>,
@@ -174,12 +155,13 @@ impl<const D: usize> Stepper<D> for Implicit<D> {
         self.dt
     }
 
+    /// The step, halved on Newton failure up to `max_cutbacks` times.
     fn step(&mut self, m: &mut Model<D>, t: f64, dt: f64, step: usize) -> Result<f64, Divergence> {
-        self.advance(m, t, dt, step)
+        self.advance_level(m, t, dt, step, 0)
     }
 
     fn active_nodes(&self) -> usize {
-        Implicit::active_nodes(self)
+        self.system.map.len()
     }
 
     fn reaction(&self) -> Option<&[(u32, Vector<D>)]> {
@@ -187,7 +169,7 @@ impl<const D: usize> Stepper<D> for Implicit<D> {
     }
 
     fn take_newton_rows(&mut self) -> Vec<NewtonRow> {
-        self.take_log()
+        std::mem::take(&mut self.newton.log)
     }
 
     fn report(&self) -> SolverReport {

@@ -251,11 +251,7 @@ fn direct_correction<const D: usize>(
     r_free: &[f64],
 ) -> Result<Correction, Failure> {
     let (triplets, symmetric) = tangent(m, sys, false)?;
-    let structure = if symmetric {
-        Structure::Symmetric
-    } else {
-        Structure::General
-    };
+    let structure = Structure::of(symmetric);
     let failed = |e: String| Failure {
         particle: None,
         message: format!("linear solve failed: {e}"),

@@ -47,7 +47,9 @@ pub struct StepSettings {
 
 /// One step's nonlinear system r(u) = 0 (2-37): the parts that do not depend on
 /// the iterate u, and the particles' trial state at the latest iterate (which
-/// the residual evaluates). The solver keeps it between steps for its buffers.
+/// the residual evaluates). The solver keeps it between steps so that the
+/// stencils, the node map and the trial state reuse their buffers; the rest is
+/// set anew by `prepare`.
 #[derive(Clone, Debug)]
 pub struct StepSystem<const D: usize> {
     /// The step t → t + dt.

@@ -38,6 +38,17 @@ pub enum Structure {
     General,
 }
 
+impl Structure {
+    /// Symmetric when the assembly says the matrix is, else general.
+    pub fn of(symmetric: bool) -> Structure {
+        if symmetric {
+            Structure::Symmetric
+        } else {
+            Structure::General
+        }
+    }
+}
+
 /// Factorization that was used by the last successful [`DirectSolver::factorize`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, strum::IntoStaticStr)]
 #[strum(serialize_all = "snake_case")]
