@@ -48,11 +48,13 @@ impl<const D: usize> Model<D> {
                 return Err(err((format!("body.{i}.shape"), "the body holds no particle centre: refine the grid or raise particles_per_cell".into())));
             }
         }
-        let faces: Vec<FaceCondition<D>> = c
-            .boundaries
+        // The velocity conditions, with the index of their [[boundary]] table.
+        let velocity: Vec<(usize, &BoundaryConfig)> = (c.boundaries.iter().enumerate())
+            .filter(|(_, b)| b.condition.prescribes_velocity())
+            .collect();
+        let faces: Vec<FaceCondition<D>> = velocity
             .iter()
-            .filter(|b| !matches!(b.condition, Condition::Absorbing | Condition::Friction))
-            .map(|b| face_condition(b, &vec))
+            .map(|(_, b)| face_condition(b, &vec))
             .collect();
         let friction = c
             .boundaries
@@ -64,11 +66,7 @@ impl<const D: usize> Model<D> {
             })
             .collect();
         // A region must hold at least one node of its face.
-        let velocity_conditions =
-            c.boundaries.iter().enumerate().filter(|(_, b)| {
-                !matches!(b.condition, Condition::Absorbing | Condition::Friction)
-            });
-        for ((i, _), fc) in velocity_conditions.zip(&faces) {
+        for ((i, _), fc) in velocity.iter().zip(&faces) {
             if !(0..grid.node_count()).any(|g| fc.acts_on(&grid, grid.node_ijk(g))) {
                 return Err(err((
                     format!("boundary.{i}.region_min"),
@@ -76,7 +74,7 @@ impl<const D: usize> Model<D> {
                 )));
             }
         }
-        let footing = footing(&c.boundaries, &faces, &grid, &particles, &base_materials);
+        let footing = footing(&velocity, &faces, &grid, &particles, &base_materials);
         let absorbing = Absorbing::new(&c.boundaries, &base_materials);
         absorbing
             .check_adjacent(&grid, &particles)
@@ -136,17 +134,16 @@ fn face_condition<const D: usize>(
 /// The footing (the velocity condition with a `footing_width`), with the cohesion
 /// of the material of the particle nearest to the centre of its region.
 fn footing<const D: usize>(
-    boundaries: &[BoundaryConfig],
+    velocity: &[(usize, &BoundaryConfig)],
     faces: &[FaceCondition<D>],
     grid: &Grid<D>,
     particles: &Particles<D>,
     materials: &[Box<dyn Material>],
 ) -> Option<Footing<D>> {
-    let (b, condition) = boundaries
+    let ((_, b), condition) = velocity
         .iter()
-        .filter(|b| !matches!(b.condition, Condition::Absorbing | Condition::Friction))
         .zip(faces)
-        .find(|(b, _)| b.footing_width.is_some())?;
+        .find(|((_, b), _)| b.footing_width.is_some())?;
     let nodes: Vec<Vector<D>> = (0..grid.node_count())
         .map(|g| grid.node_ijk(g))
         .filter(|&ijk| condition.acts_on(grid, ijk))

@@ -163,6 +163,12 @@ impl Condition {
     pub fn name(&self) -> &'static str {
         self.into()
     }
+
+    /// Fixed, roller and velocity conditions prescribe nodal velocity components;
+    /// absorbing and friction faces act through forces and contact.
+    pub fn prescribes_velocity(&self) -> bool {
+        !matches!(self, Condition::Absorbing | Condition::Friction)
+    }
 }
 
 #[derive(Clone, Debug, Deserialize)]

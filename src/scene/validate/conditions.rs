@@ -90,7 +90,7 @@ fn friction(b: &BoundaryConfig, i: usize) -> Check {
 /// not on absorbing faces.
 fn region(b: &BoundaryConfig, i: usize, dim: usize) -> Check {
     let key = |k: &str| format!("boundary.{i}.{k}");
-    if matches!(b.condition, Condition::Absorbing | Condition::Friction) {
+    if !b.condition.prescribes_velocity() {
         let what = "a fixed, roller or velocity condition (not to absorbing or friction)";
         forbidden(&b.region_min, key("region_min"), what)?;
         return forbidden(&b.region_max, key("region_max"), what);
