@@ -9,200 +9,41 @@
 //!
 //! Each model is one file that also says how a scene builds it
 //! (`parameters::FromParameters`: its name, its keys, their checks and its
-//! constructor); `registry` lists the models a scene may name. A new model is a
-//! new file, its `pub mod` line here, one line in `registry::MODELS` and its keys
+//! constructor); the `models!` list below declares each model's module and
+//! registers it, so a new model is a new file, one line in that list and its keys
 //! in docs/scene.md.
 
 pub mod driver;
-pub mod drucker_prager;
-pub mod hencky;
-pub mod linear_elastic;
-pub mod mohr_coulomb;
-pub mod mooney_rivlin;
-pub mod neo_hookean;
-pub mod ogden;
 pub mod parameters;
 pub mod registry;
 pub mod return_mapping;
 #[cfg(test)]
 mod testing;
 
-use crate::dim::Mat3;
-use nalgebra::SMatrix;
+mod law;
 
-/// ∂σ_ij/∂ΔF_kl with (i,j) and (k,l) flattened row-major (index 3i + j).
-pub type StressDerivative = SMatrix<f64, 9, 9>;
+pub(crate) use law::debug_check_elastic;
+pub use law::{
+    lame, reduced_angle, set_derivative_column, shear_modulus, CloneMaterial, Increment, Material,
+    Strength, StressDerivative,
+};
 
-/// The state at the start of an increment and the increment itself.
-#[derive(Clone, Copy, Debug)]
-pub struct Increment<'a> {
-    /// Deformation gradient at the start of the increment.
-    pub f_old: Mat3,
-    /// Incremental deformation gradient: F_new = ΔF F_old.
-    pub df: Mat3,
-    /// Time increment (rate-dependent models; 0 for quasi-static calls).
-    pub dt: f64,
-    /// Cauchy stress at the start of the increment.
-    pub stress_old: Mat3,
-    /// History variables at the start of the increment (empty if the model has none).
-    pub history_old: &'a [f64],
-}
-
-impl Increment<'_> {
-    /// An increment ΔF from the undeformed, unstressed state.
-    pub fn at_rest(df: Mat3, history_old: &[f64]) -> Increment<'_> {
-        Increment {
-            f_old: Mat3::identity(),
-            df,
-            dt: 0.0,
-            stress_old: Mat3::zeros(),
-            history_old,
-        }
-    }
-}
-
-/// Cohesion, friction angle and dilation angle (radians), or their derivatives.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Strength {
-    pub cohesion: f64,
-    pub friction_angle: f64,
-    pub dilation_angle: f64,
-}
-
-pub trait Material: CloneMaterial + Send + Sync + std::fmt::Debug {
-    /// Model name as written in scene files.
-    fn model(&self) -> &'static str;
-
-    /// Reference mass density ρ0.
-    fn density(&self) -> f64;
-
-    /// Number of history variables per particle (0: none are allocated).
-    fn n_history(&self) -> usize {
-        0
-    }
-
-    /// Cauchy stress at the end of the increment; writes the new history.
-    fn update(&self, inc: &Increment, history_new: &mut [f64]) -> Mat3;
-
-    /// Small-strain P-wave modulus λ + 2G, for the CFL condition (2-45).
-    fn p_wave_modulus(&self) -> f64;
-
-    /// Stored (strain) energy per unit current volume at deformation `f` and stress
-    /// `stress`.
-    fn strain_energy_density(&self, f: &Mat3, stress: &Mat3, history: &[f64]) -> f64;
-
-    /// Exact derivative ∂σ_new/∂ΔF of `update`, or `None` if the model has no
-    /// analytic tangent (the matrix-free implicit path still serves it).
-    fn stress_derivative(&self, _inc: &Increment) -> Option<StressDerivative> {
-        None
-    }
-
-    /// Whether the model supplies `stress_derivative` (asked at rest), which the
-    /// direct implicit solver needs; the Krylov solvers do not.
-    fn has_analytic_tangent(&self) -> bool {
-        let history = vec![0.0; self.n_history()];
-        let at_rest = Increment::at_rest(Mat3::identity(), &history);
-        self.stress_derivative(&at_rest).is_some()
-    }
-
-    /// Whether the update integrates from the stored stress (rate and
-    /// return-mapping models), so that a prescribed initial stress (geostatic)
-    /// persists; hyperelastic models compute the stress from F alone.
-    fn integrates_from_stored_stress(&self) -> bool {
-        false
-    }
-
-    /// The peak frictional strength c, φ, ψ (radians; for Jáky's K0 = 1 − sin φ
-    /// and the footing's cohesion), `None` for a model without one.
-    fn frictional_strength(&self) -> Option<Strength> {
-        None
-    }
-
-    /// The same model with its shear strength reduced by the factor F (strength
-    /// reduction, Griffiths & Lane 1999): c/F, tan φ/F and tan ψ/F, residual values
-    /// included. `None`: the model has no frictional strength to reduce.
-    fn with_reduced_strength(&self, _factor: f64) -> Option<Box<dyn Material>> {
-        None
-    }
-
-    /// The equivalent plastic strain held in `history` (`None`: the model has none).
-    fn equivalent_plastic_strain(&self, _history: &[f64]) -> Option<f64> {
-        None
-    }
-
-    /// Wave speed c = √(M/ρ) at the current Jacobian J (ρ = ρ0/J).
-    fn wave_speed(&self, j: f64) -> f64 {
-        (self.p_wave_modulus() * j / self.density()).sqrt()
-    }
-}
-
-/// A copy of a material behind `Box<dyn Material>` (the model keeps the
-/// materials as built to reduce their strength from them again).
-pub trait CloneMaterial {
-    fn clone_material(&self) -> Box<dyn Material>;
-}
-
-impl<T: Material + Clone + 'static> CloneMaterial for T {
-    fn clone_material(&self) -> Box<dyn Material> {
-        Box::new(self.clone())
-    }
-}
-
-impl Clone for Box<dyn Material> {
-    fn clone(&self) -> Self {
-        self.clone_material()
-    }
-}
-
-/// Write ∂σ/∂ΔF_kl (a 3×3 tensor) into column 3k + l of the stress derivative.
-pub fn set_derivative_column(d: &mut StressDerivative, k: usize, l: usize, ds: &Mat3) {
-    for i in 0..3 {
-        for j in 0..3 {
-            d[(3 * i + j, 3 * k + l)] = ds[(i, j)];
-        }
-    }
-}
-
-/// Debug checks of the (ρ0, E, ν) constructors; the scene validation gives the
-/// user-facing errors.
-pub(crate) fn debug_check_elastic(density: f64, youngs_modulus: f64, poisson_ratio: f64) {
-    debug_assert!(density > 0.0, "density must be positive");
-    debug_assert!(youngs_modulus > 0.0, "Young's modulus must be positive");
-    debug_assert!(
-        poisson_ratio > -1.0 && poisson_ratio < 0.5,
-        "Poisson's ratio must lie in (-1, 0.5)"
-    );
-}
-
-/// A friction (or dilation) angle whose tangent is divided by `factor`:
-/// atan(tan θ / F) (strength reduction).
-pub fn reduced_angle(theta: f64, factor: f64) -> f64 {
-    (theta.tan() / factor).atan()
-}
-
-/// Lamé constants from Young's modulus and Poisson's ratio.
-pub fn lame(youngs_modulus: f64, poisson_ratio: f64) -> (f64, f64) {
-    let g = youngs_modulus / (2.0 * (1.0 + poisson_ratio));
-    let lambda =
-        youngs_modulus * poisson_ratio / ((1.0 + poisson_ratio) * (1.0 - 2.0 * poisson_ratio));
-    (lambda, g)
-}
-
-/// Small-strain shear modulus of a material: ∂σ_xy/∂ΔF_xy at rest (unstressed,
-/// undeformed), from its stress derivative, or by a central difference of its
-/// stress update when it has none. For isotropic elasticity this is G.
-pub fn shear_modulus(m: &dyn Material) -> f64 {
-    let history = vec![0.0; m.n_history()];
-    let at_rest = |df| Increment::at_rest(df, &history);
-    if let Some(d) = m.stress_derivative(&at_rest(Mat3::identity())) {
-        return d[(1, 1)];
-    }
-    let h = 1e-7;
-    let sigma_xy = |s: f64| {
-        let mut df = Mat3::identity();
-        df[(0, 1)] = s;
-        let mut scratch = history.clone();
-        m.update(&at_rest(df), &mut scratch)[(0, 1)]
+/// Declares each model's module and lists it in `MODELS` (its file, then its type).
+macro_rules! models {
+    ($($file:ident :: $model:ident),* $(,)?) => {
+        $(pub mod $file;)*
+        /// Every model a scene may name, in the order docs/scene.md lists them.
+        pub const MODELS: &[parameters::Entry] = &[$(parameters::Entry::of::<$file::$model>()),*];
     };
-    (sigma_xy(h) - sigma_xy(-h)) / (2.0 * h)
+}
+
+// One line per model.
+models! {
+    linear_elastic::LinearElastic,
+    neo_hookean::NeoHookean,
+    hencky::Hencky,
+    mooney_rivlin::MooneyRivlin,
+    drucker_prager::DruckerPrager,
+    mohr_coulomb::MohrCoulomb,
+    ogden::Ogden,
 }

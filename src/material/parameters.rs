@@ -8,12 +8,13 @@
 //! function and cannot drift apart. The keys shared by several models (E, ν and
 //! the Mohr–Coulomb strength c, φ, ψ) are read here once.
 
+use super::Material;
 use serde::de::DeserializeOwned;
 
 /// A failed check: the dotted key path and the message.
 pub type KeyError = (String, String);
 
-/// How a scene builds a model (listed once in `registry::MODELS`).
+/// How a scene builds a model (listed once in `material::MODELS`).
 pub trait FromParameters: Sized {
     /// The model's name in scene files (`model = "…"`).
     const NAME: &'static str;
@@ -25,6 +26,37 @@ pub trait FromParameters: Sized {
     const EXAMPLE: &'static str;
     /// The model from its density and parameters, their ranges checked.
     fn from_parameters(density: f64, p: &Parameters) -> Result<Self, KeyError>;
+}
+
+/// A model's constructor from its density and parameters.
+type Constructor = fn(f64, &Parameters) -> Result<Box<dyn Material>, KeyError>;
+
+/// One model: its name, its keys, an example of its parameters and its
+/// constructor.
+#[derive(Clone, Copy, Debug)]
+pub struct Entry {
+    pub name: &'static str,
+    pub keys: &'static [&'static str],
+    pub example: &'static str,
+    pub(super) construct: Constructor,
+}
+
+impl Entry {
+    pub const fn of<M: FromParameters + Material + 'static>() -> Entry {
+        Entry {
+            name: M::NAME,
+            keys: M::KEYS,
+            example: M::EXAMPLE,
+            construct: construct::<M>,
+        }
+    }
+}
+
+fn construct<M: FromParameters + Material + 'static>(
+    density: f64,
+    p: &Parameters,
+) -> Result<Box<dyn Material>, KeyError> {
+    Ok(Box::new(M::from_parameters(density, p)?))
 }
 
 /// The parameters of one material table.

@@ -1,54 +1,13 @@
-//! The models a scene may name: the one list a new model is added to.
+//! Finding and building the models a scene may name (`material::MODELS`, the
+//! one list a new model is added to).
 //!
 //! `build` turns a material table (its model's name, density and other keys)
 //! into the model, rejecting keys the model does not take; the scene validation
 //! calls it to check a table and `Model::build` to construct the material.
 
-use super::parameters::{FromParameters, KeyError, Parameters};
-use super::Material;
+use super::parameters::{Entry, KeyError, Parameters};
+use super::{Material, MODELS};
 use std::sync::OnceLock;
-
-/// A model's constructor from its density and parameters.
-type Constructor = fn(f64, &Parameters) -> Result<Box<dyn Material>, KeyError>;
-
-/// One model: its name, its keys, an example of its parameters and its
-/// constructor.
-#[derive(Clone, Copy, Debug)]
-pub struct Entry {
-    pub name: &'static str,
-    pub keys: &'static [&'static str],
-    pub example: &'static str,
-    construct: Constructor,
-}
-
-impl Entry {
-    const fn of<M: FromParameters + Material + 'static>() -> Entry {
-        Entry {
-            name: M::NAME,
-            keys: M::KEYS,
-            example: M::EXAMPLE,
-            construct: construct::<M>,
-        }
-    }
-}
-
-fn construct<M: FromParameters + Material + 'static>(
-    density: f64,
-    p: &Parameters,
-) -> Result<Box<dyn Material>, KeyError> {
-    Ok(Box::new(M::from_parameters(density, p)?))
-}
-
-/// Every model, in the order docs/scene.md lists them: one line each.
-pub const MODELS: &[Entry] = &[
-    Entry::of::<crate::material::linear_elastic::LinearElastic>(),
-    Entry::of::<crate::material::neo_hookean::NeoHookean>(),
-    Entry::of::<crate::material::hencky::Hencky>(),
-    Entry::of::<crate::material::mooney_rivlin::MooneyRivlin>(),
-    Entry::of::<crate::material::drucker_prager::DruckerPrager>(),
-    Entry::of::<crate::material::mohr_coulomb::MohrCoulomb>(),
-    Entry::of::<crate::material::ogden::Ogden>(),
-];
 
 /// The model of this name.
 pub fn find(name: &str) -> Option<&'static Entry> {

@@ -17,7 +17,7 @@ use std::sync::OnceLock;
 #[derive(Clone, Debug)]
 pub struct MaterialConfig {
     pub name: String,
-    /// A name in `material::registry::MODELS`.
+    /// A name in `material::MODELS`.
     pub model: String,
     /// Reference mass density ρ0.
     pub density: f64,
