@@ -1,228 +1,145 @@
-//! One Newton iteration of the implicit solver, split into its costs: tangent
-//! assembly, sparse factorization (first call = symbolic + numeric, and a
-//! refactorization with the same pattern = numeric only) and the solve.
+//! One Newton iteration of the implicit solver, split into its costs, each
+//! measured through the solver's own functions on the step system it builds
+//! (`StepSettings::prepare`, `residual`, `tangent`, `DirectSolver`):
+//! - `pattern`: the step's sparsity pattern (node graph and compressed columns),
+//!   built once per step at its first assembly;
+//! - `tangent`: the assembly of one iteration into that pattern (particle
+//!   tangents A_p and the scatter of their terms);
+//! - `factorize_first` (symbolic + numeric, a fresh solver) and
+//!   `factorize_refactor` (numeric only, the pattern unchanged);
+//! - `numeric_llt`: faer's numeric Cholesky alone, with the solver's ordering
+//!   and fresh buffers, the yardstick of the others;
+//! - `solve`;
+//! - `iteration_first` and `iteration_later`: the whole path of the first
+//!   iteration of a step (pattern + tangent + factorize_first + solve) and of a
+//!   later one (tangent + refactorize + solve).
 //!
-//! The matrix is the one the solver sees at the first Newton iteration of the
-//! first load step of a quasi-static run: stencils at the initial positions, trial
-//! state at u = 0, consistent tangent A_p = ∂P/∂ΔF, no inertia term.
-//!
-//! Scenes: the column of problems/column.toml refined to 1×N cells (uGIMP, 2×2
-//! particles per cell, 4N particles; its matrix is banded, so there is almost no
-//! fill-in), and the square block of problems/bench/block.toml on 64×64 cells
-//! under self-weight with a fixed base (16,384 particles, 2D coupling, real
-//! fill-in). The solver's own pieces build the matrix: `stencils_and_nodes`, its
-//! numbering of the unknowns and its particle tangents.
-//!
-//! At the initial lattice the particles sit where the outer uGIMP weights vanish,
-//! so each particle touches 2×2 nodes instead of 3×3 and the first-step matrix
-//! is much sparser than later ones. The `*_step2` variants therefore advance the
-//! real solver by one load step first and measure the first iteration of step 2,
-//! which is what the remaining 19 of the 20 load steps look like.
+//! Problems: the block of problems/bench/block.toml (uGIMP, 2×2 particles per
+//! cell, self-weight on a fixed base) in 2D on 64² and 160² cells and in 3D on
+//! 12³ and 20³ cells (2×2×2 particles per cell), each at the first iteration of
+//! load step 2 (after one converged step of the real solver: non-zero stress,
+//! particles moved, each touching 3^D nodes as in the rest of a run; at the
+//! initial lattice they touch 2^D). Small 3D blocks by default; set
+//! `MPM_BENCH_LARGE=1` for 160² and 20³ (several minutes).
 //!
 //! Run: `cargo bench --bench implicit -- --noplot` (see docs/performance.md).
 
-use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::perm::PermRef;
+use faer::sparse::linalg::cholesky::SymmetricOrdering;
 use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering,
+    factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky,
 };
-use faer::sparse::{Pair, SparseColMat, SymbolicSparseColMat, Triplet};
 use faer::Side;
 use mpm::dim::Vector;
-use mpm::material::{Increment, StressDerivative};
 use mpm::model::Model;
-use mpm::physics::deformation::Trial;
-use mpm::physics::shape::{ShapeFunction, Stencils};
-use mpm::physics::transfer::{external_force, stencils_and_nodes, NodeMap};
 use mpm::scene::Scene;
-use mpm::solver::implicit::assembly::stiffness::{
-    particle_tangents, stiffness_triplets, Pk1Derivative,
-};
-use mpm::solver::implicit::assembly::Dofs;
-use mpm::solver::implicit::step::number_unknowns;
+use mpm::solver::implicit::assembly::{Pattern, Storage};
+use mpm::solver::implicit::residual::{ordering, residual, tangent};
+use mpm::solver::implicit::step::{StepSettings, StepSystem};
 use mpm::solver::implicit::Implicit;
-use mpm::solver::linear::direct::{DirectSolver, Structure};
+use mpm::solver::linear::direct::{DirectSolver, Ordering, Structure};
+use mpm::solver::linear::ordering::{nested_dissection, node_amd, node_metis};
 use mpm::solver::stepper::Stepper;
-use rayon::prelude::*;
 use std::hint::black_box;
+use std::time::Instant;
 
-const COLUMN: &str = include_str!("../problems/column.toml");
+const BLOCK_2D: &str = include_str!("../problems/bench/block.toml");
 
-/// The 10 m × 10 m block of problems/bench/block.toml (uGIMP, 2×2 particles per
-/// cell, self-weight, fixed base), here on 64×64 cells in 20 load steps.
-const BLOCK: &str = include_str!("../problems/bench/block.toml");
+/// The block in 3D: the 2D scene's settings on a cube.
+const BLOCK_3D: &str = r#"
+dimension = 3
+gravity = [0.0, 0.0, -10.0]
 
-/// Everything one Newton iteration works on, built with the public API.
-struct Problem {
+[grid]
+min = [0.0, 0.0, 0.0]
+max = [10.0, 10.0, 10.0]
+cells = [20, 20, 20]
+shape_function = "ugimp"
+
+[[material]]
+name = "soil"
+model = "hencky"
+density = 80.0
+youngs_modulus = 1.0e6
+poisson_ratio = 0.3
+
+[[body]]
+name = "block"
+material = "soil"
+shape = "box"
+min = [0.0, 0.0, 0.0]
+max = [10.0, 10.0, 10.0]
+particles_per_cell = 2
+
+[[boundary]]
+face = "zmin"
+condition = "fixed"
+
+[solver]
+kind = "implicit"
+integrator = "quasi_static"
+end_time = 1.0
+load_steps = 4
+
+[output]
+frames = 0
+"#;
+
+/// A model after one converged load step and the step system of the next step
+/// at its first iterate (u = 0), as the solver sets it up.
+struct Problem<const D: usize> {
     name: String,
-    scene: Scene,
-    model: Model<2>,
-    shape: ShapeFunction,
-    dt: f64,
-    load_steps: usize,
+    model: Model<D>,
+    sys: StepSystem<D>,
 }
 
-impl Problem {
-    fn new(name: String, file: &str, text: &str, overrides: &[String]) -> Problem {
-        let scene = Scene::parse(file, text, overrides).expect("valid scene");
-        let c = &scene.config;
-        assert_eq!(c.dimension, 2);
+impl<const D: usize> Problem<D> {
+    fn new(name: &str, text: &str, cells: &str) -> Problem<D> {
+        let scene = Scene::parse("block.toml", text, &[format!("grid.cells={cells}")])
+            .expect("valid scene");
+        let stage = scene.config.stages()[0];
+        let shape = scene.config.grid.shape_function;
+        let dt = stage.implicit_dt();
+        let mut model = Model::<D>::build(&scene).expect("model");
+        let mut solver = Implicit::<D>::new(shape, stage, 0.0);
+        solver.step(&mut model, 0.0, dt, 0).expect("converged");
+        let settings = StepSettings::new(shape, stage, 0.0);
+        let mut sys = StepSystem::new(stage.mass());
+        let mut accel = Vec::new();
+        settings.prepare(&model, &mut sys, &mut accel, dt, dt);
+        let u = vec![Vector::<D>::zeros(); sys.map.len()];
+        residual(&model, &mut sys, &u).expect("residual");
         Problem {
-            name,
-            shape: c.grid.shape_function,
-            dt: c.stages()[0].implicit_dt(),
-            load_steps: c.stages()[0].load_steps.unwrap_or(1),
-            model: Model::<2>::build(&scene).expect("model"),
-            scene,
+            name: format!("{name}_step2"),
+            model,
+            sys,
         }
     }
 
-    fn column(n: usize) -> Problem {
-        Problem::new(
-            format!("column_{n}"),
-            "problems/column.toml",
-            COLUMN,
-            &[format!("grid.cells=[1,{n}]")],
-        )
-    }
-
-    fn block() -> Problem {
-        Problem::new(
-            "block_64x64".into(),
-            "problems/bench/block.toml",
-            BLOCK,
-            &["grid.cells=[64,64]".into(), "solver.load_steps=20".into()],
-        )
-    }
-
-    /// The same problem after `steps` converged load steps of the real solver: the
-    /// matrix of the first Newton iteration of load step `steps + 1` (non-zero
-    /// stress, F ≠ I, particles moved).
-    fn after_steps(mut self, steps: usize) -> Problem {
-        let mut solver = Implicit::<2>::new(self.shape, self.scene.config.stages()[0], 0.0);
-        for step in 0..steps {
-            solver
-                .step(&mut self.model, step as f64 * self.dt, self.dt, step)
-                .expect("converged");
-        }
-        self.name = format!("{}_step{}", self.name, steps + 1);
-        self
+    /// The pattern of the step, built anew.
+    fn pattern(&self) -> Pattern {
+        let s = &self.sys;
+        let cells = s.trial.fbar.as_ref().map(|f| &f.cells);
+        let p = Pattern::new(&s.map, &s.stencils, &s.dofs, cells);
+        p.csc::<D>(&s.dofs, Storage::Lower);
+        p
     }
 }
 
-/// Work buffers of the assembly, reused between iterations like the solver does.
-#[derive(Default)]
-struct Workspace {
-    stencils: Stencils<2>,
-    map: NodeMap,
-    trial: Trial,
-    u: Vec<Vector<2>>,
-}
-
-/// Stencils at the step-start positions and the active-node map.
-fn stencils_and_map(p: &Problem, w: &mut Workspace) {
-    stencils_and_nodes(&p.model, p.shape, &mut w.stencils, &mut w.map);
-}
-
-/// The solver's numbering of the unknowns (weakly supported nodes tied).
-fn dofs(p: &Problem, w: &Workspace) -> Dofs {
-    let min_node_support = p.scene.config.stages()[0].min_node_support();
-    number_unknowns(&p.model, &w.stencils, &w.map, min_node_support).1
-}
-
-/// Trial state at u = 0 (the first iterate of a quasi-static step).
-fn trial_at_zero(p: &Problem, w: &mut Workspace) {
-    let m = &p.model;
-    w.u.clear();
-    w.u.resize(w.map.len(), Vector::<2>::zeros());
-    let inverted = w
-        .trial
-        .evaluate(&m.particles, &m.materials, &w.stencils, &w.map, &w.u, p.dt);
-    assert!(inverted.is_none());
-}
-
-/// A_p = ∂P/∂ΔF of every particle at the trial state.
-fn pk1_derivatives(p: &Problem, w: &Workspace) -> Vec<Pk1Derivative> {
-    particle_tangents(&p.model, &w.trial, false).expect("analytic tangent")
-}
-
-/// ∂σ/∂ΔF of every particle alone (the material part of `pk1_derivatives`).
-fn stress_derivatives(p: &Problem, w: &Workspace) -> Vec<StressDerivative> {
-    let x = &p.model.particles;
-    let history_old = x.history.slots(&x.history.data);
-    (0..x.len())
-        .into_par_iter()
-        .with_min_len(512)
-        .map(|q| {
-            let inc = Increment {
-                f_old: x.f[q],
-                df: w.trial.df[q],
-                dt: 0.0,
-                stress_old: x.stress[q],
-                history_old: history_old[q],
-            };
-            p.model.materials[x.material[q] as usize]
-                .stress_derivative(&inc)
-                .expect("analytic tangent")
-        })
-        .collect()
-}
-
-/// The whole assembly of one Newton iteration.
-fn assemble(p: &Problem, w: &mut Workspace) -> (Dofs, Vec<(usize, usize, f64)>, Structure) {
-    stencils_and_map(p, w);
-    let dofs = dofs(p, w);
-    trial_at_zero(p, w);
-    let a = pk1_derivatives(p, w);
-    let (triplets, symmetric) =
-        stiffness_triplets(&w.map, &w.stencils, &dofs, &p.model.particles.volume, &a);
-    let structure = Structure::of(symmetric);
-    (dofs, triplets, structure)
-}
-
-/// Right-hand side of the first iteration of the first step: −r(0) = f_ext at the
-/// first load factor (the internal force vanishes at zero initial stress), free
-/// components. For the `*_step2` variants it is just a realistic vector (the solve
-/// time does not depend on it).
-fn rhs(p: &Problem, w: &Workspace, dofs: &Dofs) -> Vec<f64> {
-    let m = &p.model;
-    let g = m.gravity / p.load_steps as f64;
-    let f = external_force(&w.map, &w.stencils, &m.particles, &g, &|_| 0.0);
-    dofs.reduce(&f)
-}
-
-/// The lower triangle of K in CSC form, as the direct solver builds it from the
-/// triplets (duplicates summed).
-fn lower_csc(n: usize, triplets: &[(usize, usize, f64)]) -> SparseColMat<usize, f64> {
-    let lower: Vec<Triplet<usize, usize, f64>> = triplets
-        .iter()
-        .filter(|t| t.0 >= t.1)
-        .map(|&(r, c, v)| Triplet::new(r, c, v))
-        .collect();
-    SparseColMat::try_new_from_triplets(n, n, &lower).expect("csc")
-}
-
-/// faer's symbolic Cholesky with AMD ordering (what `DirectSolver` computes once
-/// per pattern).
-fn symbolic(a: &SparseColMat<usize, f64>) -> SymbolicCholesky<usize> {
-    factorize_symbolic_cholesky(
-        a.symbolic(),
-        Side::Lower,
-        SymmetricOrdering::Amd,
-        CholeskySymbolicParams::default(),
-    )
-    .expect("symbolic")
-}
-
-/// faer's numeric LLᵀ alone, with a given symbolic factorization.
-fn numeric_llt(sym: &SymbolicCholesky<usize>, a: &SparseColMat<usize, f64>) -> Vec<f64> {
+/// faer's numeric LLᵀ alone into fresh buffers.
+fn numeric_llt(
+    sym: &SymbolicCholesky<usize>,
+    a: faer::sparse::SparseColMatRef<usize, f64>,
+) -> Vec<f64> {
     let par = faer::get_global_parallelism();
     let mut values = vec![0.0; sym.len_val()];
     let req = sym.factorize_numeric_llt_scratch::<f64>(par, Default::default());
     let mut mem = MemBuffer::new(req);
     sym.factorize_numeric_llt(
         &mut values,
-        a.as_ref(),
+        a,
         Side::Lower,
         Default::default(),
         par,
@@ -233,136 +150,158 @@ fn numeric_llt(sym: &SymbolicCholesky<usize>, a: &SparseColMat<usize, f64>) -> V
     values
 }
 
-fn bench_problem(c: &mut Criterion, p: &Problem) {
-    let mut w = Workspace::default();
-    let (dofs, triplets, structure) = assemble(p, &mut w);
-    let b = rhs(p, &w, &dofs);
-    let n = dofs.free;
-    let lower = lower_csc(n, &triplets);
-    let sym = symbolic(&lower);
-    let (nnz_lower, nnz_factor) = (lower.compute_nnz(), sym.len_val());
+fn bench_problem<const D: usize>(c: &mut Criterion, p: &mut Problem<D>) {
+    let m = &p.model;
+    p.sys.pattern = Default::default();
+    let k = tangent(m, &p.sys, false).expect("tangent");
+    assert!(k.symmetric());
+    let n = k.matrix().nrows();
+    let b: Vec<f64> = (0..n).map(|i| 1.0 + (i % 7) as f64).collect();
+    let order = ordering(&p.sys, &k);
     let mut solver = DirectSolver::new();
     let method = solver
-        .factorize(n, &triplets, structure)
+        .factorize(k.matrix(), Structure::Symmetric, order)
         .expect("factorize");
+    let symbolic = |perm: Option<&[usize]>| {
+        let inv = perm.map(|p| {
+            let mut inv = vec![0; p.len()];
+            p.iter().enumerate().for_each(|(new, &old)| inv[old] = new);
+            inv
+        });
+        let ordering = match (perm, &inv) {
+            (Some(p), Some(i)) => SymmetricOrdering::Custom(PermRef::new_checked(p, i, n)),
+            _ => SymmetricOrdering::Amd,
+        };
+        let sym = factorize_symbolic_cholesky(
+            k.matrix().symbolic(),
+            Side::Lower,
+            ordering,
+            CholeskySymbolicParams::default(),
+        )
+        .expect("symbolic");
+        sym
+    };
+    // The orderings side by side: time to compute, nnz(L), and faer's numeric
+    // LLᵀ with each (one call).
+    let pattern = p.sys.pattern.get().expect("pattern");
+    let ijk = |a: usize| {
+        m.grid
+            .node_ijk(p.sys.map.active[a] as usize)
+            .map(|i| i as i64)
+    };
+    let clock = Instant::now();
+    let node_amd_perm = node_amd(&pattern.graph());
+    let t_node_amd = clock.elapsed().as_secs_f64();
+    let clock = Instant::now();
+    let nd_perm = nested_dissection::<D>(&pattern.graph(), ijk);
+    let t_nd = clock.elapsed().as_secs_f64();
+    let clock = Instant::now();
+    let metis_perm = node_metis(&pattern.graph());
+    let t_metis = clock.elapsed().as_secs_f64();
+    for (label, perm, t_order) in [
+        ("METIS", Some(metis_perm.as_slice()), t_metis),
+        ("scalar AMD", None, 0.0),
+        ("node AMD", Some(node_amd_perm.as_slice()), t_node_amd),
+        ("nested dissection", Some(nd_perm.as_slice()), t_nd),
+    ] {
+        let clock = Instant::now();
+        let sym = symbolic(perm);
+        let t_symbolic = clock.elapsed().as_secs_f64();
+        let clock = Instant::now();
+        numeric_llt(&sym, k.matrix());
+        let t_numeric = clock.elapsed().as_secs_f64();
+        eprintln!(
+            "{}: {label}: ordering {t_order:.3} s, symbolic (incl. ordering for scalar AMD) \
+             {t_symbolic:.3} s, nnz(L) {}, numeric {t_numeric:.3} s",
+            p.name,
+            sym.len_val()
+        );
+    }
+    let sym = symbolic(match order {
+        Ordering::Given(perm) => Some(perm),
+        Ordering::Amd => None,
+    });
     eprintln!(
-        "{}: {} particles, {:.2} nodes per particle, {} active nodes, {} unknowns, {} triplets, {:?}, method {}, \
-         nnz(lower K) {}, nnz(L) {} (fill ratio {:.2})",
+        "{}: {} particles, {} active nodes, {n} unknowns, nnz(lower K) {}, nnz(L) {}, method {}",
         p.name,
-        p.model.particles.len(),
-        w.stencils.count.iter().map(|&k| k as f64).sum::<f64>() / p.model.particles.len() as f64,
-        w.map.len(),
-        n,
-        triplets.len(),
-        structure,
+        m.particles.len(),
+        p.sys.map.len(),
+        k.values.len(),
+        sym.len_val(),
         method.name(),
-        nnz_lower,
-        nnz_factor,
-        nnz_factor as f64 / nnz_lower as f64
     );
-
     let mut group = c.benchmark_group(format!("implicit/{}", p.name));
     group.sample_size(10);
-    group.throughput(Throughput::Elements(p.model.particles.len() as u64));
-
-    // (a) Assembly, whole and in parts.
-    group.bench_function("assembly", |bch| {
-        bch.iter(|| black_box(assemble(p, &mut w).1.len()))
-    });
-    group.bench_function(BenchmarkId::new("assembly_part", "stencils_map"), |bch| {
-        bch.iter(|| stencils_and_map(p, &mut w))
-    });
-    group.bench_function(BenchmarkId::new("assembly_part", "trial"), |bch| {
-        bch.iter(|| trial_at_zero(p, &mut w))
-    });
-    group.bench_function(BenchmarkId::new("assembly_part", "pk1_derivative"), |bch| {
-        bch.iter(|| black_box(pk1_derivatives(p, &w).len()))
-    });
-    group.bench_function(
-        BenchmarkId::new("assembly_part", "stress_derivative_only"),
-        |bch| bch.iter(|| black_box(stress_derivatives(p, &w).len())),
-    );
-    let a = pk1_derivatives(p, &w);
-    group.bench_function(BenchmarkId::new("assembly_part", "triplets"), |bch| {
-        bch.iter(|| {
-            let (t, s) =
-                stiffness_triplets(&w.map, &w.stencils, &dofs, &p.model.particles.volume, &a);
-            black_box((t.len(), s))
-        })
-    });
-
-    // (b) Factorization: first call (symbolic + numeric) and refactorization.
     group.throughput(Throughput::Elements(n as u64));
+    let sys = &p.sys;
+    group.bench_function("pattern", |bch| bch.iter(|| black_box(p.pattern().nodes())));
+    group.bench_function("tangent", |bch| {
+        bch.iter(|| black_box(tangent(m, sys, false).expect("tangent").values.len()))
+    });
     group.bench_function("factorize_first", |bch| {
         bch.iter(|| {
             let mut s = DirectSolver::new();
-            black_box(s.factorize(n, &triplets, structure).expect("factorize"))
+            black_box(
+                s.factorize(k.matrix(), Structure::Symmetric, order)
+                    .expect("factorize"),
+            )
         })
     });
     group.bench_function("factorize_refactor", |bch| {
         bch.iter(|| {
             black_box(
                 solver
-                    .factorize(n, &triplets, structure)
-                    .expect("factorize"),
+                    .factorize(k.matrix(), Structure::Symmetric, order)
+                    .expect("ok"),
             )
         })
     });
-    assert_eq!(solver.symbolic_count(), 1, "the pattern was reused");
-
-    // Where the factorization time goes: faer alone, outside `DirectSolver`
-    // (which adds the pattern comparison and a probe solve with three products).
-    if structure == Structure::Symmetric {
-        group.bench_function(
-            BenchmarkId::new("factorize_part", "triplets_to_csc"),
-            |bch| bch.iter(|| black_box(lower_csc(n, &triplets).compute_nnz())),
-        );
-        // What-if: the same CSC matrix when the pattern and the value order
-        // (faer's argsort) are cached, i.e. only the values are scattered.
-        let pairs: Vec<Pair<usize, usize>> = triplets
-            .iter()
-            .filter(|t| t.0 >= t.1)
-            .map(|&(row, col, _)| Pair { row, col })
-            .collect();
-        let (pattern, order) =
-            SymbolicSparseColMat::try_new_from_indices(n, n, &pairs).expect("pattern");
-        group.bench_function(
-            BenchmarkId::new("factorize_part", "csc_from_cached_order"),
-            |bch| {
-                bch.iter(|| {
-                    let values: Vec<f64> = triplets
-                        .iter()
-                        .filter(|t| t.0 >= t.1)
-                        .map(|t| t.2)
-                        .collect();
-                    let a = SparseColMat::new_from_argsort(pattern.clone(), &order, &values)
-                        .expect("csc");
-                    black_box(a.compute_nnz())
-                })
-            },
-        );
-        group.bench_function(BenchmarkId::new("factorize_part", "symbolic_amd"), |bch| {
-            bch.iter(|| black_box(symbolic(&lower).len_val()))
-        });
-        group.bench_function(BenchmarkId::new("factorize_part", "numeric_llt"), |bch| {
-            bch.iter(|| black_box(numeric_llt(&sym, &lower).len()))
-        });
-    }
-
-    // (c) Solve with the factors.
+    group.bench_function("numeric_llt", |bch| {
+        bch.iter(|| black_box(numeric_llt(&sym, k.matrix()).len()))
+    });
     group.bench_function("solve", |bch| {
         bch.iter(|| black_box(solver.solve(&b).expect("solve")))
+    });
+    let mut fresh = sys.clone();
+    group.bench_function("iteration_first", |bch| {
+        bch.iter(|| {
+            fresh.pattern = Default::default();
+            let k = tangent(m, &fresh, false).expect("tangent");
+            let mut s = DirectSolver::new();
+            s.factorize(k.matrix(), Structure::Symmetric, ordering(&fresh, &k))
+                .expect("factorize");
+            black_box(s.solve(&b).expect("solve"))
+        })
+    });
+    group.bench_function("iteration_later", |bch| {
+        bch.iter(|| {
+            let k = tangent(m, sys, false).expect("tangent");
+            solver
+                .factorize(k.matrix(), Structure::Symmetric, ordering(sys, &k))
+                .expect("factorize");
+            black_box(solver.solve(&b).expect("solve"))
+        })
     });
     group.finish();
 }
 
 fn implicit(c: &mut Criterion) {
-    for n in [64, 256, 1024] {
-        bench_problem(c, &Problem::column(n));
-    }
-    bench_problem(c, &Problem::column(1024).after_steps(1));
-    bench_problem(c, &Problem::block());
-    bench_problem(c, &Problem::block().after_steps(1));
+    let large = std::env::var_os("MPM_BENCH_LARGE").is_some();
+    let (cells_2d, cells_3d) = if large {
+        ("[160,160]", "[20,20,20]")
+    } else {
+        ("[64,64]", "[12,12,12]")
+    };
+    let name_2d = format!(
+        "block2d_{}",
+        cells_2d.trim_matches(['[', ']']).replace(',', "x")
+    );
+    let name_3d = format!(
+        "block3d_{}",
+        cells_3d.trim_matches(['[', ']']).replace(',', "x")
+    );
+    bench_problem(c, &mut Problem::<2>::new(&name_2d, BLOCK_2D, cells_2d));
+    bench_problem(c, &mut Problem::<3>::new(&name_3d, BLOCK_3D, cells_3d));
 }
 
 criterion_group!(benches, implicit);

@@ -310,7 +310,7 @@ impl Cantilever {
                     ));
                 }
                 solver
-                    .factorize(n, &k, Structure::Symmetric)
+                    .factorize_triplets(n, &k, Structure::Symmetric)
                     .map_err(|e| format!("load step {step}: {e}"))?;
                 let du = solver
                     .solve(&r)

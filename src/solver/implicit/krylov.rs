@@ -36,7 +36,7 @@
 use super::assembly::stiffness::{coupling, particle_tangents, Pk1Derivative};
 use super::assembly::Dofs;
 use super::failure::Failure;
-use super::residual::{residual, tangent};
+use super::residual::{ordering, residual, tangent};
 use super::step::StepSystem;
 use crate::dim::Vector;
 use crate::model::Model;
@@ -375,10 +375,10 @@ impl KrylovState {
             return Ok(());
         }
         // The lagged preconditioner accepts a numerical tangent.
-        let (triplets, symmetric) = tangent(m, sys, true)?;
-        let structure = Structure::of(symmetric);
+        let k = tangent(m, sys, true)?;
+        let structure = Structure::of(k.symmetric());
         self.lagged
-            .factorize(sys.dofs.free, &triplets, structure)
+            .factorize(k.matrix(), structure, ordering(sys, &k))
             .map_err(|e| Failure {
                 particle: None,
                 message: format!("lagged_direct preconditioner: factorization failed: {e}"),
@@ -479,16 +479,12 @@ mod tests {
             .collect();
         let dofs = sys.dofs.clone();
         let r0 = dofs.reduce(&residual(&m, sys, &u).unwrap());
-        let (triplets, _) = tangent(&m, sys, false).unwrap();
         // A smooth direction with ‖v‖_∞ = 1.
         let n = dofs.free;
         let v: Vec<f64> = (0..n).map(|i| (0.37 * i as f64).sin()).collect();
         let v_max = v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
         let v: Vec<f64> = v.iter().map(|x| x / v_max).collect();
-        let mut kv = vec![0.0; n];
-        for (r, c, val) in triplets {
-            kv[r] += val * v[c];
-        }
+        let kv = tangent(&m, sys, false).unwrap().apply(&v);
         let kv_norm = norm(&kv);
         let errors = steps
             .iter()

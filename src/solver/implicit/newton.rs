@@ -16,7 +16,7 @@
 
 use super::failure::Failure;
 use super::krylov::{Correction, KrylovConfig, KrylovState};
-use super::residual::{inertial_force, reactions, residual, tangent};
+use super::residual::{inertial_force, ordering, reactions, residual, tangent};
 use super::step::StepSystem;
 use crate::dim::Vector;
 use crate::model::Model;
@@ -250,14 +250,14 @@ fn direct_correction<const D: usize>(
     solver: &mut DirectSolver,
     r_free: &[f64],
 ) -> Result<Correction, Failure> {
-    let (triplets, symmetric) = tangent(m, sys, false)?;
-    let structure = Structure::of(symmetric);
+    let k = tangent(m, sys, false)?;
+    let structure = Structure::of(k.symmetric());
     let failed = |e: String| Failure {
         particle: None,
         message: format!("linear solve failed: {e}"),
     };
     let used = solver
-        .factorize(sys.dofs.free, &triplets, structure)
+        .factorize(k.matrix(), structure, ordering(sys, &k))
         .map_err(|e| failed(e.to_string()))?;
     let rhs: Vec<f64> = r_free.iter().map(|x| -x).collect();
     let du = solver.solve(&rhs).map_err(|e| failed(e.to_string()))?;

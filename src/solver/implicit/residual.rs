@@ -11,11 +11,11 @@
 //! tangent K = ∂r/∂u (2-40) is assembled over the unknowns from the terms of
 //! `assembly`.
 
-use super::assembly::absorbing::absorbing_triplets;
-use super::assembly::fbar::fbar_triplets;
-use super::assembly::mass::{consistent_mass_triplets, lumped_mass_triplets};
-use super::assembly::stiffness::{particle_tangents, relative_pk1, stiffness_triplets};
-use super::assembly::Triplets;
+use super::assembly::absorbing::add_absorbing;
+use super::assembly::fbar::add_fbar_stiffness;
+use super::assembly::mass::{add_consistent_mass, add_lumped_mass};
+use super::assembly::stiffness::{add_stiffness, major_symmetric, particle_tangents, relative_pk1};
+use super::assembly::{Pattern, Storage, Tangent};
 use super::failure::Failure;
 use super::step::StepSystem;
 use crate::dim::Vector;
@@ -24,6 +24,8 @@ use crate::model::particles::Particles;
 use crate::model::Model;
 use crate::physics::transfer::{consistent_mass_product, internal_force};
 use crate::scene::MassMatrix;
+use crate::solver::linear::direct::Ordering;
+use rayon::prelude::*;
 
 /// r(u) at the active nodes; evaluates the particles' trial state at u.
 pub fn residual<const D: usize>(
@@ -89,29 +91,54 @@ pub fn reactions<const D: usize>(constraint: &[Constraint<D>], r: &[Vector<D>]) 
 /// springs, and the inertia; and whether K is symmetric. `numerical` lets
 /// materials without an analytic tangent use a numerical one (Krylov
 /// preconditioners only).
-pub fn tangent<const D: usize>(
+pub fn tangent<'s, const D: usize>(
     m: &Model<D>,
-    sys: &StepSystem<D>,
+    sys: &'s StepSystem<D>,
     numerical: bool,
-) -> Result<(Triplets, bool), Failure> {
+) -> Result<Tangent<'s>, Failure> {
     let p = &m.particles;
     let (st, map, dofs) = (&sys.stencils, &sys.map, &sys.dofs);
     let a = particle_tangents(m, &sys.trial, numerical)?;
-    let (mut triplets, symmetric) = match &sys.trial.fbar {
-        None => stiffness_triplets(map, st, dofs, &p.volume, &a),
-        Some(state) => (fbar_triplets(map, st, dofs, &p.volume, state, &a), false),
+    let fbar = sys.trial.fbar.as_ref();
+    let pattern = sys
+        .pattern
+        .get_or_init(|| Pattern::new(map, st, dofs, fbar.map(|f| &f.cells)));
+    // Symmetric unless F-bar or a non-associated material breaks it.
+    let symmetric = fbar.is_none() && a.par_iter().all(major_symmetric);
+    let storage = if symmetric {
+        Storage::Lower
+    } else {
+        Storage::Full
     };
+    let csc = pattern.csc::<D>(dofs, storage);
+    let mut k = Tangent {
+        pattern: csc,
+        values: vec![0.0; csc.row_idx().len()],
+        storage,
+    };
+    match fbar {
+        None => add_stiffness(&mut k, pattern, map, st, dofs, &p.volume, &a),
+        Some(state) => add_fbar_stiffness(&mut k, pattern, map, st, dofs, &p.volume, state, &a),
+    }
     // Absorbing faces: Σ S_I S_J (γ/(βΔt) C + K), symmetric.
-    absorbing_triplets(&sys.absorbing, map, st, dofs, &mut triplets);
+    add_absorbing(&mut k, &sys.absorbing, pattern, map, st, dofs);
     if sys.inertia > 0.0 {
         match sys.mass_matrix {
-            MassMatrix::Lumped => {
-                lumped_mass_triplets::<D>(dofs, &sys.mass, sys.inertia, &mut triplets)
-            }
+            MassMatrix::Lumped => add_lumped_mass::<D>(&mut k, dofs, &sys.mass, sys.inertia),
             MassMatrix::Consistent => {
-                consistent_mass_triplets(map, st, dofs, &p.mass, sys.inertia, &mut triplets)
+                add_consistent_mass(&mut k, pattern, map, st, dofs, &p.mass, sys.inertia)
             }
         }
     }
-    Ok((triplets, symmetric))
+    Ok(k)
+}
+
+/// The fill-reducing ordering for the factorization of the tangent `k` of
+/// `sys`: the pattern's ordering of whole nodes when `k` is symmetric (LU
+/// orders its columns itself).
+pub fn ordering<'s, const D: usize>(sys: &'s StepSystem<D>, k: &Tangent) -> Ordering<'s> {
+    match (k.symmetric(), sys.pattern.get()) {
+        (true, Some(pattern)) => Ordering::Given(pattern.ordering::<D>()),
+        _ => Ordering::Amd,
+    }
 }

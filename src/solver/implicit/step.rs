@@ -10,7 +10,7 @@
 //! the particle accelerations of M a = f_ext − f_int at the first step.
 //! [`StepSettings::commit`] makes the converged increment the particles' state.
 
-use super::assembly::Dofs;
+use super::assembly::{Dofs, Pattern};
 use super::newmark::Newmark;
 use super::ties::{nodal_support, ties};
 use crate::dim::Vector;
@@ -27,6 +27,7 @@ use crate::physics::transfer::{
 };
 use crate::scene::{Integrator, MassMatrix, SolverConfig};
 use rayon::prelude::*;
+use std::sync::OnceLock;
 
 /// How the steps of a stage are set up (scene [solver]).
 #[derive(Clone, Debug)]
@@ -79,6 +80,8 @@ pub struct StepSystem<const D: usize> {
     pub scales_new: Vec<f64>,
     /// The particles' state at the latest iterate.
     pub trial: Trial,
+    /// The tangent's sparsity pattern (built at the step's first assembly).
+    pub pattern: OnceLock<Pattern>,
 }
 
 impl<const D: usize> StepSystem<D> {
@@ -101,6 +104,7 @@ impl<const D: usize> StepSystem<D> {
             g_new: 0.0,
             scales_new: Vec::new(),
             trial: Trial::default(),
+            pattern: OnceLock::new(),
         }
     }
 }
@@ -197,6 +201,7 @@ impl StepSettings {
         sys.dt = dt;
         sys.constraint = constraint;
         sys.dofs = dofs;
+        sys.pattern = OnceLock::new();
         sys.mass = mass;
         sys.f_ext = f_ext;
         sys.a_n = a_n;

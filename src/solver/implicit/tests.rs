@@ -99,11 +99,17 @@ fn tangent_error_of<const D: usize>(
     res(sys, &u);
     // History of the materials used here: equivalent plastic strain or none.
     let plastic = sys.trial.history.iter().filter(|&&k| k > 0.0).count();
-    let (triplets, _) = tangent(&m, sys, false).unwrap();
     let n = dofs.free;
     let mut k = vec![0.0; n * n];
-    for (r, c, v) in triplets {
-        k[r * n + c] += v;
+    let kt = tangent(&m, sys, false).unwrap();
+    let km = kt.matrix();
+    for c in 0..n {
+        for (&r, &v) in km.row_idx_of_col_raw(c).iter().zip(km.val_of_col(c)) {
+            k[r * n + c] += v;
+            if kt.symmetric() && r != c {
+                k[c * n + r] += v;
+            }
+        }
     }
     let kmax = k.iter().fold(0.0f64, |a, b| a.max(b.abs()));
     let h = 1e-7;

@@ -17,9 +17,7 @@ use faer::sparse::linalg::lu::{
     factorize_symbolic_lu, LuRef, LuSymbolicParams, NumericLu, SymbolicLu,
 };
 use faer::sparse::linalg::LuError;
-use faer::sparse::{
-    Argsort, CreationError, Pair, SparseColMat, SparseColMatRef, SymbolicSparseColMat, Triplet,
-};
+use faer::sparse::{CreationError, SparseColMat, SparseColMatRef, Triplet};
 use faer::{Conj, MatMut, Par, Side};
 
 /// Largest accepted normwise backward error `‖K y − b‖ / (‖|K||y|‖ + ‖b‖)` of the probe solve.
@@ -85,23 +83,24 @@ pub enum SolveError {
     Backend(String),
 }
 
-/// Sorted, deduplicated pattern of the last factorized matrix (key of the symbolic cache).
+/// The fill-reducing ordering of the symbolic Cholesky factorization.
+#[derive(Clone, Copy, Debug)]
+pub enum Ordering<'a> {
+    /// faer's approximate minimum degree on the scalar matrix.
+    Amd,
+    /// A permutation of the unknowns (`perm[new] = old`), e.g. from
+    /// `super::ordering`.
+    Given(&'a [usize]),
+}
+
+/// Sorted, deduplicated pattern of the last factorized matrix and the ordering
+/// given with it (key of the symbolic cache).
 struct Pattern {
     n: usize,
     structure: Structure,
     col_ptr: Vec<usize>,
     row_idx: Vec<usize>,
-}
-
-/// The (row, col) sequence of the last triplet list with its CSC pattern and value
-/// order: a list with the same sequence (every Newton iteration of a step) is
-/// scattered into CSC without sorting again.
-struct ValueOrder {
-    n: usize,
-    structure: Structure,
-    indices: Vec<(usize, usize)>,
-    symbolic: SymbolicSparseColMat<usize>,
-    order: Argsort<usize>,
+    perm: Option<Vec<usize>>,
 }
 
 /// Numeric factors of the last successful factorization.
@@ -120,7 +119,12 @@ enum Numeric {
 
 /// Sparse direct solver holding the symbolic factorizations and the pattern they belong to.
 pub struct DirectSolver {
-    value_order: Option<ValueOrder>,
+    /// The factors of the previous factorization while the pattern is
+    /// unchanged: their buffers are refilled instead of allocated again.
+    kept: Numeric,
+    /// faer's workspace, grown as needed and kept.
+    work: MemBuffer,
+    work_size: StackReq,
     pattern: Option<Pattern>,
     chol: Option<SymbolicCholesky<usize>>,
     lu: Option<SymbolicLu<usize>>,
@@ -138,7 +142,9 @@ impl DirectSolver {
     /// Empty solver: no pattern, no factorization.
     pub fn new() -> Self {
         Self {
-            value_order: None,
+            kept: Numeric::None,
+            work: MemBuffer::new(StackReq::EMPTY),
+            work_size: StackReq::EMPTY,
             pattern: None,
             chol: None,
             lu: None,
@@ -147,22 +153,44 @@ impl DirectSolver {
         }
     }
 
-    /// Factorize K given as triplets (duplicates summed); reuses the symbolic factorization
-    /// when the pattern (the sorted, deduplicated set of (row, col)) equals the previous one.
-    /// Symmetric: LLᵀ, else LBLᵀ, else LU; General: LU. On error no factorization is kept.
+    /// Factorize K given in compressed columns (its lower triangle for
+    /// `Symmetric`, rows sorted within each column); reuses the symbolic
+    /// factorization when the pattern equals the previous one. Symmetric: LLᵀ,
+    /// else LBLᵀ, else LU; General: LU. On error no factorization is kept.
     pub fn factorize(
+        &mut self,
+        a: SparseColMatRef<usize, f64>,
+        structure: Structure,
+        ordering: Ordering,
+    ) -> Result<Method, SolveError> {
+        let kept = std::mem::replace(&mut self.numeric, Numeric::None);
+        check_entries(a, structure)?;
+        if let Ordering::Given(perm) = ordering {
+            if perm.len() != a.nrows() {
+                let msg = format!("ordering of length {}, expected {}", perm.len(), a.nrows());
+                return Err(SolveError::InvalidInput(msg));
+            }
+        }
+        if self.update_pattern(a.nrows(), structure, a, ordering) {
+            self.kept = kept;
+        }
+        match structure {
+            Structure::General => self.factor_lu(a),
+            Structure::Symmetric => self.factor_symmetric(a),
+        }
+    }
+
+    /// [`Self::factorize`] of K given as triplets (duplicates summed; with
+    /// `Symmetric` only those with row ≥ column are read).
+    pub fn factorize_triplets(
         &mut self,
         n: usize,
         triplets: &[(usize, usize, f64)],
         structure: Structure,
     ) -> Result<Method, SolveError> {
         self.numeric = Numeric::None;
-        let a = self.build_csc(n, triplets, structure)?;
-        self.update_pattern(n, structure, a.as_ref());
-        match structure {
-            Structure::General => self.factor_lu(a.as_ref()),
-            Structure::Symmetric => self.factor_symmetric(a.as_ref()),
-        }
+        let a = csc_from_triplets(n, triplets, structure)?;
+        self.factorize(a.as_ref(), structure, Ordering::Amd)
     }
 
     /// Solve `K x = b` with the last factorization; `b` is left untouched and `x` returned.
@@ -190,11 +218,26 @@ impl DirectSolver {
         self.symbolic_count
     }
 
-    /// Keep the cached symbolic factorizations iff the new pattern equals the stored one.
-    fn update_pattern(&mut self, n: usize, structure: Structure, a: SparseColMatRef<usize, f64>) {
+    /// Keep the cached symbolic factorizations iff the new pattern and ordering
+    /// equal the stored ones; returns whether they do.
+    fn update_pattern(
+        &mut self,
+        n: usize,
+        structure: Structure,
+        a: SparseColMatRef<usize, f64>,
+        ordering: Ordering,
+    ) -> bool {
         let (col_ptr, row_idx) = (a.symbolic().col_ptr(), a.symbolic().row_idx());
+        let perm = match ordering {
+            Ordering::Amd => None,
+            Ordering::Given(p) => Some(p),
+        };
         let same = self.pattern.as_ref().is_some_and(|p| {
-            p.n == n && p.structure == structure && p.col_ptr == col_ptr && p.row_idx == row_idx
+            p.n == n
+                && p.structure == structure
+                && p.col_ptr == col_ptr
+                && p.row_idx == row_idx
+                && p.perm.as_deref() == perm
         });
         if !same {
             self.chol = None;
@@ -204,8 +247,10 @@ impl DirectSolver {
                 structure,
                 col_ptr: col_ptr.to_vec(),
                 row_idx: row_idx.to_vec(),
+                perm: perm.map(|p| p.to_vec()),
             });
         }
+        same
     }
 
     /// LLᵀ, then LBLᵀ, then LU on the mirrored full matrix; `lower` holds the lower triangle.
@@ -224,17 +269,21 @@ impl DirectSolver {
         self.factor_lu(full.as_ref())
     }
 
-    /// Compute the symbolic Cholesky (AMD ordering) of the lower triangle unless cached.
+    /// Compute the symbolic Cholesky of the lower triangle unless cached (with
+    /// the given ordering, else AMD).
     fn ensure_chol(&mut self, lower: SparseColMatRef<usize, f64>) -> Result<(), SolveError> {
         if self.chol.is_none() {
             let params = CholeskySymbolicParams::default();
-            let sym = factorize_symbolic_cholesky(
-                lower.symbolic(),
-                Side::Lower,
-                SymmetricOrdering::Amd,
-                params,
-            )
-            .map_err(backend)?;
+            let perm = self.pattern.as_ref().and_then(|p| p.perm.as_ref());
+            let inverse = perm.map(|p| inverse(p));
+            let ordering = match (perm, &inverse) {
+                (Some(fwd), Some(inv)) => {
+                    SymmetricOrdering::Custom(PermRef::new_checked(fwd, inv, fwd.len()))
+                }
+                _ => SymmetricOrdering::Amd,
+            };
+            let sym = factorize_symbolic_cholesky(lower.symbolic(), Side::Lower, ordering, params)
+                .map_err(backend)?;
             self.chol = Some(sym);
             self.symbolic_count += 1;
         }
@@ -252,23 +301,47 @@ impl DirectSolver {
         Ok(())
     }
 
-    /// Numeric LLᵀ with the cached symbolic factorization, then the probe check.
+    /// A workspace of at least `req`, kept between calls.
+    fn workspace(&mut self, req: StackReq) -> Result<&mut MemStack, SolveError> {
+        if req.size_bytes() > self.work_size.size_bytes()
+            || req.align_bytes() > self.work_size.align_bytes()
+        {
+            self.work = buffer(req)?;
+            self.work_size = req;
+        }
+        Ok(MemStack::new(&mut self.work))
+    }
+
+    /// Numeric LLᵀ with the cached symbolic factorization (into the kept
+    /// factor's buffer when there is one), then the probe check.
     fn try_llt(&mut self, lower: SparseColMatRef<usize, f64>) -> Result<(), SolveError> {
-        let sym = self.chol.as_ref().ok_or(SolveError::NotFactorized)?;
+        let sym = self.chol.take().ok_or(SolveError::NotFactorized)?;
         let par = faer::get_global_parallelism();
-        let mut values = vec![0.0; sym.len_val()];
-        let mut mem = buffer(sym.factorize_numeric_llt_scratch::<f64>(par, Default::default()))?;
-        let stack = MemStack::new(&mut mem);
-        sym.factorize_numeric_llt(
-            &mut values,
-            lower,
-            Side::Lower,
-            Default::default(),
-            par,
-            stack,
-            Default::default(),
-        )
-        .map_err(|e| SolveError::Singular(format!("LLT: {e:?}")))?;
+        let mut values = match std::mem::replace(&mut self.kept, Numeric::None) {
+            Numeric::Llt(v) if v.len() == sym.len_val() => v,
+            _ => vec![0.0; sym.len_val()],
+        };
+        let req = sym.factorize_numeric_llt_scratch::<f64>(par, Default::default());
+        let stack = match self.workspace(req) {
+            Ok(stack) => stack,
+            Err(e) => {
+                self.chol = Some(sym);
+                return Err(e);
+            }
+        };
+        let result = sym
+            .factorize_numeric_llt(
+                &mut values,
+                lower,
+                Side::Lower,
+                Default::default(),
+                par,
+                stack,
+                Default::default(),
+            )
+            .map(|_| ());
+        self.chol = Some(sym);
+        result.map_err(|e| SolveError::Singular(format!("LLT: {e:?}")))?;
         self.numeric = Numeric::Llt(values);
         self.check(lower, true)
     }
@@ -401,6 +474,15 @@ impl DirectSolver {
     }
 }
 
+/// The inverse of a permutation.
+fn inverse(perm: &[usize]) -> Vec<usize> {
+    let mut inv = vec![0; perm.len()];
+    for (new, &old) in perm.iter().enumerate() {
+        inv[old] = new;
+    }
+    inv
+}
+
 /// Deterministic probe vector entry in [0.5, 1.5), not aligned with grid structure.
 fn probe_entry(i: usize) -> f64 {
     0.5 + ((i as u64).wrapping_mul(2_654_435_761) % 1_000_003) as f64 / 1_000_003.0
@@ -431,67 +513,51 @@ fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).fold(0.0, |m, (s, t)| m.max((s - t).abs()))
 }
 
-impl DirectSolver {
-    /// Build the CSC matrix (duplicates summed); lower triangle only for
-    /// `Symmetric`. The sort into CSC order is skipped when the (row, col)
-    /// sequence repeats the previous call's.
-    fn build_csc(
-        &mut self,
-        n: usize,
-        triplets: &[(usize, usize, f64)],
-        structure: Structure,
-    ) -> Result<SparseColMat<usize, f64>, SolveError> {
-        if let Some(&(r, c, v)) = triplets.iter().find(|t| !t.2.is_finite()) {
-            return Err(SolveError::InvalidInput(format!(
-                "non-finite value {v} at ({r}, {c})"
-            )));
-        }
-        let upper_only = structure == Structure::Symmetric
-            && triplets.iter().any(|t| t.0 < t.1)
-            && !triplets.iter().any(|t| t.0 > t.1);
-        if upper_only {
-            let msg =
-                "Symmetric structure reads the lower triangle, but only upper entries were given";
-            return Err(SolveError::InvalidInput(msg.into()));
-        }
-        let keep = |t: &&(usize, usize, f64)| structure == Structure::General || t.0 >= t.1;
-        let same = self.value_order.as_ref().is_some_and(|o| {
-            o.n == n
-                && o.structure == structure
-                && triplets
-                    .iter()
-                    .filter(keep)
-                    .map(|t| (t.0, t.1))
-                    .eq(o.indices.iter().copied())
-        });
-        if !same {
-            self.value_order = None;
-            if let Some(&(r, c, _)) = triplets.iter().find(|t| t.0 >= n || t.1 >= n) {
-                return Err(creation_error(CreationError::OutOfBounds {
-                    row: r,
-                    col: c,
-                }));
+/// Non-finite values, and entries above the diagonal of a `Symmetric` matrix, are
+/// invalid input.
+fn check_entries(a: SparseColMatRef<usize, f64>, structure: Structure) -> Result<(), SolveError> {
+    for j in 0..a.ncols() {
+        for (&i, &v) in a.row_idx_of_col_raw(j).iter().zip(a.val_of_col(j)) {
+            if !v.is_finite() {
+                return Err(SolveError::InvalidInput(format!(
+                    "non-finite value {v} at ({i}, {j})"
+                )));
             }
-            let indices: Vec<(usize, usize)> =
-                triplets.iter().filter(keep).map(|t| (t.0, t.1)).collect();
-            let pairs: Vec<Pair<usize, usize>> = indices
-                .iter()
-                .map(|&(row, col)| Pair { row, col })
-                .collect();
-            let (symbolic, order) =
-                SymbolicSparseColMat::try_new_from_indices(n, n, &pairs).map_err(creation_error)?;
-            self.value_order = Some(ValueOrder {
-                n,
-                structure,
-                indices,
-                symbolic,
-                order,
-            });
+            if structure == Structure::Symmetric && i < j {
+                let msg =
+                    "Symmetric structure reads the lower triangle, but an upper entry was given";
+                return Err(SolveError::InvalidInput(msg.into()));
+            }
         }
-        let o = self.value_order.as_ref().expect("value order just set");
-        let values: Vec<f64> = triplets.iter().filter(keep).map(|t| t.2).collect();
-        SparseColMat::new_from_argsort(o.symbolic.clone(), &o.order, &values).map_err(backend)
     }
+    Ok(())
+}
+
+/// The CSC matrix of triplets (duplicates summed); lower triangle only for
+/// `Symmetric`.
+fn csc_from_triplets(
+    n: usize,
+    triplets: &[(usize, usize, f64)],
+    structure: Structure,
+) -> Result<SparseColMat<usize, f64>, SolveError> {
+    if let Some(&(r, c, v)) = triplets.iter().find(|t| !t.2.is_finite()) {
+        return Err(SolveError::InvalidInput(format!(
+            "non-finite value {v} at ({r}, {c})"
+        )));
+    }
+    let upper_only = structure == Structure::Symmetric
+        && triplets.iter().any(|t| t.0 < t.1)
+        && !triplets.iter().any(|t| t.0 > t.1);
+    if upper_only {
+        let msg = "Symmetric structure reads the lower triangle, but only upper entries were given";
+        return Err(SolveError::InvalidInput(msg.into()));
+    }
+    let entries: Vec<Triplet<usize, usize, f64>> = triplets
+        .iter()
+        .filter(|t| structure == Structure::General || t.0 >= t.1)
+        .map(|&(r, c, v)| Triplet::new(r, c, v))
+        .collect();
+    SparseColMat::try_new_from_triplets(n, n, &entries).map_err(creation_error)
 }
 
 /// Full symmetric matrix from its lower triangle (for the LU fallback).
@@ -580,7 +646,7 @@ mod tests {
         t: &[(usize, usize, f64)],
         st: Structure,
     ) -> (Method, f64, f64) {
-        let method = s.factorize(n, t, st).expect("factorize");
+        let method = s.factorize_triplets(n, t, st).expect("factorize");
         let xs = x_star(n);
         let b = apply(n, t, &xs);
         let x = s.solve(&b).expect("solve");
@@ -674,9 +740,11 @@ mod tests {
         let lower: Trip = full.iter().copied().filter(|t| t.0 >= t.1).collect();
         let b = apply(n, &full, &x_star(n));
         let mut s = DirectSolver::new();
-        s.factorize(n, &full, Structure::Symmetric).unwrap();
+        s.factorize_triplets(n, &full, Structure::Symmetric)
+            .unwrap();
         let x_full = s.solve(&b).unwrap();
-        s.factorize(n, &lower, Structure::Symmetric).unwrap();
+        s.factorize_triplets(n, &lower, Structure::Symmetric)
+            .unwrap();
         assert_eq!(x_full, s.solve(&b).unwrap());
         assert_eq!(s.symbolic_count(), 1, "same lower pattern");
     }
@@ -723,12 +791,12 @@ mod tests {
         let t = laplace_2d(m, 1.0, 0.0);
         let mut s = DirectSolver::new();
         let t0 = Instant::now();
-        s.factorize(n, &t, Structure::Symmetric).unwrap();
+        s.factorize_triplets(n, &t, Structure::Symmetric).unwrap();
         let first = t0.elapsed();
         let mut times = Vec::new();
         for _ in 0..5 {
             let t0 = Instant::now();
-            s.factorize(n, &t, Structure::Symmetric).unwrap();
+            s.factorize_triplets(n, &t, Structure::Symmetric).unwrap();
             times.push(t0.elapsed());
         }
         let b = vec![1.0; n];
@@ -820,7 +888,7 @@ mod tests {
             .into_iter()
             .filter(|e| e.0 != k)
             .collect();
-        let r = s.factorize(n, &t, Structure::General);
+        let r = s.factorize_triplets(n, &t, Structure::General);
         eprintln!("zero row (general): {r:?}");
         assert!(matches!(r, Err(SolveError::Singular(_))));
         assert!(matches!(
@@ -831,7 +899,7 @@ mod tests {
         let mut t0 = t.clone();
         t0.retain(|e| e.1 != k);
         t0.push((k, k, 0.0));
-        let r = s.factorize(n, &t0, Structure::General);
+        let r = s.factorize_triplets(n, &t0, Structure::General);
         eprintln!("zero row+column with explicit zero diagonal (general): {r:?}");
         assert!(matches!(r, Err(SolveError::Singular(_))));
         // Symmetric: zero row and column.
@@ -839,11 +907,11 @@ mod tests {
             .into_iter()
             .filter(|e| e.0 != k && e.1 != k)
             .collect();
-        let r = s.factorize(n, &t, Structure::Symmetric);
+        let r = s.factorize_triplets(n, &t, Structure::Symmetric);
         eprintln!("zero row and column (symmetric): {r:?}");
         assert!(matches!(r, Err(SolveError::Singular(_))));
         // Symmetric: pure-Neumann Laplacians, 1D and 2D.
-        let r = s.factorize(n, &laplace_1d(n, false), Structure::Symmetric);
+        let r = s.factorize_triplets(n, &laplace_1d(n, false), Structure::Symmetric);
         eprintln!("pure Neumann 1D: {r:?}");
         assert!(matches!(r, Err(SolveError::Singular(_))));
         let m = 40;
@@ -857,7 +925,7 @@ mod tests {
                     .count() as f64;
             }
         }
-        let r = s.factorize(m * m, &t, Structure::Symmetric);
+        let r = s.factorize_triplets(m * m, &t, Structure::Symmetric);
         eprintln!("pure Neumann 2D: {r:?}");
         assert!(matches!(r, Err(SolveError::Singular(_))));
     }
@@ -866,20 +934,20 @@ mod tests {
     fn invalid_input_is_reported() {
         let mut s = DirectSolver::new();
         assert!(matches!(s.solve(&[1.0]), Err(SolveError::NotFactorized)));
-        let r = s.factorize(3, &[(0, 0, 1.0), (3, 0, 1.0)], Structure::General);
+        let r = s.factorize_triplets(3, &[(0, 0, 1.0), (3, 0, 1.0)], Structure::General);
         assert!(matches!(r, Err(SolveError::InvalidInput(_))));
-        let r = s.factorize(2, &[(0, 0, 1.0), (1, 1, f64::NAN)], Structure::General);
+        let r = s.factorize_triplets(2, &[(0, 0, 1.0), (1, 1, f64::NAN)], Structure::General);
         assert!(matches!(r, Err(SolveError::InvalidInput(_))));
         let upper = [(0, 0, 2.0), (0, 1, -1.0), (1, 1, 2.0)];
-        let r = s.factorize(2, &upper, Structure::Symmetric);
+        let r = s.factorize_triplets(2, &upper, Structure::Symmetric);
         assert!(matches!(r, Err(SolveError::InvalidInput(_))));
-        s.factorize(2, &[(0, 0, 2.0), (1, 1, 4.0)], Structure::Symmetric)
+        s.factorize_triplets(2, &[(0, 0, 2.0), (1, 1, 4.0)], Structure::Symmetric)
             .unwrap();
         assert!(matches!(s.solve(&[1.0]), Err(SolveError::InvalidInput(_))));
         let x = s.solve(&[1.0, 1.0]).unwrap();
         assert!((x[0] - 0.5).abs() < 1e-15 && (x[1] - 0.25).abs() < 1e-15);
         for st in [Structure::Symmetric, Structure::General] {
-            assert!(s.factorize(0, &[], st).is_ok());
+            assert!(s.factorize_triplets(0, &[], st).is_ok());
             assert!(s.solve(&[]).unwrap().is_empty());
         }
     }
@@ -895,13 +963,13 @@ mod tests {
         for (n, t, st) in cases {
             let b = apply(n, &t, &x_star(n));
             let mut s1 = DirectSolver::new();
-            let m1 = s1.factorize(n, &t, st).unwrap();
+            let m1 = s1.factorize_triplets(n, &t, st).unwrap();
             let x1 = s1.solve(&b).unwrap();
             let x1b = s1.solve(&b).unwrap();
-            s1.factorize(n, &t, st).unwrap();
+            s1.factorize_triplets(n, &t, st).unwrap();
             let x1c = s1.solve(&b).unwrap();
             let mut s2 = DirectSolver::new();
-            let m2 = s2.factorize(n, &t, st).unwrap();
+            let m2 = s2.factorize_triplets(n, &t, st).unwrap();
             let x2 = s2.solve(&b).unwrap();
             eprintln!(
                 "determinism n={n} {st:?}: {m1:?}, rel error {:.2e}",

@@ -5,4 +5,5 @@ pub mod cg;
 pub mod direct;
 pub mod gmres;
 pub mod iterative;
+pub mod ordering;
 pub mod preconditioner;

@@ -3,30 +3,50 @@
 //! v(u) = v* + rate · u, the springs through u, so each layer particle adds
 //! S_Ip S_Jp (rate C_p + K_p), diagonal in the components.
 
-use super::{push_stencil_pairs, Components, Dofs, Triplets};
+use super::{Components, Dofs, Pattern, Tangent};
+use crate::dim::Vector;
 use crate::physics::absorbing::AbsorbingStep;
 use crate::physics::shape::Stencils;
 use crate::physics::transfer::NodeMap;
 
-/// Adds Σ_p S_Ip S_Jp (rate C_p + K_p) over the layer particles onto the unknowns
-/// (tied nodes through their masters; symmetric, positive semi-definite).
-pub fn absorbing_triplets<const D: usize>(
+/// Adds Σ_p S_Ip S_Jp (rate C_p + K_p) over the layer particles (a particle in
+/// the layers of several faces takes the sum; symmetric, positive semi-definite).
+pub fn add_absorbing<const D: usize>(
+    k: &mut Tangent,
     step: &AbsorbingStep<D>,
+    pattern: &Pattern,
     map: &NodeMap,
     st: &Stencils<D>,
     dofs: &Dofs,
-    out: &mut Triplets,
 ) {
-    for lp in &step.layer {
-        let coefficient = lp.damping * step.rate + lp.stiffness;
-        push_stencil_pairs(
-            out,
-            map,
-            st,
-            dofs,
-            lp.q,
-            Components::Diagonal,
-            |e1, e2, d, _| st.weight[e1] * st.weight[e2] * coefficient[d],
-        );
+    if step.is_empty() {
+        return;
     }
+    let mut coefficient: Vec<Option<Vector<D>>> = vec![None; st.count.len()];
+    for lp in &step.layer {
+        let c = lp.damping * step.rate + lp.stiffness;
+        *coefficient[lp.q].get_or_insert_with(Vector::<D>::zeros) += c;
+    }
+    let (csc, storage) = (k.pattern, k.storage);
+    pattern.add_stencil_terms(
+        &mut k.values,
+        csc,
+        storage,
+        map,
+        st,
+        dofs,
+        Components::Diagonal,
+        |q, e2, block| {
+            let Some(c) = coefficient[q] else {
+                return false;
+            };
+            for (local, e1) in st.range(q).enumerate() {
+                let w = st.weight[e1] * st.weight[e2];
+                for d in 0..D {
+                    block[local * D * D + d * D + d] = w * c[d];
+                }
+            }
+            true
+        },
+    );
 }

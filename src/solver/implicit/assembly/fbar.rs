@@ -2,8 +2,9 @@
 //! each particle follows ΔF̄_p = (ΔJ̄_c / ΔJ_p)^{1/n} ΔF_p, so it couples to the
 //! nodes of every particle in its cell.
 
-use super::stiffness::{stiffness_triplets, Pk1Derivative};
-use super::{push_terms, Dofs, Triplets};
+use super::pattern::slot;
+use super::stiffness::{add_stiffness, Pk1Derivative};
+use super::{Dofs, Pattern, Tangent};
 use crate::dim::{Mat3, Vector};
 use crate::parallel::MIN_PARALLEL_LEN;
 use crate::physics::fbar::{scale_factor, FBarState};
@@ -11,8 +12,9 @@ use crate::physics::shape::Stencils;
 use crate::physics::transfer::NodeMap;
 use rayon::prelude::*;
 
-/// Consistent tangent of the F-bar internal force f_Ii = Σ_p V_p P̄_ij(ΔF̄_p) ∂S_Ip/∂X_j
-/// over the free unknowns (particles in order, then cells in order: deterministic).
+/// Adds the consistent tangent of the F-bar internal force
+/// f_Ii = Σ_p V_p P̄_ij(ΔF̄_p) ∂S_Ip/∂X_j to `k` (stored whole: it is not
+/// symmetric); the cell terms are added cell by cell in order (deterministic).
 ///
 /// With g_q^J = ΔF_q⁻ᵀ ∇S_Jq (so ∂ΔJ_q/∂u_Jk = ΔJ_q g_qk^J) and w_q = V_q / Σ_{c} V,
 ///   ∂ΔF̄_p,ab/∂u_Jk = β_p [δ_ak ∇S_Jp,b − ΔF_p,ab g_pk^J / n]
@@ -23,14 +25,17 @@ use rayon::prelude::*;
 ///   a_c(I)_i = Σ_{p∈c} V_p β_p / (n ΔJ̄_c) ∇S_Ip,j M_p,ij,
 ///   h_c(J)_k = Σ_{q∈c} w_q ΔJ_q g_qk^J,
 /// which couples each particle to the nodes of every particle in its cell.
-pub fn fbar_triplets<const D: usize>(
+#[allow(clippy::too_many_arguments)]
+pub fn add_fbar_stiffness<const D: usize>(
+    k: &mut Tangent,
+    pattern: &Pattern,
     map: &NodeMap,
     st: &Stencils<D>,
     dofs: &Dofs,
     volume: &[f64],
     state: &FBarState,
     a: &[Pk1Derivative],
-) -> Triplets {
+) {
     let n = D as f64;
     let cells = &state.cells;
     let dj = &state.dj;
@@ -73,7 +78,7 @@ pub fn fbar_triplets<const D: usize>(
             })
         })
         .collect();
-    let (mut triplets, _) = stiffness_triplets(map, st, dofs, volume, &a_tilde);
+    add_stiffness(k, pattern, map, st, dofs, volume, &a_tilde);
 
     // Adds v at `node` of a short list of (node, vector) pairs.
     fn add<const D: usize>(list: &mut Vec<(usize, Vector<D>)>, node: usize, v: Vector<D>) {
@@ -82,7 +87,8 @@ pub fn fbar_triplets<const D: usize>(
             None => list.push((node, v)),
         }
     }
-    let per_cell: Vec<Triplets> = (0..cells.len())
+    type Outer<const D: usize> = (Vec<(usize, Vector<D>)>, Vec<(usize, Vector<D>)>);
+    let per_cell: Vec<Outer<D>> = (0..cells.len())
         .into_par_iter()
         .with_min_len(MIN_PARALLEL_LEN / 16)
         .map(|c| {
@@ -107,24 +113,25 @@ pub fn fbar_triplets<const D: usize>(
                     add(&mut h_c, map.local_of(st, e), hv);
                 }
             }
-            let mut out = Triplets::new();
-            for (n1, av) in &a_c {
-                for i in 0..D {
-                    let rows = dofs.terms(*n1, i, D);
-                    if rows.as_slice().is_empty() {
-                        continue;
-                    }
-                    for (n2, hv) in &h_c {
-                        for k in 0..D {
-                            let cols = dofs.terms(*n2, k, D);
-                            push_terms(&mut out, &rows, &cols, av[i] * hv[k]);
+            (a_c, h_c)
+        })
+        .collect();
+    // k += a_c ⊗ h_c, spread onto the unknowns.
+    for (a_c, h_c) in &per_cell {
+        for (n1, av) in a_c {
+            for i in 0..D {
+                let rows = dofs.terms(*n1, i, D);
+                for (n2, hv) in h_c {
+                    for kk in 0..D {
+                        for &(r, cr) in rows.as_slice() {
+                            for &(c, cc) in dofs.terms(*n2, kk, D).as_slice() {
+                                let s = slot(k.pattern, r, c).expect("cell entry in the pattern");
+                                k.values[s] += av[i] * hv[kk] * cr * cc;
+                            }
                         }
                     }
                 }
             }
-            out
-        })
-        .collect();
-    triplets.extend(per_cell.into_iter().flatten());
-    triplets
+        }
+    }
 }

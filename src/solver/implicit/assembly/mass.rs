@@ -2,43 +2,56 @@
 //! lumped nodal mass m_I (2-24) or the consistent mass M_IJ = Σ_p m_p S_Ip S_Jp,
 //! diagonal in the components.
 
-use super::{push_stencil_pairs, push_terms, Components, Dofs, Triplets};
+use super::pattern::slot;
+use super::{Components, Dofs, Pattern, Storage, Tangent};
 use crate::physics::shape::Stencils;
 use crate::physics::transfer::NodeMap;
 
-/// Adds m_I · inertia on the diagonal of every node's components.
-pub fn lumped_mass_triplets<const D: usize>(
-    dofs: &Dofs,
-    mass: &[f64],
-    inertia: f64,
-    out: &mut Triplets,
-) {
+/// Adds m_I · inertia on the diagonal of every node's components (a tied node's
+/// mass spread onto its masters, T_rowᵀ m T_col).
+pub fn add_lumped_mass<const D: usize>(k: &mut Tangent, dofs: &Dofs, mass: &[f64], inertia: f64) {
     for (node, m_i) in mass.iter().enumerate() {
         for d in 0..D {
             let t = dofs.terms(node, d, D);
-            push_terms(out, &t, &t, m_i * inertia);
+            for &(r, cr) in t.as_slice() {
+                for &(c, cc) in t.as_slice() {
+                    if k.storage == Storage::Full || r >= c {
+                        let s = slot(k.pattern, r, c).expect("mass entry in the pattern");
+                        k.values[s] += m_i * inertia * cr * cc;
+                    }
+                }
+            }
         }
     }
 }
 
-/// Adds Σ_p m_p S_Ip S_Jp · inertia, particle by particle in order.
-pub fn consistent_mass_triplets<const D: usize>(
+/// Adds Σ_p m_p S_Ip S_Jp · inertia.
+pub fn add_consistent_mass<const D: usize>(
+    k: &mut Tangent,
+    pattern: &Pattern,
     map: &NodeMap,
     st: &Stencils<D>,
     dofs: &Dofs,
     particle_mass: &[f64],
     inertia: f64,
-    out: &mut Triplets,
 ) {
-    for (q, m_q) in particle_mass.iter().enumerate() {
-        push_stencil_pairs(
-            out,
-            map,
-            st,
-            dofs,
-            q,
-            Components::Diagonal,
-            |e1, e2, _, _| m_q * st.weight[e1] * st.weight[e2] * inertia,
-        );
-    }
+    let (csc, storage) = (k.pattern, k.storage);
+    pattern.add_stencil_terms(
+        &mut k.values,
+        csc,
+        storage,
+        map,
+        st,
+        dofs,
+        Components::Diagonal,
+        |q, e2, block| {
+            for (local, e1) in st.range(q).enumerate() {
+                let v = particle_mass[q] * st.weight[e1] * st.weight[e2] * inertia;
+                for i in 0..D {
+                    block[local * D * D + i * D + i] = v;
+                }
+            }
+            true
+        },
+    );
 }

@@ -8,7 +8,7 @@
 //! the material part (from the exact derivative of the stress update, 2-41) and
 //! the geometric part (2-42).
 
-use super::{push_stencil_pairs, Components, Dofs, Triplets};
+use super::{Components, Dofs, Pattern, Tangent};
 use crate::dim::{Mat3, Vector};
 use crate::material::driver::numerical_stress_derivative;
 use crate::material::{Increment, StressDerivative};
@@ -107,41 +107,55 @@ pub fn coupling<const D: usize>(
     v
 }
 
-/// Triplets of Σ_p V_p ∇S_I A_p ∇S_J over the free unknowns, particle by particle
-/// in order (deterministic). Also reports whether every A_p has major symmetry
-/// (A_ijkl = A_klij), i.e. whether the assembled matrix is symmetric.
-pub fn stiffness_triplets<const D: usize>(
+/// Whether A has major symmetry (A_ijkl = A_klij) to round-off, i.e. whether
+/// its term of the tangent is symmetric.
+pub fn major_symmetric(a: &Pk1Derivative) -> bool {
+    (a - a.transpose()).amax() <= 1e-10 * a.amax().max(f64::MIN_POSITIVE)
+}
+
+/// Adds Σ_p V_p ∇S_I A_p ∇S_J (2-41, 2-42) to the tangent `k`.
+pub fn add_stiffness<const D: usize>(
+    k: &mut Tangent,
+    pattern: &Pattern,
     map: &NodeMap,
     st: &Stencils<D>,
     dofs: &Dofs,
     volume: &[f64],
     a: &[Pk1Derivative],
-) -> (Triplets, bool) {
-    let per_particle: Vec<(Triplets, bool)> = (0..volume.len())
-        .into_par_iter()
-        .with_min_len(MIN_PARALLEL_LEN / 8)
-        .map(|q| {
-            let ap = &a[q];
-            let symmetric =
-                (ap - ap.transpose()).amax() <= 1e-10 * ap.amax().max(f64::MIN_POSITIVE);
-            let mut out = Vec::new();
-            push_stencil_pairs(
-                &mut out,
-                map,
-                st,
-                dofs,
-                q,
-                Components::All,
-                |e1, e2, i, k| coupling(&st.grad[e1], ap, &st.grad[e2], i, k) * volume[q],
-            );
-            (out, symmetric)
-        })
-        .collect();
-    let symmetric = per_particle.iter().all(|(_, s)| *s);
-    (
-        per_particle.into_iter().flat_map(|(t, _)| t).collect(),
-        symmetric,
-    )
+) {
+    let (csc, storage) = (k.pattern, k.storage);
+    pattern.add_stencil_terms(
+        &mut k.values,
+        csc,
+        storage,
+        map,
+        st,
+        dofs,
+        Components::All,
+        |q, e2, block| {
+            // b_ijk = Σ_l A_ijkl ∂S_J/∂X_l, then V Σ_j ∂S_I/∂X_j b_ijk for each node I.
+            let (ap, g2) = (&a[q], &st.grad[e2]);
+            let mut b = [[[0.0; D]; D]; D];
+            for (i, bi) in b.iter_mut().enumerate() {
+                for (j, bij) in bi.iter_mut().enumerate() {
+                    for (kk, bijk) in bij.iter_mut().enumerate() {
+                        *bijk = (0..D).map(|l| ap[(3 * i + j, 3 * kk + l)] * g2[l]).sum();
+                    }
+                }
+            }
+            for (local, e1) in st.range(q).enumerate() {
+                let g1 = &st.grad[e1];
+                let out = &mut block[local * D * D..(local + 1) * D * D];
+                for i in 0..D {
+                    for kk in 0..D {
+                        let v: f64 = (0..D).map(|j| g1[j] * b[i][j][kk]).sum();
+                        out[i * D + kk] = v * volume[q];
+                    }
+                }
+            }
+            true
+        },
+    );
 }
 
 #[cfg(test)]

@@ -1,0 +1,418 @@
+//! The sparsity pattern of the tangent and the scatter of its terms into it.
+//!
+//! Every term of K couples the nodes of one particle's stencil (with F-bar, of
+//! one cell's particles), so the pattern is known once the step's stencils and
+//! unknowns are: node b couples to node a when some stencil (cell) holds both,
+//! a tied node counting as its masters. [`Pattern::new`] builds that node graph
+//! once per step, and from it the compressed-column pattern of the unknowns, the
+//! lower triangle for a symmetric tangent or the whole matrix otherwise
+//! ([`Pattern::csc`]). Each Newton iteration then adds the particles' terms
+//! straight into the value array of that pattern ([`Pattern::add_stencil_terms`]):
+//! no triplet list, no sort.
+//!
+//! The scatter runs in parallel over the columns' nodes: the task of node b
+//! writes only b's columns, and it visits b's stencil entries (its own, then
+//! those of nodes tied to it, in increasing entry order, so in increasing
+//! particle order), so every value is the same sum in the same order for any
+//! number of threads.
+
+use super::Dofs;
+use crate::physics::fbar::Cells;
+use crate::physics::shape::Stencils;
+use crate::physics::transfer::NodeMap;
+use crate::solver::linear::ordering::{node_amd, node_metis, NodeGraph};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
+use rayon::prelude::*;
+use std::sync::OnceLock;
+
+/// Which part of the tangent is stored.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Storage {
+    /// Rows ≥ column only (a symmetric tangent).
+    Lower,
+    /// Every entry.
+    Full,
+}
+
+/// Which component pairs (i, k) of two nodes a term couples.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Components {
+    /// Every pair: a full D×D block (stiffness).
+    All,
+    /// i = k only: a diagonal block (mass, dashpots, springs).
+    Diagonal,
+}
+
+/// The node graph of one step's tangent and the compressed-column patterns of
+/// its unknowns.
+#[derive(Clone, Debug, Default)]
+pub struct Pattern {
+    /// Unknowns of nodes 0..b: the columns of node b are `first[b]..first[b + 1]`
+    /// (unknowns are numbered node by node).
+    first: Vec<usize>,
+    /// Per node: the stencil entries it takes terms from (its own; for a master,
+    /// also those of the nodes tied to it) with the coefficient of the tie
+    /// (1 for its own), in increasing entry order.
+    source_start: Vec<usize>,
+    sources: Vec<(u32, f64)>,
+    /// Per node: the nodes it couples to (masters for tied nodes), ascending.
+    neighbour_start: Vec<usize>,
+    neighbours: Vec<u32>,
+    lower: OnceLock<SymbolicSparseColMat<usize>>,
+    full: OnceLock<SymbolicSparseColMat<usize>>,
+    ordering: OnceLock<Vec<usize>>,
+}
+
+impl Pattern {
+    /// The node graph of the stencils `st` over the active nodes of `map` with
+    /// the unknowns `dofs`; with `cells` (F-bar), every particle also couples to
+    /// the nodes of the other particles of its cell.
+    pub fn new<const D: usize>(
+        map: &NodeMap,
+        st: &Stencils<D>,
+        dofs: &Dofs,
+        cells: Option<&Cells>,
+    ) -> Pattern {
+        let n = map.len();
+        let mut first = Vec::with_capacity(n + 1);
+        first.push(0);
+        for a in 0..n {
+            let count = (0..D).filter(|&d| dofs.of(a, d, D).is_some()).count();
+            first.push(first[a] + count);
+        }
+        debug_assert_eq!(first[n], dofs.free);
+        let (source_start, sources) = sources(map, dofs);
+        let (neighbour_start, neighbours) = if let Some(cells) = cells {
+            node_graph(
+                n,
+                st.stride,
+                &source_start,
+                &sources,
+                |q, out| {
+                    for &p in cells.members(cells.of[q] as usize) {
+                        out.extend(st.range(p as usize).map(|e| map.local_of(st, e)));
+                    }
+                },
+                dofs,
+            )
+        } else {
+            node_graph(
+                n,
+                st.stride,
+                &source_start,
+                &sources,
+                |q, out| {
+                    out.extend(st.range(q).map(|e| map.local_of(st, e)));
+                },
+                dofs,
+            )
+        };
+        Pattern {
+            first,
+            source_start,
+            sources,
+            neighbour_start,
+            neighbours,
+            lower: OnceLock::new(),
+            full: OnceLock::new(),
+            ordering: OnceLock::new(),
+        }
+    }
+
+    /// The node graph with the unknowns of each node.
+    pub fn graph(&self) -> NodeGraph<'_> {
+        NodeGraph {
+            start: &self.neighbour_start,
+            adjacency: &self.neighbours,
+            first: &self.first,
+        }
+    }
+
+    /// The fill-reducing ordering of the unknowns for a Cholesky factorization
+    /// (built at the first call): METIS' nested dissection of the node graph in
+    /// 3D, its minimum degree in 2D (docs/performance.md has the measurements
+    /// behind the choice).
+    pub fn ordering<const D: usize>(&self) -> &[usize] {
+        self.ordering.get_or_init(|| {
+            if D == 3 {
+                node_metis(&self.graph())
+            } else {
+                node_amd(&self.graph())
+            }
+        })
+    }
+
+    /// Number of active nodes.
+    pub fn nodes(&self) -> usize {
+        self.first.len() - 1
+    }
+
+    /// The nodes coupled to node b (ascending).
+    pub fn neighbours(&self, b: usize) -> &[u32] {
+        &self.neighbours[self.neighbour_start[b]..self.neighbour_start[b + 1]]
+    }
+
+    /// The unknowns of node b (consecutive).
+    pub fn columns(&self, b: usize) -> std::ops::Range<usize> {
+        self.first[b]..self.first[b + 1]
+    }
+
+    /// The compressed-column pattern of the unknowns (built at the first call).
+    pub fn csc<const D: usize>(
+        &self,
+        dofs: &Dofs,
+        storage: Storage,
+    ) -> &SymbolicSparseColMat<usize> {
+        let cell = match storage {
+            Storage::Lower => &self.lower,
+            Storage::Full => &self.full,
+        };
+        cell.get_or_init(|| self.build_csc::<D>(dofs, storage))
+    }
+
+    /// Rows of column c of node b: the unknowns of b's neighbours (all
+    /// components: the stiffness couples every pair), ascending; with `Lower`,
+    /// those ≥ c.
+    fn build_csc<const D: usize>(
+        &self,
+        dofs: &Dofs,
+        storage: Storage,
+    ) -> SymbolicSparseColMat<usize> {
+        let n = dofs.free;
+        let mut col_ptr = Vec::with_capacity(n + 1);
+        let mut rows = Vec::new();
+        col_ptr.push(0);
+        for b in 0..self.nodes() {
+            for k in 0..D {
+                let Some(c) = dofs.of(b, k, D) else { continue };
+                for &a in self.neighbours(b) {
+                    for i in 0..D {
+                        if let Some(r) = dofs.of(a as usize, i, D) {
+                            if storage == Storage::Full || r >= c {
+                                rows.push(r);
+                            }
+                        }
+                    }
+                }
+                col_ptr.push(rows.len());
+            }
+        }
+        // Rows ascending within each column: neighbours ascending and unknowns
+        // numbered node by node.
+        SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows)
+    }
+
+    /// Adds the term of every particle q with `column(q, e2, block)` true to the
+    /// values of `csc` (`Pattern::csc` with `storage`): for each stencil entry e2
+    /// of q, `column` fills `block[(e1 − first entry of q)·D² + i·D + k]` with the
+    /// term at (node of e1, component i) × (node of e2, component k) for every
+    /// entry e1 of q; `components` says which (i, k) it sets. Spread onto the
+    /// unknowns through the ties; rows below the diagonal only with `Lower`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn add_stencil_terms<const D: usize>(
+        &self,
+        values: &mut [f64],
+        csc: &SymbolicSparseColMat<usize>,
+        storage: Storage,
+        map: &NodeMap,
+        st: &Stencils<D>,
+        dofs: &Dofs,
+        components: Components,
+        column: impl Fn(usize, usize, &mut [f64]) -> bool + Sync,
+    ) {
+        let col_ptr = csc.col_ptr();
+        let row_idx = csc.row_idx();
+        let n = dofs.free;
+        // Split the values into the columns of each node (disjoint, in order).
+        let mut per_node: Vec<&mut [f64]> = Vec::with_capacity(self.nodes());
+        let mut rest = values;
+        for b in 0..self.nodes() {
+            let cols = self.columns(b);
+            let len = col_ptr[cols.end] - col_ptr[cols.start];
+            let (head, tail) = rest.split_at_mut(len);
+            per_node.push(head);
+            rest = tail;
+        }
+        per_node
+            .into_par_iter()
+            .enumerate()
+            .with_min_len(16)
+            .for_each_init(
+                || (vec![u32::MAX; D * n], vec![0.0; st.stride * D * D]),
+                |(slot, block), (b, vals)| {
+                    let cols = self.columns(b);
+                    if cols.is_empty() {
+                        return;
+                    }
+                    // slot[k·n + r]: the position of row r in b's column of component k.
+                    let base = col_ptr[cols.start];
+                    let mut col_of = [usize::MAX; D];
+                    for k in 0..D {
+                        if let Some(c) = dofs.of(b, k, D) {
+                            col_of[k] = c;
+                            for s in col_ptr[c]..col_ptr[c + 1] {
+                                slot[k * n + row_idx[s]] = (s - base) as u32;
+                            }
+                        }
+                    }
+                    let sources = &self.sources[self.source_start[b]..self.source_start[b + 1]];
+                    for &(e2, cc) in sources {
+                        let e2 = e2 as usize;
+                        let q = e2 / st.stride;
+                        if !column(q, e2, block) {
+                            continue;
+                        }
+                        for (local, e1) in st.range(q).enumerate() {
+                            let n1 = map.local_of(st, e1);
+                            for i in 0..D {
+                                let rows = dofs.terms(n1, i, D);
+                                let coupled = match components {
+                                    Components::All => 0..D,
+                                    Components::Diagonal => i..i + 1,
+                                };
+                                for k in coupled {
+                                    let c = col_of[k];
+                                    if c == usize::MAX {
+                                        continue;
+                                    }
+                                    let v = block[local * D * D + i * D + k] * cc;
+                                    for &(r, cr) in rows.as_slice() {
+                                        if storage == Storage::Full || r >= c {
+                                            vals[slot[k * n + r] as usize] += v * cr;
+                                        }
+                                    }
+                                }
+                            }
+                        }
+                    }
+                },
+            );
+    }
+}
+
+/// Position of row r in column c of `csc`, if the pattern has it.
+pub fn slot(csc: &SymbolicSparseColMat<usize>, r: usize, c: usize) -> Option<usize> {
+    let (start, end) = (csc.col_ptr()[c], csc.col_ptr()[c + 1]);
+    csc.row_idx()[start..end]
+        .binary_search(&r)
+        .ok()
+        .map(|s| start + s)
+}
+
+/// Per node, the stencil entries it takes terms from: its own (coefficient 1)
+/// and, for a master, those of the nodes tied to it (the tie's coefficient),
+/// each list in increasing entry order.
+fn sources(map: &NodeMap, dofs: &Dofs) -> (Vec<usize>, Vec<(u32, f64)>) {
+    let n = map.len();
+    // Entries of node a in increasing order: its own list from the node map,
+    // merged with those of the nodes tied to it.
+    let mut tied_to: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
+    for (t, tie) in dofs.ties.iter().enumerate() {
+        if let Some(tie) = tie {
+            for (m, c) in tie.master.iter().zip(tie.coef) {
+                tied_to[*m].push((t, c));
+            }
+        }
+    }
+    let mut start = Vec::with_capacity(n + 1);
+    let mut list: Vec<(u32, f64)> = Vec::new();
+    start.push(0);
+    for a in 0..n {
+        let from = list.len();
+        if dofs.ties.get(a).is_none_or(|t| t.is_none()) {
+            list.extend(map.node_entries(a).iter().map(|&e| (e, 1.0)));
+        }
+        for &(t, c) in &tied_to[a] {
+            list.extend(map.node_entries(t).iter().map(|&e| (e, c)));
+        }
+        if !tied_to[a].is_empty() {
+            list[from..].sort_by_key(|&(e, _)| e);
+        }
+        start.push(list.len());
+    }
+    (start, list)
+}
+
+/// The node graph: per node b, the owners (masters for tied nodes) of every
+/// node that `nodes_of(q, …)` lists for a particle q of b's sources, ascending.
+fn node_graph<F: Fn(usize, &mut Vec<usize>) + Sync>(
+    n: usize,
+    stride: usize,
+    source_start: &[usize],
+    sources: &[(u32, f64)],
+    nodes_of: F,
+    dofs: &Dofs,
+) -> (Vec<usize>, Vec<u32>) {
+    let lists: Vec<Vec<u32>> = (0..n)
+        .into_par_iter()
+        .with_min_len(64)
+        .map_init(
+            || (vec![false; n], Vec::new()),
+            |(seen, scratch), b| {
+                let mut out = Vec::new();
+                let mut last_q = usize::MAX;
+                for &(e, _) in &sources[source_start[b]..source_start[b + 1]] {
+                    let q = e as usize / stride;
+                    if q == last_q {
+                        continue;
+                    }
+                    last_q = q;
+                    scratch.clear();
+                    nodes_of(q, scratch);
+                    for &a in scratch.iter() {
+                        for (o, _) in dofs.owners(a) {
+                            if !seen[o] {
+                                seen[o] = true;
+                                out.push(o as u32);
+                            }
+                        }
+                    }
+                }
+                for &a in &out {
+                    seen[a as usize] = false;
+                }
+                out.sort_unstable();
+                out
+            },
+        )
+        .collect();
+    let mut start = Vec::with_capacity(n + 1);
+    start.push(0);
+    for l in &lists {
+        start.push(start.last().unwrap() + l.len());
+    }
+    (start, lists.concat())
+}
+
+/// The assembled tangent of one Newton iterate: values in the step's pattern.
+pub struct Tangent<'a> {
+    pub pattern: &'a SymbolicSparseColMat<usize>,
+    pub values: Vec<f64>,
+    /// `Lower` when the tangent is symmetric (only rows ≥ column stored).
+    pub storage: Storage,
+}
+
+impl Tangent<'_> {
+    pub fn matrix(&self) -> SparseColMatRef<'_, usize, f64> {
+        SparseColMatRef::new(self.pattern.as_ref(), &self.values)
+    }
+
+    pub fn symmetric(&self) -> bool {
+        self.storage == Storage::Lower
+    }
+
+    /// y = K x (both triangles when only the lower one is stored).
+    pub fn apply(&self, x: &[f64]) -> Vec<f64> {
+        let k = self.matrix();
+        let mut y = vec![0.0; k.nrows()];
+        for c in 0..k.ncols() {
+            for (&r, &v) in k.row_idx_of_col_raw(c).iter().zip(k.val_of_col(c)) {
+                y[r] += v * x[c];
+                if self.symmetric() && r != c {
+                    y[c] += v * x[r];
+                }
+            }
+        }
+        y
+    }
+}
