@@ -35,12 +35,13 @@ use faer::Side;
 use mpm::dim::Vector;
 use mpm::model::Model;
 use mpm::scene::Scene;
+use mpm::solver::implicit::assembly::stiffness::particle_tangents;
 use mpm::solver::implicit::assembly::{Pattern, Storage};
 use mpm::solver::implicit::residual::{ordering, residual, tangent};
 use mpm::solver::implicit::step::{StepSettings, StepSystem};
 use mpm::solver::implicit::Implicit;
 use mpm::solver::linear::direct::{DirectSolver, Ordering, Structure};
-use mpm::solver::linear::ordering::{nested_dissection, node_amd, node_metis};
+use mpm::solver::linear::ordering::{node_amd, node_metis};
 use mpm::solver::stepper::Stepper;
 use std::hint::black_box;
 use std::time::Instant;
@@ -184,17 +185,9 @@ fn bench_problem<const D: usize>(c: &mut Criterion, p: &mut Problem<D>) {
     // The orderings side by side: time to compute, nnz(L), and faer's numeric
     // LLᵀ with each (one call).
     let pattern = p.sys.pattern.get().expect("pattern");
-    let ijk = |a: usize| {
-        m.grid
-            .node_ijk(p.sys.map.active[a] as usize)
-            .map(|i| i as i64)
-    };
     let clock = Instant::now();
     let node_amd_perm = node_amd(&pattern.graph());
     let t_node_amd = clock.elapsed().as_secs_f64();
-    let clock = Instant::now();
-    let nd_perm = nested_dissection::<D>(&pattern.graph(), ijk);
-    let t_nd = clock.elapsed().as_secs_f64();
     let clock = Instant::now();
     let metis_perm = node_metis(&pattern.graph());
     let t_metis = clock.elapsed().as_secs_f64();
@@ -202,7 +195,6 @@ fn bench_problem<const D: usize>(c: &mut Criterion, p: &mut Problem<D>) {
         ("METIS", Some(metis_perm.as_slice()), t_metis),
         ("scalar AMD", None, 0.0),
         ("node AMD", Some(node_amd_perm.as_slice()), t_node_amd),
-        ("nested dissection", Some(nd_perm.as_slice()), t_nd),
     ] {
         let clock = Instant::now();
         let sym = symbolic(perm);
@@ -237,6 +229,9 @@ fn bench_problem<const D: usize>(c: &mut Criterion, p: &mut Problem<D>) {
     group.bench_function("pattern", |bch| bch.iter(|| black_box(p.pattern().nodes())));
     group.bench_function("tangent", |bch| {
         bch.iter(|| black_box(tangent(m, sys, false).expect("tangent").values.len()))
+    });
+    group.bench_function("tangent_part/particle_tangents", |bch| {
+        bch.iter(|| black_box(particle_tangents(m, &sys.trial, false).expect("A").len()))
     });
     group.bench_function("factorize_first", |bch| {
         bch.iter(|| {

@@ -104,7 +104,7 @@ pub fn tangent<'s, const D: usize>(
         .pattern
         .get_or_init(|| Pattern::new(map, st, dofs, fbar.map(|f| &f.cells)));
     // Symmetric unless F-bar or a non-associated material breaks it.
-    let symmetric = fbar.is_none() && a.par_iter().all(major_symmetric);
+    let symmetric = fbar.is_none() && a.par_iter().all(major_symmetric::<D>);
     let storage = if symmetric {
         Storage::Lower
     } else {

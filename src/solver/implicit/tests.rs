@@ -324,3 +324,58 @@ fn ties_keep_linear_fields_exact() {
         assert!(node_error < 1e-14 && grad_error < 1e-12, "{shape}");
     }
 }
+
+/// The assembled tangent is the same, bit for bit, on one thread and on two
+/// (each column's values are summed by one task in a fixed order), with ties,
+/// absorbing faces and the consistent mass; and the F-bar tangent too.
+#[test]
+fn tangent_does_not_depend_on_the_number_of_threads() {
+    let text = BLOCK.replace("[solver]", &format!("{ABSORBING}[solver]"));
+    for fbar in [false, true] {
+        let overrides = vec![
+            "grid.cells=[24,24]".to_string(),
+            "grid.shape_function=bspline2".to_string(),
+            "body.0.min=[0.0,0.0]".to_string(),
+            "body.0.max=[3.93,2.38]".to_string(),
+            "solver.mass=consistent".to_string(),
+            "solver.min_node_support=0.3".to_string(),
+            format!("solver.fbar={fbar}"),
+        ];
+        let scene = Scene::parse("block.toml", &text, &overrides).unwrap();
+        let m = Model::<2>::build(&scene).unwrap();
+        let values = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let mut solver = Implicit::<2>::new(
+                    scene.config.grid.shape_function,
+                    scene.config.stages()[0],
+                    0.0,
+                );
+                solver.prepare(&m, 0.0, 0.01);
+                let sys = &mut solver.system;
+                let u: Vec<Vector<2>> = (0..sys.map.len())
+                    .map(|a| Vector::<2>::new(1e-3 * (a as f64).sin(), -1e-3))
+                    .collect();
+                residual(&m, sys, &u).unwrap();
+                let k = tangent(&m, sys, false).unwrap();
+                let tied = sys.dofs.ties.iter().flatten().count();
+                (k.values.clone(), k.symmetric(), tied)
+            })
+        };
+        let (one, symmetric, tied) = values(1);
+        let (two, _, _) = values(2);
+        println!(
+            "F-bar {fbar}: {} values, symmetric {symmetric}, {tied} tied",
+            one.len()
+        );
+        assert!(tied > 0 && one.len() > 10_000);
+        assert_eq!(symmetric, !fbar);
+        assert!(
+            one == two,
+            "F-bar {fbar}: values differ between 1 and 2 threads"
+        );
+    }
+}

@@ -119,8 +119,8 @@ enum Numeric {
 
 /// Sparse direct solver holding the symbolic factorizations and the pattern they belong to.
 pub struct DirectSolver {
-    /// The factors of the previous factorization while the pattern is
-    /// unchanged: their buffers are refilled instead of allocated again.
+    /// The factors of the previous factorization: their buffers are refilled
+    /// instead of allocated again.
     kept: Numeric,
     /// faer's workspace, grown as needed and kept.
     work: MemBuffer,
@@ -171,9 +171,8 @@ impl DirectSolver {
                 return Err(SolveError::InvalidInput(msg));
             }
         }
-        if self.update_pattern(a.nrows(), structure, a, ordering) {
-            self.kept = kept;
-        }
+        self.update_pattern(a.nrows(), structure, a, ordering);
+        self.kept = kept;
         match structure {
             Structure::General => self.factor_lu(a),
             Structure::Symmetric => self.factor_symmetric(a),
@@ -317,8 +316,13 @@ impl DirectSolver {
     fn try_llt(&mut self, lower: SparseColMatRef<usize, f64>) -> Result<(), SolveError> {
         let sym = self.chol.take().ok_or(SolveError::NotFactorized)?;
         let par = faer::get_global_parallelism();
+        // faer overwrites every value of the factor, so the old buffer serves
+        // (grown if the new pattern needs more).
         let mut values = match std::mem::replace(&mut self.kept, Numeric::None) {
-            Numeric::Llt(v) if v.len() == sym.len_val() => v,
+            Numeric::Llt(mut v) => {
+                v.resize(sym.len_val(), 0.0);
+                v
+            }
             _ => vec![0.0; sym.len_val()],
         };
         let req = sym.factorize_numeric_llt_scratch::<f64>(par, Default::default());
@@ -980,5 +984,62 @@ mod tests {
             assert_eq!(x1, x1c);
             assert_eq!(x1, x2);
         }
+    }
+
+    /// A solver that factored another matrix first (its factor buffer and
+    /// workspace are refilled, grown or not) gives bit for bit the solution
+    /// of a fresh one: simplicial (small) and supernodal factors.
+    #[test]
+    fn kept_buffers_give_the_same_factors() {
+        let cases: Vec<(usize, Trip)> = vec![
+            (900, laplace_2d(30, 1.0, 1.2345)),
+            (10_000, laplace_2d(100, 1.0, 0.0)),
+            (8_000, laplace_3d(20)),
+        ];
+        for (n, t) in &cases {
+            let b = apply(*n, t, &x_star(*n));
+            let mut fresh = DirectSolver::new();
+            fresh
+                .factorize_triplets(*n, t, Structure::Symmetric)
+                .unwrap();
+            let x = fresh.solve(&b).unwrap();
+            for (m, other) in &cases {
+                let mut reused = DirectSolver::new();
+                reused
+                    .factorize_triplets(*m, other, Structure::Symmetric)
+                    .unwrap();
+                reused
+                    .factorize_triplets(*n, t, Structure::Symmetric)
+                    .unwrap();
+                assert_eq!(reused.solve(&b).unwrap(), x, "n = {n} after m = {m}");
+            }
+        }
+    }
+
+    /// A given ordering is used (the solution agrees with AMD's to round-off)
+    /// and kept with the symbolic factorization while it does not change.
+    #[test]
+    fn a_given_ordering_is_used_and_kept() {
+        let n = 10_000;
+        let t = laplace_2d(100, 1.0, 0.0);
+        let a = csc_from_triplets(n, &t, Structure::Symmetric).unwrap();
+        let b = apply(n, &t, &x_star(n));
+        let reversed: Vec<usize> = (0..n).rev().collect();
+        let mut s = DirectSolver::new();
+        s.factorize(a.as_ref(), Structure::Symmetric, Ordering::Given(&reversed))
+            .unwrap();
+        let x = s.solve(&b).unwrap();
+        assert!(rel_diff(&x, &x_star(n)) < 1e-10);
+        s.factorize(a.as_ref(), Structure::Symmetric, Ordering::Given(&reversed))
+            .unwrap();
+        assert_eq!(s.symbolic_count(), 1);
+        s.factorize(a.as_ref(), Structure::Symmetric, Ordering::Amd)
+            .unwrap();
+        assert_eq!(s.symbolic_count(), 2, "another ordering, another analysis");
+        let short = vec![0; n - 1];
+        assert!(matches!(
+            s.factorize(a.as_ref(), Structure::Symmetric, Ordering::Given(&short)),
+            Err(SolveError::InvalidInput(_))
+        ));
     }
 }

@@ -221,8 +221,6 @@ impl Pattern {
         column: impl Fn(usize, usize, &mut [f64]) -> bool + Sync,
     ) {
         let col_ptr = csc.col_ptr();
-        let row_idx = csc.row_idx();
-        let n = dofs.free;
         // Split the values into the columns of each node (disjoint, in order).
         let mut per_node: Vec<&mut [f64]> = Vec::with_capacity(self.nodes());
         let mut rest = values;
@@ -238,55 +236,92 @@ impl Pattern {
             .enumerate()
             .with_min_len(16)
             .for_each_init(
-                || (vec![u32::MAX; D * n], vec![0.0; st.stride * D * D]),
-                |(slot, block), (b, vals)| {
-                    let cols = self.columns(b);
-                    if cols.is_empty() {
-                        return;
-                    }
-                    // slot[k·n + r]: the position of row r in b's column of component k.
-                    let base = col_ptr[cols.start];
-                    let mut col_of = [usize::MAX; D];
-                    for k in 0..D {
-                        if let Some(c) = dofs.of(b, k, D) {
-                            col_of[k] = c;
-                            for s in col_ptr[c]..col_ptr[c + 1] {
-                                slot[k * n + row_idx[s]] = (s - base) as u32;
-                            }
-                        }
-                    }
-                    let sources = &self.sources[self.source_start[b]..self.source_start[b + 1]];
-                    for &(e2, cc) in sources {
-                        let e2 = e2 as usize;
-                        let q = e2 / st.stride;
-                        if !column(q, e2, block) {
-                            continue;
-                        }
-                        for (local, e1) in st.range(q).enumerate() {
-                            let n1 = map.local_of(st, e1);
-                            for i in 0..D {
-                                let rows = dofs.terms(n1, i, D);
-                                let coupled = match components {
-                                    Components::All => 0..D,
-                                    Components::Diagonal => i..i + 1,
-                                };
-                                for k in coupled {
-                                    let c = col_of[k];
-                                    if c == usize::MAX {
-                                        continue;
-                                    }
-                                    let v = block[local * D * D + i * D + k] * cc;
-                                    for &(r, cr) in rows.as_slice() {
-                                        if storage == Storage::Full || r >= c {
-                                            vals[slot[k * n + r] as usize] += v * cr;
-                                        }
-                                    }
-                                }
-                            }
-                        }
-                    }
+                || (Vec::new(), vec![0.0; st.stride * D * D]),
+                |(offsets, block), (b, vals)| {
+                    self.add_column_terms(
+                        b, vals, col_ptr, storage, map, st, dofs, components, &column, offsets,
+                        block,
+                    )
                 },
             );
+    }
+
+    /// The terms of node b's columns (`vals`, from `col_ptr[first column]` on).
+    /// Row r of node a (a neighbour of b) sits in column c at
+    /// `offsets[k][j] + r − max(first[a], c)`, j the position of a among b's
+    /// neighbours and `offsets[k][j]` the rows of the neighbours before it.
+    #[allow(clippy::too_many_arguments)]
+    fn add_column_terms<const D: usize>(
+        &self,
+        b: usize,
+        vals: &mut [f64],
+        col_ptr: &[usize],
+        storage: Storage,
+        map: &NodeMap,
+        st: &Stencils<D>,
+        dofs: &Dofs,
+        components: Components,
+        column: &impl Fn(usize, usize, &mut [f64]) -> bool,
+        offsets: &mut Vec<usize>,
+        block: &mut [f64],
+    ) {
+        let cols = self.columns(b);
+        if cols.is_empty() {
+            return;
+        }
+        let base = col_ptr[cols.start];
+        let neighbours = self.neighbours(b);
+        let m = neighbours.len();
+        // Rows of column c: the unknowns first[a]..first[a + 1] of each
+        // neighbour a in order, those < c dropped when only the lower
+        // triangle is stored.
+        let lowest = |c: usize| if storage == Storage::Lower { c } else { 0 };
+        offsets.clear();
+        offsets.resize(D * m, usize::MAX);
+        let mut col_of = [usize::MAX; D];
+        for k in 0..D {
+            let Some(c) = dofs.of(b, k, D) else { continue };
+            col_of[k] = c;
+            let mut at = col_ptr[c] - base;
+            for (j, &a) in neighbours.iter().enumerate() {
+                offsets[k * m + j] = at;
+                let (lo, hi) = (self.first[a as usize], self.first[a as usize + 1]);
+                at += hi.saturating_sub(lo.max(lowest(c)));
+            }
+            debug_assert_eq!(at, col_ptr[c + 1] - base);
+        }
+        let sources = &self.sources[self.source_start[b]..self.source_start[b + 1]];
+        for &(e2, cc) in sources {
+            let e2 = e2 as usize;
+            let q = e2 / st.stride;
+            if !column(q, e2, block) {
+                continue;
+            }
+            for (local, e1) in st.range(q).enumerate() {
+                let n1 = map.local_of(st, e1);
+                for (a, cr) in dofs.owners(n1) {
+                    let Ok(j) = neighbours.binary_search(&(a as u32)) else {
+                        continue;
+                    };
+                    let lo = self.first[a];
+                    for i in 0..D {
+                        let Some(r) = dofs.of(a, i, D) else { continue };
+                        let coupled = match components {
+                            Components::All => 0..D,
+                            Components::Diagonal => i..i + 1,
+                        };
+                        for k in coupled {
+                            let c = col_of[k];
+                            if c == usize::MAX || r < lowest(c) {
+                                continue;
+                            }
+                            let slot = offsets[k * m + j] + r - lo.max(lowest(c));
+                            vals[slot] += block[local * D * D + i * D + k] * cr * cc;
+                        }
+                    }
+                }
+            }
+        }
     }
 }
 
@@ -317,15 +352,15 @@ fn sources(map: &NodeMap, dofs: &Dofs) -> (Vec<usize>, Vec<(u32, f64)>) {
     let mut start = Vec::with_capacity(n + 1);
     let mut list: Vec<(u32, f64)> = Vec::new();
     start.push(0);
-    for a in 0..n {
+    for (a, tied) in tied_to.iter().enumerate() {
         let from = list.len();
         if dofs.ties.get(a).is_none_or(|t| t.is_none()) {
             list.extend(map.node_entries(a).iter().map(|&e| (e, 1.0)));
         }
-        for &(t, c) in &tied_to[a] {
+        for &(t, c) in tied {
             list.extend(map.node_entries(t).iter().map(|&e| (e, c)));
         }
-        if !tied_to[a].is_empty() {
+        if !tied.is_empty() {
             list[from..].sort_by_key(|&(e, _)| e);
         }
         start.push(list.len());

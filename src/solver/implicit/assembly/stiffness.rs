@@ -35,16 +35,31 @@ pub fn relative_pk1(df: &Mat3, sigma: &Mat3) -> Mat3 {
 }
 
 /// A_ijkl = ∂P_ij/∂ΔF_kl = J [G_kl (σG)_ij + (∂σ_im/∂ΔF_kl) G_mj − (σG)_il G_kj],
-/// G = ΔF⁻ᵀ (from ∂J/∂ΔF = J G and ∂G_mj/∂ΔF_kl = −G_ml G_kj).
-pub fn pk1_derivative(df: &Mat3, sigma: &Mat3, dsigma: &StressDerivative) -> Pk1Derivative {
+/// G = ΔF⁻ᵀ (from ∂J/∂ΔF = J G and ∂G_mj/∂ΔF_kl = −G_ml G_kj), for the indices
+/// i, j, k, l < D that the tangent of a D-dimensional problem reads (zero
+/// elsewhere; plane strain has no out-of-plane gradients).
+pub fn pk1_derivative<const D: usize>(
+    df: &Mat3,
+    sigma: &Mat3,
+    dsigma: &StressDerivative,
+) -> Pk1Derivative {
     let j = df.determinant();
     let g = df.try_inverse().unwrap_or_else(Mat3::zeros).transpose();
     let sg = sigma * g;
-    Pk1Derivative::from_fn(|row, col| {
-        let (i, jj, k, l) = (row / 3, row % 3, col / 3, col % 3);
-        let material: f64 = (0..3).map(|m| dsigma[(3 * i + m, col)] * g[(m, jj)]).sum();
-        j * (g[(k, l)] * sg[(i, jj)] + material - sg[(i, l)] * g[(k, jj)])
-    })
+    let mut a = Pk1Derivative::zeros();
+    for i in 0..D {
+        for jj in 0..D {
+            for k in 0..D {
+                for l in 0..D {
+                    let col = 3 * k + l;
+                    let material: f64 = (0..3).map(|m| dsigma[(3 * i + m, col)] * g[(m, jj)]).sum();
+                    a[(3 * i + jj, col)] =
+                        j * (g[(k, l)] * sg[(i, jj)] + material - sg[(i, l)] * g[(k, jj)]);
+                }
+            }
+        }
+    }
+    a
 }
 
 /// A_p = ∂P/∂ΔF of every particle at the trial state: from the material's
@@ -57,10 +72,13 @@ pub fn particle_tangents<const D: usize>(
 ) -> Result<Vec<Pk1Derivative>, Failure> {
     let p = &m.particles;
     let history_old = p.history.slots(&p.history.data);
-    let a: Vec<Option<Pk1Derivative>> = (0..p.len())
-        .into_par_iter()
+    let mut a = vec![Pk1Derivative::zeros(); p.len()];
+    // The first particle without a tangent (the same for any number of threads).
+    let failed = a
+        .par_iter_mut()
+        .enumerate()
         .with_min_len(MIN_PARALLEL_LEN)
-        .map(|q| {
+        .filter_map(|(q, a_q)| {
             let inc = Increment {
                 f_old: p.f[q],
                 df: trial.df[q],
@@ -73,21 +91,25 @@ pub fn particle_tangents<const D: usize>(
                 .or_else(|| {
                     numerical.then(|| numerical_stress_derivative(mat, &inc, NUMERICAL_STEP))
                 })
-                .map(|ds| pk1_derivative(&trial.df[q], &trial.stress[q], &ds))
+                .map(|ds| *a_q = pk1_derivative::<D>(&trial.df[q], &trial.stress[q], &ds))
+                .is_none()
+                .then_some(q)
         })
-        .collect();
-    if let Some(q) = a.iter().position(|x| x.is_none()) {
-        let model = m.materials[p.material[q] as usize].model();
-        return Err(Failure {
-            particle: Some(q),
-            message: format!(
-                "material model `{model}` has no analytic tangent, which the direct solver \
+        .min();
+    match failed {
+        None => Ok(a),
+        Some(q) => {
+            let model = m.materials[p.material[q] as usize].model();
+            Err(Failure {
+                particle: Some(q),
+                message: format!(
+                    "material model `{model}` has no analytic tangent, which the direct solver \
                  needs; choose a matrix-free solver: linear_solver = \"gmres\" (or \"cg\" \
                  for symmetric problems) in [solver] or the [[stage]]"
-            ),
-        });
+                ),
+            })
+        }
     }
-    Ok(a.into_iter().map(|x| x.unwrap()).collect())
 }
 
 /// ∇S_I · A · ∇S_J for components (i, k): Σ_jl ∂S_I/∂X_j A_ijkl ∂S_J/∂X_l.
@@ -107,10 +129,17 @@ pub fn coupling<const D: usize>(
     v
 }
 
-/// Whether A has major symmetry (A_ijkl = A_klij) to round-off, i.e. whether
-/// its term of the tangent is symmetric.
-pub fn major_symmetric(a: &Pk1Derivative) -> bool {
-    (a - a.transpose()).amax() <= 1e-10 * a.amax().max(f64::MIN_POSITIVE)
+/// Whether A has major symmetry (A_ijkl = A_klij, indices < D) to round-off,
+/// i.e. whether its term of the tangent is symmetric.
+pub fn major_symmetric<const D: usize>(a: &Pk1Derivative) -> bool {
+    let (mut asymmetry, mut size) = (0.0f64, f64::MIN_POSITIVE);
+    for row in (0..3 * D).filter(|r| r % 3 < D) {
+        for col in (0..3 * D).filter(|c| c % 3 < D) {
+            asymmetry = asymmetry.max((a[(row, col)] - a[(col, row)]).abs());
+            size = size.max(a[(row, col)].abs());
+        }
+    }
+    asymmetry <= 1e-10 * size
 }
 
 /// Adds Σ_p V_p ∇S_I A_p ∇S_J (2-41, 2-42) to the tangent `k`.
@@ -188,7 +217,7 @@ mod tests {
             stress_old,
             history_old: &[],
         };
-        let a = pk1_derivative(
+        let a = pk1_derivative::<3>(
             &df,
             &m.update(&inc, &mut []),
             &m.stress_derivative(&inc).unwrap(),
