@@ -6,4 +6,5 @@
 mod common;
 
 mod bench;
+mod key_paths;
 mod scene_errors;
