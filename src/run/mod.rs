@@ -11,6 +11,7 @@ pub mod summary;
 
 pub use energy::{kinetic_energy, strain_energy};
 
+use crate::model::memory::{self, Estimate};
 use crate::model::Model;
 use crate::output::{write_particles_csv_with, Progress};
 use crate::scene::{Scene, SceneError, SolverKind};
@@ -48,10 +49,70 @@ pub struct RunOptions {
     /// Report the displacement of the particle nearest to this point
     /// (summary.json `monitor_displacement`).
     pub monitor: Option<Vec<f64>>,
+    /// The memory the run may take, in GiB (`None`: the machine's available
+    /// memory; `model::memory`).
+    pub memory_limit: Option<f64>,
+}
+
+/// What a run checks before it allocates and steps: the memory estimate, then the
+/// model's build (a body that holds no particle, an absorbing face with no
+/// material, …). `mpm check` calls it, so it rejects what `mpm run` would.
+pub fn set_up_check(scene: &Scene, opts: &RunOptions) -> Result<(), SceneError> {
+    check_memory(scene, opts)?;
+    match scene.config.dimension {
+        2 => check_steps(scene, &Model::<2>::build(scene)?),
+        3 => check_steps(scene, &Model::<3>::build(scene)?),
+        d => unreachable!("validated dimension {d}"),
+    }
+}
+
+/// The most steps a stage may take: more is a mistake in the scene (a run of
+/// 10⁹ steps of the smallest scene takes hours), refused before it starts.
+pub const MAX_STEPS: f64 = 1e9;
+
+/// Each stage's step count, from its Δt (explicit: cfl × the critical step of
+/// the model as built), within [`MAX_STEPS`].
+fn check_steps<const D: usize>(scene: &Scene, model: &Model<D>) -> Result<(), SceneError> {
+    let dt_critical = Explicit::critical_dt(model);
+    let c = &scene.config;
+    for (k, sc) in c.stages().into_iter().enumerate() {
+        let prefix = match c.solver {
+            Some(_) => "solver".to_string(),
+            None => format!("stage.{k}"),
+        };
+        let dt = match sc.kind {
+            SolverKind::Explicit => sc.dt.unwrap_or(sc.cfl() * dt_critical),
+            SolverKind::Implicit => sc.implicit_dt(),
+        };
+        let steps = sc.end_time / dt;
+        if steps.is_nan() || steps > MAX_STEPS {
+            let why = match (sc.kind, sc.dt) {
+                (SolverKind::Explicit, None) => format!(
+                    " (cfl × the critical step min h/(c + |v|) = {dt_critical:.3e} of the model as built)"
+                ),
+                _ => String::new(),
+            };
+            return Err(scene.at_key(
+                &format!("{prefix}.end_time"),
+                format!(
+                    "the stage would take {steps:.3e} steps of Δt = {dt:.3e}{why}, more than \
+                     {MAX_STEPS:e}: shorten it or take larger steps"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn check_memory(scene: &Scene, opts: &RunOptions) -> Result<(), SceneError> {
+    Estimate::of(&scene.config)
+        .check(memory::limit(opts.memory_limit))
+        .map_err(|(key, m)| scene.at_key(&key, m))
 }
 
 /// Run a scene, writing its outputs into `out`.
 pub fn run(scene: &Scene, out: &Path, opts: &RunOptions) -> Result<Summary, RunError> {
+    check_memory(scene, opts)?;
     std::fs::create_dir_all(out)?;
     match scene.config.dimension {
         2 => run_dim::<2>(scene, out, opts),
@@ -94,6 +155,10 @@ impl Timeline {
         while self.t < end - 1e-12 * self.total_time {
             let dt = stepper.dt(model).min(end - self.t);
             last_dt = dt;
+            // A step too small to move the clock would never end the stage.
+            if !(dt > 0.0 && self.t + dt > self.t) {
+                return Ok((Err(stalled(self.step, self.t, dt)), last_dt));
+            }
             let result = stepper.step(model, self.t, dt, self.step);
             self.recorders.newton(&stepper.take_newton_rows())?;
             match result {
@@ -114,6 +179,15 @@ impl Timeline {
     }
 }
 
+fn stalled(step: usize, time: f64, dt: f64) -> Divergence {
+    Divergence {
+        step,
+        time,
+        particle: None,
+        message: format!("the time step {dt:e} no longer advances the time"),
+    }
+}
+
 fn run_dim<const D: usize>(
     scene: &Scene,
     out: &Path,
@@ -121,6 +195,7 @@ fn run_dim<const D: usize>(
 ) -> Result<Summary, RunError> {
     let cfg = &scene.config;
     let mut model = Model::<D>::build(scene)?;
+    check_steps(scene, &model)?;
     // A search trial's factor holds for the whole run; otherwise each stage may
     // set its own (validation keeps the two apart).
     let mut strength_factor = opts.strength_factor.unwrap_or(1.0);

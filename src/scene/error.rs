@@ -128,7 +128,7 @@ impl<'a> Source<'a> {
             path == key || path.starts_with(key) && path[key.len()..].starts_with('.')
         };
         // The key, or a table holding it, was set by an override.
-        if let Some((o, _)) = keys().filter(|(_, k)| under(&path, k)).last() {
+        if let Some((o, _)) = keys().rev().find(|(_, k)| under(&path, k)) {
             e.set = Some(o.clone());
             return e;
         }
@@ -140,7 +140,7 @@ impl<'a> Source<'a> {
         };
         if e.position.is_none() {
             // Not in the file: a table that an override created.
-            if let Some((o, _)) = keys().filter(|(_, k)| under(k, &path)).last() {
+            if let Some((o, _)) = keys().rev().find(|(_, k)| under(k, &path)) {
                 e.set = Some(o.clone());
             }
         }

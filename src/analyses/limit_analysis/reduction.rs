@@ -52,7 +52,12 @@ impl std::fmt::Display for ReductionError {
 
 impl std::error::Error for ReductionError {}
 
-/// Find F with α(F) = 1 in [low, high] to a bracket narrower than `tolerance`.
+/// The most regula-falsi steps of one search (the Illinois variant converges
+/// superlinearly: a dozen is usual).
+pub const MAX_NARROWINGS: usize = 100;
+
+/// Find F with α(F) = 1 in [low, high] to a bracket narrower than `tolerance`, or
+/// as narrow as round-off and [`MAX_NARROWINGS`] steps make it.
 pub fn factor_of_safety(
     model: &Model,
     bound: fn(&Model) -> Result<Bound, SolverFailure>,
@@ -94,11 +99,18 @@ pub fn factor_of_safety(
     }
     let (mut ga, mut gb) = (g(&a), g(&b));
     let mut side = 0;
+    let mut narrowings = 0;
     while b.factor - a.factor > tolerance && ga != 0.0 && gb != 0.0 {
         let mut f = (a.factor * gb - b.factor * ga) / (gb - ga);
         // Never step closer than a tenth of the tolerance to an end.
         let margin = 0.1 * tolerance;
         f = f.clamp(a.factor + margin, b.factor - margin);
+        // A tolerance below the round-off of F cannot be met: stop with the
+        // bracket as it is (also after MAX_NARROWINGS solves).
+        if !(f > a.factor && f < b.factor) || narrowings == MAX_NARROWINGS {
+            break;
+        }
+        narrowings += 1;
         let t = eval(f)?;
         let gt = g(&t);
         if gt >= 0.0 {
