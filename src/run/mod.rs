@@ -225,6 +225,8 @@ fn run_dim<const D: usize>(
     }
     let mut stages = Vec::new();
     let mut last: Option<(SolverReport, f64, usize)> = None;
+    // An output that cannot be written ends the run as failed.
+    let mut failure: Option<std::io::Error> = None;
     for (k, sc) in cfg.stages().into_iter().enumerate() {
         if outcome.is_err() {
             break;
@@ -238,7 +240,13 @@ fn run_dim<const D: usize>(
         }
         let mut stepper = crate::solver::stepper::<D>(cfg.grid.shape_function, sc, line.t);
         let (start, steps_before, stage_clock) = (line.t, line.step, Instant::now());
-        let (result, dt) = line.stage(&mut model, stepper.as_mut(), sc.end_time)?;
+        let (result, dt) = match line.stage(&mut model, stepper.as_mut(), sc.end_time) {
+            Ok(ended) => ended,
+            Err(e) => {
+                failure = Some(e);
+                break;
+            }
+        };
         outcome = result;
         let report = stepper.report();
         stages.push(StageSummary {
@@ -279,6 +287,7 @@ fn run_dim<const D: usize>(
         particle_steps_per_second: (particles * line.step) as f64 / wall.max(1e-9),
         active_nodes_last_step: active_nodes,
         status: Status::Completed,
+        message: None,
         divergence: None,
         solver: run_totals(solver, &stages, implicit),
         stages,
@@ -288,14 +297,18 @@ fn run_dim<const D: usize>(
             .map(|q| (model.particles.x[q] - model.particles.x0[q]).norm()),
         strength_factor: opts.strength_factor,
     };
+    let summary_path = out.join("summary.json");
+    if let Some(e) = failure {
+        return Err(failed(summary, &summary_path, e));
+    }
     if let Err(d) = outcome {
         summary.status = Status::Diverged;
+        summary.message = Some(d.to_string());
         summary.divergence = Some(DivergenceReport {
-            message: d.to_string(),
             diverged_step: d.step,
             diverged_particle: d.particle,
         });
-        summary.write(&out.join("summary.json"))?;
+        summary.write(&summary_path)?;
         return Err(RunError::Diverged {
             message: format!(
                 "{}: {d}; outputs written so far are in {}",
@@ -305,12 +318,29 @@ fn run_dim<const D: usize>(
             summary: Box::new(summary),
         });
     }
-    line.recorders.state(&line.moment(&model), true)?;
-    let eps_p = model.plastic_strain();
-    let extra: Vec<(&str, &[f64])> = eps_p.iter().map(|e| ("eps_p", e.as_slice())).collect();
-    write_particles_csv_with(&out.join("particles_final.csv"), &model.particles, &extra)?;
-    summary.write(&out.join("summary.json"))?;
+    let finish = line
+        .recorders
+        .state(&line.moment(&model), true)
+        .and_then(|()| {
+            let eps_p = model.plastic_strain();
+            let extra: Vec<(&str, &[f64])> =
+                eps_p.iter().map(|e| ("eps_p", e.as_slice())).collect();
+            write_particles_csv_with(&out.join("particles_final.csv"), &model.particles, &extra)
+        });
+    if let Err(e) = finish {
+        return Err(failed(summary, &summary_path, e));
+    }
+    summary.write(&summary_path)?;
     Ok(summary)
+}
+
+/// A run that could not write an output: summary.json says so if it still can be
+/// written, and the error goes up.
+fn failed(mut summary: Summary, path: &Path, e: std::io::Error) -> RunError {
+    summary.status = Status::Failed;
+    summary.message = Some(format!("cannot write outputs: {e}"));
+    summary.write(path).ok();
+    RunError::Io(e)
 }
 
 /// The run's solver fields: the last stage's, with the Newton, cut-back and

@@ -498,7 +498,7 @@ fn status(exit: Exit, dir: &Path, timeout: f64) -> String {
         .to_string();
     let message = || -> String {
         match read_summary(dir) {
-            Some(ChildSummary::Run(s)) => s.divergence.map(|d| d.message),
+            Some(ChildSummary::Run(s)) => s.message,
             Some(ChildSummary::Search(s)) => s.message,
             None => None,
         }
