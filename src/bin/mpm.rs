@@ -223,6 +223,11 @@ fn main() -> ExitCode {
                     return ExitCode::from(2);
                 }
             };
+            // SIGINT and SIGTERM stop the run at the end of a step (run/interrupt.rs).
+            if let Err(e) = mpm::run::interrupt::install() {
+                eprintln!("error: cannot catch signals: {e}");
+                return ExitCode::from(1);
+            }
             let opts = RunOptions {
                 progress: true,
                 memory_limit,
@@ -268,6 +273,12 @@ fn main() -> ExitCode {
                 Err(e @ RunError::Scene(_)) => {
                     eprintln!("error: {e}");
                     ExitCode::from(2)
+                }
+                Err(RunError::Interrupted {
+                    signal, message, ..
+                }) => {
+                    eprintln!("{message}");
+                    ExitCode::from(128 + signal as u8)
                 }
                 Err(e) => {
                     eprintln!("error: {e}");

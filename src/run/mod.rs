@@ -6,6 +6,7 @@
 
 pub mod energy;
 pub mod footing;
+pub mod interrupt;
 pub mod recorders;
 pub mod summary;
 
@@ -33,6 +34,14 @@ pub enum RunError {
     /// The run stopped early; its summary (also in summary.json) says where.
     #[error("{message}")]
     Diverged {
+        message: String,
+        summary: Box<Summary>,
+    },
+    /// A signal stopped the run at the end of a step; its outputs so far are
+    /// written (`interrupt.rs`).
+    #[error("{message}")]
+    Interrupted {
+        signal: i32,
         message: String,
         summary: Box<Summary>,
     },
@@ -131,6 +140,8 @@ struct Timeline {
     total_time: f64,
     recorders: Recorders,
     progress: Option<Progress>,
+    /// The signal that stopped the run at the end of a step, if one did.
+    interrupted: Option<i32>,
 }
 
 impl Timeline {
@@ -172,6 +183,10 @@ impl Timeline {
             self.recorders.state(&self.moment(model), false)?;
             if let Some(p) = &self.progress {
                 p.set(self.t, self.step);
+            }
+            if let Some(signal) = interrupt::requested() {
+                self.interrupted = Some(signal);
+                return Ok((Ok(()), last_dt));
             }
         }
         self.t = end;
@@ -216,6 +231,7 @@ fn run_dim<const D: usize>(
         total_time: cfg.total_time(),
         recorders: Recorders::create(out, cfg, &model)?,
         progress: opts.progress.then(|| Progress::new(cfg.total_time())),
+        interrupted: None,
     };
     let dt_critical = Explicit::critical_dt(&model);
     let started = Instant::now();
@@ -261,6 +277,9 @@ fn run_dim<const D: usize>(
             strength_reduction_factor: sc.strength_reduction_factor.map(|_| strength_factor),
         });
         last = Some((report, dt, stepper.active_nodes()));
+        if line.interrupted.is_some() {
+            break;
+        }
     }
     if let Some(p) = &line.progress {
         p.finish();
@@ -329,6 +348,23 @@ fn run_dim<const D: usize>(
         });
     if let Err(e) = finish {
         return Err(failed(summary, &summary_path, e));
+    }
+    if let Some(signal) = line.interrupted {
+        let message = format!(
+            "interrupted by {} at step {} (t = {:.6e}); outputs written so far are in {}",
+            interrupt::name(signal),
+            line.step,
+            line.t,
+            out.display()
+        );
+        summary.status = Status::Interrupted;
+        summary.message = Some(message.clone());
+        summary.write(&summary_path)?;
+        return Err(RunError::Interrupted {
+            signal,
+            message: format!("{}: {message}", scene.file),
+            summary: Box::new(summary),
+        });
     }
     summary.write(&summary_path)?;
     Ok(summary)

@@ -10,5 +10,6 @@ mod ended;
 mod extremes;
 mod implicit_extremes;
 mod krylov;
+mod signals;
 mod stability;
 mod threads;
