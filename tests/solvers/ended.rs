@@ -32,12 +32,8 @@ fn a_completed_run_says_so_and_leaves_no_partial_file() {
         "{text}"
     );
     assert_eq!(leftovers(dir.path()), Vec::<String>::new());
-    assert!(
-        Table::read(&dir.path().join("particles_final.csv"))
-            .unwrap()
-            .len()
-            > 0
-    );
+    let particles = Table::read(&dir.path().join("particles_final.csv")).unwrap();
+    assert_eq!(particles.len(), summary.particles);
 }
 
 #[test]
