@@ -141,3 +141,53 @@ pub fn factor_of_safety(
         trials,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analyses::limit_analysis::config::LimitScene;
+    use std::sync::OnceLock;
+
+    /// The cohesion of the unreduced model.
+    static BASE_COHESION: OnceLock<f64> = OnceLock::new();
+
+    /// A stand-in for a bound, α(F) = 1.37 / F (the cohesion is divided by F),
+    /// so that the factor of safety is 1.37 and a solve costs nothing.
+    fn inverse(m: &Model) -> Result<Bound, SolverFailure> {
+        let base = BASE_COHESION.get().unwrap();
+        Ok(Bound {
+            multiplier: 1.37 * m.strength.cohesion / base,
+            elements: 0,
+            variables: 0,
+            equalities: 0,
+            cones: 0,
+            iterations: 0,
+            seconds: 0.0,
+            field: Vec::new(),
+        })
+    }
+
+    /// A tolerance below the round-off of F cannot be met: the search stops
+    /// within MAX_NARROWINGS steps with a bracket around the root.
+    #[test]
+    fn an_unreachable_tolerance_ends_with_the_bracket_it_has() {
+        let text = include_str!("../../../problems/limit_slope.toml");
+        let scene = LimitScene::parse("limit_slope.toml", text, &[]).unwrap();
+        let model = scene.model(0);
+        BASE_COHESION.get_or_init(|| model.strength.cohesion);
+        for tolerance in [0.0, 5e-324, 1e-300] {
+            let f = factor_of_safety(&model, inverse, [1.0, 2.0], tolerance).unwrap();
+            assert!(
+                f.trials.len() <= 2 + 4 + MAX_NARROWINGS,
+                "{}",
+                f.trials.len()
+            );
+            assert!(
+                f.bracket[0] <= 1.37 && 1.37 <= f.bracket[1],
+                "{:?}",
+                f.bracket
+            );
+            assert!((f.factor - 1.37).abs() < 1e-12, "{}", f.factor);
+        }
+    }
+}
