@@ -138,6 +138,7 @@ pub fn trial(
         progress: false,
         strength_factor: Some(factor),
         monitor: cfg.monitor.clone(),
+        ..Default::default()
     };
     let started = Instant::now();
     let (summary, mut status, message) = match run(scene, &out.join(dir), &opts) {

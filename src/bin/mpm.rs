@@ -6,7 +6,7 @@ use clap::{Parser, Subcommand};
 use mpm::analyses::bench::{bench, BenchError, BenchOptions};
 use mpm::analyses::reference;
 use mpm::analyses::strength_reduction::{search, SearchError};
-use mpm::run::{run, RunError, RunOptions};
+use mpm::run::{run, set_up_check, RunError, RunOptions};
 use mpm::scene::Scene;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -36,12 +36,19 @@ enum Command {
         /// Number of worker threads (default: all cores). Results do not depend on it.
         #[arg(long)]
         threads: Option<usize>,
+        /// Memory the run may take, in GiB (default: the machine's available memory).
+        #[arg(long, value_name = "GIB")]
+        memory_limit: Option<f64>,
     },
-    /// Validate a scene without running it.
+    /// Validate a scene without running it: everything `mpm run` checks before its
+    /// first step (the model is built, the memory estimated).
     Check {
         scene: PathBuf,
         #[arg(long = "set", value_name = "KEY=VALUE")]
         overrides: Vec<String>,
+        /// Memory the run may take, in GiB (default: the machine's available memory).
+        #[arg(long, value_name = "GIB")]
+        memory_limit: Option<f64>,
     },
     /// Run a scene over solver configurations and sweeps of Δt (or load steps) and
     /// grid size; write DIR/bench.csv and PNG plots (docs/bench.md).
@@ -161,7 +168,17 @@ fn main() -> ExitCode {
             out,
             overrides,
         } => limit(&scene, &out, &overrides),
-        Command::Check { scene, overrides } => match load(&scene, &overrides) {
+        Command::Check {
+            scene,
+            overrides,
+            memory_limit,
+        } => match load(&scene, &overrides).and_then(|s| {
+            let opts = RunOptions {
+                memory_limit,
+                ..Default::default()
+            };
+            set_up_check(&s, &opts).map(|_| s)
+        }) {
             Ok(s) => {
                 let c = &s.config;
                 let stages: Vec<&str> = c.stages().iter().map(|st| st.kind.name()).collect();
@@ -188,6 +205,7 @@ fn main() -> ExitCode {
             out,
             overrides,
             threads,
+            memory_limit,
         } => {
             if let Some(n) = threads {
                 if let Err(e) = rayon::ThreadPoolBuilder::new()
@@ -205,8 +223,14 @@ fn main() -> ExitCode {
                     return ExitCode::from(2);
                 }
             };
+            // SIGINT and SIGTERM stop the run at the end of a step (run/interrupt.rs).
+            if let Err(e) = mpm::run::interrupt::install() {
+                eprintln!("error: cannot catch signals: {e}");
+                return ExitCode::from(1);
+            }
             let opts = RunOptions {
                 progress: true,
+                memory_limit,
                 ..Default::default()
             };
             if scene.config.strength_reduction.is_some() {
@@ -249,6 +273,12 @@ fn main() -> ExitCode {
                 Err(e @ RunError::Scene(_)) => {
                     eprintln!("error: {e}");
                     ExitCode::from(2)
+                }
+                Err(RunError::Interrupted {
+                    signal, message, ..
+                }) => {
+                    eprintln!("{message}");
+                    ExitCode::from(128 + signal as u8)
                 }
                 Err(e) => {
                     eprintln!("error: {e}");

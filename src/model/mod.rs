@@ -7,6 +7,7 @@ pub mod conditions;
 pub mod geometry;
 pub mod grid;
 pub mod loads;
+pub mod memory;
 pub mod particles;
 
 pub use loads::{load_factor, LoadTime};

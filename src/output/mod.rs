@@ -6,7 +6,10 @@
 //! Every writer is generic over the dimension `D` (2 or 3). Floating-point numbers in
 //! text files are written with the shortest representation that parses back to the
 //! same `f64`: plain notation for moderate magnitudes, scientific (`1e-7`) otherwise.
+//! Files written whole (summary.json, particles_final.csv, frames) are replaced
+//! atomically (`atomic.rs`).
 
+pub mod atomic;
 pub mod csv_file;
 mod history;
 mod particles_csv;

@@ -60,18 +60,21 @@ pub fn write_particles_csv_with<const D: usize>(
         assert_eq!(values.len(), p.len(), "extra column {name}");
         head.push(name.to_string());
     }
-    let mut w = CsvWriter::create(path, &head)?;
-    let stress = stress_columns(D);
-    for i in 0..p.len() {
-        let ids = [Field::from(i), Field::from(p.body[i])];
-        let kinematics = p.x0[i].iter().chain(p.x[i].iter()).chain(p.v[i].iter());
-        let sigma = stress.iter().map(|&(_, r, c)| p.stress[i][(r, c)]);
-        let sizes = [p.volume0[i], p.volume[i], p.mass[i]];
-        let more = extra.iter().map(|(_, values)| values[i]);
-        let numbers = kinematics.copied().chain(sigma).chain(sizes).chain(more);
-        w.row(ids.into_iter().chain(numbers.map(Field::Number)))?;
-    }
-    w.flush()
+    // Replaced atomically: a run killed while writing leaves the old file whole.
+    super::atomic::replace(path, |tmp| {
+        let mut w = CsvWriter::create(tmp, &head)?;
+        let stress = stress_columns(D);
+        for i in 0..p.len() {
+            let ids = [Field::from(i), Field::from(p.body[i])];
+            let kinematics = p.x0[i].iter().chain(p.x[i].iter()).chain(p.v[i].iter());
+            let sigma = stress.iter().map(|&(_, r, c)| p.stress[i][(r, c)]);
+            let sizes = [p.volume0[i], p.volume[i], p.mass[i]];
+            let more = extra.iter().map(|(_, values)| values[i]);
+            let numbers = kinematics.copied().chain(sigma).chain(sizes).chain(more);
+            w.row(ids.into_iter().chain(numbers.map(Field::Number)))?;
+        }
+        w.flush()
+    })
 }
 
 #[cfg(test)]

@@ -1,17 +1,16 @@
 //! Numbers and JSON as text: the shortest decimal that reads back to the same
 //! `f64`, and pretty-printed JSON files.
 
-use std::fs::File;
-use std::io::{self, BufWriter, Write};
+use std::io::{self, Write};
 use std::path::Path;
 
 /// Write `value` to `path` as pretty-printed JSON followed by a newline (used for
-/// `summary.json`).
+/// `summary.json`), replacing the file atomically.
 pub fn write_json(path: &Path, value: &impl serde::Serialize) -> io::Result<()> {
-    let mut w = BufWriter::new(File::create(path)?);
-    serde_json::to_writer_pretty(&mut w, value)?;
-    w.write_all(b"\n")?;
-    w.flush()
+    super::atomic::write_atomically(path, |w| {
+        serde_json::to_writer_pretty(&mut *w, value)?;
+        w.write_all(b"\n")
+    })
 }
 
 /// Write `x` with the shortest decimal text that round-trips to the same `f64`:

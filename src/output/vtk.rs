@@ -6,8 +6,9 @@
 //! Both the frames and the collection are written to a temporary file and renamed,
 //! so a run that stops at any moment leaves a loadable collection.
 
-use std::fs::{self, File};
-use std::io::{self, BufWriter, Write};
+use super::atomic::write_atomically;
+use std::fs;
+use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 
 use vtkio::model::{
@@ -185,22 +186,6 @@ fn frame_model<const D: usize>(p: &Particles<D>, extra: &[(&str, &[f64])]) -> Vt
             },
         }),
     }
-}
-
-/// Write `path` through a temporary sibling file and a rename, so readers never see a
-/// half-written file.
-fn write_atomically(
-    path: &Path,
-    write: impl FnOnce(&mut BufWriter<File>) -> io::Result<()>,
-) -> io::Result<()> {
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".part");
-    let tmp = PathBuf::from(tmp);
-    let mut w = BufWriter::new(File::create(&tmp)?);
-    write(&mut w)?;
-    w.flush()?;
-    drop(w);
-    fs::rename(&tmp, path)
 }
 
 /// Escape the five XML special characters for use in an attribute value.

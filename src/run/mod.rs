@@ -6,11 +6,13 @@
 
 pub mod energy;
 pub mod footing;
+pub mod interrupt;
 pub mod recorders;
 pub mod summary;
 
 pub use energy::{kinetic_energy, strain_energy};
 
+use crate::model::memory::{self, Estimate};
 use crate::model::Model;
 use crate::output::{write_particles_csv_with, Progress};
 use crate::scene::{Scene, SceneError, SolverKind};
@@ -35,6 +37,14 @@ pub enum RunError {
         message: String,
         summary: Box<Summary>,
     },
+    /// A signal stopped the run at the end of a step; its outputs so far are
+    /// written (`interrupt.rs`).
+    #[error("{message}")]
+    Interrupted {
+        signal: i32,
+        message: String,
+        summary: Box<Summary>,
+    },
 }
 
 /// Options that do not belong in the scene.
@@ -48,10 +58,70 @@ pub struct RunOptions {
     /// Report the displacement of the particle nearest to this point
     /// (summary.json `monitor_displacement`).
     pub monitor: Option<Vec<f64>>,
+    /// The memory the run may take, in GiB (`None`: the machine's available
+    /// memory; `model::memory`).
+    pub memory_limit: Option<f64>,
+}
+
+/// What a run checks before it allocates and steps: the memory estimate, then the
+/// model's build (a body that holds no particle, an absorbing face with no
+/// material, …). `mpm check` calls it, so it rejects what `mpm run` would.
+pub fn set_up_check(scene: &Scene, opts: &RunOptions) -> Result<(), SceneError> {
+    check_memory(scene, opts)?;
+    match scene.config.dimension {
+        2 => check_steps(scene, &Model::<2>::build(scene)?),
+        3 => check_steps(scene, &Model::<3>::build(scene)?),
+        d => unreachable!("validated dimension {d}"),
+    }
+}
+
+/// The most steps a stage may take: more is a mistake in the scene (a run of
+/// 10⁹ steps of the smallest scene takes hours), refused before it starts.
+pub const MAX_STEPS: f64 = 1e9;
+
+/// Each stage's step count, from its Δt (explicit: cfl × the critical step of
+/// the model as built), within [`MAX_STEPS`].
+fn check_steps<const D: usize>(scene: &Scene, model: &Model<D>) -> Result<(), SceneError> {
+    let dt_critical = Explicit::critical_dt(model);
+    let c = &scene.config;
+    for (k, sc) in c.stages().into_iter().enumerate() {
+        let prefix = match c.solver {
+            Some(_) => "solver".to_string(),
+            None => format!("stage.{k}"),
+        };
+        let dt = match sc.kind {
+            SolverKind::Explicit => sc.dt.unwrap_or(sc.cfl() * dt_critical),
+            SolverKind::Implicit => sc.implicit_dt(),
+        };
+        let steps = sc.end_time / dt;
+        if steps.is_nan() || steps > MAX_STEPS {
+            let why = match (sc.kind, sc.dt) {
+                (SolverKind::Explicit, None) => format!(
+                    " (cfl × the critical step min h/(c + |v|) = {dt_critical:.3e} of the model as built)"
+                ),
+                _ => String::new(),
+            };
+            return Err(scene.at_key(
+                &format!("{prefix}.end_time"),
+                format!(
+                    "the stage would take {steps:.3e} steps of Δt = {dt:.3e}{why}, more than \
+                     {MAX_STEPS:e}: shorten it or take larger steps"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn check_memory(scene: &Scene, opts: &RunOptions) -> Result<(), SceneError> {
+    Estimate::of(&scene.config)
+        .check(memory::limit(opts.memory_limit))
+        .map_err(|(key, m)| scene.at_key(&key, m))
 }
 
 /// Run a scene, writing its outputs into `out`.
 pub fn run(scene: &Scene, out: &Path, opts: &RunOptions) -> Result<Summary, RunError> {
+    check_memory(scene, opts)?;
     std::fs::create_dir_all(out)?;
     match scene.config.dimension {
         2 => run_dim::<2>(scene, out, opts),
@@ -70,6 +140,8 @@ struct Timeline {
     total_time: f64,
     recorders: Recorders,
     progress: Option<Progress>,
+    /// The signal that stopped the run at the end of a step, if one did.
+    interrupted: Option<i32>,
 }
 
 impl Timeline {
@@ -94,6 +166,10 @@ impl Timeline {
         while self.t < end - 1e-12 * self.total_time {
             let dt = stepper.dt(model).min(end - self.t);
             last_dt = dt;
+            // A step too small to move the clock would never end the stage.
+            if !(dt > 0.0 && self.t + dt > self.t) {
+                return Ok((Err(stalled(self.step, self.t, dt)), last_dt));
+            }
             let result = stepper.step(model, self.t, dt, self.step);
             self.recorders.newton(&stepper.take_newton_rows())?;
             match result {
@@ -108,9 +184,22 @@ impl Timeline {
             if let Some(p) = &self.progress {
                 p.set(self.t, self.step);
             }
+            if let Some(signal) = interrupt::requested() {
+                self.interrupted = Some(signal);
+                return Ok((Ok(()), last_dt));
+            }
         }
         self.t = end;
         Ok((Ok(()), last_dt))
+    }
+}
+
+fn stalled(step: usize, time: f64, dt: f64) -> Divergence {
+    Divergence {
+        step,
+        time,
+        particle: None,
+        message: format!("the time step {dt:e} no longer advances the time"),
     }
 }
 
@@ -121,6 +210,7 @@ fn run_dim<const D: usize>(
 ) -> Result<Summary, RunError> {
     let cfg = &scene.config;
     let mut model = Model::<D>::build(scene)?;
+    check_steps(scene, &model)?;
     // A search trial's factor holds for the whole run; otherwise each stage may
     // set its own (validation keeps the two apart).
     let mut strength_factor = opts.strength_factor.unwrap_or(1.0);
@@ -141,6 +231,7 @@ fn run_dim<const D: usize>(
         total_time: cfg.total_time(),
         recorders: Recorders::create(out, cfg, &model)?,
         progress: opts.progress.then(|| Progress::new(cfg.total_time())),
+        interrupted: None,
     };
     let dt_critical = Explicit::critical_dt(&model);
     let started = Instant::now();
@@ -150,6 +241,8 @@ fn run_dim<const D: usize>(
     }
     let mut stages = Vec::new();
     let mut last: Option<(SolverReport, f64, usize)> = None;
+    // An output that cannot be written ends the run as failed.
+    let mut failure: Option<std::io::Error> = None;
     for (k, sc) in cfg.stages().into_iter().enumerate() {
         if outcome.is_err() {
             break;
@@ -163,7 +256,13 @@ fn run_dim<const D: usize>(
         }
         let mut stepper = crate::solver::stepper::<D>(cfg.grid.shape_function, sc, line.t);
         let (start, steps_before, stage_clock) = (line.t, line.step, Instant::now());
-        let (result, dt) = line.stage(&mut model, stepper.as_mut(), sc.end_time)?;
+        let (result, dt) = match line.stage(&mut model, stepper.as_mut(), sc.end_time) {
+            Ok(ended) => ended,
+            Err(e) => {
+                failure = Some(e);
+                break;
+            }
+        };
         outcome = result;
         let report = stepper.report();
         stages.push(StageSummary {
@@ -178,6 +277,9 @@ fn run_dim<const D: usize>(
             strength_reduction_factor: sc.strength_reduction_factor.map(|_| strength_factor),
         });
         last = Some((report, dt, stepper.active_nodes()));
+        if line.interrupted.is_some() {
+            break;
+        }
     }
     if let Some(p) = &line.progress {
         p.finish();
@@ -204,6 +306,7 @@ fn run_dim<const D: usize>(
         particle_steps_per_second: (particles * line.step) as f64 / wall.max(1e-9),
         active_nodes_last_step: active_nodes,
         status: Status::Completed,
+        message: None,
         divergence: None,
         solver: run_totals(solver, &stages, implicit),
         stages,
@@ -213,14 +316,18 @@ fn run_dim<const D: usize>(
             .map(|q| (model.particles.x[q] - model.particles.x0[q]).norm()),
         strength_factor: opts.strength_factor,
     };
+    let summary_path = out.join("summary.json");
+    if let Some(e) = failure {
+        return Err(failed(summary, &summary_path, e));
+    }
     if let Err(d) = outcome {
         summary.status = Status::Diverged;
+        summary.message = Some(d.to_string());
         summary.divergence = Some(DivergenceReport {
-            message: d.to_string(),
             diverged_step: d.step,
             diverged_particle: d.particle,
         });
-        summary.write(&out.join("summary.json"))?;
+        summary.write(&summary_path)?;
         return Err(RunError::Diverged {
             message: format!(
                 "{}: {d}; outputs written so far are in {}",
@@ -230,12 +337,46 @@ fn run_dim<const D: usize>(
             summary: Box::new(summary),
         });
     }
-    line.recorders.state(&line.moment(&model), true)?;
-    let eps_p = model.plastic_strain();
-    let extra: Vec<(&str, &[f64])> = eps_p.iter().map(|e| ("eps_p", e.as_slice())).collect();
-    write_particles_csv_with(&out.join("particles_final.csv"), &model.particles, &extra)?;
-    summary.write(&out.join("summary.json"))?;
+    let finish = line
+        .recorders
+        .state(&line.moment(&model), true)
+        .and_then(|()| {
+            let eps_p = model.plastic_strain();
+            let extra: Vec<(&str, &[f64])> =
+                eps_p.iter().map(|e| ("eps_p", e.as_slice())).collect();
+            write_particles_csv_with(&out.join("particles_final.csv"), &model.particles, &extra)
+        });
+    if let Err(e) = finish {
+        return Err(failed(summary, &summary_path, e));
+    }
+    if let Some(signal) = line.interrupted {
+        let message = format!(
+            "interrupted by {} at step {} (t = {:.6e}); outputs written so far are in {}",
+            interrupt::name(signal),
+            line.step,
+            line.t,
+            out.display()
+        );
+        summary.status = Status::Interrupted;
+        summary.message = Some(message.clone());
+        summary.write(&summary_path)?;
+        return Err(RunError::Interrupted {
+            signal,
+            message: format!("{}: {message}", scene.file),
+            summary: Box::new(summary),
+        });
+    }
+    summary.write(&summary_path)?;
     Ok(summary)
+}
+
+/// A run that could not write an output: summary.json says so if it still can be
+/// written, and the error goes up.
+fn failed(mut summary: Summary, path: &Path, e: std::io::Error) -> RunError {
+    summary.status = Status::Failed;
+    summary.message = Some(format!("cannot write outputs: {e}"));
+    summary.write(path).ok();
+    RunError::Io(e)
 }
 
 /// The run's solver fields: the last stage's, with the Newton, cut-back and

@@ -12,8 +12,15 @@ use std::path::Path;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Status {
+    /// It reached the end time.
     Completed,
+    /// It stopped early on a divergence (`message`, `diverged_step`, …).
     Diverged,
+    /// A signal (SIGINT, SIGTERM) stopped it at the end of a step; a checkpoint
+    /// lets it go on (`message` says where).
+    Interrupted,
+    /// It could not go on: an output could not be written (`message`).
+    Failed,
 }
 
 /// summary.json.
@@ -33,6 +40,9 @@ pub struct Summary {
     pub particle_steps_per_second: f64,
     pub active_nodes_last_step: usize,
     pub status: Status,
+    /// Why a run did not complete (absent when it did).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub message: Option<String>,
     /// Where a diverged run stopped.
     #[serde(flatten, default, skip_serializing_if = "Option::is_none")]
     pub divergence: Option<DivergenceReport>,
@@ -54,10 +64,9 @@ pub struct Summary {
     pub strength_factor: Option<f64>,
 }
 
-/// Where and why a run stopped early.
+/// Where a run diverged (why: the summary's `message`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct DivergenceReport {
-    pub message: String,
     pub diverged_step: usize,
     /// The offending particle (null for a Newton failure).
     pub diverged_particle: Option<usize>,

@@ -122,7 +122,10 @@ impl BodyConfig {
 }
 
 #[derive(Clone, Debug, Deserialize)]
-#[serde(untagged)]
+#[serde(
+    untagged,
+    expecting = "a number of particles per direction, or an array with one per direction"
+)]
 pub enum PerDirection {
     Same(usize),
     Each(Vec<usize>),

@@ -1,5 +1,15 @@
-//! Scene errors that name the file, the key and the line and column.
+//! Scene errors that name the file, the key and the line and column, or the
+//! `--set KEY=VALUE` override they come from.
+//!
+//! [`Source`] is what an error is located in: the file's text, the text after the
+//! overrides and the overrides themselves. An error at a key path points at the
+//! override that set the key (its value is not in the file), else at the key's
+//! line and column in the file. Deserialisation runs through
+//! `serde_path_to_error`, which records the key path of a failing value (type
+//! errors, unknown enum values, untagged-enum mismatches) while the TOML
+//! deserialiser keeps its span.
 
+use serde::de::DeserializeOwned;
 use std::fmt;
 
 #[derive(Clone, Debug, PartialEq)]
@@ -9,6 +19,9 @@ pub struct SceneError {
     pub key: Option<String>,
     /// 1-based line and column.
     pub position: Option<(usize, usize)>,
+    /// The `--set KEY=VALUE` override the error comes from (then there is no
+    /// position: the value is not in the file).
+    pub set: Option<String>,
     pub message: String,
 }
 
@@ -19,6 +32,9 @@ impl fmt::Display for SceneError {
             write!(f, ":{line}:{col}")?;
         }
         write!(f, ": ")?;
+        if let Some(set) = &self.set {
+            write!(f, "override `--set {set}`: ")?;
+        }
         if let Some(key) = &self.key {
             write!(f, "key `{key}`: ")?;
         }
@@ -34,6 +50,7 @@ impl SceneError {
             file: file.into(),
             key: None,
             position: None,
+            set: None,
             message: message.into(),
         }
     }
@@ -42,22 +59,121 @@ impl SceneError {
     pub fn from_toml(file: &str, text: &str, e: &toml::de::Error) -> Self {
         let position = e.span().map(|s| line_col(text, s.start));
         SceneError {
-            file: file.into(),
-            key: None,
             position,
-            message: e.message().trim().to_string(),
+            ..SceneError::plain(file, e.message().trim())
         }
     }
 
     /// A validation error at a dotted key path; the position is looked up in the text.
     pub fn at_key(file: &str, text: &str, path: &str, message: impl Into<String>) -> Self {
-        SceneError {
-            file: file.into(),
-            key: Some(path.to_string()),
-            position: locate(text, path),
-            message: message.into(),
+        Source::new(file, text, text, &[]).at_key(path, message)
+    }
+}
+
+/// Where the errors of one scene are located: the file's text, the text after
+/// the `--set` overrides, and the overrides.
+#[derive(Clone, Copy, Debug)]
+pub struct Source<'a> {
+    pub file: &'a str,
+    /// The file's text.
+    pub original: &'a str,
+    /// The text after the overrides (what was parsed).
+    pub text: &'a str,
+    pub overrides: &'a [String],
+}
+
+impl<'a> Source<'a> {
+    pub fn new(file: &'a str, original: &'a str, text: &'a str, overrides: &'a [String]) -> Self {
+        Source {
+            file,
+            original,
+            text,
+            overrides,
         }
     }
+
+    /// Deserialise the text, an error naming its key path.
+    pub fn deserialize<T: DeserializeOwned>(&self) -> Result<T, SceneError> {
+        let de = toml::Deserializer::new(self.text);
+        serde_path_to_error::deserialize(de).map_err(|e| {
+            let path = key_path(e.path(), e.inner().message());
+            let span = e.inner().span().map(|s| s.start);
+            self.error(path, span, e.inner().message().trim())
+        })
+    }
+
+    /// An error at a dotted key path.
+    pub fn at_key(&self, path: &str, message: impl Into<String>) -> SceneError {
+        self.error(Some(path.to_string()), None, message)
+    }
+
+    /// An error at a key path (if known) and a byte offset in the parsed text (if
+    /// known): the override that set the key, or the position in the file.
+    fn error(
+        &self,
+        key: Option<String>,
+        span: Option<usize>,
+        message: impl Into<String>,
+    ) -> SceneError {
+        let mut e = SceneError {
+            key: key.clone(),
+            ..SceneError::plain(self.file, message)
+        };
+        let Some(path) = key else {
+            e.position = span.map(|s| line_col(self.text, s));
+            return e;
+        };
+        let keys = || self.overrides.iter().map(|o| (o, override_key(o)));
+        let under = |path: &str, key: &str| {
+            path == key || path.starts_with(key) && path[key.len()..].starts_with('.')
+        };
+        // The key, or a table holding it, was set by an override.
+        if let Some((o, _)) = keys().rev().find(|(_, k)| under(&path, k)) {
+            e.set = Some(o.clone());
+            return e;
+        }
+        e.position = if self.overrides.is_empty() {
+            span.map(|s| line_col(self.text, s))
+                .or_else(|| locate(self.text, &path))
+        } else {
+            locate(self.original, &path)
+        };
+        if e.position.is_none() {
+            // Not in the file: a table that an override created.
+            if let Some((o, _)) = keys().rev().find(|(_, k)| under(k, &path)) {
+                e.set = Some(o.clone());
+            }
+        }
+        e
+    }
+}
+
+/// The dotted key of an override `KEY=VALUE`.
+fn override_key(o: &str) -> &str {
+    o.split_once('=').map_or(o, |(k, _)| k).trim()
+}
+
+/// The dotted key path of a deserialisation error (`body.0.radius`); an unknown
+/// field is named at its own key, not only its table's.
+fn key_path(path: &serde_path_to_error::Path, message: &str) -> Option<String> {
+    use serde_path_to_error::Segment;
+    let mut parts: Vec<String> = path
+        .iter()
+        .filter_map(|s| match s {
+            Segment::Seq { index } => Some(index.to_string()),
+            Segment::Map { key } => Some(key.clone()),
+            Segment::Enum { .. } => None,
+            Segment::Unknown => Some("?".into()),
+        })
+        .collect();
+    let field = ["unknown field `", "missing field `"]
+        .iter()
+        .find_map(|p| message.strip_prefix(p))
+        .and_then(|m| m.split('`').next());
+    if let Some(field) = field.filter(|f| parts.last().map(String::as_str) != Some(*f)) {
+        parts.push(field.to_string());
+    }
+    (!parts.is_empty()).then(|| parts.join("."))
 }
 
 /// 1-based line and column of a byte offset.

@@ -2,8 +2,9 @@
 //!
 //! `Scene::load` reads a file, applies `--set KEY=VALUE` overrides (dotted TOML
 //! paths, values in TOML syntax), deserialises, and validates physical ranges.
-//! Every error names the file and the key and, where the TOML gives it, the line
-//! and column. The keys are documented in `docs/scene.md`.
+//! Every error names the file and the key path and, where the TOML gives it, the
+//! line and column; an error at a key set by `--set` names the override instead
+//! (`error.rs`). The keys are documented in `docs/scene.md`.
 
 mod config;
 mod error;
@@ -15,7 +16,7 @@ mod solver;
 pub mod validate;
 
 pub use config::*;
-pub use error::SceneError;
+pub use error::{SceneError, Source};
 pub use grid::*;
 pub use material::MaterialConfig;
 pub use solver::*;
@@ -29,30 +30,57 @@ pub struct Scene {
     pub config: SceneConfig,
     /// The text after overrides (to locate keys in errors found after parsing).
     pub text: String,
+    /// The file's text and the overrides applied to it.
+    pub original: String,
+    pub overrides: Vec<String>,
 }
 
 impl Scene {
     /// Read, override, parse and validate a scene file.
     pub fn load(path: &Path, overrides: &[String]) -> Result<Scene, SceneError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| SceneError::plain(&file, format!("cannot read the scene file: {e}")))?;
+        let text = read_text(&file, path)?;
         Scene::parse(&file, &text, overrides)
     }
 
     /// Parse scene text (`file` names it in errors).
     pub fn parse(file: &str, text: &str, overrides: &[String]) -> Result<Scene, SceneError> {
-        let text = overrides::apply(file, text, overrides)?;
-        let config: SceneConfig =
-            toml::from_str(&text).map_err(|e| SceneError::from_toml(file, &text, &e))?;
-        validate::validate(&config)
-            .map_err(|(path, msg)| SceneError::at_key(file, &text, &path, msg))?;
+        let applied = overrides::apply(file, text, overrides)?;
+        let source = Source::new(file, text, &applied, overrides);
+        let config: SceneConfig = source.deserialize()?;
+        validate::validate(&config).map_err(|(path, msg)| source.at_key(&path, msg))?;
         Ok(Scene {
             file: file.to_string(),
             config,
-            text,
+            text: applied,
+            original: text.to_string(),
+            overrides: overrides.to_vec(),
         })
     }
+
+    /// An error at a dotted key path of this scene (found after parsing).
+    pub fn at_key(&self, path: &str, message: impl Into<String>) -> SceneError {
+        Source::new(&self.file, &self.original, &self.text, &self.overrides).at_key(path, message)
+    }
+}
+
+/// A scene file's text; a file that is not UTF-8 is refused at the byte offset
+/// of its first bad byte.
+pub fn read_text(file: &str, path: &Path) -> Result<String, SceneError> {
+    let bytes = std::fs::read(path)
+        .map_err(|e| SceneError::plain(file, format!("cannot read the scene file: {e}")))?;
+    String::from_utf8(bytes).map_err(|e| {
+        let offset = e.utf8_error().valid_up_to();
+        let (line, col) =
+            error::line_col(&String::from_utf8_lossy(&e.as_bytes()[..offset]), offset);
+        SceneError {
+            position: Some((line, col)),
+            ..SceneError::plain(
+                file,
+                format!("the file is not UTF-8 text: invalid byte at byte offset {offset}"),
+            )
+        }
+    })
 }
 
 #[cfg(test)]

@@ -13,19 +13,19 @@ pub fn apply(file: &str, text: &str, overrides: &[String]) -> Result<String, Sce
     }
     let mut doc = parse(file, text)?;
     for o in overrides {
-        let bad = |m: String| SceneError::plain(file, m);
+        let bad = |m: String| SceneError {
+            set: Some(o.clone()),
+            ..SceneError::plain(file, m)
+        };
         let (key, value) = o
             .split_once('=')
-            .ok_or_else(|| bad(format!("override `{o}` is not of the form KEY=VALUE")))?;
+            .ok_or_else(|| bad("is not of the form KEY=VALUE".into()))?;
         let value: Value = value
             .trim()
             .parse()
             .unwrap_or_else(|_| Value::from(value.trim()));
-        set(doc.as_table_mut(), key.trim(), value).ok_or_else(|| {
-            bad(format!(
-                "override `{o}`: the scene has no place for key `{key}`"
-            ))
-        })?;
+        set(doc.as_table_mut(), key.trim(), value)
+            .ok_or_else(|| bad(format!("the scene has no place for key `{}`", key.trim())))?;
     }
     Ok(doc.to_string())
 }
@@ -46,10 +46,8 @@ fn parse(file: &str, text: &str) -> Result<DocumentMut, SceneError> {
     text.parse().map_err(|e: toml_edit::TomlError| {
         let position = e.span().map(|s| super::error::line_col(text, s.start));
         SceneError {
-            file: file.into(),
-            key: None,
             position,
-            message: e.message().trim().to_string(),
+            ..SceneError::plain(file, e.message().trim())
         }
     })
 }
@@ -162,7 +160,9 @@ mod tests {
     fn malformed_overrides_are_errors() {
         let e = apply("s.toml", SCENE, &["grid.cells".into()]).unwrap_err();
         assert!(e.message.contains("KEY=VALUE"), "{e}");
+        assert_eq!(e.set.as_deref(), Some("grid.cells"));
         let e = apply("s.toml", SCENE, &["material.3.density=1".into()]).unwrap_err();
         assert!(e.message.contains("material.3.density"), "{e}");
+        assert!(e.to_string().contains("--set material.3.density=1"), "{e}");
     }
 }

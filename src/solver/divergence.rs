@@ -29,7 +29,8 @@ impl std::fmt::Display for Divergence {
     }
 }
 
-/// Stop on non-finite state or particles outside the grid (first offender).
+/// Stop on non-finite state, an inverted or collapsed particle (det F ≤ 0) or
+/// particles outside the grid (first offender).
 pub fn check_state<const D: usize>(m: &Model<D>, step: usize, time: f64) -> Result<(), Divergence> {
     let p = &m.particles;
     let bad = (0..p.len())
@@ -39,6 +40,7 @@ pub fn check_state<const D: usize>(m: &Model<D>, step: usize, time: f64) -> Resu
             !(p.x[q].iter().all(|v| v.is_finite())
                 && p.v[q].iter().all(|v| v.is_finite())
                 && p.stress[q].iter().all(|v| v.is_finite())
+                && p.f[q].determinant() > 0.0
                 && m.grid.contains(&p.x[q]))
         });
     match bad {
@@ -49,7 +51,13 @@ pub fn check_state<const D: usize>(m: &Model<D>, step: usize, time: f64) -> Resu
                 .chain(p.v[q].iter())
                 .chain(p.stress[q].iter())
                 .all(|v| v.is_finite());
-            let message = if finite {
+            let det = p.f[q].determinant();
+            let message = if finite && (det.is_nan() || det <= 0.0) {
+                format!(
+                    "(body {}) is inverted or collapsed: det F = {det:e}",
+                    p.body[q]
+                )
+            } else if finite {
                 format!(
                     "(body {}) left the grid: x = {:?}",
                     p.body[q],
@@ -69,6 +77,50 @@ pub fn check_state<const D: usize>(m: &Model<D>, step: usize, time: f64) -> Resu
                 particle: Some(q),
                 message,
             })
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dim::Mat3;
+    use crate::scene::Scene;
+
+    const BLOCK: &str = r#"dimension = 2
+[grid]
+min = [0.0, 0.0]
+max = [2.0, 1.0]
+cells = [2, 1]
+[[material]]
+name = "m"
+model = "linear_elastic"
+density = 1.0
+youngs_modulus = 100.0
+poisson_ratio = 0.3
+[[body]]
+material = "m"
+shape = "rectangle"
+min = [0.0, 0.0]
+max = [1.0, 1.0]
+[solver]
+kind = "explicit"
+end_time = 1.0
+"#;
+
+    #[test]
+    fn a_collapsed_or_inverted_particle_stops_the_run() {
+        let scene = Scene::parse("block.toml", BLOCK, &[]).unwrap();
+        let mut m = Model::<2>::build(&scene).unwrap();
+        assert!(check_state(&m, 0, 0.0).is_ok());
+        for f in [
+            Mat3::new(1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0),
+            -Mat3::identity(),
+        ] {
+            m.particles.f[2] = f;
+            let d = check_state(&m, 5, 0.5).unwrap_err();
+            assert_eq!((d.step, d.particle), (5, Some(2)));
+            assert!(d.message.contains("inverted or collapsed"), "{d}");
         }
     }
 }

@@ -6,4 +6,7 @@
 mod common;
 
 mod bench;
+mod fuzz;
+mod key_paths;
+mod robustness;
 mod scene_errors;

@@ -6,8 +6,10 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod ended;
 mod extremes;
 mod implicit_extremes;
 mod krylov;
+mod signals;
 mod stability;
 mod threads;

@@ -20,7 +20,7 @@ use crate::physics::transfer::NodeMap;
 use crate::run::summary::Summary;
 use crate::scene::overrides;
 use crate::scene::validate;
-use crate::scene::{BenchConfig, Integrator, Scene, SceneConfig, SceneError, SolverKind};
+use crate::scene::{BenchConfig, Integrator, Scene, SceneConfig, SceneError, SolverKind, Source};
 use crate::solver::explicit::Explicit;
 use child::{run_child, Exit};
 use configurations::Configuration;
@@ -82,8 +82,7 @@ pub struct BenchReport {
 /// Run the benchmark.
 pub fn bench(opts: &BenchOptions) -> Result<BenchReport, BenchError> {
     let file = opts.scene.display().to_string();
-    let text = std::fs::read_to_string(&opts.scene)
-        .map_err(|e| SceneError::plain(&file, format!("cannot read the scene file: {e}")))?;
+    let text = crate::scene::read_text(&file, &opts.scene)?;
     let first = reference::checked(Scene::parse(&file, &text, &opts.overrides)?)?;
     let (settings, names_source) = settings(opts, &first)?;
     // Every run: no ParaView frames (they would dominate small runs), the [bench]
@@ -158,11 +157,8 @@ fn settings(opts: &BenchOptions, scene: &Scene) -> Result<(BenchConfig, NamesSou
     let (mut b, mut source) = match &opts.config {
         Some(path) => {
             let file = path.display().to_string();
-            let text = std::fs::read_to_string(path).map_err(|e| {
-                SceneError::plain(&file, format!("cannot read the bench file: {e}"))
-            })?;
-            let parsed: BenchFile =
-                toml::from_str(&text).map_err(|e| SceneError::from_toml(&file, &text, &e))?;
+            let text = crate::scene::read_text(&file, path)?;
+            let parsed: BenchFile = Source::new(&file, &text, &text, &[]).deserialize()?;
             validate::bench(&parsed.bench, "bench")
                 .map_err(|(key, m)| SceneError::at_key(&file, &text, &key, m))?;
             (parsed.bench, NamesSource::File(file, text))
@@ -502,7 +498,7 @@ fn status(exit: Exit, dir: &Path, timeout: f64) -> String {
         .to_string();
     let message = || -> String {
         match read_summary(dir) {
-            Some(ChildSummary::Run(s)) => s.divergence.map(|d| d.message),
+            Some(ChildSummary::Run(s)) => s.message,
             Some(ChildSummary::Search(s)) => s.message,
             None => None,
         }

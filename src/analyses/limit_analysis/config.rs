@@ -4,7 +4,7 @@
 
 use super::cone::MohrCoulomb;
 use super::model::{MeshSize, Model, SlopeGeometry};
-use crate::scene::SceneError;
+use crate::scene::{SceneError, Source};
 use serde::Deserialize;
 use std::path::Path;
 
@@ -222,16 +222,15 @@ fn validate(c: &LimitConfig) -> Check {
 impl LimitScene {
     pub fn load(path: &Path, overrides: &[String]) -> Result<LimitScene, SceneError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| SceneError::plain(&file, format!("cannot read the scene file: {e}")))?;
+        let text = crate::scene::read_text(&file, path)?;
         LimitScene::parse(&file, &text, overrides)
     }
 
     pub fn parse(file: &str, text: &str, overrides: &[String]) -> Result<LimitScene, SceneError> {
-        let text = crate::scene::overrides::apply(file, text, overrides)?;
-        let config: LimitConfig =
-            toml::from_str(&text).map_err(|e| SceneError::from_toml(file, &text, &e))?;
-        validate(&config).map_err(|(key, msg)| SceneError::at_key(file, &text, &key, msg))?;
+        let applied = crate::scene::overrides::apply(file, text, overrides)?;
+        let source = Source::new(file, text, &applied, overrides);
+        let config: LimitConfig = source.deserialize()?;
+        validate(&config).map_err(|(key, msg)| source.at_key(&key, msg))?;
         Ok(LimitScene {
             file: file.to_string(),
             config,

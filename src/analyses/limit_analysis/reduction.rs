@@ -52,7 +52,12 @@ impl std::fmt::Display for ReductionError {
 
 impl std::error::Error for ReductionError {}
 
-/// Find F with α(F) = 1 in [low, high] to a bracket narrower than `tolerance`.
+/// The most regula-falsi steps of one search (the Illinois variant converges
+/// superlinearly: a dozen is usual).
+pub const MAX_NARROWINGS: usize = 100;
+
+/// Find F with α(F) = 1 in [low, high] to a bracket narrower than `tolerance`, or
+/// as narrow as round-off and [`MAX_NARROWINGS`] steps make it.
 pub fn factor_of_safety(
     model: &Model,
     bound: fn(&Model) -> Result<Bound, SolverFailure>,
@@ -94,11 +99,18 @@ pub fn factor_of_safety(
     }
     let (mut ga, mut gb) = (g(&a), g(&b));
     let mut side = 0;
+    let mut narrowings = 0;
     while b.factor - a.factor > tolerance && ga != 0.0 && gb != 0.0 {
         let mut f = (a.factor * gb - b.factor * ga) / (gb - ga);
         // Never step closer than a tenth of the tolerance to an end.
         let margin = 0.1 * tolerance;
         f = f.clamp(a.factor + margin, b.factor - margin);
+        // A tolerance below the round-off of F cannot be met: stop with the
+        // bracket as it is (also after MAX_NARROWINGS solves).
+        if !(f > a.factor && f < b.factor) || narrowings == MAX_NARROWINGS {
+            break;
+        }
+        narrowings += 1;
         let t = eval(f)?;
         let gt = g(&t);
         if gt >= 0.0 {
@@ -128,4 +140,54 @@ pub fn factor_of_safety(
         bracket: [a.factor, b.factor],
         trials,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analyses::limit_analysis::config::LimitScene;
+    use std::sync::OnceLock;
+
+    /// The cohesion of the unreduced model.
+    static BASE_COHESION: OnceLock<f64> = OnceLock::new();
+
+    /// A stand-in for a bound, α(F) = 1.37 / F (the cohesion is divided by F),
+    /// so that the factor of safety is 1.37 and a solve costs nothing.
+    fn inverse(m: &Model) -> Result<Bound, SolverFailure> {
+        let base = BASE_COHESION.get().unwrap();
+        Ok(Bound {
+            multiplier: 1.37 * m.strength.cohesion / base,
+            elements: 0,
+            variables: 0,
+            equalities: 0,
+            cones: 0,
+            iterations: 0,
+            seconds: 0.0,
+            field: Vec::new(),
+        })
+    }
+
+    /// A tolerance below the round-off of F cannot be met: the search stops
+    /// within MAX_NARROWINGS steps with a bracket around the root.
+    #[test]
+    fn an_unreachable_tolerance_ends_with_the_bracket_it_has() {
+        let text = include_str!("../../../problems/limit_slope.toml");
+        let scene = LimitScene::parse("limit_slope.toml", text, &[]).unwrap();
+        let model = scene.model(0);
+        BASE_COHESION.get_or_init(|| model.strength.cohesion);
+        for tolerance in [0.0, 5e-324, 1e-300] {
+            let f = factor_of_safety(&model, inverse, [1.0, 2.0], tolerance).unwrap();
+            assert!(
+                f.trials.len() <= 2 + 4 + MAX_NARROWINGS,
+                "{}",
+                f.trials.len()
+            );
+            assert!(
+                f.bracket[0] <= 1.37 && 1.37 <= f.bracket[1],
+                "{:?}",
+                f.bracket
+            );
+            assert!((f.factor - 1.37).abs() < 1e-12, "{}", f.factor);
+        }
+    }
 }

@@ -41,6 +41,6 @@ pub fn from_scene(s: &SceneConfig) -> Result<Option<Box<dyn ErrorMeasure>>, KeyE
 pub fn checked(scene: Scene) -> Result<Scene, SceneError> {
     match from_scene(&scene.config) {
         Ok(_) => Ok(scene),
-        Err((key, m)) => Err(SceneError::at_key(&scene.file, &scene.text, &key, m)),
+        Err((key, m)) => Err(scene.at_key(&key, m)),
     }
 }

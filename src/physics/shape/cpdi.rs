@@ -59,10 +59,10 @@ pub fn evaluate<const D: usize>(
         grid.degree, 1,
         "CPDI interpolates the hats of a degree-1 grid"
     );
-    let inv_t = r
-        .try_inverse()
-        .expect("CPDI domain vectors r_i must be independent")
-        .transpose();
+    // A collapsed domain (dependent r_i, det F = 0) has no gradient; the divergence
+    // check stops a run at the end of the step that collapses one (det F ≤ 0), so
+    // this zero is only a guard against a panic.
+    let inv_t = r.try_inverse().unwrap_or_else(Tensor::zeros).transpose();
     let corners = 1usize << D;
     let share = 1.0 / corners as f64;
     let mut count = 0;
@@ -150,6 +150,22 @@ mod tests {
             }
         }
         assert!(interior > 50, "only {interior} interior particles");
+    }
+
+    /// Dependent domain vectors (a collapsed particle, det F = 0): the weights
+    /// still sum to one and reproduce the corners' mean, the gradients are zero,
+    /// and nothing panics.
+    #[test]
+    fn a_collapsed_domain_has_weights_and_no_gradient() {
+        let g = test_grid::<2>(1);
+        let x = Vector::<2>::from_fn(|d, _| g.min[d] + 0.43 * (g.max[d] - g.min[d]));
+        let a = Vector::<2>::new(0.3 * g.h[0], 0.2 * g.h[1]);
+        let r = Tensor::<2>::from_columns(&[a, 0.5 * a]);
+        let s = eval(&g, &x, &r);
+        let sum: f64 = s.w.iter().sum();
+        assert!((sum - 1.0).abs() < 1e-12, "Σ S = {sum}");
+        assert!(s.grad.iter().all(|gr| *gr == Vector::<2>::zeros()));
+        s.check_linear_reproduction(&g, &x, 1e-12);
     }
 
     #[test]

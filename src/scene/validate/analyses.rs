@@ -73,6 +73,11 @@ pub fn strength_reduction(
         format!("{p}.max_trials"),
         "must be at least 2",
     )?;
+    ensure(
+        r.max_trials() <= 200,
+        format!("{p}.max_trials"),
+        "must be at most 200",
+    )?;
     if let Some(m) = &r.monitor {
         vector(m, s.dimension, &format!("{p}.monitor"))?;
     }

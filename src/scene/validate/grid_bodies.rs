@@ -18,7 +18,32 @@ pub fn grid(g: &GridConfig, dim: usize) -> Check {
         "every direction needs at least one cell",
     )?;
     let ok = (0..dim).all(|d| g.max[d] > g.min[d]);
-    ensure(ok, "grid.max", "must exceed grid.min in every direction")
+    ensure(ok, "grid.max", "must exceed grid.min in every direction")?;
+    for d in 0..dim {
+        let extent = g.max[d] - g.min[d];
+        ensure(
+            extent.is_finite(),
+            "grid.max",
+            "the grid's extent must be a finite number",
+        )?;
+        // Cells must be resolved in floating point at the grid's coordinates.
+        let h = extent / g.cells[d] as f64;
+        let scale = g.min[d].abs().max(g.max[d].abs());
+        ensure(
+            h.is_normal() && h >= 1e-12 * scale,
+            "grid.cells",
+            format!(
+                "the cell size {h:e} along axis {d} is too small to resolve at \
+                 coordinates of {scale:e}"
+            ),
+        )?;
+    }
+    Ok(())
+}
+
+/// The grid's cell size along axis `d` (the grid validated).
+fn cell_size(g: &GridConfig, d: usize) -> f64 {
+    (g.max[d] - g.min[d]) / g.cells[d] as f64
 }
 
 pub fn body(b: &BodyConfig, i: usize, s: &SceneConfig) -> Check {
@@ -49,6 +74,15 @@ pub fn body(b: &BodyConfig, i: usize, s: &SceneConfig) -> Check {
             format!("needs {dim} entries, each at least 1"),
         )?,
     }
+    // The particles' half-spacing (their domain's half-width) must be a normal
+    // number: GIMP and CPDI divide by it.
+    let spacing_ok = (0..dim)
+        .all(|d| (cell_size(&s.grid, d) / b.particles_per_cell.get(d) as f64 / 2.0).is_normal());
+    ensure(
+        spacing_ok,
+        key("particles_per_cell"),
+        "the particle spacing is too small to represent",
+    )?;
     if let Some(v) = &b.velocity {
         vector(v, dim, &key("velocity"))?;
     }

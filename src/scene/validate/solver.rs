@@ -72,6 +72,12 @@ pub fn stage_strength_factor(
     )
 }
 
+/// Caps on the iteration counts a scene may ask for, so that no loop runs
+/// without end on a tolerance it cannot reach.
+pub const MAX_NEWTON_ITERATIONS: usize = 1000;
+pub const MAX_CUTBACKS: usize = 50;
+pub const MAX_KRYLOV_ITERATIONS: usize = 100_000;
+
 pub fn solver(s: &SolverConfig, prefix: &str) -> Check {
     let key = |k: &str| format!("{prefix}.{k}");
     ensure(
@@ -156,10 +162,15 @@ fn implicit(s: &SolverConfig, prefix: &str) -> Check {
         format!("{prefix}.min_node_support"),
         format!("must lie in [0, 0.5) (a fraction of one cell volume); got {support}"),
     )?;
-    ensure(
-        s.max_iterations() >= 1,
+    at_most(
+        s.max_iterations(),
+        MAX_NEWTON_ITERATIONS,
         format!("{prefix}.max_iterations"),
-        "must be at least 1",
+    )?;
+    ensure(
+        s.max_cutbacks() <= MAX_CUTBACKS,
+        format!("{prefix}.max_cutbacks"),
+        format!("must be at most {MAX_CUTBACKS} (each halves the step)"),
     )?;
     linear_solver(s, prefix)
 }
@@ -175,10 +186,10 @@ fn linear_solver(s: &SolverConfig, prefix: &str) -> Check {
             "F-bar makes the tangent unsymmetric, which linear_solver = \"cg\" cannot \
              solve: use linear_solver = \"gmres\" or \"direct\"",
         )?,
-        LinearSolver::Gmres => ensure(
-            s.krylov_restart() >= 1,
+        LinearSolver::Gmres => at_most(
+            s.krylov_restart(),
+            MAX_KRYLOV_ITERATIONS,
             key("krylov_restart"),
-            "must be at least 1",
         )?,
     }
     if let Some(eta) = s.krylov_tolerance {
@@ -188,9 +199,15 @@ fn linear_solver(s: &SolverConfig, prefix: &str) -> Check {
             format!("must lie in (0, 1) (a relative residual of the linear solve); got {eta}"),
         )?;
     }
-    ensure(
-        s.krylov_max_iterations() >= 1,
+    at_most(
+        s.krylov_max_iterations(),
+        MAX_KRYLOV_ITERATIONS,
         key("krylov_max_iterations"),
-        "must be at least 1",
     )
+}
+
+/// A count in [1, max].
+fn at_most(n: usize, max: usize, key: String) -> Check {
+    ensure(n >= 1, key.clone(), "must be at least 1")?;
+    ensure(n <= max, key, format!("must be at most {max}"))
 }

@@ -1,0 +1,246 @@
+//! The memory a run will need, estimated from the scene before anything is
+//! allocated, and the limit it is held to: a grid, particle set or tangent too
+//! large for the machine is a scene error naming its key, not an abort on
+//! allocation failure or a set-up that fills billions of lattice points.
+//!
+//! The estimate counts the large arrays, in bytes:
+//! - particles: the lattice points `Model::build` visits (each body's bounding
+//!   box at `particles_per_cell`, an upper bound of its particles) times the
+//!   fields of `Particles` (vectors, F and σ, history) and a step's stencil (the
+//!   shape function's support, a weight, a gradient and a node index each);
+//! - grid: the nodes times a step's nodal arrays (mass, momentum, force,
+//!   velocity and their implicit counterparts);
+//! - tangent (implicit stages with the direct solver or the lagged-direct
+//!   preconditioner): D² entries per node pair for the nodes within a support
+//!   width of each other, index and value, with four times that again for the
+//!   fill of the factor.
+//!
+//! It is an estimate to within a small factor, meant to catch the scenes that
+//! cannot fit, not to predict the peak. The limit defaults to the machine's
+//! available memory (`MemAvailable` of /proc/meminfo); `mpm run` and `mpm check`
+//! take `--memory-limit GIB` to set another.
+
+use crate::scene::{LinearSolver, PreconditionerKind, SceneConfig, SolverKind};
+
+/// The estimate's parts, in bytes, and the counts they come from.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Estimate {
+    pub dim: usize,
+    /// Lattice points visited when the bodies are filled, per body.
+    pub lattice_points: Vec<f64>,
+    /// Particles per cell (the product over the directions), per body.
+    pub per_cell: Vec<f64>,
+    pub grid_nodes: f64,
+    pub particle_bytes: f64,
+    pub grid_bytes: f64,
+    pub tangent_bytes: f64,
+}
+
+impl Estimate {
+    pub fn of(c: &SceneConfig) -> Estimate {
+        let dim = c.dimension;
+        let d = dim as f64;
+        let shape = c.grid.shape_function;
+        let support = shape.max_support(dim) as f64;
+        let cells = |k: usize| c.grid.cells.get(k).copied().unwrap_or(1) as f64;
+        let h = |k: usize| (c.grid.max[k] - c.grid.min[k]) / cells(k);
+        let grid_nodes: f64 = (0..dim).map(|k| cells(k) + shape.degree() as f64).product();
+        let lattice_points: Vec<f64> = (c.bodies.iter())
+            .map(|b| {
+                let (lo, hi) = b.bounds();
+                (0..dim)
+                    .map(|k| {
+                        let spacing = h(k) / b.particles_per_cell.get(k) as f64;
+                        ((hi[k] - lo[k]) / spacing).abs().ceil() + 1.0
+                    })
+                    .product()
+            })
+            .collect();
+        let per_cell: Vec<f64> = (c.bodies.iter())
+            .map(|b| {
+                (0..dim)
+                    .map(|k| b.particles_per_cell.get(k) as f64)
+                    .product()
+            })
+            .collect();
+        let particles: f64 = lattice_points.iter().sum();
+        // x, x0, v, half-lengths, load; mass and volumes; F and σ; ids; history;
+        // the stencil (weight, gradient, node).
+        let per_particle =
+            5.0 * 8.0 * d + 3.0 * 8.0 + 2.0 * 72.0 + 8.0 + 80.0 + support * (8.0 + 8.0 * d + 8.0);
+        // Mass and momentum, force, velocity, acceleration; implicit unknowns.
+        let per_node = 8.0 * (1.0 + 8.0 * d);
+        let implicit_stages = || {
+            c.stages()
+                .into_iter()
+                .filter(|s| s.kind == SolverKind::Implicit)
+        };
+        let assembles = implicit_stages().any(|s| {
+            s.linear_solver() == LinearSolver::Direct
+                || s.preconditioner() == PreconditionerKind::LaggedDirect
+        });
+        let tangent_bytes = if assembles {
+            let width = (support.powf(1.0 / d) * 2.0 - 1.0).powf(d);
+            let active = grid_nodes.min(particles * support);
+            let entries = active * d * d * width;
+            5.0 * 12.0 * entries
+        } else {
+            let restart = implicit_stages()
+                .map(|s| s.krylov_restart() as f64)
+                .fold(0.0, f64::max);
+            grid_nodes * d * 8.0 * restart
+        };
+        Estimate {
+            dim,
+            particle_bytes: 2.0 * particles * per_particle,
+            grid_bytes: 2.0 * grid_nodes * per_node,
+            grid_nodes,
+            lattice_points,
+            per_cell,
+            tangent_bytes,
+        }
+    }
+
+    pub fn total(&self) -> f64 {
+        self.particle_bytes + self.grid_bytes + self.tangent_bytes
+    }
+
+    /// Within `limit` bytes, or an error at the key of the largest part.
+    pub fn check(&self, limit: f64) -> Result<(), (String, String)> {
+        let total = self.total();
+        if total <= limit {
+            return Ok(());
+        }
+        let gib = |b: f64| {
+            let g = b / GIB;
+            if g < 1e4 {
+                format!("{g:.3}")
+            } else {
+                format!("{g:.3e}")
+            }
+        };
+        let parts = format!(
+            "particles {} GiB (up to {:.3e} lattice points), grid {} GiB ({:.3e} nodes), \
+             tangent or Krylov basis {} GiB",
+            gib(self.particle_bytes),
+            self.lattice_points.iter().sum::<f64>(),
+            gib(self.grid_bytes),
+            self.grid_nodes,
+            gib(self.tangent_bytes)
+        );
+        // The particles of the largest body are blamed on its particles_per_cell
+        // when that is large (more than 10 per direction), else on the grid.
+        let body = (0..self.lattice_points.len())
+            .max_by(|&a, &b| self.lattice_points[a].total_cmp(&self.lattice_points[b]));
+        let key = match body {
+            Some(i)
+                if self.particle_bytes >= self.grid_bytes + self.tangent_bytes
+                    && self.per_cell[i] > 10f64.powi(self.dim as i32) =>
+            {
+                format!("body.{i}.particles_per_cell")
+            }
+            _ => "grid.cells".to_string(),
+        };
+        Err((
+            key,
+            format!(
+                "the run would need about {} GiB ({parts}), more than the limit of \
+                 {} GiB (the available memory, or --memory-limit GIB)",
+                gib(total),
+                gib(limit)
+            ),
+        ))
+    }
+}
+
+pub const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
+
+/// The memory the machine has available now, in bytes (`MemAvailable` of
+/// /proc/meminfo); `None` where that cannot be read.
+pub fn available() -> Option<f64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024.0)
+}
+
+/// The limit: `given` GiB, else the available memory, else no limit.
+pub fn limit(given: Option<f64>) -> f64 {
+    given
+        .map(|g| g * GIB)
+        .or_else(available)
+        .unwrap_or(f64::INFINITY)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Scene;
+
+    const SCENE: &str = r#"dimension = 2
+[grid]
+min = [0.0, 0.0]
+max = [10.0, 10.0]
+cells = [100, 100]
+[[material]]
+name = "m"
+model = "linear_elastic"
+density = 1.0
+youngs_modulus = 100.0
+poisson_ratio = 0.3
+[[body]]
+material = "m"
+shape = "rectangle"
+min = [0.0, 0.0]
+max = [5.0, 5.0]
+[solver]
+kind = "implicit"
+end_time = 1.0
+dt = 0.1
+"#;
+
+    fn estimate(overrides: &[&str]) -> Estimate {
+        let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+        Estimate::of(&Scene::parse("s.toml", SCENE, &o).unwrap().config)
+    }
+
+    #[test]
+    fn counts_the_lattice_and_the_nodes() {
+        let e = estimate(&[]);
+        assert_eq!(e.grid_nodes, 101.0 * 101.0);
+        // 50 cells of the body per direction at 2 particles per cell, and the
+        // closing lattice line.
+        assert_eq!(e.lattice_points, vec![101.0 * 101.0]);
+        assert!(e.total() > 1e6 && e.total() < 1e9, "{e:?}");
+        assert!(e.check(e.total()).is_ok());
+    }
+
+    #[test]
+    fn a_huge_grid_or_particle_count_is_refused_at_its_key() {
+        let e = estimate(&["body.0.particles_per_cell=100000"]);
+        let (key, msg) = e.check(limit(Some(16.0))).unwrap_err();
+        assert_eq!(key, "body.0.particles_per_cell", "{msg}");
+        let e = estimate(&["grid.cells=[2147483648, 2147483648]"]);
+        let (key, msg) = e.check(limit(Some(16.0))).unwrap_err();
+        assert_eq!(key, "grid.cells", "{msg}");
+        assert!(msg.contains("e") && msg.contains("16.000 GiB"), "{msg}");
+        let e = estimate(&["grid.cells=[100000, 100000]", "body.0.max=[0.1, 0.1]"]);
+        let (key, msg) = e.check(limit(Some(16.0))).unwrap_err();
+        assert_eq!(key, "grid.cells", "{msg}");
+        assert!(msg.contains("16.000 GiB"), "{msg}");
+        // The same grid fits with a Krylov solver's basis only in more memory.
+        let e = estimate(&[
+            "grid.cells=[100000, 100000]",
+            "body.0.max=[0.1, 0.1]",
+            "solver.linear_solver=gmres",
+        ]);
+        assert!(e.tangent_bytes < estimate(&["grid.cells=[100000, 100000]"]).tangent_bytes);
+    }
+
+    #[test]
+    fn the_available_memory_is_read() {
+        let a = available().expect("/proc/meminfo on Linux");
+        assert!(a > 1e6, "{a}");
+        assert_eq!(limit(Some(2.0)), 2.0 * GIB);
+    }
+}
