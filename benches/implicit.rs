@@ -41,7 +41,7 @@ use mpm::solver::implicit::residual::{ordering, residual, tangent};
 use mpm::solver::implicit::step::{StepSettings, StepSystem};
 use mpm::solver::implicit::Implicit;
 use mpm::solver::linear::direct::{DirectSolver, Ordering, Structure};
-use mpm::solver::linear::ordering::{node_amd, node_metis};
+use mpm::solver::linear::ordering::{fill_reducing, node_amd, node_metis};
 use mpm::solver::stepper::Stepper;
 use std::hint::black_box;
 use std::time::Instant;
@@ -129,12 +129,13 @@ impl<const D: usize> Problem<D> {
     }
 }
 
-/// faer's numeric LLᵀ alone into fresh buffers.
+/// faer's numeric LLᵀ alone into fresh buffers, sequential like the direct
+/// solver's.
 fn numeric_llt(
     sym: &SymbolicCholesky<usize>,
     a: faer::sparse::SparseColMatRef<usize, f64>,
 ) -> Vec<f64> {
-    let par = faer::get_global_parallelism();
+    let par = faer::Par::Seq;
     let mut values = vec![0.0; sym.len_val()];
     let req = sym.factorize_numeric_llt_scratch::<f64>(par, Default::default());
     let mut mem = MemBuffer::new(req);
@@ -222,6 +223,9 @@ fn bench_problem<const D: usize>(c: &mut Criterion, p: &mut Problem<D>) {
         sym.len_val(),
         method.name(),
     );
+    if let Some(dir) = std::env::var_os("MPM_EXPORT_TANGENTS") {
+        export(std::path::Path::new(&dir), &p.name, k.matrix(), &b).expect("export");
+    }
     let mut group = c.benchmark_group(format!("implicit/{}", p.name));
     group.sample_size(10);
     group.throughput(Throughput::Elements(n as u64));
@@ -258,6 +262,17 @@ fn bench_problem<const D: usize>(c: &mut Criterion, p: &mut Problem<D>) {
         bch.iter(|| black_box(solver.solve(&b).expect("solve")))
     });
     let mut fresh = sys.clone();
+    // The direct path from scratch on a given matrix (what the CHOLMOD
+    // comparison times: ordering, analysis, factorization, solve).
+    group.bench_function("direct", |bch| {
+        bch.iter(|| {
+            let perm = fill_reducing::<D>(&pattern.graph());
+            let mut s = DirectSolver::new();
+            s.factorize(k.matrix(), Structure::Symmetric, Ordering::Given(&perm))
+                .expect("factorize");
+            black_box(s.solve(&b).expect("solve"))
+        })
+    });
     group.bench_function("iteration_first", |bch| {
         bch.iter(|| {
             fresh.pattern = Default::default();
@@ -278,6 +293,33 @@ fn bench_problem<const D: usize>(c: &mut Criterion, p: &mut Problem<D>) {
         })
     });
     group.finish();
+}
+
+/// Writes the lower triangle of K as a symmetric Matrix Market file
+/// (`NAME.mtx`) and the right-hand side, one value a line (`NAME_rhs.txt`),
+/// for scripts/cholmod/compare.sh.
+fn export(
+    dir: &std::path::Path,
+    name: &str,
+    k: faer::sparse::SparseColMatRef<usize, f64>,
+    b: &[f64],
+) -> std::io::Result<()> {
+    use std::io::Write;
+    std::fs::create_dir_all(dir)?;
+    let mut f = std::io::BufWriter::new(std::fs::File::create(dir.join(format!("{name}.mtx")))?);
+    writeln!(f, "%%MatrixMarket matrix coordinate real symmetric")?;
+    writeln!(f, "{} {} {}", k.nrows(), k.ncols(), k.compute_nnz())?;
+    for c in 0..k.ncols() {
+        for (&r, v) in k.row_idx_of_col_raw(c).iter().zip(k.val_of_col(c)) {
+            writeln!(f, "{} {} {v:e}", r + 1, c + 1)?;
+        }
+    }
+    let mut g =
+        std::io::BufWriter::new(std::fs::File::create(dir.join(format!("{name}_rhs.txt")))?);
+    for x in b {
+        writeln!(g, "{x:e}")?;
+    }
+    Ok(())
 }
 
 fn implicit(c: &mut Criterion) {

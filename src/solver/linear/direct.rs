@@ -20,6 +20,13 @@ use faer::sparse::linalg::LuError;
 use faer::sparse::{CreationError, SparseColMat, SparseColMatRef, Triplet};
 use faer::{Conj, MatMut, Par, Side};
 
+/// faer's parallelism for factorizations and solves: sequential. Its parallel
+/// supernodal factorization rounds differently with one and two threads
+/// (`factors_do_not_depend_on_the_number_of_threads` fails with it), and results
+/// must not depend on the thread count; on this project's 2-core machines the
+/// second thread gained little (docs/performance.md).
+const PARALLELISM: Par = Par::Seq;
+
 /// Largest accepted normwise backward error `‖K y − b‖ / (‖|K||y|‖ + ‖b‖)` of the probe solve.
 pub const CHECK_BACKWARD_TOL: f64 = 1e-10;
 /// Largest accepted relative forward error `‖y − v‖∞ / ‖v‖∞` of the probe solve `K y = K v`;
@@ -203,7 +210,7 @@ impl DirectSolver {
             return Err(SolveError::InvalidInput(msg));
         }
         let mut x = b.to_vec();
-        let par = faer::get_global_parallelism();
+        let par = PARALLELISM;
         let rhs = MatMut::from_column_major_slice_mut(&mut x, n, 1);
         match &self.numeric {
             Numeric::Lu(num) => self.solve_lu(num, rhs, par)?,
@@ -315,7 +322,7 @@ impl DirectSolver {
     /// factor's buffer when there is one), then the probe check.
     fn try_llt(&mut self, lower: SparseColMatRef<usize, f64>) -> Result<(), SolveError> {
         let sym = self.chol.take().ok_or(SolveError::NotFactorized)?;
-        let par = faer::get_global_parallelism();
+        let par = PARALLELISM;
         // faer overwrites every value of the factor, so the old buffer serves
         // (grown if the new pattern needs more).
         let mut values = match std::mem::replace(&mut self.kept, Numeric::None) {
@@ -353,7 +360,7 @@ impl DirectSolver {
     /// Numeric intranodal LBLᵀ with the cached symbolic factorization, then the probe check.
     fn try_lblt(&mut self, lower: SparseColMatRef<usize, f64>) -> Result<(), SolveError> {
         let sym = self.chol.as_ref().ok_or(SolveError::NotFactorized)?;
-        let (n, par) = (sym.nrows(), faer::get_global_parallelism());
+        let (n, par) = (sym.nrows(), PARALLELISM);
         let mut values = vec![0.0; sym.len_val()];
         let mut subdiag = vec![0.0; n];
         let (mut fwd, mut inv) = (vec![0usize; n], vec![0usize; n]);
@@ -384,7 +391,7 @@ impl DirectSolver {
     fn factor_lu(&mut self, a: SparseColMatRef<usize, f64>) -> Result<Method, SolveError> {
         self.ensure_lu(a)?;
         let sym = self.lu.as_ref().ok_or(SolveError::NotFactorized)?;
-        let par = faer::get_global_parallelism();
+        let par = PARALLELISM;
         let mut num = NumericLu::new();
         let mut mem = buffer(sym.factorize_numeric_lu_scratch::<f64>(par, Default::default()))?;
         let stack = MemStack::new(&mut mem);
@@ -1041,5 +1048,29 @@ mod tests {
             s.factorize(a.as_ref(), Structure::Symmetric, Ordering::Given(&short)),
             Err(SolveError::InvalidInput(_))
         ));
+    }
+
+    /// A supernodal factorization large enough to run in parallel gives the
+    /// same solution, bit for bit, on one thread and on two.
+    #[test]
+    fn factors_do_not_depend_on_the_number_of_threads() {
+        for (n, t) in [
+            (27_000, laplace_3d(30)),
+            (40_000, laplace_2d(200, 1.0, 0.0)),
+        ] {
+            let b = apply(n, &t, &x_star(n));
+            let solve = |threads: usize| {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                pool.install(|| {
+                    let mut s = DirectSolver::new();
+                    s.factorize_triplets(n, &t, Structure::Symmetric).unwrap();
+                    s.solve(&b).unwrap()
+                })
+            };
+            assert!(solve(1) == solve(2), "n = {n}: 1 and 2 threads differ");
+        }
     }
 }

@@ -102,6 +102,18 @@ fn amd_order(start: &[usize], adjacency: &[u32]) -> Vec<u32> {
     }
 }
 
+/// The ordering the direct solver uses for a D-dimensional problem: METIS in
+/// 3D, where it stores a quarter less than minimum degree and factors faster;
+/// minimum degree in 2D, where the fill is the same and AMD is 10× faster to
+/// compute (docs/performance.md).
+pub fn fill_reducing<const D: usize>(g: &NodeGraph) -> Vec<usize> {
+    if D == 3 {
+        node_metis(g)
+    } else {
+        node_amd(g)
+    }
+}
+
 /// METIS' nested dissection (`METIS_NodeND`, default options) on the node
 /// graph, each node weighted by its unknowns.
 pub fn node_metis(g: &NodeGraph) -> Vec<usize> {

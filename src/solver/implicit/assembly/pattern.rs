@@ -20,7 +20,7 @@ use super::Dofs;
 use crate::physics::fbar::Cells;
 use crate::physics::shape::Stencils;
 use crate::physics::transfer::NodeMap;
-use crate::solver::linear::ordering::{node_amd, node_metis, NodeGraph};
+use crate::solver::linear::ordering::{fill_reducing, NodeGraph};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use rayon::prelude::*;
 use std::sync::OnceLock;
@@ -129,17 +129,10 @@ impl Pattern {
     }
 
     /// The fill-reducing ordering of the unknowns for a Cholesky factorization
-    /// (built at the first call): METIS' nested dissection of the node graph in
-    /// 3D, its minimum degree in 2D (docs/performance.md has the measurements
-    /// behind the choice).
+    /// (built at the first call): `ordering::fill_reducing` of the node graph.
     pub fn ordering<const D: usize>(&self) -> &[usize] {
-        self.ordering.get_or_init(|| {
-            if D == 3 {
-                node_metis(&self.graph())
-            } else {
-                node_amd(&self.graph())
-            }
-        })
+        self.ordering
+            .get_or_init(|| fill_reducing::<D>(&self.graph()))
     }
 
     /// Number of active nodes.
