@@ -349,3 +349,33 @@ fn a_lagged_direct_restart_refactorizes_and_stays_within_the_tolerances() {
         }
     }
 }
+
+#[test]
+fn wall_clock_checkpoints_keep_the_last_two_and_restart_exactly() {
+    // Due after every step (1e-9 s of wall clock): 452 checkpoints written, the
+    // last two kept; the earlier one (the step before the last) restarts exactly.
+    let sets = ["solver.end_time=2", "output.checkpoint_wall_seconds=1e-9"];
+    let whole = tempfile::tempdir().unwrap();
+    succeeded(&mpm("column_explicit.toml", 1, whole.path(), &sets, None));
+    let kept = checkpoints(whole.path());
+    let steps = summary(whole.path()).steps;
+    let names: Vec<String> = (kept.iter())
+        .map(|c| c.file_name().unwrap().to_string_lossy().to_string())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            format!("checkpoint_{:09}.json", steps - 1),
+            format!("checkpoint_{steps:09}.json")
+        ]
+    );
+    let again = tempfile::tempdir().unwrap();
+    succeeded(&mpm(
+        "column_explicit.toml",
+        1,
+        again.path(),
+        &sets,
+        Some(&kept[0]),
+    ));
+    assert!(same_outputs(whole.path(), again.path()) >= 3);
+}
