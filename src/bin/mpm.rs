@@ -39,6 +39,10 @@ enum Command {
         /// Memory the run may take, in GiB (default: the machine's available memory).
         #[arg(long, value_name = "GIB")]
         memory_limit: Option<f64>,
+        /// Continue from a checkpoint written by a run of the same scene (and
+        /// --set overrides); see docs/robustness.md.
+        #[arg(long, value_name = "CHECKPOINT")]
+        restart: Option<PathBuf>,
     },
     /// Validate a scene without running it: everything `mpm run` checks before its
     /// first step (the model is built, the memory estimated).
@@ -206,6 +210,7 @@ fn main() -> ExitCode {
             overrides,
             threads,
             memory_limit,
+            restart,
         } => {
             if let Some(n) = threads {
                 if let Err(e) = rayon::ThreadPoolBuilder::new()
@@ -231,8 +236,13 @@ fn main() -> ExitCode {
             let opts = RunOptions {
                 progress: true,
                 memory_limit,
+                restart,
                 ..Default::default()
             };
+            if scene.config.strength_reduction.is_some() && opts.restart.is_some() {
+                eprintln!("error: --restart does not apply to a strength-reduction search");
+                return ExitCode::from(2);
+            }
             if scene.config.strength_reduction.is_some() {
                 return match search(&scene, &out, &opts) {
                     Ok(s) => {
@@ -259,6 +269,12 @@ fn main() -> ExitCode {
             }
             match run(&scene, &out, &opts) {
                 Ok(s) => {
+                    if let Some(r) = &s.resumed_from {
+                        println!(
+                            "{}: resumed from {} at step {} (t = {:.6e})",
+                            scene.file, r.checkpoint, r.step, r.time
+                        );
+                    }
                     println!(
                         "{}: {} steps to t = {:.6e}, {} particles, {:.2} s wall; outputs in {}",
                         scene.file,
@@ -270,7 +286,7 @@ fn main() -> ExitCode {
                     );
                     ExitCode::SUCCESS
                 }
-                Err(e @ RunError::Scene(_)) => {
+                Err(e @ (RunError::Scene(_) | RunError::Checkpoint(_))) => {
                     eprintln!("error: {e}");
                     ExitCode::from(2)
                 }

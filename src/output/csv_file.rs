@@ -84,6 +84,17 @@ impl CsvWriter {
         Ok(w)
     }
 
+    /// Create (truncate) `path` with `text`, the file as an earlier run had
+    /// written it so far (header and rows, from a checkpoint), and write on after it.
+    pub fn resume(path: &Path, text: &str) -> io::Result<Self> {
+        let mut file = File::create(path)?;
+        io::Write::write_all(&mut file, text.as_bytes())?;
+        Ok(CsvWriter {
+            w: csv::Writer::from_writer(file),
+            number: Vec::with_capacity(32),
+        })
+    }
+
     /// Write one row.
     pub fn row<'a>(&mut self, fields: impl IntoIterator<Item = Field<'a>>) -> io::Result<()> {
         for f in fields {

@@ -44,6 +44,19 @@ impl HistoryWriter {
         })
     }
 
+    /// Write on after `text`, the file as an earlier run had written it (header
+    /// and rows, from a checkpoint).
+    pub fn resume(path: &Path, dim: usize, n_bodies: usize, text: &str) -> io::Result<Self> {
+        let mut w = CsvWriter::resume(path, text)?;
+        w.flush()?;
+        Ok(Self {
+            w,
+            dim,
+            n_bodies,
+            last_flush: Instant::now(),
+        })
+    }
+
     /// Append one row; `com` and `com_velocity` hold one entry per body (see [`body_centres`]).
     pub fn write_row<const D: usize>(
         &mut self,

@@ -43,6 +43,22 @@ impl FrameWriter {
         })
     }
 
+    /// Write on after the `frames` (time, file name) an earlier run had written
+    /// into `dir` (from a checkpoint): the numbering and the collection continue.
+    pub fn resume(dir: &Path, prefix: &str, frames: Vec<(f64, String)>) -> io::Result<Self> {
+        let mut w = Self::new(dir, prefix)?;
+        w.frames = frames;
+        if !w.frames.is_empty() {
+            w.write_pvd()?;
+        }
+        Ok(w)
+    }
+
+    /// (time, file name) of every frame written so far.
+    pub fn frames(&self) -> &[(f64, String)] {
+        &self.frames
+    }
+
     /// Write the next frame (time `t`) and rewrite the `.pvd` collection. Each `extra`
     /// entry is a named scalar point field with one value per particle.
     pub fn write_frame<const D: usize>(

@@ -30,6 +30,28 @@ impl FootingCurve {
         Ok(curve)
     }
 
+    /// Write on after `text`, footing.csv as an earlier run had written it, with
+    /// its points `rows` and `settlement` so far (from a checkpoint).
+    pub fn resume(
+        path: &Path,
+        text: &str,
+        rows: Vec<[f64; 4]>,
+        settlement: f64,
+    ) -> io::Result<Self> {
+        let mut csv = CsvWriter::resume(path, text)?;
+        csv.flush()?;
+        Ok(FootingCurve {
+            rows,
+            csv,
+            settlement,
+        })
+    }
+
+    /// The points so far and the settlement (for a checkpoint).
+    pub fn state(&self) -> (&[[f64; 4]], f64) {
+        (&self.rows, self.settlement)
+    }
+
     /// Add the point (t, settlement, load, pressure).
     fn push(&mut self, row: [f64; 4]) -> io::Result<()> {
         self.csv.row(row.map(Field::Number))?;

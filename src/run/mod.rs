@@ -2,8 +2,11 @@
 //! record as it goes (history.csv, ParaView frames, newton.csv, footing.csv) and
 //! finish with particles_final.csv and summary.json. A divergence stops the run
 //! cleanly: everything written so far is flushed and summary.json records what
-//! happened where.
+//! happened where. A run may write checkpoints as it goes and start from one
+//! (`checkpoint.rs`): the restarted run writes the same bytes as one that was
+//! never stopped.
 
+pub mod checkpoint;
 pub mod energy;
 pub mod footing;
 pub mod interrupt;
@@ -15,15 +18,16 @@ pub use energy::{kinetic_energy, strain_energy};
 use crate::model::memory::{self, Estimate};
 use crate::model::Model;
 use crate::output::{write_particles_csv_with, Progress};
-use crate::scene::{Scene, SceneError, SolverKind};
+use crate::scene::{Integrator, Scene, SceneError, SolverConfig, SolverKind};
 use crate::solver::divergence::{check_state, Divergence};
 use crate::solver::explicit::Explicit;
 use crate::solver::report::SolverReport;
 use crate::solver::stepper::Stepper;
+use checkpoint::{Checkpoint, Kept, ParticleState};
 use recorders::{Moment, Recorders};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
-use summary::{DivergenceReport, StageSummary, Status, Summary};
+use summary::{DivergenceReport, ResumedFrom, StageSummary, Status, Summary};
 
 #[derive(Debug, thiserror::Error)]
 pub enum RunError {
@@ -31,6 +35,10 @@ pub enum RunError {
     Scene(#[from] SceneError),
     #[error("cannot write outputs: {0}")]
     Io(#[from] std::io::Error),
+    /// A checkpoint to restart from that cannot be used (unreadable, of another
+    /// format version, damaged, or of another scene).
+    #[error("{0}")]
+    Checkpoint(String),
     /// The run stopped early; its summary (also in summary.json) says where.
     #[error("{message}")]
     Diverged {
@@ -61,6 +69,8 @@ pub struct RunOptions {
     /// The memory the run may take, in GiB (`None`: the machine's available
     /// memory; `model::memory`).
     pub memory_limit: Option<f64>,
+    /// Continue from this checkpoint instead of starting at t = 0.
+    pub restart: Option<PathBuf>,
 }
 
 /// What a run checks before it allocates and steps: the memory estimate, then the
@@ -122,12 +132,46 @@ fn check_memory(scene: &Scene, opts: &RunOptions) -> Result<(), SceneError> {
 /// Run a scene, writing its outputs into `out`.
 pub fn run(scene: &Scene, out: &Path, opts: &RunOptions) -> Result<Summary, RunError> {
     check_memory(scene, opts)?;
+    let resume = match &opts.restart {
+        Some(path) => Some(Resume {
+            checkpoint: matching_checkpoint(scene, path)?,
+            path: path.clone(),
+        }),
+        None => None,
+    };
     std::fs::create_dir_all(out)?;
     match scene.config.dimension {
-        2 => run_dim::<2>(scene, out, opts),
-        3 => run_dim::<3>(scene, out, opts),
+        2 => run_dim::<2>(scene, out, opts, resume),
+        3 => run_dim::<3>(scene, out, opts, resume),
         d => unreachable!("validated dimension {d}"),
     }
+}
+
+/// A checkpoint to continue from, and where it was read.
+struct Resume {
+    checkpoint: Checkpoint,
+    path: PathBuf,
+}
+
+/// The checkpoint at `path`, if it was written by a run of this scene (the same
+/// text after overrides, hence the same dimension) and this build can read it.
+fn matching_checkpoint(scene: &Scene, path: &Path) -> Result<Checkpoint, RunError> {
+    let ck = Checkpoint::read(path).map_err(RunError::Checkpoint)?;
+    let name = path.display();
+    if ck.dimension != scene.config.dimension {
+        return Err(RunError::Checkpoint(format!(
+            "checkpoint {name} is of a {}D run, {} is {}D",
+            ck.dimension, scene.file, scene.config.dimension
+        )));
+    }
+    if ck.scene_text != scene.text {
+        return Err(RunError::Checkpoint(format!(
+            "checkpoint {name} was written by a run of another scene ({}, or other --set \
+             overrides): restart with the scene text and overrides it was written with",
+            ck.scene_file
+        )));
+    }
+    Ok(ck)
 }
 
 /// The run's course: where it is (time, step, the work done so far) and what it
@@ -142,6 +186,38 @@ struct Timeline {
     progress: Option<Progress>,
     /// The signal that stopped the run at the end of a step, if one did.
     interrupted: Option<i32>,
+    checkpoints: Checkpoints,
+}
+
+/// When checkpoints are due and which ones are kept.
+struct Checkpoints {
+    /// Simulation time between checkpoints, and when the next is due.
+    interval: Option<f64>,
+    next: f64,
+    /// Wall-clock seconds between checkpoints, and when the last was written.
+    wall_seconds: Option<f64>,
+    last_written: Instant,
+    kept: Kept,
+}
+
+/// What a checkpoint records about the stage under way and the run around it.
+struct StageContext<'a> {
+    scene: &'a Scene,
+    index: usize,
+    start: f64,
+    first_step: usize,
+    done: &'a [StageSummary],
+    /// The stage's duration when it is quasi-static (its load factor is reported).
+    quasi_static: Option<f64>,
+    strength_factor: f64,
+    dt_critical: f64,
+}
+
+impl<'a> StageContext<'a> {
+    fn quasi_static(sc: &SolverConfig) -> Option<f64> {
+        (sc.kind == SolverKind::Implicit && sc.integrator() == Integrator::QuasiStatic)
+            .then_some(sc.end_time)
+    }
 }
 
 impl Timeline {
@@ -153,16 +229,19 @@ impl Timeline {
         }
     }
 
-    /// Advance one stage of length `duration`: step, record, repeat. Returns how
-    /// the stage ended and its last step; the outer error is an output failure.
+    /// Advance the stage of `ctx`, of length `duration`, from where it is (its
+    /// last step `last_dt`, 0 at its start): step, record, write a checkpoint
+    /// when one is due, repeat. Returns how the stage ended and its last step;
+    /// the outer error is an output failure.
     fn stage<const D: usize>(
         &mut self,
+        ctx: &StageContext,
         model: &mut Model<D>,
         stepper: &mut dyn Stepper<D>,
         duration: f64,
+        mut last_dt: f64,
     ) -> std::io::Result<(Result<(), Divergence>, f64)> {
-        let end = self.t + duration;
-        let mut last_dt = 0.0;
+        let end = ctx.start + duration;
         while self.t < end - 1e-12 * self.total_time {
             let dt = stepper.dt(model).min(end - self.t);
             last_dt = dt;
@@ -184,13 +263,75 @@ impl Timeline {
             if let Some(p) = &self.progress {
                 p.set(self.t, self.step);
             }
-            if let Some(signal) = interrupt::requested() {
+            let signal = interrupt::requested();
+            if signal.is_some() || self.checkpoint_due() {
+                self.checkpoint(ctx, model, stepper, last_dt)?;
+            }
+            if let Some(signal) = signal {
                 self.interrupted = Some(signal);
                 return Ok((Ok(()), last_dt));
             }
         }
         self.t = end;
         Ok((Ok(()), last_dt))
+    }
+
+    /// Whether a checkpoint is due now (by simulation time or wall clock); the
+    /// next one by time is then set past now.
+    fn checkpoint_due(&mut self) -> bool {
+        let c = &mut self.checkpoints;
+        let tolerance = 1e-12 * self.total_time;
+        let by_time = match c.interval {
+            Some(interval) if self.t >= c.next - tolerance => {
+                while c.next <= self.t + tolerance {
+                    c.next += interval;
+                }
+                true
+            }
+            _ => false,
+        };
+        let by_clock = c
+            .wall_seconds
+            .is_some_and(|s| c.last_written.elapsed().as_secs_f64() >= s);
+        by_time || by_clock
+    }
+
+    /// Write the checkpoint of this moment into the output directory, keeping
+    /// the last two.
+    fn checkpoint<const D: usize>(
+        &mut self,
+        ctx: &StageContext,
+        model: &Model<D>,
+        stepper: &dyn Stepper<D>,
+        last_dt: f64,
+    ) -> std::io::Result<()> {
+        let ck = Checkpoint {
+            scene_file: ctx.scene.file.clone(),
+            scene_text: ctx.scene.text.clone(),
+            dimension: D,
+            stage: ctx.index,
+            stage_start: ctx.start,
+            stage_first_step: ctx.first_step,
+            stages_done: ctx.done.to_vec(),
+            time: self.t,
+            step: self.step,
+            dt: last_dt,
+            load_factor: ctx
+                .quasi_static
+                .map(|d| ((self.t - ctx.start) / d).clamp(0.0, 1.0)),
+            strength_factor: ctx.strength_factor,
+            external_work: self.external_work,
+            dt_critical: ctx.dt_critical,
+            next_checkpoint: self.checkpoints.next,
+            particles: ParticleState::of(&model.particles),
+            solver: stepper.state(),
+            recorders: self.recorders.saved()?,
+        };
+        let path = (self.recorders.directory()).join(checkpoint::file_name(self.step));
+        ck.write(&path)?;
+        self.checkpoints.kept.push(path);
+        self.checkpoints.last_written = Instant::now();
+        Ok(())
     }
 }
 
@@ -207,6 +348,7 @@ fn run_dim<const D: usize>(
     scene: &Scene,
     out: &Path,
     opts: &RunOptions,
+    resume: Option<Resume>,
 ) -> Result<Summary, RunError> {
     let cfg = &scene.config;
     let mut model = Model::<D>::build(scene)?;
@@ -214,39 +356,69 @@ fn run_dim<const D: usize>(
     // A search trial's factor holds for the whole run; otherwise each stage may
     // set its own (validation keeps the two apart).
     let mut strength_factor = opts.strength_factor.unwrap_or(1.0);
+    if let Some(r) = &resume {
+        strength_factor = r.checkpoint.strength_factor;
+        model.particles = restored_particles(&r.checkpoint, &r.path, model.particles.len())?;
+    }
     if strength_factor != 1.0 {
         model.reduce_strength(strength_factor);
     }
-    if let Some(g) = &cfg.geostatic {
+    if let (Some(g), None) = (&cfg.geostatic, &resume) {
         crate::physics::geostatic::initialise(&mut model, g);
     }
     let monitor = opts
         .monitor
         .as_deref()
         .and_then(|x| model.nearest_particle(x));
+    let ck = resume.as_ref().map(|r| &r.checkpoint);
+    let recorders = match &resume {
+        Some(r) => {
+            let from = r.path.parent().unwrap_or(Path::new("."));
+            let from = if from.as_os_str().is_empty() {
+                Path::new(".")
+            } else {
+                from
+            };
+            Recorders::resume(out, from, cfg, &model, r.checkpoint.recorders.clone())?
+        }
+        None => Recorders::create(out, cfg, &model)?,
+    };
     let mut line = Timeline {
-        t: 0.0,
-        step: 0,
-        external_work: 0.0,
+        t: ck.map_or(0.0, |c| c.time),
+        step: ck.map_or(0, |c| c.step),
+        external_work: ck.map_or(0.0, |c| c.external_work),
         total_time: cfg.total_time(),
-        recorders: Recorders::create(out, cfg, &model)?,
+        recorders,
         progress: opts.progress.then(|| Progress::new(cfg.total_time())),
         interrupted: None,
+        checkpoints: Checkpoints {
+            interval: cfg.output.checkpoint_interval,
+            next: ck.map_or(cfg.output.checkpoint_interval.unwrap_or(0.0), |c| {
+                c.next_checkpoint
+            }),
+            wall_seconds: cfg.output.checkpoint_wall_seconds,
+            last_written: Instant::now(),
+            kept: Kept::default(),
+        },
     };
-    let dt_critical = Explicit::critical_dt(&model);
+    let first_step = line.step;
+    let dt_critical = ck.map_or_else(|| Explicit::critical_dt(&model), |c| c.dt_critical);
     let started = Instant::now();
     let mut outcome = check_state(&model, 0, 0.0);
-    if outcome.is_ok() {
+    if outcome.is_ok() && resume.is_none() {
         line.recorders.state(&line.moment(&model), true)?;
     }
-    let mut stages = Vec::new();
+    let first_stage = ck.map_or(0, |c| c.stage);
+    let mut stages = ck.map_or_else(Vec::new, |c| c.stages_done.clone());
     let mut last: Option<(SolverReport, f64, usize)> = None;
     // An output that cannot be written ends the run as failed.
     let mut failure: Option<std::io::Error> = None;
-    for (k, sc) in cfg.stages().into_iter().enumerate() {
+    for (k, sc) in cfg.stages().into_iter().enumerate().skip(first_stage) {
         if outcome.is_err() {
             break;
         }
+        // The stage a checkpoint was written in continues where it was.
+        let resumed = ck.filter(|c| c.stage == k);
         if let Some(f) = sc
             .strength_reduction_factor
             .filter(|&f| f != strength_factor)
@@ -254,9 +426,26 @@ fn run_dim<const D: usize>(
             model.reduce_strength(f);
             strength_factor = f;
         }
-        let mut stepper = crate::solver::stepper::<D>(cfg.grid.shape_function, sc, line.t);
-        let (start, steps_before, stage_clock) = (line.t, line.step, Instant::now());
-        let (result, dt) = match line.stage(&mut model, stepper.as_mut(), sc.end_time) {
+        let (start, steps_before, last_dt) = resumed.map_or((line.t, line.step, 0.0), |c| {
+            (c.stage_start, c.stage_first_step, c.dt)
+        });
+        let mut stepper = crate::solver::stepper::<D>(cfg.grid.shape_function, sc, start);
+        if let Some(c) = resumed {
+            stepper.restore(&c.solver);
+        }
+        let stage_clock = Instant::now();
+        let ctx = StageContext {
+            scene,
+            index: k,
+            start,
+            first_step: steps_before,
+            done: &stages,
+            quasi_static: StageContext::quasi_static(sc),
+            strength_factor,
+            dt_critical,
+        };
+        let ended = line.stage(&ctx, &mut model, stepper.as_mut(), sc.end_time, last_dt);
+        let (result, dt) = match ended {
             Ok(ended) => ended,
             Err(e) => {
                 failure = Some(e);
@@ -303,7 +492,7 @@ fn run_dim<const D: usize>(
         dt_critical,
         end_time: line.t,
         wall_seconds: wall,
-        particle_steps_per_second: (particles * line.step) as f64 / wall.max(1e-9),
+        particle_steps_per_second: (particles * (line.step - first_step)) as f64 / wall.max(1e-9),
         active_nodes_last_step: active_nodes,
         status: Status::Completed,
         message: None,
@@ -315,6 +504,11 @@ fn run_dim<const D: usize>(
         monitor_displacement: monitor
             .map(|q| (model.particles.x[q] - model.particles.x0[q]).norm()),
         strength_factor: opts.strength_factor,
+        resumed_from: resume.as_ref().map(|r| ResumedFrom {
+            checkpoint: r.path.display().to_string(),
+            step: r.checkpoint.step,
+            time: r.checkpoint.time,
+        }),
     };
     let summary_path = out.join("summary.json");
     if let Some(e) = failure {
@@ -368,6 +562,24 @@ fn run_dim<const D: usize>(
     }
     summary.write(&summary_path)?;
     Ok(summary)
+}
+
+/// The particles of a checkpoint, which must be as many as the scene builds.
+fn restored_particles<const D: usize>(
+    ck: &Checkpoint,
+    path: &Path,
+    built: usize,
+) -> Result<crate::model::particles::Particles<D>, RunError> {
+    let name = path.display();
+    let p = (ck.particles.particles::<D>())
+        .map_err(|e| RunError::Checkpoint(format!("checkpoint {name}: {e}")))?;
+    if p.len() != built {
+        return Err(RunError::Checkpoint(format!(
+            "checkpoint {name} holds {} particles, the scene builds {built}",
+            p.len()
+        )));
+    }
+    Ok(p)
 }
 
 /// A run that could not write an output: summary.json says so if it still can be

@@ -11,8 +11,9 @@ use crate::run::footing::FootingCurve;
 use crate::run::summary::FootingSummary;
 use crate::scene::{SceneConfig, SolverKind};
 use crate::solver::report::NewtonRow;
+use serde::{Deserialize, Serialize};
 use std::io;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// The columns of newton.csv.
 pub const NEWTON_COLUMNS: [&str; 11] = [
@@ -37,8 +38,28 @@ pub struct Moment<'a, const D: usize> {
     pub external_work: f64,
 }
 
+/// Where the recorders are, for a checkpoint: the streamed files as written so
+/// far and when the next row and frame are due, so that a restarted run writes
+/// them on exactly as the uninterrupted run would.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct RecorderState {
+    pub history_csv: String,
+    pub next_history: f64,
+    /// Time of the last history row (none before the first).
+    pub last_history: Option<f64>,
+    /// (time, file name) of every frame so far.
+    pub frames: Vec<(f64, String)>,
+    pub next_frame: f64,
+    pub last_frame: Option<f64>,
+    pub newton_csv: Option<String>,
+    pub footing_csv: Option<String>,
+    pub footing_rows: Vec<[f64; 4]>,
+    pub footing_settlement: f64,
+}
+
 /// The output files that grow during a run.
 pub struct Recorders {
+    out: PathBuf,
     history: HistoryWriter,
     history_interval: f64,
     next_history: f64,
@@ -67,6 +88,7 @@ impl Recorders {
         let end_time = cfg.total_time();
         let implicit = cfg.stages().iter().any(|s| s.kind == SolverKind::Implicit);
         Ok(Recorders {
+            out: out.to_path_buf(),
             history: HistoryWriter::create(&out.join("history.csv"), D, n_bodies)?,
             history_interval: cfg.output.history_interval,
             next_history: 0.0,
@@ -85,6 +107,88 @@ impl Recorders {
                 Some(_) => Some(FootingCurve::create(&out.join("footing.csv"))?),
                 None => None,
             },
+        })
+    }
+
+    /// The recorders of a run resumed from a checkpoint's `saved` state, writing
+    /// into `out`. Frames named in the state are copied from `from` (the
+    /// checkpoint's directory) when `out` is another directory and they are there.
+    pub fn resume<const D: usize>(
+        out: &Path,
+        from: &Path,
+        cfg: &SceneConfig,
+        model: &Model<D>,
+        saved: RecorderState,
+    ) -> io::Result<Self> {
+        let mut r = Self::create(out, cfg, model)?;
+        // The fresh files' headers reach the disk now, not when they are dropped
+        // under the resumed writers.
+        r.history.flush()?;
+        if let Some(csv) = &mut r.newton {
+            csv.flush()?;
+        }
+        let n_bodies = r.n_bodies;
+        r.history =
+            HistoryWriter::resume(&out.join("history.csv"), D, n_bodies, &saved.history_csv)?;
+        r.next_history = saved.next_history;
+        r.last_history = saved.last_history.unwrap_or(f64::NAN);
+        r.next_frame = saved.next_frame;
+        r.last_frame = saved.last_frame.unwrap_or(f64::NAN);
+        if !same_directory(out, from) {
+            for (_, name) in &saved.frames {
+                let source = from.join(name);
+                if source.exists() {
+                    crate::output::atomic::replace(&out.join(name), |tmp| {
+                        std::fs::copy(&source, tmp).map(|_| ())
+                    })?;
+                }
+            }
+        }
+        r.frames = FrameWriter::resume(out, "particles", saved.frames)?;
+        if let (Some(_), Some(text)) = (&r.newton, &saved.newton_csv) {
+            r.newton = Some(CsvWriter::resume(&out.join("newton.csv"), text)?);
+        }
+        if let (Some(_), Some(text)) = (&r.footing, &saved.footing_csv) {
+            r.footing = Some(FootingCurve::resume(
+                &out.join("footing.csv"),
+                text,
+                saved.footing_rows,
+                saved.footing_settlement,
+            )?);
+        }
+        Ok(r)
+    }
+
+    /// The state to save in a checkpoint (the streamed files are flushed and
+    /// read back).
+    pub fn saved(&mut self) -> io::Result<RecorderState> {
+        self.history.flush()?;
+        let read = |name: &str| std::fs::read_to_string(self.out.join(name));
+        let newton_csv = match &mut self.newton {
+            Some(csv) => {
+                csv.flush()?;
+                Some(read("newton.csv")?)
+            }
+            None => None,
+        };
+        let (footing_csv, footing_rows, footing_settlement) = match &self.footing {
+            Some(curve) => {
+                let (rows, settlement) = curve.state();
+                (Some(read("footing.csv")?), rows.to_vec(), settlement)
+            }
+            None => (None, Vec::new(), 0.0),
+        };
+        Ok(RecorderState {
+            history_csv: read("history.csv")?,
+            next_history: self.next_history,
+            last_history: Some(self.last_history).filter(|t| !t.is_nan()),
+            frames: self.frames.frames().to_vec(),
+            next_frame: self.next_frame,
+            last_frame: Some(self.last_frame).filter(|t| !t.is_nan()),
+            newton_csv,
+            footing_csv,
+            footing_rows,
+            footing_settlement,
         })
     }
 
@@ -154,9 +258,22 @@ impl Recorders {
         }
     }
 
+    /// The directory the files are written into.
+    pub fn directory(&self) -> &Path {
+        &self.out
+    }
+
     /// The footing's limit pressure and its neighbours, for summary.json.
     pub fn footing_summary<const D: usize>(&self, m: &Model<D>) -> Option<FootingSummary> {
         let f = m.footing.as_ref()?;
         self.footing.as_ref()?.summary(f.cohesion)
+    }
+}
+
+/// Whether two paths name the same directory.
+fn same_directory(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => a == b,
     }
 }

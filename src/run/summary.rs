@@ -62,6 +62,18 @@ pub struct Summary {
     /// The factor a strength-reduction trial divided the strengths by.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub strength_factor: Option<f64>,
+    /// The checkpoint a restarted run continued from (`wall_seconds` and
+    /// `particle_steps_per_second` then count this run's part only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub resumed_from: Option<ResumedFrom>,
+}
+
+/// Where a restarted run began.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ResumedFrom {
+    pub checkpoint: String,
+    pub step: usize,
+    pub time: f64,
 }
 
 /// Where a run diverged (why: the summary's `message`).

@@ -297,6 +297,12 @@ pub struct OutputConfig {
     /// Time between rows of history.csv (0: every step).
     #[serde(default)]
     pub history_interval: f64,
+    /// Simulation time between checkpoints (none: no checkpoints by time).
+    #[serde(default)]
+    pub checkpoint_interval: Option<f64>,
+    /// Wall-clock seconds between checkpoints (none: no checkpoints by the clock).
+    #[serde(default)]
+    pub checkpoint_wall_seconds: Option<f64>,
 }
 
 fn default_frames() -> usize {
@@ -308,6 +314,8 @@ impl Default for OutputConfig {
         OutputConfig {
             frames: default_frames(),
             history_interval: 0.0,
+            checkpoint_interval: None,
+            checkpoint_wall_seconds: None,
         }
     }
 }

@@ -5,6 +5,21 @@ use crate::dim::Vector;
 use crate::model::Model;
 use crate::solver::divergence::Divergence;
 use crate::solver::report::{NewtonRow, SolverReport};
+use serde::{Deserialize, Serialize};
+
+/// What a stepper carries from one step to the next that a restart needs
+/// (`run::checkpoint`): the Newmark particle accelerations and the counts that
+/// summary.json reports. Buffers rebuilt every step are not part of it.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct SolverState {
+    /// Newmark particle accelerations a_p, D values per particle (empty when the
+    /// stepper keeps none, or before its first step).
+    pub acceleration: Vec<f64>,
+    pub newton_iterations: usize,
+    pub cutbacks: usize,
+    pub krylov_iterations: usize,
+    pub lagged_factorizations: usize,
+}
 
 pub trait Stepper<const D: usize> {
     /// The step to take now (at most what is left of the stage is taken).
@@ -30,4 +45,12 @@ pub trait Stepper<const D: usize> {
 
     /// The solver fields of summary.json, counts so far.
     fn report(&self) -> SolverReport;
+
+    /// The state carried across steps, for a checkpoint.
+    fn state(&self) -> SolverState {
+        SolverState::default()
+    }
+
+    /// Continue from a checkpoint's state (`state` of the same kind of stepper).
+    fn restore(&mut self, _state: &SolverState) {}
 }

@@ -87,6 +87,18 @@ pub fn validate(s: &SceneConfig) -> Check {
         "output.history_interval",
         "must be ≥ 0",
     )?;
+    for (key, value) in [
+        ("checkpoint_interval", s.output.checkpoint_interval),
+        ("checkpoint_wall_seconds", s.output.checkpoint_wall_seconds),
+    ] {
+        if let Some(v) = value {
+            ensure(
+                v > 0.0 && v.is_finite(),
+                format!("output.{key}"),
+                "must be > 0",
+            )?;
+        }
+    }
     if let Some(g) = &s.geostatic {
         geostatic(g, s, &materials)?;
     }

@@ -34,7 +34,7 @@ use crate::physics::transfer::{stencils_and_nodes, NodeMap};
 use crate::scene::{Integrator, LinearSolver, SolverConfig, SolverKind};
 use crate::solver::divergence::{check_state, Divergence};
 use crate::solver::report::{NewtonRow, SolverReport};
-use crate::solver::stepper::Stepper;
+use crate::solver::stepper::{SolverState, Stepper};
 use failure::Failure;
 use newton::Newton;
 use std::time::Instant;
@@ -187,6 +187,32 @@ impl<const D: usize> Stepper<D> for Implicit<D> {
             lagged_factorizations: krylov.map(|_| self.lagged_factorizations()),
             beta: newmark.then_some(self.settings.newmark.beta),
             gamma: newmark.then_some(self.settings.newmark.gamma),
+        }
+    }
+
+    /// The Newmark accelerations and the counts. The lagged_direct
+    /// preconditioner's factorization is not saved: a restarted solver factorizes
+    /// afresh at its first Krylov solve (docs/robustness.md).
+    fn state(&self) -> SolverState {
+        let krylov = self.newton.krylov();
+        SolverState {
+            acceleration: self.accel.iter().flat_map(|a| a.iter().copied()).collect(),
+            newton_iterations: self.newton.iterations,
+            cutbacks: self.cutbacks,
+            krylov_iterations: self.newton.krylov_iterations(),
+            lagged_factorizations: krylov.map_or(0, |k| k.factorizations),
+        }
+    }
+
+    fn restore(&mut self, s: &SolverState) {
+        self.accel = (s.acceleration.chunks_exact(D))
+            .map(Vector::<D>::from_column_slice)
+            .collect();
+        self.newton.iterations = s.newton_iterations;
+        self.cutbacks = s.cutbacks;
+        if let newton::Linear::Krylov(k) = &mut self.newton.linear {
+            k.iterations = s.krylov_iterations;
+            k.factorizations = s.lagged_factorizations;
         }
     }
 }

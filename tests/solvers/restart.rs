@@ -1,0 +1,381 @@
+//! Checkpoints and restarts (issue 12, part 1): a run restarted from a checkpoint
+//! writes the same bytes as the run that was never stopped (particles_final.csv,
+//! history.csv, newton.csv but for its wall-clock column, footing.csv, every
+//! frame and the collection), for each solver kind, a staged scene and across a
+//! stage boundary; a checkpoint that does not fit is refused with its name.
+
+use crate::common::problem;
+use mpm::run::summary::Summary;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// `mpm run problems/NAME --threads N --out DIR --set …` (and `--restart`).
+fn mpm(name: &str, threads: usize, out: &Path, sets: &[&str], restart: Option<&Path>) -> Output {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_mpm"));
+    cmd.arg("run")
+        .arg(problem(name))
+        .args(["--threads", &threads.to_string(), "--out"])
+        .arg(out);
+    for s in sets {
+        cmd.args(["--set", s]);
+    }
+    if let Some(c) = restart {
+        cmd.arg("--restart").arg(c);
+    }
+    cmd.output().unwrap()
+}
+
+fn succeeded(o: &Output) {
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+/// The checkpoints in `dir`, in step order.
+fn checkpoints(dir: &Path) -> Vec<PathBuf> {
+    let mut c: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            p.file_name()
+                .unwrap()
+                .to_string_lossy()
+                .starts_with("checkpoint_")
+        })
+        .collect();
+    c.sort();
+    c
+}
+
+/// newton.csv without its wall_seconds column (the only column that differs
+/// between two runs of the same scene).
+fn without_wall_clock(text: &str) -> String {
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let wall = header.iter().position(|h| *h == "wall_seconds").unwrap();
+    text.lines()
+        .map(|l| {
+            let mut f: Vec<&str> = l.split(',').collect();
+            f.remove(wall);
+            f.join(",")
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// Every output of `a` but summary.json and the checkpoints is in `b` with the
+/// same bytes (newton.csv: but for wall_seconds); returns how many files.
+fn same_outputs(a: &Path, b: &Path) -> usize {
+    let mut compared = 0;
+    for e in std::fs::read_dir(a).unwrap() {
+        let name = e.unwrap().file_name().to_string_lossy().to_string();
+        if name == "summary.json" || name.starts_with("checkpoint_") {
+            continue;
+        }
+        let (x, y) = (a.join(&name), b.join(&name));
+        let y = std::fs::read(&y).unwrap_or_else(|e| panic!("{}: {e}", y.display()));
+        let x = std::fs::read(&x).unwrap();
+        if name == "newton.csv" {
+            let (x, y) = (String::from_utf8(x).unwrap(), String::from_utf8(y).unwrap());
+            assert_eq!(without_wall_clock(&x), without_wall_clock(&y), "{name}");
+        } else {
+            assert!(x == y, "{name} differs after the restart");
+        }
+        compared += 1;
+    }
+    compared
+}
+
+/// Run `name` with checkpoints every `interval` into one directory, restart from
+/// each checkpoint it kept into another, and compare. Returns the steps the
+/// checkpoints were written at.
+fn restarts_are_exact(name: &str, sets: &[&str], interval: f64, threads: usize) -> Vec<usize> {
+    let interval = format!("output.checkpoint_interval={interval}");
+    let sets: Vec<&str> = sets.iter().copied().chain([interval.as_str()]).collect();
+    let whole = tempfile::tempdir().unwrap();
+    succeeded(&mpm(name, 1, whole.path(), &sets, None));
+    let kept = checkpoints(whole.path());
+    assert_eq!(kept.len(), 2, "{name}: the last two checkpoints are kept");
+    let mut steps = Vec::new();
+    for c in &kept {
+        let again = tempfile::tempdir().unwrap();
+        succeeded(&mpm(name, threads, again.path(), &sets, Some(c)));
+        let files = same_outputs(whole.path(), again.path());
+        assert!(files >= 3, "{name}: {files} files compared");
+        let file = c.file_name().unwrap().to_string_lossy().to_string();
+        let step: usize = file["checkpoint_".len()..file.len() - 5].parse().unwrap();
+        // The run did continue from the checkpoint, and its counts are the whole run's.
+        let (a, b) = (summary(whole.path()), summary(again.path()));
+        assert_eq!(b.resumed_from.as_ref().map(|r| r.step), Some(step));
+        assert_eq!(
+            (a.steps, a.solver.newton_iterations),
+            (b.steps, b.solver.newton_iterations)
+        );
+        let stage_steps = |s: &Summary| s.stages.iter().map(|s| s.steps).collect::<Vec<_>>();
+        assert_eq!(stage_steps(&a), stage_steps(&b));
+        steps.push(step);
+    }
+    steps
+}
+
+fn summary(dir: &Path) -> Summary {
+    Summary::read(&dir.join("summary.json")).unwrap()
+}
+
+#[test]
+fn explicit_restart_is_byte_identical() {
+    let steps = restarts_are_exact(
+        "column_explicit.toml",
+        &["solver.end_time=2", "output.history_interval=0"],
+        0.8,
+        1,
+    );
+    assert!(steps[0] > 0 && steps[1] > steps[0], "{steps:?}");
+}
+
+#[test]
+fn quasi_static_restart_is_byte_identical() {
+    restarts_are_exact("column.toml", &[], 0.4, 1);
+}
+
+#[test]
+fn newmark_restart_is_byte_identical() {
+    restarts_are_exact(
+        "vibrating_bar_implicit.toml",
+        &["solver.end_time=3"],
+        1.2,
+        1,
+    );
+}
+
+#[test]
+fn gmres_restart_is_byte_identical() {
+    restarts_are_exact(
+        "column.toml",
+        &[
+            "solver.linear_solver=\"gmres\"",
+            "solver.preconditioner=\"jacobi\"",
+        ],
+        0.4,
+        1,
+    );
+}
+
+#[test]
+fn footing_restart_keeps_the_curve_and_the_plastic_history() {
+    // Mohr–Coulomb (history variables), footing.csv and its summary.
+    restarts_are_exact("footing_mc.toml", &["solver.load_steps=8"], 0.3, 2);
+}
+
+#[test]
+fn staged_restart_crosses_into_the_next_stage() {
+    // Stages of 1, 2 and 0.1: checkpoints at t ≈ 2.4 in the explicit stage and
+    // at its last step (t = 3.0); both restarts go on into the Newmark stage.
+    restarts_are_exact("column_staged.toml", &["stage.2.end_time=0.1"], 0.6, 1);
+}
+
+#[test]
+fn staged_restart_at_a_stage_end() {
+    // Stages of 1, 0.5 and 0.3, checkpoints every 1.0 s: at the last step of the
+    // quasi-static stage only; the restart begins with the explicit stage.
+    let dir = tempfile::tempdir().unwrap();
+    let sets = [
+        "stage.1.end_time=0.5",
+        "stage.2.end_time=0.3",
+        "output.checkpoint_interval=1.0",
+    ];
+    succeeded(&mpm("column_staged.toml", 1, dir.path(), &sets, None));
+    let kept = checkpoints(dir.path());
+    assert_eq!(kept.len(), 1);
+    let again = tempfile::tempdir().unwrap();
+    succeeded(&mpm(
+        "column_staged.toml",
+        1,
+        again.path(),
+        &sets,
+        Some(&kept[0]),
+    ));
+    same_outputs(dir.path(), again.path());
+    let (a, b) = (summary(dir.path()), summary(again.path()));
+    let steps = |s: &Summary| s.stages.iter().map(|s| s.steps).collect::<Vec<_>>();
+    assert_eq!((a.steps, steps(&a)), (b.steps, steps(&b)));
+    assert_eq!(a.solver.newton_iterations, b.solver.newton_iterations);
+}
+
+#[test]
+fn a_restart_on_another_thread_count_is_byte_identical_too() {
+    restarts_are_exact("column_explicit.toml", &["solver.end_time=2"], 0.8, 2);
+    restarts_are_exact("column.toml", &[], 0.4, 2);
+}
+
+/// A checkpoint of column.toml (2D), and where it is.
+fn a_checkpoint() -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    succeeded(&mpm(
+        "column.toml",
+        1,
+        dir.path(),
+        &["output.checkpoint_interval=0.5"],
+        None,
+    ));
+    let c = checkpoints(dir.path()).remove(0);
+    (dir, c)
+}
+
+/// Restart column.toml from `checkpoint`, expecting a refusal that names it.
+fn refused(checkpoint: &Path, name: &str, sets: &[&str]) -> String {
+    let out = tempfile::tempdir().unwrap();
+    let o = mpm(name, 1, out.path(), sets, Some(checkpoint));
+    assert_eq!(o.status.code(), Some(2));
+    let e = String::from_utf8_lossy(&o.stderr).to_string();
+    assert!(e.contains(&checkpoint.display().to_string()), "{e}");
+    assert!(
+        !out.path().join("history.csv").exists(),
+        "nothing was run: {e}"
+    );
+    e
+}
+
+#[test]
+fn a_checkpoint_of_another_scene_is_refused() {
+    let (_dir, c) = a_checkpoint();
+    let sets = ["output.checkpoint_interval=0.5"];
+    let e = refused(&c, "column.toml", &["output.checkpoint_interval=0.25"]);
+    assert!(e.contains("another scene"), "{e}");
+    let e = refused(&c, "column_explicit.toml", &sets);
+    assert!(e.contains("another scene"), "{e}");
+    let e = refused(&c, "half_space.toml", &[]);
+    assert!(e.contains("2D run") || e.contains("another scene"), "{e}");
+}
+
+#[test]
+fn a_damaged_truncated_or_foreign_checkpoint_is_refused() {
+    let (dir, c) = a_checkpoint();
+    let sets = ["output.checkpoint_interval=0.5"];
+    let bytes = std::fs::read(&c).unwrap();
+    let bad = dir.path().join("bad.json");
+
+    std::fs::write(&bad, &bytes[..bytes.len() / 2]).unwrap();
+    assert!(refused(&bad, "column.toml", &sets).contains("truncated"));
+
+    let mut damaged = bytes.clone();
+    let at = damaged.len() - 100;
+    damaged[at] = if damaged[at] == b'1' { b'2' } else { b'1' };
+    std::fs::write(&bad, &damaged).unwrap();
+    assert!(refused(&bad, "column.toml", &sets).contains("checksum"));
+
+    let text = String::from_utf8(bytes.clone()).unwrap();
+    std::fs::write(&bad, text.replacen("\"version\":1,", "\"version\":99,", 1)).unwrap();
+    assert!(refused(&bad, "column.toml", &sets).contains("format version 99"));
+
+    std::fs::write(&bad, b"{\"status\":\"completed\"}\n").unwrap();
+    assert!(refused(&bad, "column.toml", &sets).contains("not an mpm checkpoint"));
+
+    let missing = dir.path().join("missing.json");
+    assert!(refused(&missing, "column.toml", &sets).contains("cannot read"));
+}
+
+/// FNV-1a 64 (the checkpoint's checksum), to alter a body and keep it valid.
+fn fnv1a64(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
+
+#[test]
+fn the_restart_takes_its_state_from_the_checkpoint() {
+    // A checkpoint with 1000 J more work done (and its checksum redone): the
+    // restarted run carries it into history.csv.
+    let (dir, c) = a_checkpoint();
+    let text = std::fs::read_to_string(&c).unwrap();
+    let (_, body) = text.trim_end().split_once('\n').unwrap();
+    let mut ck: serde_json::Value = serde_json::from_str(body).unwrap();
+    let work = ck["external_work"].as_f64().unwrap();
+    ck["external_work"] = serde_json::json!(work + 1000.0);
+    let body = serde_json::to_string(&ck).unwrap();
+    let header = format!(
+        "{{\"format\":\"mpm checkpoint\",\"version\":1,\"body_bytes\":{},\"body_fnv1a64\":\"{:016x}\"}}",
+        body.len(),
+        fnv1a64(body.as_bytes())
+    );
+    let moved = dir.path().join("moved.json");
+    std::fs::write(&moved, format!("{header}\n{body}\n")).unwrap();
+    let sets = ["output.checkpoint_interval=0.5"];
+    let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    succeeded(&mpm("column.toml", 1, a.path(), &sets, Some(&c)));
+    succeeded(&mpm("column.toml", 1, b.path(), &sets, Some(&moved)));
+    let work = |d: &Path| {
+        let t = crate::common::Table::read(&d.join("history.csv")).unwrap();
+        *t.col("external_work").last().unwrap()
+    };
+    let more = work(b.path()) - work(a.path());
+    assert!((more - 1000.0).abs() < 1e-6, "{more} J more work");
+}
+
+#[test]
+fn checkpoint_keys_are_checked() {
+    for (key, value) in [
+        ("checkpoint_interval", "0"),
+        ("checkpoint_interval", "-1"),
+        ("checkpoint_wall_seconds", "0"),
+        ("checkpoint_wall_seconds", "\"10\""),
+    ] {
+        let set = format!("output.{key}={value}");
+        let e = mpm::scene::Scene::load(&problem("column.toml"), std::slice::from_ref(&set))
+            .err()
+            .unwrap_or_else(|| panic!("{set} accepted"))
+            .to_string();
+        assert!(e.contains(&format!("output.{key}")), "{set}: {e}");
+    }
+}
+
+#[test]
+fn a_lagged_direct_restart_refactorizes_and_stays_within_the_tolerances() {
+    // The lagged factorization is not saved: the restart factorizes afresh, so
+    // the last bits may differ (docs/robustness.md); the results agree closely.
+    let sets = [
+        "solver.linear_solver=\"gmres\"",
+        "solver.preconditioner=\"lagged_direct\"",
+        "output.checkpoint_interval=0.4",
+    ];
+    let whole = tempfile::tempdir().unwrap();
+    succeeded(&mpm("column.toml", 1, whole.path(), &sets, None));
+    let again = tempfile::tempdir().unwrap();
+    let first = checkpoints(whole.path()).remove(0);
+    succeeded(&mpm("column.toml", 1, again.path(), &sets, Some(&first)));
+    let read = |d: &Path| crate::common::Table::read(&d.join("particles_final.csv")).unwrap();
+    let (a, b) = (read(whole.path()), read(again.path()));
+    for column in ["x", "y", "syy"] {
+        let scale = a.col(column).iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        for (u, v) in a.col(column).iter().zip(b.col(column)) {
+            assert!((u - v).abs() <= 1e-6 * scale, "{column}: {u} against {v}");
+        }
+    }
+}
+
+#[test]
+fn wall_clock_checkpoints_keep_the_last_two_and_restart_exactly() {
+    // Due after every step (1e-9 s of wall clock): 452 checkpoints written, the
+    // last two kept; the earlier one (the step before the last) restarts exactly.
+    let sets = ["solver.end_time=2", "output.checkpoint_wall_seconds=1e-9"];
+    let whole = tempfile::tempdir().unwrap();
+    succeeded(&mpm("column_explicit.toml", 1, whole.path(), &sets, None));
+    let kept = checkpoints(whole.path());
+    let steps = summary(whole.path()).steps;
+    let names: Vec<String> = (kept.iter())
+        .map(|c| c.file_name().unwrap().to_string_lossy().to_string())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            format!("checkpoint_{:09}.json", steps - 1),
+            format!("checkpoint_{steps:09}.json")
+        ]
+    );
+    let again = tempfile::tempdir().unwrap();
+    succeeded(&mpm(
+        "column_explicit.toml",
+        1,
+        again.path(),
+        &sets,
+        Some(&kept[0]),
+    ));
+    assert!(same_outputs(whole.path(), again.path()) >= 3);
+}
