@@ -23,6 +23,7 @@ use crate::physics::transfer::NodeMap;
 use crate::solver::linear::ordering::{fill_reducing, NodeGraph};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use rayon::prelude::*;
+use std::collections::HashSet;
 use std::sync::OnceLock;
 
 /// Which part of the tangent is stored.
@@ -93,6 +94,7 @@ impl Pattern {
                         out.extend(st.range(p as usize).map(|e| map.local_of(st, e)));
                     }
                 },
+                |q| std::slice::from_ref(&cells.of[q]),
                 dofs,
             )
         } else {
@@ -104,6 +106,7 @@ impl Pattern {
                 |q, out| {
                     out.extend(st.range(q).map(|e| map.local_of(st, e)));
                 },
+                |q| &st.node[st.range(q)],
                 dofs,
             )
         };
@@ -363,14 +366,21 @@ fn sources(map: &NodeMap, dofs: &Dofs) -> (Vec<usize>, Vec<(u32, f64)>) {
 
 /// The node graph: per node b, the owners (masters for tied nodes) of every
 /// node that `nodes_of(q, …)` lists for a particle q of b's sources, ascending.
-fn node_graph<F: Fn(usize, &mut Vec<usize>) + Sync>(
+/// Particles with the same `group(q)` (the same stencil nodes, or the same
+/// cell with F-bar) list the same nodes, so each group is visited once per node.
+fn node_graph<'g, F, G>(
     n: usize,
     stride: usize,
     source_start: &[usize],
     sources: &[(u32, f64)],
     nodes_of: F,
+    group: G,
     dofs: &Dofs,
-) -> (Vec<usize>, Vec<u32>) {
+) -> (Vec<usize>, Vec<u32>)
+where
+    F: Fn(usize, &mut Vec<usize>) + Sync,
+    G: Fn(usize) -> &'g [u32] + Sync,
+{
     let lists: Vec<Vec<u32>> = (0..n)
         .into_par_iter()
         .with_min_len(64)
@@ -378,13 +388,12 @@ fn node_graph<F: Fn(usize, &mut Vec<usize>) + Sync>(
             || (vec![false; n], Vec::new()),
             |(seen, scratch), b| {
                 let mut out = Vec::new();
-                let mut last_q = usize::MAX;
+                let mut visited: HashSet<&[u32]> = HashSet::new();
                 for &(e, _) in &sources[source_start[b]..source_start[b + 1]] {
                     let q = e as usize / stride;
-                    if q == last_q {
+                    if !visited.insert(group(q)) {
                         continue;
                     }
-                    last_q = q;
                     scratch.clear();
                     nodes_of(q, scratch);
                     for &a in scratch.iter() {
