@@ -108,3 +108,31 @@ pub fn newton_order(r: &[f64]) -> (f64, usize) {
         .fold(f64::NAN, f64::max);
     (best, r.len() - 1)
 }
+
+/// A small valid 2D scene (explicit elastic bar on 4 × 1 cells) that the input
+/// tests spoil one key at a time.
+pub const GOOD: &str = r#"dimension = 2
+
+[grid]
+min = [0.0, 0.0]
+max = [4.0, 1.0]
+cells = [4, 1]
+
+[[material]]
+name = "m"
+model = "linear_elastic"
+density = 1.0
+youngs_modulus = 100.0
+poisson_ratio = 0.3
+
+[[body]]
+material = "m"
+shape = "rectangle"
+min = [0.0, 0.0]
+max = [2.0, 1.0]
+
+[solver]
+kind = "explicit"
+end_time = 1.0
+cfl = 0.5
+"#;

@@ -7,31 +7,7 @@
 use mpm::scene::Scene;
 use std::process::Command;
 
-const GOOD: &str = r#"dimension = 2
-
-[grid]
-min = [0.0, 0.0]
-max = [4.0, 1.0]
-cells = [4, 1]
-
-[[material]]
-name = "m"
-model = "linear_elastic"
-density = 1.0
-youngs_modulus = 100.0
-poisson_ratio = 0.3
-
-[[body]]
-material = "m"
-shape = "rectangle"
-min = [0.0, 0.0]
-max = [2.0, 1.0]
-
-[solver]
-kind = "explicit"
-end_time = 1.0
-cfl = 0.5
-"#;
+use crate::common::GOOD;
 
 /// `mpm check` (and, where `run`, `mpm run`) on `text` with `args`: exit code 2
 /// and stderr naming `key` and containing `words`.

@@ -500,7 +500,7 @@ fn probe_entry(i: usize) -> f64 {
 }
 
 /// `y = A x` (or `|A| x` when `abs`); with `sym`, `a` holds the lower triangle of a symmetric matrix.
-fn spmv(a: SparseColMatRef<usize, f64>, sym: bool, x: &[f64], abs: bool) -> Vec<f64> {
+pub fn spmv(a: SparseColMatRef<usize, f64>, sym: bool, x: &[f64], abs: bool) -> Vec<f64> {
     let mut y = vec![0.0; a.nrows()];
     for j in 0..a.ncols() {
         for (&i, &v) in a.row_idx_of_col_raw(j).iter().zip(a.val_of_col(j)) {

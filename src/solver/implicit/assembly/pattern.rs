@@ -20,6 +20,7 @@ use super::Dofs;
 use crate::physics::fbar::Cells;
 use crate::physics::shape::Stencils;
 use crate::physics::transfer::NodeMap;
+use crate::solver::linear::direct::spmv;
 use crate::solver::linear::ordering::{fill_reducing, NodeGraph};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use rayon::prelude::*;
@@ -440,16 +441,6 @@ impl Tangent<'_> {
 
     /// y = K x (both triangles when only the lower one is stored).
     pub fn apply(&self, x: &[f64]) -> Vec<f64> {
-        let k = self.matrix();
-        let mut y = vec![0.0; k.nrows()];
-        for c in 0..k.ncols() {
-            for (&r, &v) in k.row_idx_of_col_raw(c).iter().zip(k.val_of_col(c)) {
-                y[r] += v * x[c];
-                if self.symmetric() && r != c {
-                    y[c] += v * x[r];
-                }
-            }
-        }
-        y
+        spmv(self.matrix(), self.symmetric(), x, false)
     }
 }
