@@ -10,9 +10,12 @@
 //! - `numeric_llt`: faer's numeric Cholesky alone, with the solver's ordering
 //!   and fresh buffers, the yardstick of the others;
 //! - `solve`;
-//! - `iteration_first` and `iteration_later`: the whole path of the first
-//!   iteration of a step (pattern + tangent + factorize_first + solve) and of a
-//!   later one (tangent + refactorize + solve).
+//! - `iteration_first`: the whole path of the first iteration of a step whose
+//!   stencils changed (pattern + ordering + tangent + symbolic and numeric
+//!   factorization into the solver's kept buffers + solve);
+//! - `iteration_later`: a later one, or the first of a step that keeps the
+//!   pattern (tangent + refactorize + solve);
+//! - `iteration_first_of_run`: the first, with a fresh solver.
 //!
 //! Problems: the block of problems/bench/block.toml (uGIMP, 2×2 particles per
 //! cell, self-weight on a fixed base) in 2D on 64² and 160² cells and in 3D on
@@ -20,7 +23,8 @@
 //! load step 2 (after one converged step of the real solver: non-zero stress,
 //! particles moved, each touching 3^D nodes as in the rest of a run; at the
 //! initial lattice they touch 2^D). Small 3D blocks by default; set
-//! `MPM_BENCH_LARGE=1` for 160² and 20³ (several minutes).
+//! `MPM_BENCH_LARGE=1` for 160² and 20³ (several minutes); `MPM_BENCH_DIM=2`
+//! (or 3) for one dimension only.
 //!
 //! Run: `cargo bench --bench implicit -- --noplot` (see docs/performance.md).
 
@@ -34,7 +38,7 @@ use faer::sparse::linalg::cholesky::{
 use faer::Side;
 use mpm::dim::Vector;
 use mpm::model::Model;
-use mpm::scene::Scene;
+use mpm::scene::{DirectOrdering, Scene};
 use mpm::solver::implicit::assembly::stiffness::particle_tangents;
 use mpm::solver::implicit::assembly::{Pattern, Storage};
 use mpm::solver::implicit::residual::{ordering, residual, tangent};
@@ -266,14 +270,31 @@ fn bench_problem<const D: usize>(c: &mut Criterion, p: &mut Problem<D>) {
     // comparison times: ordering, analysis, factorization, solve).
     group.bench_function("direct", |bch| {
         bch.iter(|| {
-            let perm = fill_reducing::<D>(&pattern.graph());
+            let perm = fill_reducing::<D>(&pattern.graph(), DirectOrdering::Auto);
             let mut s = DirectSolver::new();
             s.factorize(k.matrix(), Structure::Symmetric, Ordering::Given(&perm))
                 .expect("factorize");
             black_box(s.solve(&b).expect("solve"))
         })
     });
+    // The first iteration of a step whose stencils changed: a new pattern,
+    // ordering and symbolic factorization; the solver's buffers are those of
+    // the earlier steps, as in a run.
+    let mut kept = DirectSolver::new();
+    kept.factorize(k.matrix(), Structure::Symmetric, order)
+        .expect("factorize");
     group.bench_function("iteration_first", |bch| {
+        bch.iter(|| {
+            fresh.pattern = Default::default();
+            kept.forget_pattern();
+            let k = tangent(m, &fresh, false).expect("tangent");
+            kept.factorize(k.matrix(), Structure::Symmetric, ordering(&fresh, &k))
+                .expect("factorize");
+            black_box(kept.solve(&b).expect("solve"))
+        })
+    });
+    // The first iteration of a run: fresh buffers too.
+    group.bench_function("iteration_first_of_run", |bch| {
         bch.iter(|| {
             fresh.pattern = Default::default();
             let k = tangent(m, &fresh, false).expect("tangent");
@@ -337,8 +358,13 @@ fn implicit(c: &mut Criterion) {
         "block3d_{}",
         cells_3d.trim_matches(['[', ']']).replace(',', "x")
     );
-    bench_problem(c, &mut Problem::<2>::new(&name_2d, BLOCK_2D, cells_2d));
-    bench_problem(c, &mut Problem::<3>::new(&name_3d, BLOCK_3D, cells_3d));
+    let dim = std::env::var("MPM_BENCH_DIM").unwrap_or_default();
+    if dim != "3" {
+        bench_problem(c, &mut Problem::<2>::new(&name_2d, BLOCK_2D, cells_2d));
+    }
+    if dim != "2" {
+        bench_problem(c, &mut Problem::<3>::new(&name_3d, BLOCK_3D, cells_3d));
+    }
 }
 
 criterion_group!(benches, implicit);

@@ -114,6 +114,7 @@ mod tests {
         names_agree::<MassMatrix>();
         names_agree::<LinearSolver>();
         names_agree::<PreconditionerKind>();
+        names_agree::<DirectOrdering>();
         names_agree::<ReferenceKind>();
         names_agree::<Beam>();
     }

@@ -1,7 +1,10 @@
 //! What the solvers report: one row per Newton iteration (newton.csv) and the
 //! solver fields of a stage in summary.json.
 
-use crate::scene::{Integrator, LinearSolver, PreconditionerKind, Scheme, SolverKind};
+use crate::scene::{
+    DirectOrdering, Integrator, LinearSolver, PreconditionerKind, Scheme, SolverKind,
+};
+use crate::solver::linear::direct::Statistics;
 use serde::{Deserialize, Serialize};
 
 /// One Newton iteration, as written to newton.csv.
@@ -52,6 +55,10 @@ pub struct SolverReport {
     /// Factorizations of the lagged_direct preconditioner (Krylov solvers only).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lagged_factorizations: Option<usize>,
+    /// The sparse direct solver of the stage (the direct linear solver, or the
+    /// lagged_direct preconditioner).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub direct: Option<DirectReport>,
     /// Newmark only.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub beta: Option<f64>,
@@ -72,8 +79,37 @@ impl SolverReport {
             krylov_iterations: None,
             preconditioner: None,
             lagged_factorizations: None,
+            direct: None,
             beta: None,
             gamma: None,
+        }
+    }
+}
+
+/// What the sparse direct solver of a stage did: its ordering, how often it
+/// factorized and analysed a new pattern, and its largest factor.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DirectReport {
+    /// The fill-reducing ordering used (`auto` resolved: amd or metis).
+    pub ordering: DirectOrdering,
+    pub factorizations: usize,
+    /// Symbolic analyses: one per new pattern (a step whose stencils,
+    /// constraints or ties changed).
+    pub symbolic_analyses: usize,
+    /// Stored entries of the largest Cholesky factor (0 when only LU was used)
+    /// and its values' memory.
+    pub largest_factor_entries: usize,
+    pub largest_factor_mib: f64,
+}
+
+impl DirectReport {
+    pub fn new(ordering: DirectOrdering, s: Statistics) -> DirectReport {
+        DirectReport {
+            ordering,
+            factorizations: s.factorizations,
+            symbolic_analyses: s.symbolic_analyses,
+            largest_factor_entries: s.largest_factor_entries,
+            largest_factor_mib: (s.largest_factor_entries * 8) as f64 / (1024.0 * 1024.0),
         }
     }
 }

@@ -4,6 +4,7 @@
 use crate::dim::Vector;
 use crate::model::Model;
 use crate::solver::divergence::Divergence;
+use crate::solver::linear::direct::Statistics;
 use crate::solver::report::{NewtonRow, SolverReport};
 use serde::{Deserialize, Serialize};
 
@@ -19,6 +20,9 @@ pub struct SolverState {
     pub cutbacks: usize,
     pub krylov_iterations: usize,
     pub lagged_factorizations: usize,
+    /// The direct solver's counts (zero in checkpoints written before they were kept).
+    #[serde(default)]
+    pub direct: Statistics,
 }
 
 pub trait Stepper<const D: usize> {

@@ -89,6 +89,12 @@ fn an_unknown_enum_value_names_its_key() {
         (30, 17),
         "unknown variant `gmress`",
     );
+    at(
+        &(GOOD.to_string() + "direct_ordering = \"nested\"\n"),
+        "stage.1.direct_ordering",
+        (30, 19),
+        "unknown variant `nested`",
+    );
 }
 
 #[test]

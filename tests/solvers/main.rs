@@ -6,6 +6,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod direct;
 mod ended;
 mod extremes;
 mod implicit_extremes;

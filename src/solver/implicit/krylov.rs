@@ -147,7 +147,7 @@ pub struct KrylovState {
     forcing: Forcing,
     /// The lagged_direct preconditioner's factorization, and the active nodes and
     /// unknown numbering it belongs to.
-    lagged: DirectSolver,
+    pub lagged: DirectSolver,
     lagged_for: Option<(Vec<u32>, Vec<u32>)>,
     refresh: bool,
     /// Lagged factorizations computed so far.

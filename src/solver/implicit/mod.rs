@@ -31,9 +31,10 @@ use crate::dim::Vector;
 use crate::model::Model;
 use crate::physics::shape::{ShapeFunction, Stencils};
 use crate::physics::transfer::{stencils_and_nodes, NodeMap};
-use crate::scene::{Integrator, LinearSolver, SolverConfig, SolverKind};
+use crate::scene::{Integrator, LinearSolver, PreconditionerKind, SolverConfig, SolverKind};
 use crate::solver::divergence::{check_state, Divergence};
-use crate::solver::report::{NewtonRow, SolverReport};
+use crate::solver::linear::direct::DirectSolver;
+use crate::solver::report::{DirectReport, NewtonRow, SolverReport};
 use crate::solver::stepper::{SolverState, Stepper};
 use failure::Failure;
 use newton::Newton;
@@ -68,6 +69,17 @@ impl<const D: usize> Implicit<D> {
             accel: Vec::new(),
             reaction: Vec::new(),
             cutbacks: 0,
+        }
+    }
+
+    /// The sparse direct solver: the linear solver's, or the lagged_direct
+    /// preconditioner's (None for other Krylov preconditioners).
+    fn direct_solver(&self) -> Option<&DirectSolver> {
+        match &self.newton.linear {
+            newton::Linear::Direct(d) => Some(d),
+            newton::Linear::Krylov(k) => {
+                (k.config.preconditioner == PreconditionerKind::LaggedDirect).then_some(&k.lagged)
+            }
         }
     }
 
@@ -185,6 +197,10 @@ impl<const D: usize> Stepper<D> for Implicit<D> {
             krylov_iterations: Some(self.newton.krylov_iterations()),
             preconditioner: krylov.map(|k| k.preconditioner),
             lagged_factorizations: krylov.map(|_| self.lagged_factorizations()),
+            direct: self.direct_solver().map(|d| {
+                let ordering = self.settings.direct_ordering.resolved(D);
+                DirectReport::new(ordering, d.statistics())
+            }),
             beta: newmark.then_some(self.settings.newmark.beta),
             gamma: newmark.then_some(self.settings.newmark.gamma),
         }
@@ -201,6 +217,9 @@ impl<const D: usize> Stepper<D> for Implicit<D> {
             cutbacks: self.cutbacks,
             krylov_iterations: self.newton.krylov_iterations(),
             lagged_factorizations: krylov.map_or(0, |k| k.factorizations),
+            direct: self
+                .direct_solver()
+                .map_or_else(Default::default, |d| d.statistics()),
         }
     }
 
@@ -210,9 +229,13 @@ impl<const D: usize> Stepper<D> for Implicit<D> {
             .collect();
         self.newton.iterations = s.newton_iterations;
         self.cutbacks = s.cutbacks;
-        if let newton::Linear::Krylov(k) = &mut self.newton.linear {
-            k.iterations = s.krylov_iterations;
-            k.factorizations = s.lagged_factorizations;
+        match &mut self.newton.linear {
+            newton::Linear::Krylov(k) => {
+                k.iterations = s.krylov_iterations;
+                k.factorizations = s.lagged_factorizations;
+                k.lagged.restore_statistics(s.direct);
+            }
+            newton::Linear::Direct(d) => d.restore_statistics(s.direct),
         }
     }
 }

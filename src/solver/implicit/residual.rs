@@ -138,7 +138,7 @@ pub fn tangent<'s, const D: usize>(
 /// orders its columns itself).
 pub fn ordering<'s, const D: usize>(sys: &'s StepSystem<D>, k: &Tangent) -> Ordering<'s> {
     match (k.symmetric(), sys.pattern.get()) {
-        (true, Some(pattern)) => Ordering::Given(pattern.ordering::<D>()),
+        (true, Some(pattern)) => Ordering::Given(pattern.ordering::<D>(sys.direct_ordering)),
         _ => Ordering::Amd,
     }
 }

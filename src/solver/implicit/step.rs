@@ -25,7 +25,7 @@ use crate::physics::transfer::{
     applied_force, external_force, interpolate, mass_average, mass_momentum, mass_weighted,
     nodal_force, stencils_and_nodes, NodeMap,
 };
-use crate::scene::{Integrator, MassMatrix, SolverConfig};
+use crate::scene::{DirectOrdering, Integrator, MassMatrix, SolverConfig};
 use rayon::prelude::*;
 use std::sync::OnceLock;
 
@@ -44,6 +44,8 @@ pub struct StepSettings {
     pub min_node_support: f64,
     /// F-bar against volumetric locking (`crate::physics::fbar`).
     pub fbar: bool,
+    /// The direct solver's fill-reducing ordering.
+    pub direct_ordering: DirectOrdering,
 }
 
 /// One step's nonlinear system r(u) = 0 (2-37): the parts that do not depend on
@@ -80,7 +82,10 @@ pub struct StepSystem<const D: usize> {
     pub scales_new: Vec<f64>,
     /// The particles' state at the latest iterate.
     pub trial: Trial,
-    /// The tangent's sparsity pattern (built at the step's first assembly).
+    /// The fill-reducing ordering of the direct factorizations.
+    pub direct_ordering: DirectOrdering,
+    /// The tangent's sparsity pattern (built at the step's first assembly, kept
+    /// for the next step if it fits).
     pub pattern: OnceLock<Pattern>,
 }
 
@@ -104,6 +109,7 @@ impl<const D: usize> StepSystem<D> {
             g_new: 0.0,
             scales_new: Vec::new(),
             trial: Trial::default(),
+            direct_ordering: DirectOrdering::Auto,
             pattern: OnceLock::new(),
         }
     }
@@ -124,6 +130,7 @@ impl StepSettings {
             gravity_ramp: s.gravity_ramp(),
             min_node_support: s.min_node_support(),
             fbar: s.fbar(),
+            direct_ordering: s.direct_ordering(),
         }
     }
 
@@ -200,8 +207,18 @@ impl StepSettings {
         sys.t = t;
         sys.dt = dt;
         sys.constraint = constraint;
-        sys.dofs = dofs;
+        // The previous step's pattern, ordering and (in the direct solver) symbolic
+        // factorization serve again when no stencil, constraint or tie changed.
+        let cells = sys.trial.fbar.as_ref().map(|f| &f.cells);
+        let kept = std::mem::take(&mut sys.pattern)
+            .into_inner()
+            .filter(|pattern| pattern.fits(st, &dofs, cells));
         sys.pattern = OnceLock::new();
+        if let Some(pattern) = kept {
+            let _ = sys.pattern.set(pattern);
+        }
+        sys.dofs = dofs;
+        sys.direct_ordering = self.direct_ordering;
         sys.mass = mass;
         sys.f_ext = f_ext;
         sys.a_n = a_n;

@@ -379,3 +379,39 @@ fn tangent_does_not_depend_on_the_number_of_threads() {
         );
     }
 }
+
+/// The step's pattern is kept for the next step only when it is the one the
+/// next step would build: same stencil nodes, unknowns, ties and F-bar cells.
+#[test]
+fn a_pattern_is_kept_only_while_it_fits() {
+    use super::assembly::Pattern;
+    let overrides = vec!["solver.fbar=true".to_string()];
+    let scene = Scene::parse("block.toml", BLOCK, &overrides).unwrap();
+    let mut m = Model::<2>::build(&scene).unwrap();
+    let mut solver = Implicit::<2>::new(
+        scene.config.grid.shape_function,
+        scene.config.stages()[0],
+        0.0,
+    );
+    solver.prepare(&m, 0.0, 0.01);
+    let sys = &solver.system;
+    let cells = sys.trial.fbar.as_ref().map(|f| &f.cells);
+    let pattern = Pattern::new(&sys.map, &sys.stencils, &sys.dofs, cells);
+    assert!(pattern.fits(&sys.stencils, &sys.dofs, cells));
+    // Another node in one stencil, another unknown, other cells: a new pattern.
+    let mut moved = sys.stencils.clone();
+    moved.node[0] += 1;
+    assert!(!pattern.fits(&moved, &sys.dofs, cells));
+    let mut dofs = sys.dofs.clone();
+    dofs.free -= 1;
+    assert!(!pattern.fits(&sys.stencils, &dofs, cells));
+    assert!(!pattern.fits(&sys.stencils, &sys.dofs, None));
+    // Through the solver: the next step keeps the pattern while the particles
+    // stay put, and builds a new one after one crosses into another cell.
+    let _ = solver.system.pattern.set(pattern);
+    solver.prepare(&m, 0.01, 0.01);
+    assert!(solver.system.pattern.get().is_some(), "kept");
+    m.particles.x[0][0] += 1.0;
+    solver.prepare(&m, 0.02, 0.01);
+    assert!(solver.system.pattern.get().is_none(), "dropped");
+}

@@ -19,6 +19,7 @@ use faer::sparse::linalg::lu::{
 use faer::sparse::linalg::LuError;
 use faer::sparse::{CreationError, SparseColMat, SparseColMatRef, Triplet};
 use faer::{Conj, MatMut, Par, Side};
+use serde::{Deserialize, Serialize};
 
 /// faer's parallelism for factorizations and solves: sequential. Its parallel
 /// supernodal factorization rounds differently with one and two threads
@@ -136,7 +137,19 @@ pub struct DirectSolver {
     chol: Option<SymbolicCholesky<usize>>,
     lu: Option<SymbolicLu<usize>>,
     numeric: Numeric,
-    symbolic_count: usize,
+    statistics: Statistics,
+}
+
+/// What a direct solver did so far (summary.json's `direct`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Statistics {
+    /// Numeric factorizations (each LLᵀ, LBLᵀ or LU attempt that succeeded).
+    pub factorizations: usize,
+    /// Symbolic analyses (a new pattern or ordering).
+    pub symbolic_analyses: usize,
+    /// Stored entries of the largest Cholesky-family factor (LLᵀ or LBLᵀ,
+    /// supernodal: dense blocks counted whole); 0 if only LU was used.
+    pub largest_factor_entries: usize,
 }
 
 impl Default for DirectSolver {
@@ -156,7 +169,7 @@ impl DirectSolver {
             chol: None,
             lu: None,
             numeric: Numeric::None,
-            symbolic_count: 0,
+            statistics: Statistics::default(),
         }
     }
 
@@ -180,10 +193,18 @@ impl DirectSolver {
         }
         self.update_pattern(a.nrows(), structure, a, ordering);
         self.kept = kept;
-        match structure {
+        let method = match structure {
             Structure::General => self.factor_lu(a),
             Structure::Symmetric => self.factor_symmetric(a),
-        }
+        }?;
+        self.statistics.factorizations += 1;
+        let entries = match &self.numeric {
+            Numeric::Llt(values) | Numeric::Lblt { values, .. } => values.len(),
+            _ => 0,
+        };
+        let largest = &mut self.statistics.largest_factor_entries;
+        *largest = (*largest).max(entries);
+        Ok(method)
     }
 
     /// [`Self::factorize`] of K given as triplets (duplicates summed; with
@@ -219,9 +240,28 @@ impl DirectSolver {
         Ok(x)
     }
 
+    /// Drop the symbolic factorizations but keep the buffers: the next
+    /// factorization analyses its pattern anew, as after a pattern change
+    /// (the first Newton iteration of a step whose stencils changed).
+    pub fn forget_pattern(&mut self) {
+        self.pattern = None;
+        self.chol = None;
+        self.lu = None;
+    }
+
     /// How many symbolic factorizations (Cholesky or LU analyses) were computed so far.
     pub fn symbolic_count(&self) -> usize {
-        self.symbolic_count
+        self.statistics.symbolic_analyses
+    }
+
+    /// The counts and the largest factor so far.
+    pub fn statistics(&self) -> Statistics {
+        self.statistics
+    }
+
+    /// Continue the counts of an earlier solver (a restart).
+    pub fn restore_statistics(&mut self, s: Statistics) {
+        self.statistics = s;
     }
 
     /// Keep the cached symbolic factorizations iff the new pattern and ordering
@@ -291,7 +331,7 @@ impl DirectSolver {
             let sym = factorize_symbolic_cholesky(lower.symbolic(), Side::Lower, ordering, params)
                 .map_err(backend)?;
             self.chol = Some(sym);
-            self.symbolic_count += 1;
+            self.statistics.symbolic_analyses += 1;
         }
         Ok(())
     }
@@ -302,7 +342,7 @@ impl DirectSolver {
             let sym = factorize_symbolic_lu(a.symbolic(), LuSymbolicParams::default())
                 .map_err(backend)?;
             self.lu = Some(sym);
-            self.symbolic_count += 1;
+            self.statistics.symbolic_analyses += 1;
         }
         Ok(())
     }

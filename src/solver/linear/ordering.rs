@@ -18,6 +18,7 @@
 //! orderings return the permutation of the unknowns as faer takes it
 //! (`perm[new] = old`).
 
+use crate::scene::DirectOrdering;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::amd;
 use faer::sparse::SymbolicSparseColMatRef;
@@ -102,15 +103,12 @@ fn amd_order(start: &[usize], adjacency: &[u32]) -> Vec<u32> {
     }
 }
 
-/// The ordering the direct solver uses for a D-dimensional problem: METIS in
-/// 3D, where it stores a quarter less than minimum degree and factors faster;
-/// minimum degree in 2D, where the fill is the same and AMD is 10× faster to
-/// compute (docs/performance.md).
-pub fn fill_reducing<const D: usize>(g: &NodeGraph) -> Vec<usize> {
-    if D == 3 {
-        node_metis(g)
-    } else {
-        node_amd(g)
+/// The ordering `kind` of the node graph in D dimensions (`auto`:
+/// `DirectOrdering::resolved`).
+pub fn fill_reducing<const D: usize>(g: &NodeGraph, kind: DirectOrdering) -> Vec<usize> {
+    match kind.resolved(D) {
+        DirectOrdering::Metis => node_metis(g),
+        _ => node_amd(g),
     }
 }
 

@@ -14,7 +14,7 @@ pub struct Tie {
 
 /// Global numbering of the unknowns: one per free component of each active node.
 /// Prescribed components and the components of tied nodes have no equation.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Dofs {
     /// index[a·D + d]: equation number, or `NONE`.
     pub index: Vec<u32>,

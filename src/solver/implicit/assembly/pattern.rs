@@ -20,8 +20,9 @@ use super::Dofs;
 use crate::physics::fbar::Cells;
 use crate::physics::shape::Stencils;
 use crate::physics::transfer::NodeMap;
+use crate::scene::DirectOrdering;
 use crate::solver::linear::direct::spmv;
-use crate::solver::linear::ordering::{fill_reducing, NodeGraph};
+use crate::solver::linear::ordering::{node_amd, node_metis, NodeGraph};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use rayon::prelude::*;
 use std::collections::HashSet;
@@ -62,7 +63,38 @@ pub struct Pattern {
     neighbours: Vec<u32>,
     lower: OnceLock<SymbolicSparseColMat<usize>>,
     full: OnceLock<SymbolicSparseColMat<usize>>,
-    ordering: OnceLock<Vec<usize>>,
+    amd: OnceLock<Vec<usize>>,
+    metis: OnceLock<Vec<usize>>,
+    /// What the pattern was built from, to tell whether a later step's fits.
+    built_for: BuiltFor,
+}
+
+/// The inputs of a pattern: the stencils' nodes (which also fix the node map),
+/// the cells of F-bar and the unknowns with their ties.
+#[derive(Clone, Debug, Default, PartialEq)]
+struct BuiltFor {
+    count: Vec<u32>,
+    node: Vec<u32>,
+    cell_of: Option<Vec<u32>>,
+    dofs: Dofs,
+}
+
+impl BuiltFor {
+    fn new<const D: usize>(st: &Stencils<D>, dofs: &Dofs, cells: Option<&Cells>) -> BuiltFor {
+        BuiltFor {
+            count: st.count.clone(),
+            node: st.node.clone(),
+            cell_of: cells.map(|c| c.of.clone()),
+            dofs: dofs.clone(),
+        }
+    }
+
+    fn fits<const D: usize>(&self, st: &Stencils<D>, dofs: &Dofs, cells: Option<&Cells>) -> bool {
+        self.count == st.count
+            && self.node == st.node
+            && self.cell_of.as_deref() == cells.map(|c| c.of.as_slice())
+            && self.dofs == *dofs
+    }
 }
 
 impl Pattern {
@@ -119,8 +151,22 @@ impl Pattern {
             neighbours,
             lower: OnceLock::new(),
             full: OnceLock::new(),
-            ordering: OnceLock::new(),
+            amd: OnceLock::new(),
+            metis: OnceLock::new(),
+            built_for: BuiltFor::new(st, dofs, cells),
         }
+    }
+
+    /// Whether this pattern (and its ordering) is the one [`Pattern::new`]
+    /// would build for these stencils, unknowns and cells: true when no
+    /// particle changed its stencil's nodes, no node its constraint or tie.
+    pub fn fits<const D: usize>(
+        &self,
+        st: &Stencils<D>,
+        dofs: &Dofs,
+        cells: Option<&Cells>,
+    ) -> bool {
+        self.built_for.fits(st, dofs, cells)
     }
 
     /// The node graph with the unknowns of each node.
@@ -132,11 +178,13 @@ impl Pattern {
         }
     }
 
-    /// The fill-reducing ordering of the unknowns for a Cholesky factorization
-    /// (built at the first call): `ordering::fill_reducing` of the node graph.
-    pub fn ordering<const D: usize>(&self) -> &[usize] {
-        self.ordering
-            .get_or_init(|| fill_reducing::<D>(&self.graph()))
+    /// The fill-reducing ordering `kind` of the unknowns for a Cholesky
+    /// factorization (computed on the node graph at the first call).
+    pub fn ordering<const D: usize>(&self, kind: DirectOrdering) -> &[usize] {
+        match kind.resolved(D) {
+            DirectOrdering::Metis => self.metis.get_or_init(|| node_metis(&self.graph())),
+            _ => self.amd.get_or_init(|| node_amd(&self.graph())),
+        }
     }
 
     /// Number of active nodes.

@@ -1,0 +1,82 @@
+//! Memory of the implicit solver apart from the model: the peak resident memory
+//! during each step minus the resident memory of the built model before the
+//! first step (everything the solver holds: the step system, the pattern, the
+//! tangent, the factor and the workspaces), beside the stored factor's values
+//! (summary.json's `largest_factor_mib`).
+//!
+//! Runs the first stage of SCENE for `steps` steps (default 3); Linux only
+//! (reads /proc/self/status and resets the peak through /proc/self/clear_refs).
+//!
+//! `cargo run --release --example step_memory -- SCENE [STEPS] [--set key=value ...]`
+
+use mpm::model::Model;
+use mpm::scene::Scene;
+use mpm::solver::implicit::Implicit;
+use mpm::solver::stepper::Stepper;
+use std::path::Path;
+
+/// A field of /proc/self/status in MiB (VmRSS: now, VmHWM: peak).
+fn status_mib(field: &str) -> f64 {
+    let status = std::fs::read_to_string("/proc/self/status").expect("/proc/self/status");
+    let line = status
+        .lines()
+        .find(|l| l.starts_with(field))
+        .expect("field in /proc/self/status");
+    let kib: f64 = line[field.len() + 1..]
+        .trim()
+        .trim_end_matches("kB")
+        .trim()
+        .parse()
+        .expect("a number of kB");
+    kib / 1024.0
+}
+
+/// Reset the peak resident memory to the current one.
+fn reset_peak() {
+    std::fs::write("/proc/self/clear_refs", "5").expect("reset the peak (Linux)");
+}
+
+fn run<const D: usize>(scene: &Scene, steps: usize) {
+    let stage = scene.config.stages()[0];
+    let shape = scene.config.grid.shape_function;
+    let mut model = Model::<D>::build(scene).expect("model");
+    let mut solver = Implicit::<D>::new(shape, stage, 0.0);
+    let dt = stage.implicit_dt();
+    let mut t = 0.0;
+    let model_mib = status_mib("VmRSS:");
+    println!("model built: resident {model_mib:.1} MiB");
+    for step in 0..steps {
+        reset_peak();
+        solver.step(&mut model, t, dt, step).expect("converged");
+        t += dt;
+        let peak = status_mib("VmHWM:");
+        let report = solver.report();
+        let factor = report.direct.as_ref().map_or(0.0, |d| d.largest_factor_mib);
+        let solver_mib = peak - model_mib;
+        println!(
+            "step {}: peak {peak:.1} MiB, solver {solver_mib:.1} MiB, largest factor's values \
+             {factor:.1} MiB, solver / factor {:.2}; {} active nodes",
+            step + 1,
+            solver_mib / factor,
+            solver.active_nodes()
+        );
+    }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let scene_path = args
+        .first()
+        .expect("usage: step_memory SCENE [STEPS] [--set k=v ...]");
+    let steps = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(3usize);
+    let sets: Vec<String> = args
+        .windows(2)
+        .filter(|w| w[0] == "--set")
+        .map(|w| w[1].clone())
+        .collect();
+    let scene = Scene::load(Path::new(scene_path), &sets).unwrap_or_else(|e| panic!("{e}"));
+    match scene.config.dimension {
+        3 => run::<3>(&scene, steps),
+        _ => run::<2>(&scene, steps),
+    }
+}
