@@ -33,7 +33,7 @@
 //! forming K; or K itself assembled and factorized with the direct solver and
 //! kept while it works (lagged, see [`LAGGED_REFRESH_ITERATIONS`]).
 
-use super::assembly::stiffness::{coupling, particle_tangents, Pk1Derivative};
+use super::assembly::stiffness::{coupling, particle_tangents, ParticleTangents};
 use super::assembly::Dofs;
 use super::failure::Failure;
 use super::residual::{ordering, residual, tangent};
@@ -176,7 +176,7 @@ pub struct Correction {
 pub fn diagonal_blocks<const D: usize>(
     m: &Model<D>,
     sys: &StepSystem<D>,
-    a: &[Pk1Derivative],
+    a: &ParticleTangents<D>,
 ) -> Vec<SMatrix<f64, D, D>> {
     let p = &m.particles;
     let (st, inertia) = (&sys.stencils, sys.inertia);
@@ -186,7 +186,7 @@ pub fn diagonal_blocks<const D: usize>(
         .gather(st.stride, SMatrix::<f64, D, D>::zeros(), |q, e| {
             let g = &st.grad[e];
             let mut b =
-                SMatrix::<f64, D, D>::from_fn(|i, k| coupling(g, &a[q], g, i, k) * p.volume[q]);
+                SMatrix::<f64, D, D>::from_fn(|i, k| coupling(g, a.of(q), g, i, k) * p.volume[q]);
             if consistent {
                 let w = st.weight[e];
                 b += SMatrix::<f64, D, D>::identity() * (p.mass[q] * w * w * inertia);

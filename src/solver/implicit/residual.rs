@@ -14,7 +14,9 @@
 use super::assembly::absorbing::add_absorbing;
 use super::assembly::fbar::add_fbar_stiffness;
 use super::assembly::mass::{add_consistent_mass, add_lumped_mass};
-use super::assembly::stiffness::{add_stiffness, major_symmetric, particle_tangents, relative_pk1};
+use super::assembly::stiffness::{
+    add_stiffness, major_symmetric, particle_tangents, relative_pk1, ParticleTangents,
+};
 use super::assembly::{Pattern, Storage, Tangent};
 use super::failure::Failure;
 use super::step::StepSystem;
@@ -104,7 +106,10 @@ pub fn tangent<'s, const D: usize>(
         .pattern
         .get_or_init(|| Pattern::new(map, st, dofs, fbar.map(|f| &f.cells)));
     // Symmetric unless F-bar or a non-associated material breaks it.
-    let symmetric = fbar.is_none() && a.par_iter().all(major_symmetric::<D>);
+    let symmetric = fbar.is_none()
+        && (a.values)
+            .par_chunks(ParticleTangents::<D>::LEN)
+            .all(major_symmetric::<D>);
     let storage = if symmetric {
         Storage::Lower
     } else {

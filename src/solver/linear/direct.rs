@@ -365,12 +365,14 @@ impl DirectSolver {
         let par = PARALLELISM;
         // faer overwrites every value of the factor, so the old buffer serves
         // (grown if the new pattern needs more).
+        // A larger factor gets a buffer of its exact size, the old one freed first.
+        let len = sym.len_val();
         let mut values = match std::mem::replace(&mut self.kept, Numeric::None) {
-            Numeric::Llt(mut v) => {
-                v.resize(sym.len_val(), 0.0);
+            Numeric::Llt(mut v) if v.capacity() >= len => {
+                v.resize(len, 0.0);
                 v
             }
-            _ => vec![0.0; sym.len_val()],
+            _ => vec![0.0; len],
         };
         let req = sym.factorize_numeric_llt_scratch::<f64>(par, Default::default());
         let stack = match self.workspace(req) {

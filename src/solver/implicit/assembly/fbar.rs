@@ -3,7 +3,7 @@
 //! nodes of every particle in its cell.
 
 use super::pattern::slot;
-use super::stiffness::{add_stiffness, Pk1Derivative};
+use super::stiffness::{add_stiffness, indices, ParticleTangents};
 use super::{Dofs, Pattern, Tangent};
 use crate::dim::{Mat3, Vector};
 use crate::parallel::MIN_PARALLEL_LEN;
@@ -34,8 +34,9 @@ pub fn add_fbar_stiffness<const D: usize>(
     dofs: &Dofs,
     volume: &[f64],
     state: &FBarState,
-    a: &[Pk1Derivative],
+    a: &ParticleTangents<D>,
 ) {
+    let at = ParticleTangents::<D>::at;
     let n = D as f64;
     let cells = &state.cells;
     let dj = &state.dj;
@@ -54,30 +55,30 @@ pub fn add_fbar_stiffness<const D: usize>(
         .map(|q| {
             Mat3::from_fn(|i, j| {
                 let mut s = 0.0;
+                if i >= D || j >= D {
+                    return s; // A has no such components in D dimensions.
+                }
                 for a2 in 0..D {
                     for b in 0..D {
-                        s += a[q][(3 * i + j, 3 * a2 + b)] * state.df[q][(a2, b)];
+                        s += a.of(q)[at(i, j, a2, b)] * state.df[q][(a2, b)];
                     }
                 }
                 s
             })
         })
         .collect();
-    let a_tilde: Vec<Pk1Derivative> = (0..volume.len())
-        .into_par_iter()
+    let mut a_tilde = ParticleTangents::<D>::zeros(volume.len());
+    a_tilde
+        .values
+        .par_chunks_mut(ParticleTangents::<D>::LEN)
+        .enumerate()
         .with_min_len(MIN_PARALLEL_LEN)
-        .map(|q| {
-            Pk1Derivative::from_fn(|row, col| {
-                let (i, j, k, l) = (row / 3, row % 3, col / 3, col % 3);
-                let local = if k < D && l < D {
-                    m[q][(i, j)] * inv_t[q][(k, l)] / n
-                } else {
-                    0.0
-                };
-                beta[q] * (a[q][(row, col)] - local)
-            })
-        })
-        .collect();
+        .for_each(|(q, out)| {
+            for (n_ijkl, (i, j, k, l)) in indices::<D>().enumerate() {
+                let local = m[q][(i, j)] * inv_t[q][(k, l)] / n;
+                out[n_ijkl] = beta[q] * (a.of(q)[n_ijkl] - local);
+            }
+        });
     add_stiffness(k, pattern, map, st, dofs, volume, &a_tilde);
 
     // Adds v at `node` of a short list of (node, vector) pairs.

@@ -24,6 +24,36 @@ use rayon::prelude::*;
 /// ∂P_ij/∂ΔF_kl, row 3i + j, column 3k + l.
 pub type Pk1Derivative = SMatrix<f64, 9, 9>;
 
+/// A_p = ∂P/∂ΔF of every particle, only the D⁴ components A_ijkl with
+/// i, j, k, l < D that a D-dimensional tangent reads (16 numbers a particle in
+/// 2D instead of 81), at [`ParticleTangents::at`].
+#[derive(Clone, Debug)]
+pub struct ParticleTangents<const D: usize> {
+    pub values: Vec<f64>,
+}
+
+impl<const D: usize> ParticleTangents<D> {
+    /// Components per particle.
+    pub const LEN: usize = D * D * D * D;
+
+    /// Zero tangents of `n` particles.
+    pub fn zeros(n: usize) -> Self {
+        ParticleTangents {
+            values: vec![0.0; n * Self::LEN],
+        }
+    }
+
+    /// The components of particle q.
+    pub fn of(&self, q: usize) -> &[f64] {
+        &self.values[q * Self::LEN..(q + 1) * Self::LEN]
+    }
+
+    /// Position of A_ijkl within a particle's components.
+    pub const fn at(i: usize, j: usize, k: usize, l: usize) -> usize {
+        ((i * D + j) * D + k) * D + l
+    }
+}
+
 /// Central-difference step of the numerical stress derivative (preconditioners
 /// of materials without an analytic tangent).
 const NUMERICAL_STEP: f64 = 1e-6;
@@ -69,13 +99,14 @@ pub fn particle_tangents<const D: usize>(
     m: &Model<D>,
     trial: &Trial,
     numerical: bool,
-) -> Result<Vec<Pk1Derivative>, Failure> {
+) -> Result<ParticleTangents<D>, Failure> {
     let p = &m.particles;
     let history_old = p.history.slots(&p.history.data);
-    let mut a = vec![Pk1Derivative::zeros(); p.len()];
+    let mut a = ParticleTangents::<D>::zeros(p.len());
     // The first particle without a tangent (the same for any number of threads).
     let failed = a
-        .par_iter_mut()
+        .values
+        .par_chunks_mut(ParticleTangents::<D>::LEN)
         .enumerate()
         .with_min_len(MIN_PARALLEL_LEN)
         .filter_map(|(q, a_q)| {
@@ -91,7 +122,10 @@ pub fn particle_tangents<const D: usize>(
                 .or_else(|| {
                     numerical.then(|| numerical_stress_derivative(mat, &inc, NUMERICAL_STEP))
                 })
-                .map(|ds| *a_q = pk1_derivative::<D>(&trial.df[q], &trial.stress[q], &ds))
+                .map(|ds| {
+                    let full = pk1_derivative::<D>(&trial.df[q], &trial.stress[q], &ds);
+                    compact::<D>(&full, a_q)
+                })
                 .is_none()
                 .then_some(q)
         })
@@ -112,10 +146,24 @@ pub fn particle_tangents<const D: usize>(
     }
 }
 
-/// ∇S_I · A · ∇S_J for components (i, k): Σ_jl ∂S_I/∂X_j A_ijkl ∂S_J/∂X_l.
+/// The components with indices < D of a 9×9 A, into `out` (`ParticleTangents`).
+fn compact<const D: usize>(full: &Pk1Derivative, out: &mut [f64]) {
+    for i in 0..D {
+        for j in 0..D {
+            for k in 0..D {
+                for l in 0..D {
+                    out[ParticleTangents::<D>::at(i, j, k, l)] = full[(3 * i + j, 3 * k + l)];
+                }
+            }
+        }
+    }
+}
+
+/// ∇S_I · A · ∇S_J for components (i, k): Σ_jl ∂S_I/∂X_j A_ijkl ∂S_J/∂X_l, with
+/// `a` one particle's components (`ParticleTangents::of`).
 pub fn coupling<const D: usize>(
     grad_i: &Vector<D>,
-    a: &Pk1Derivative,
+    a: &[f64],
     grad_j: &Vector<D>,
     i: usize,
     k: usize,
@@ -123,23 +171,28 @@ pub fn coupling<const D: usize>(
     let mut v = 0.0;
     for j in 0..D {
         for l in 0..D {
-            v += grad_i[j] * a[(3 * i + j, 3 * k + l)] * grad_j[l];
+            v += grad_i[j] * a[ParticleTangents::<D>::at(i, j, k, l)] * grad_j[l];
         }
     }
     v
 }
 
-/// Whether A has major symmetry (A_ijkl = A_klij, indices < D) to round-off,
-/// i.e. whether its term of the tangent is symmetric.
-pub fn major_symmetric<const D: usize>(a: &Pk1Derivative) -> bool {
+/// Whether one particle's A (`ParticleTangents::of`) has major symmetry
+/// (A_ijkl = A_klij) to round-off, i.e. whether its term of the tangent is
+/// symmetric.
+pub fn major_symmetric<const D: usize>(a: &[f64]) -> bool {
+    let at = ParticleTangents::<D>::at;
     let (mut asymmetry, mut size) = (0.0f64, f64::MIN_POSITIVE);
-    for row in (0..3 * D).filter(|r| r % 3 < D) {
-        for col in (0..3 * D).filter(|c| c % 3 < D) {
-            asymmetry = asymmetry.max((a[(row, col)] - a[(col, row)]).abs());
-            size = size.max(a[(row, col)].abs());
-        }
+    for (i, j, k, l) in indices::<D>() {
+        asymmetry = asymmetry.max((a[at(i, j, k, l)] - a[at(k, l, i, j)]).abs());
+        size = size.max(a[at(i, j, k, l)].abs());
     }
     asymmetry <= 1e-10 * size
+}
+
+/// Every (i, j, k, l) with indices < D, in the order of `ParticleTangents`.
+pub fn indices<const D: usize>() -> impl Iterator<Item = (usize, usize, usize, usize)> {
+    (0..ParticleTangents::<D>::LEN).map(|n| (n / (D * D * D), n / (D * D) % D, n / D % D, n % D))
 }
 
 /// Adds Σ_p V_p ∇S_I A_p ∇S_J (2-41, 2-42) to the tangent `k`.
@@ -150,9 +203,10 @@ pub fn add_stiffness<const D: usize>(
     st: &Stencils<D>,
     dofs: &Dofs,
     volume: &[f64],
-    a: &[Pk1Derivative],
+    a: &ParticleTangents<D>,
 ) {
     let (csc, storage) = (k.pattern, k.storage);
+    let at = ParticleTangents::<D>::at;
     pattern.add_stencil_terms(
         &mut k.values,
         csc,
@@ -163,12 +217,12 @@ pub fn add_stiffness<const D: usize>(
         Components::All,
         |q, e2, block| {
             // b_ijk = Σ_l A_ijkl ∂S_J/∂X_l, then V Σ_j ∂S_I/∂X_j b_ijk for each node I.
-            let (ap, g2) = (&a[q], &st.grad[e2]);
+            let (ap, g2) = (a.of(q), &st.grad[e2]);
             let mut b = [[[0.0; D]; D]; D];
             for (i, bi) in b.iter_mut().enumerate() {
                 for (j, bij) in bi.iter_mut().enumerate() {
                     for (kk, bijk) in bij.iter_mut().enumerate() {
-                        *bijk = (0..D).map(|l| ap[(3 * i + j, 3 * kk + l)] * g2[l]).sum();
+                        *bijk = (0..D).map(|l| ap[at(i, j, kk, l)] * g2[l]).sum();
                     }
                 }
             }
