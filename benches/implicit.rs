@@ -7,8 +7,9 @@
 //!   tangents A_p and the scatter of their terms);
 //! - `factorize_first` (symbolic + numeric, a fresh solver) and
 //!   `factorize_refactor` (numeric only, the pattern unchanged);
-//! - `numeric_llt`: faer's numeric Cholesky alone, with the solver's ordering
-//!   and fresh buffers, the yardstick of the others;
+//! - `numeric_llt`: faer's numeric Cholesky alone, with the solver's ordering,
+//!   parallelism and fresh buffers, the yardstick of the others;
+//!   `numeric_llt_sequential`: the same on one thread;
 //! - `solve`;
 //! - `iteration_first`: the whole path of the first iteration of a step whose
 //!   stencils changed (pattern + ordering + tangent + symbolic and numeric
@@ -44,7 +45,7 @@ use mpm::solver::implicit::assembly::{Pattern, Storage};
 use mpm::solver::implicit::residual::{ordering, residual, tangent};
 use mpm::solver::implicit::step::{StepSettings, StepSystem};
 use mpm::solver::implicit::Implicit;
-use mpm::solver::linear::direct::{DirectSolver, Ordering, Structure};
+use mpm::solver::linear::direct::{parallelism, DirectSolver, Ordering, Structure};
 use mpm::solver::linear::ordering::{fill_reducing, node_amd, node_metis};
 use mpm::solver::stepper::Stepper;
 use std::hint::black_box;
@@ -133,13 +134,13 @@ impl<const D: usize> Problem<D> {
     }
 }
 
-/// faer's numeric LLᵀ alone into fresh buffers, sequential like the direct
-/// solver's.
+/// faer's numeric LLᵀ alone into fresh buffers, with the direct solver's
+/// parallelism (`par`: `direct::parallelism()`) or sequential.
 fn numeric_llt(
     sym: &SymbolicCholesky<usize>,
     a: faer::sparse::SparseColMatRef<usize, f64>,
+    par: faer::Par,
 ) -> Vec<f64> {
-    let par = faer::Par::Seq;
     let mut values = vec![0.0; sym.len_val()];
     let req = sym.factorize_numeric_llt_scratch::<f64>(par, Default::default());
     let mut mem = MemBuffer::new(req);
@@ -205,7 +206,7 @@ fn bench_problem<const D: usize>(c: &mut Criterion, p: &mut Problem<D>) {
         let sym = symbolic(perm);
         let t_symbolic = clock.elapsed().as_secs_f64();
         let clock = Instant::now();
-        numeric_llt(&sym, k.matrix());
+        numeric_llt(&sym, k.matrix(), parallelism());
         let t_numeric = clock.elapsed().as_secs_f64();
         eprintln!(
             "{}: {label}: ordering {t_order:.3} s, symbolic (incl. ordering for scalar AMD) \
@@ -267,7 +268,10 @@ fn bench_problem<const D: usize>(c: &mut Criterion, p: &mut Problem<D>) {
         })
     });
     group.bench_function("numeric_llt", |bch| {
-        bch.iter(|| black_box(numeric_llt(&sym, k.matrix()).len()))
+        bch.iter(|| black_box(numeric_llt(&sym, k.matrix(), parallelism()).len()))
+    });
+    group.bench_function("numeric_llt_sequential", |bch| {
+        bch.iter(|| black_box(numeric_llt(&sym, k.matrix(), faer::Par::Seq).len()))
     });
     group.bench_function("solve", |bch| {
         bch.iter(|| black_box(solver.solve(&b).expect("solve")))

@@ -21,12 +21,18 @@ use faer::sparse::{CreationError, SparseColMat, SparseColMatRef, Triplet};
 use faer::{Conj, MatMut, Par, Side};
 use serde::{Deserialize, Serialize};
 
-/// faer's parallelism for factorizations and solves: sequential. Its parallel
-/// supernodal factorization rounds differently with one and two threads
-/// (`factors_do_not_depend_on_the_number_of_threads` fails with it), and results
-/// must not depend on the thread count; on this project's 2-core machines the
-/// second thread gained little (docs/performance.md).
-const PARALLELISM: Par = Par::Seq;
+/// The number of tasks faer splits a factorization or solve into. faer divides
+/// the supernodal elimination tree and its dense kernels by this count, not by
+/// the threads there are, so a fixed count rounds the same on any number of
+/// threads (`factors_do_not_depend_on_the_number_of_threads`; with the pool's
+/// thread count instead, 1 and 2 threads give different last bits) and still
+/// lets two cores share the work.
+const FACTOR_TASKS: usize = 2;
+
+/// faer's parallelism for [`FACTOR_TASKS`] tasks on the current rayon pool.
+pub fn parallelism() -> Par {
+    Par::rayon(FACTOR_TASKS)
+}
 
 /// Largest accepted normwise backward error `‖K y − b‖ / (‖|K||y|‖ + ‖b‖)` of the probe solve.
 pub const CHECK_BACKWARD_TOL: f64 = 1e-10;
@@ -231,7 +237,7 @@ impl DirectSolver {
             return Err(SolveError::InvalidInput(msg));
         }
         let mut x = b.to_vec();
-        let par = PARALLELISM;
+        let par = parallelism();
         let rhs = MatMut::from_column_major_slice_mut(&mut x, n, 1);
         match &self.numeric {
             Numeric::Lu(num) => self.solve_lu(num, rhs, par)?,
@@ -362,7 +368,7 @@ impl DirectSolver {
     /// factor's buffer when there is one), then the probe check.
     fn try_llt(&mut self, lower: SparseColMatRef<usize, f64>) -> Result<(), SolveError> {
         let sym = self.chol.take().ok_or(SolveError::NotFactorized)?;
-        let par = PARALLELISM;
+        let par = parallelism();
         // faer overwrites every value of the factor, so the old buffer serves
         // (grown if the new pattern needs more).
         // A larger factor gets a buffer of its exact size, the old one freed first.
@@ -402,7 +408,7 @@ impl DirectSolver {
     /// Numeric intranodal LBLᵀ with the cached symbolic factorization, then the probe check.
     fn try_lblt(&mut self, lower: SparseColMatRef<usize, f64>) -> Result<(), SolveError> {
         let sym = self.chol.as_ref().ok_or(SolveError::NotFactorized)?;
-        let (n, par) = (sym.nrows(), PARALLELISM);
+        let (n, par) = (sym.nrows(), parallelism());
         let mut values = vec![0.0; sym.len_val()];
         let mut subdiag = vec![0.0; n];
         let (mut fwd, mut inv) = (vec![0usize; n], vec![0usize; n]);
@@ -433,7 +439,7 @@ impl DirectSolver {
     fn factor_lu(&mut self, a: SparseColMatRef<usize, f64>) -> Result<Method, SolveError> {
         self.ensure_lu(a)?;
         let sym = self.lu.as_ref().ok_or(SolveError::NotFactorized)?;
-        let par = PARALLELISM;
+        let par = parallelism();
         let mut num = NumericLu::new();
         let mut mem = buffer(sym.factorize_numeric_lu_scratch::<f64>(par, Default::default()))?;
         let stack = MemStack::new(&mut mem);
@@ -1112,7 +1118,9 @@ mod tests {
                     s.solve(&b).unwrap()
                 })
             };
-            assert!(solve(1) == solve(2), "n = {n}: 1 and 2 threads differ");
+            let one = solve(1);
+            assert!(one == solve(2), "n = {n}: 1 and 2 threads differ");
+            assert!(one == solve(3), "n = {n}: 1 and 3 threads differ");
         }
     }
 }
