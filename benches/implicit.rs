@@ -39,6 +39,7 @@ use faer::sparse::linalg::cholesky::{
 use faer::Side;
 use mpm::dim::Vector;
 use mpm::model::Model;
+use mpm::output::matrix_market::{write_sparse, write_vector};
 use mpm::scene::{DirectOrdering, Scene};
 use mpm::solver::implicit::assembly::stiffness::particle_tangents;
 use mpm::solver::implicit::assembly::{Pattern, Storage};
@@ -328,30 +329,17 @@ fn bench_problem<const D: usize>(c: &mut Criterion, p: &mut Problem<D>) {
 }
 
 /// Writes the lower triangle of K as a symmetric Matrix Market file
-/// (`NAME.mtx`) and the right-hand side, one value a line (`NAME_rhs.txt`),
-/// for scripts/cholmod/compare.sh.
+/// (`NAME.mtx`) and the right-hand side (`NAME_rhs.mtx`), for
+/// scripts/cholmod/compare.sh.
 fn export(
     dir: &std::path::Path,
     name: &str,
     k: faer::sparse::SparseColMatRef<usize, f64>,
     b: &[f64],
 ) -> std::io::Result<()> {
-    use std::io::Write;
     std::fs::create_dir_all(dir)?;
-    let mut f = std::io::BufWriter::new(std::fs::File::create(dir.join(format!("{name}.mtx")))?);
-    writeln!(f, "%%MatrixMarket matrix coordinate real symmetric")?;
-    writeln!(f, "{} {} {}", k.nrows(), k.ncols(), k.compute_nnz())?;
-    for c in 0..k.ncols() {
-        for (&r, v) in k.row_idx_of_col_raw(c).iter().zip(k.val_of_col(c)) {
-            writeln!(f, "{} {} {v:e}", r + 1, c + 1)?;
-        }
-    }
-    let mut g =
-        std::io::BufWriter::new(std::fs::File::create(dir.join(format!("{name}_rhs.txt")))?);
-    for x in b {
-        writeln!(g, "{x:e}")?;
-    }
-    Ok(())
+    write_sparse(&dir.join(format!("{name}.mtx")), k, true)?;
+    write_vector(&dir.join(format!("{name}_rhs.mtx")), b)
 }
 
 fn implicit(c: &mut Criterion) {

@@ -12,7 +12,7 @@ REPEATS = 7
 for path in sorted(glob.glob(os.path.join(sys.argv[1], "*.mtx"))):
     name = os.path.basename(path)[:-4]
     a = sp.csc_matrix(scipy.io.mmread(path))  # the symmetric file gives both triangles
-    b = np.loadtxt(path[:-4] + "_rhs.txt")
+    b = np.asarray(scipy.io.mmread(path[:-4] + "_rhs.mtx")).ravel()
     times = []
     for rep in range(REPEATS + 1):
         start = time.perf_counter()

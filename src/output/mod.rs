@@ -12,6 +12,7 @@
 pub mod atomic;
 pub mod csv_file;
 mod history;
+pub mod matrix_market;
 mod particles_csv;
 mod progress;
 mod table;

@@ -18,7 +18,7 @@ pub use energy::{kinetic_energy, strain_energy};
 use crate::model::memory::{self, Estimate};
 use crate::model::Model;
 use crate::output::{write_particles_csv_with, Progress};
-use crate::scene::{Integrator, Scene, SceneError, SolverConfig, SolverKind};
+use crate::scene::{Integrator, LinearSystems, Scene, SceneError, SolverConfig, SolverKind};
 use crate::solver::divergence::{check_state, Divergence};
 use crate::solver::explicit::Explicit;
 use crate::solver::report::SolverReport;
@@ -432,6 +432,11 @@ fn run_dim<const D: usize>(
         let mut stepper = crate::solver::stepper::<D>(cfg.grid.shape_function, sc, start);
         if let Some(c) = resumed {
             stepper.restore(&c.solver);
+        }
+        if cfg.output.linear_systems != LinearSystems::None {
+            let dir = out.join("linear_systems");
+            std::fs::create_dir_all(&dir)?;
+            stepper.export_linear_systems(&dir, cfg.output.linear_systems);
         }
         let stage_clock = Instant::now();
         let ctx = StageContext {

@@ -303,6 +303,23 @@ pub struct OutputConfig {
     /// Wall-clock seconds between checkpoints (none: no checkpoints by the clock).
     #[serde(default)]
     pub checkpoint_wall_seconds: Option<f64>,
+    /// Matrix Market files of the implicit solver's linear systems.
+    #[serde(default)]
+    pub linear_systems: LinearSystems,
+}
+
+/// Which Newton iterations write their linear system K δu = −r to
+/// `linear_systems/` (the direct linear solver only).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, IntoStaticStr, EnumIter)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum LinearSystems {
+    #[default]
+    None,
+    /// The first Newton iteration of every step (and of every cut-back attempt).
+    First,
+    /// Every Newton iteration.
+    All,
 }
 
 fn default_frames() -> usize {
@@ -316,6 +333,7 @@ impl Default for OutputConfig {
             history_interval: 0.0,
             checkpoint_interval: None,
             checkpoint_wall_seconds: None,
+            linear_systems: LinearSystems::None,
         }
     }
 }

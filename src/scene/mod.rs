@@ -115,6 +115,7 @@ mod tests {
         names_agree::<LinearSolver>();
         names_agree::<PreconditionerKind>();
         names_agree::<DirectOrdering>();
+        names_agree::<LinearSystems>();
         names_agree::<ReferenceKind>();
         names_agree::<Beam>();
     }

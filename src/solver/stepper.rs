@@ -3,6 +3,7 @@
 
 use crate::dim::Vector;
 use crate::model::Model;
+use crate::scene::LinearSystems;
 use crate::solver::divergence::Divergence;
 use crate::solver::linear::direct::Statistics;
 use crate::solver::report::{NewtonRow, SolverReport};
@@ -46,6 +47,10 @@ pub trait Stepper<const D: usize> {
     fn take_newton_rows(&mut self) -> Vec<NewtonRow> {
         Vec::new()
     }
+
+    /// Write the linear systems of the Newton iterations `which` to `dir`
+    /// (`[output] linear_systems`; only steppers that assemble them do).
+    fn export_linear_systems(&mut self, _dir: &std::path::Path, _which: LinearSystems) {}
 
     /// The solver fields of summary.json, counts so far.
     fn report(&self) -> SolverReport;

@@ -49,3 +49,89 @@ fn metis_and_amd_give_the_same_column() {
         "syy differs by {worst:e} (scale {scale:e})"
     );
 }
+
+/// Matrix Market coordinate file → (n, triplets, symmetric).
+fn read_mtx(path: &std::path::Path) -> (usize, Vec<(usize, usize, f64)>, bool) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap();
+    assert!(header.starts_with("%%MatrixMarket matrix coordinate real"));
+    let size: Vec<usize> = lines
+        .next()
+        .unwrap()
+        .split(' ')
+        .map(|x| x.parse().unwrap())
+        .collect();
+    let entries: Vec<(usize, usize, f64)> = lines
+        .map(|l| {
+            let f: Vec<&str> = l.split(' ').collect();
+            let (r, c): (usize, usize) = (f[0].parse().unwrap(), f[1].parse().unwrap());
+            (r - 1, c - 1, f[2].parse().unwrap())
+        })
+        .collect();
+    assert_eq!((size[0], size[2]), (size[1], entries.len()));
+    (size[0], entries, header.ends_with("symmetric"))
+}
+
+#[test]
+fn linear_systems_are_written_as_matrix_market() {
+    use mpm::solver::linear::direct::{DirectSolver, Method, Structure};
+    let (result, dir) = run_problem(
+        "column.toml",
+        &["output.frames=0", "output.linear_systems=\"all\""],
+    );
+    let s = result.unwrap();
+    let systems = dir.path().join("linear_systems");
+    let mut names: Vec<String> = std::fs::read_dir(&systems)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .collect();
+    names.sort();
+    let matrices: Vec<&String> = names
+        .iter()
+        .filter(|n| n.ends_with(".mtx") && !n.ends_with("_rhs.mtx"))
+        .collect();
+    // One system per Newton correction, one table of unknowns per step.
+    assert_eq!(Some(matrices.len()), s.solver.newton_iterations);
+    let tables = names
+        .iter()
+        .filter(|n| n.ends_with("_unknowns.csv"))
+        .count();
+    assert_eq!(tables, s.steps);
+    assert_eq!(matrices[0], "step000001_cut0_iter00.mtx");
+    // The first system: symmetric positive definite (LLᵀ), its right-hand side
+    // and table sized to its unknowns, the solution finite.
+    let (n, t, symmetric) = read_mtx(&systems.join(matrices[0]));
+    assert!(symmetric && n > 10);
+    assert!(t.iter().all(|&(r, c, _)| r >= c && r < n));
+    let rhs_text = std::fs::read_to_string(systems.join("step000001_cut0_iter00_rhs.mtx")).unwrap();
+    let rhs: Vec<f64> = rhs_text
+        .lines()
+        .skip(2)
+        .map(|l| l.parse().unwrap())
+        .collect();
+    assert_eq!(rhs.len(), n);
+    let unknowns = Table::read(&systems.join("step000001_cut0_unknowns.csv")).unwrap();
+    assert_eq!(unknowns.col("unknown").len(), n);
+    assert!(unknowns
+        .col("component")
+        .iter()
+        .all(|&c| c == 0.0 || c == 1.0));
+    let mut solver = DirectSolver::new();
+    let method = solver
+        .factorize_triplets(n, &t, Structure::Symmetric)
+        .unwrap();
+    assert_eq!(method, Method::Llt);
+    assert!(solver.solve(&rhs).unwrap().iter().all(|x| x.is_finite()));
+}
+
+#[test]
+fn linear_systems_need_the_direct_solver() {
+    let sets = [
+        "output.linear_systems=\"first\"".to_string(),
+        "solver.linear_solver=\"gmres\"".to_string(),
+    ];
+    let e = mpm::scene::Scene::load(&crate::common::problem("column.toml"), &sets).unwrap_err();
+    assert_eq!(e.key.as_deref(), Some("output.linear_systems"));
+    assert!(e.to_string().contains("linear_solver = \"direct\""), "{e}");
+}

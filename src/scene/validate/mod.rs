@@ -15,7 +15,7 @@ mod solver;
 pub use analyses::bench;
 pub use check::{Check, KeyError};
 
-use crate::scene::SceneConfig;
+use crate::scene::{LinearSolver, LinearSystems, SceneConfig, SolverConfig, SolverKind};
 use analyses::{geostatic, strength_reduction};
 use check::{ensure, vector};
 use conditions::{boundary, load};
@@ -99,6 +99,15 @@ pub fn validate(s: &SceneConfig) -> Check {
             )?;
         }
     }
+    let direct = |st: &SolverConfig| {
+        st.kind != SolverKind::Implicit || st.linear_solver() == LinearSolver::Direct
+    };
+    ensure(
+        s.output.linear_systems == LinearSystems::None || s.stages().into_iter().all(direct),
+        "output.linear_systems",
+        "is written by the direct linear solver: give linear_solver = \"direct\" (the \
+         default) to every implicit stage",
+    )?;
     if let Some(g) = &s.geostatic {
         geostatic(g, s, &materials)?;
     }

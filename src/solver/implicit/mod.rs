@@ -17,6 +17,7 @@
 //! time.
 
 pub mod assembly;
+pub mod export;
 pub mod failure;
 pub mod krylov;
 pub mod newmark;
@@ -31,7 +32,9 @@ use crate::dim::Vector;
 use crate::model::Model;
 use crate::physics::shape::{ShapeFunction, Stencils};
 use crate::physics::transfer::{stencils_and_nodes, NodeMap};
-use crate::scene::{Integrator, LinearSolver, PreconditionerKind, SolverConfig, SolverKind};
+use crate::scene::{
+    Integrator, LinearSolver, LinearSystems, PreconditionerKind, SolverConfig, SolverKind,
+};
 use crate::solver::divergence::{check_state, Divergence};
 use crate::solver::linear::direct::DirectSolver;
 use crate::solver::report::{DirectReport, NewtonRow, SolverReport};
@@ -182,6 +185,13 @@ impl<const D: usize> Stepper<D> for Implicit<D> {
 
     fn take_newton_rows(&mut self) -> Vec<NewtonRow> {
         std::mem::take(&mut self.newton.log)
+    }
+
+    fn export_linear_systems(&mut self, dir: &std::path::Path, which: LinearSystems) {
+        self.newton.export = Some(export::Export {
+            dir: dir.to_path_buf(),
+            which,
+        });
     }
 
     fn report(&self) -> SolverReport {

@@ -14,6 +14,7 @@
 //! convergence in `max_iterations` fails the attempt: the caller cuts the step
 //! back. Every iteration is a row of newton.csv.
 
+use super::export::{Export, Iterate};
 use super::failure::Failure;
 use super::krylov::{Correction, KrylovConfig, KrylovState};
 use super::residual::{inertial_force, ordering, reactions, residual, tangent};
@@ -38,6 +39,8 @@ pub struct Newton {
     pub log: Vec<NewtonRow>,
     /// Corrections so far.
     pub iterations: usize,
+    /// Matrix Market files of the linear systems (`[output] linear_systems`).
+    pub export: Option<Export>,
 }
 
 /// The linear solver of the corrections K δu = −r (2-38).
@@ -67,6 +70,7 @@ impl Newton {
             },
             log: Vec::new(),
             iterations: 0,
+            export: None,
         }
     }
 
@@ -148,7 +152,15 @@ impl Newton {
             // solver, or matrix-free Krylov (2-39) to the forcing term.
             let krylov_before = self.krylov_iterations();
             let correction = match &mut self.linear {
-                Linear::Direct(solver) => direct_correction(m, sys, solver, &r_free),
+                Linear::Direct(solver) => {
+                    let at = Iterate {
+                        step: step + 1,
+                        cutback,
+                        iteration,
+                    };
+                    let export = self.export.as_ref().filter(|e| e.wants(iteration));
+                    direct_correction(m, sys, solver, &r_free, export.map(|e| (e, at)))
+                }
                 Linear::Krylov(krylov) => {
                     let stop = self.residual_tolerance * reference;
                     krylov.correction(m, sys, &u, &r_free, stop, iteration)
@@ -243,14 +255,19 @@ impl Convergence {
 }
 
 /// δu = −K⁻¹ r with the assembled consistent tangent (2-40), factorized by the
-/// direct solver.
+/// direct solver; with `export`, K and −r are written first.
 fn direct_correction<const D: usize>(
     m: &Model<D>,
     sys: &StepSystem<D>,
     solver: &mut DirectSolver,
     r_free: &[f64],
+    export: Option<(&Export, Iterate)>,
 ) -> Result<Correction, Failure> {
     let k = tangent(m, sys, false)?;
+    if let Some((e, at)) = export {
+        let rhs: Vec<f64> = r_free.iter().map(|x| -x).collect();
+        e.write(m, sys, &k, &rhs, at)?;
+    }
     let structure = Structure::of(k.symmetric());
     let failed = |e: String| Failure {
         particle: None,
