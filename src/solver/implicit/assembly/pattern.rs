@@ -25,7 +25,6 @@ use crate::solver::linear::direct::spmv;
 use crate::solver::linear::ordering::{node_amd, node_metis, NodeGraph};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use rayon::prelude::*;
-use std::collections::HashSet;
 use std::sync::OnceLock;
 
 /// Which part of the tangent is stored.
@@ -127,7 +126,7 @@ impl Pattern {
                         out.extend(st.range(p as usize).map(|e| map.local_of(st, e)));
                     }
                 },
-                |q| std::slice::from_ref(&cells.of[q]),
+                &cells.of,
                 dofs,
             )
         } else {
@@ -139,7 +138,7 @@ impl Pattern {
                 |q, out| {
                     out.extend(st.range(q).map(|e| map.local_of(st, e)));
                 },
-                |q| &st.node[st.range(q)],
+                &stencil_groups(st),
                 dofs,
             )
         };
@@ -413,49 +412,66 @@ fn sources(map: &NodeMap, dofs: &Dofs) -> (Vec<usize>, Vec<(u32, f64)>) {
     (start, list)
 }
 
+/// Particles with the same stencil nodes, numbered: `group[q]` for particle q.
+/// Particles sorted by their stencil's node list (ties by index, so the
+/// numbering does not depend on the thread count); equal lists share a number.
+fn stencil_groups<const D: usize>(st: &Stencils<D>) -> Vec<u32> {
+    let nodes = |q: u32| &st.node[st.range(q as usize)];
+    let mut order: Vec<u32> = (0..st.count.len() as u32).collect();
+    order.par_sort_unstable_by(|&p, &q| nodes(p).cmp(nodes(q)).then(p.cmp(&q)));
+    let mut group = vec![0u32; order.len()];
+    let mut g = 0;
+    for (i, &q) in order.iter().enumerate() {
+        if i > 0 && nodes(order[i - 1]) != nodes(q) {
+            g += 1;
+        }
+        group[q as usize] = g;
+    }
+    group
+}
+
 /// The node graph: per node b, the owners (masters for tied nodes) of every
 /// node that `nodes_of(q, …)` lists for a particle q of b's sources, ascending.
-/// Particles with the same `group(q)` (the same stencil nodes, or the same
+/// Particles of one group (`group[q]`: the same stencil nodes, or the same
 /// cell with F-bar) list the same nodes, so each group is visited once per node.
-fn node_graph<'g, F, G>(
+fn node_graph<F>(
     n: usize,
     stride: usize,
     source_start: &[usize],
     sources: &[(u32, f64)],
     nodes_of: F,
-    group: G,
+    group: &[u32],
     dofs: &Dofs,
 ) -> (Vec<usize>, Vec<u32>)
 where
     F: Fn(usize, &mut Vec<usize>) + Sync,
-    G: Fn(usize) -> &'g [u32] + Sync,
 {
+    let count = group.iter().max().map_or(0, |&g| g as usize + 1);
     let lists: Vec<Vec<u32>> = (0..n)
         .into_par_iter()
         .with_min_len(64)
         .map_init(
-            || (vec![false; n], Vec::new()),
-            |(seen, scratch), b| {
+            // Per task: which nodes and groups node b has met (marked with b).
+            || (vec![u32::MAX; n], vec![u32::MAX; count], Vec::new()),
+            |(seen, visited, scratch), b| {
                 let mut out = Vec::new();
-                let mut visited: HashSet<&[u32]> = HashSet::new();
                 for &(e, _) in &sources[source_start[b]..source_start[b + 1]] {
                     let q = e as usize / stride;
-                    if !visited.insert(group(q)) {
+                    let g = group[q] as usize;
+                    if visited[g] == b as u32 {
                         continue;
                     }
+                    visited[g] = b as u32;
                     scratch.clear();
                     nodes_of(q, scratch);
                     for &a in scratch.iter() {
                         for (o, _) in dofs.owners(a) {
-                            if !seen[o] {
-                                seen[o] = true;
+                            if seen[o] != b as u32 {
+                                seen[o] = b as u32;
                                 out.push(o as u32);
                             }
                         }
                     }
-                }
-                for &a in &out {
-                    seen[a as usize] = false;
                 }
                 out.sort_unstable();
                 out
