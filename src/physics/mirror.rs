@@ -224,7 +224,9 @@ mod tests {
     #[test]
     fn image_mass_reproduces_linear_velocity() {
         let a = 0.7;
-        let cases: [(usize, &[f64], &[f64], &[f64]); 2] = [
+        // (degree, ∫ N_i, ∫ y N_i, Greville abscissae X_i) of the first p functions.
+        type Case<'a> = (usize, &'a [f64], &'a [f64], &'a [f64]);
+        let cases: [Case; 2] = [
             (2, &[1.0 / 3.0, 2.0 / 3.0], &[1.0 / 12.0, 0.5], &[0.0, 0.5]),
             (
                 3,
