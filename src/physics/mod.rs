@@ -7,5 +7,6 @@ pub mod boundary;
 pub mod deformation;
 pub mod fbar;
 pub mod geostatic;
+pub mod mirror;
 pub mod shape;
 pub mod transfer;

@@ -38,6 +38,9 @@ pub enum ShapeFunction {
     Bspline2,
     /// Cubic B-spline on a clamped uniform knot vector.
     Bspline3,
+    /// Quadratic B-spline averaged over the contiguous particle domain (axis-aligned,
+    /// stretched by the diagonal of F as in cpGIMP): no knot-crossing error.
+    Cpbspline2,
 }
 
 impl ShapeFunction {
@@ -48,7 +51,7 @@ impl ShapeFunction {
     /// Polynomial degree of the underlying grid basis (sets the node layout).
     pub fn degree(&self) -> usize {
         match self {
-            ShapeFunction::Bspline2 => 2,
+            ShapeFunction::Bspline2 | ShapeFunction::Cpbspline2 => 2,
             ShapeFunction::Bspline3 => 3,
             _ => 1,
         }
@@ -61,7 +64,7 @@ impl ShapeFunction {
             ShapeFunction::Ugimp | ShapeFunction::Cpgimp => 3,
             ShapeFunction::Cpdi => 4,
             ShapeFunction::Bspline2 => 3,
-            ShapeFunction::Bspline3 => 4,
+            ShapeFunction::Bspline3 | ShapeFunction::Cpbspline2 => 4,
         };
         per_dir.pow(dim as u32)
     }

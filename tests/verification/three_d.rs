@@ -92,3 +92,14 @@ fn three_d_output_columns() {
     assert_eq!(p.header.join(","), expected);
     assert_eq!(p.col("id").len(), 50);
 }
+
+/// Quadratic B-splines averaged over the particle domains (4×4×4 nodes per
+/// particle) in 3D: the bar's period within 1 %.
+#[test]
+fn bar_period_in_3d_with_domain_averaged_bsplines() {
+    let (period, _) = bar_3d("linear_elastic", LINEAR, "cpbspline2");
+    assert!(
+        (period / 10.0 - 1.0).abs() < 0.01,
+        "cpbspline2: 3D period {period} s"
+    );
+}

@@ -34,12 +34,12 @@ pub fn evaluate<const D: usize>(
         ShapeFunction::Linear => linear::evaluate(grid, x, node, w, grad),
         ShapeFunction::Ugimp => gimp::evaluate(grid, x, half_length0, node, w, grad),
         ShapeFunction::Cpgimp => {
-            // Stretched by F_dd, kept within (0, h/2] so the support stays 3^D
-            // nodes: a domain stretched beyond a cell is capped at one cell.
-            let half = Vector::<D>::from_fn(|d, _| {
-                (half_length0[d] * f[(d, d)]).clamp(1e-3 * half_length0[d], 0.5 * grid.h[d])
-            });
+            let half = contiguous_half_length(grid, half_length0, f);
             gimp::evaluate(grid, x, &half, node, w, grad)
+        }
+        ShapeFunction::Cpbspline2 => {
+            let half = contiguous_half_length(grid, half_length0, f);
+            bspline::evaluate_domain(grid, x, &half, 2, node, w, grad)
         }
         ShapeFunction::Cpdi => {
             let r: Tensor<D> = restrict::<D>(f) * Tensor::<D>::from_diagonal(half_length0);
@@ -48,6 +48,19 @@ pub fn evaluate<const D: usize>(
         ShapeFunction::Bspline2 => bspline::evaluate(grid, x, 2, node, w, grad),
         ShapeFunction::Bspline3 => bspline::evaluate(grid, x, 3, node, w, grad),
     }
+}
+
+/// The contiguous particle domain's half-lengths (cpGIMP): the reference ones
+/// stretched by F_dd, kept within (0, h/2] so the support stays within two cells per
+/// axis (a domain stretched beyond a cell is capped at one cell).
+fn contiguous_half_length<const D: usize>(
+    grid: &Grid<D>,
+    half_length0: &Vector<D>,
+    f: &Mat3,
+) -> Vector<D> {
+    Vector::<D>::from_fn(|d, _| {
+        (half_length0[d] * f[(d, d)]).clamp(1e-3 * half_length0[d], 0.5 * grid.h[d])
+    })
 }
 
 /// Shape-function values of all particles for one step, in fixed-stride storage:
@@ -345,7 +358,7 @@ pub(crate) mod tests {
                     rng.range(0.05, 1.0)
                 };
                 let mut f = random_deformation::<D>(&mut rng, &g.h, reach);
-                if shape == ShapeFunction::Cpgimp {
+                if matches!(shape, ShapeFunction::Cpgimp | ShapeFunction::Cpbspline2) {
                     // cpGIMP needs 2·half ≤ h, i.e. F_dd ≤ 2 for half0 = h/4.
                     let widest = (0..D).map(|d| f[(d, d)]).fold(0.0, f64::max);
                     f *= 2.0 * reach / widest;

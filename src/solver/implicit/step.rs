@@ -3,7 +3,8 @@
 //! [`StepSettings::prepare`] sets up everything of the step t → t + Δt that does
 //! not depend on the iterate: the shape functions at the step-start positions
 //! (updated Lagrangian), the conditions and unknowns of the active nodes (weakly
-//! supported nodes tied to their neighbours, `super::ties`), the lumped mass, the
+//! supported nodes tied to their neighbours and the natural end condition of cubic
+//! B-splines at faces with prescribed velocities, `super::ties`), the lumped mass, the
 //! external force at t + Δt, the Newmark predictor ũ (2-36) and the absorbing
 //! faces of the step. Quasi-static steps scale gravity and loads with the load
 //! factor λ = (t − t_start) / duration and have no inertia. Newmark starts from
@@ -12,7 +13,7 @@
 
 use super::assembly::{Dofs, Pattern};
 use super::newmark::Newmark;
-use super::ties::{nodal_support, ties};
+use super::ties::{merge, natural_end_ties, nodal_support, ties};
 use crate::dim::Vector;
 use crate::model::conditions::Constraint;
 use crate::model::{load_factor, Model};
@@ -346,7 +347,9 @@ pub fn number_unknowns<const D: usize>(
         .map(|&g| implicit_node_constraint(&m.grid, &m.faces, &m.friction, g as usize))
         .collect();
     let support = nodal_support(map, st, &m.particles.volume, m.grid.cell_volume());
-    let ties = ties(&m.grid, map, &support, &constraint, min_node_support);
+    let weak = ties(&m.grid, map, &support, &constraint, min_node_support);
+    let natural = natural_end_ties(&m.grid, &m.faces, map);
+    let ties = merge(weak, natural, map.len());
     let dofs = Dofs::with_ties(constraint.iter().map(|c| c.fixed), ties);
     (constraint, dofs)
 }

@@ -325,6 +325,56 @@ fn ties_keep_linear_fields_exact() {
     }
 }
 
+/// Cubic B-splines on a block resting on the fixed base: the third layer of nodes
+/// above the base is tied to the first two, u₂ = 3 u₁ − 2 u₀ (u'' = 0 at the
+/// face), which keeps linear fields exact; no weak-node ties here.
+#[test]
+fn natural_end_ties_at_the_fixed_base() {
+    let overrides = vec![
+        "grid.shape_function=bspline3".to_string(),
+        "grid.cells=[8,8]".to_string(),
+        "solver.min_node_support=0".to_string(),
+    ];
+    let scene = Scene::parse("block.toml", BLOCK, &overrides).unwrap();
+    let m = Model::<2>::build(&scene).unwrap();
+    let mut solver = Implicit::<2>::new(
+        scene.config.grid.shape_function,
+        scene.config.stages()[0],
+        0.0,
+    );
+    solver.prepare(&m, 0.0, 1.0);
+    let sys = &solver.system;
+    let ties = &sys.dofs.ties;
+    let mut tied = 0;
+    for (a, t) in ties.iter().enumerate() {
+        let Some(t) = t else { continue };
+        tied += 1;
+        let ijk = |n: usize| m.grid.node_ijk(sys.map.active[n] as usize);
+        assert_eq!(t.coef, [3.0, -2.0]);
+        assert_eq!(
+            (ijk(a)[1], ijk(t.master[0])[1], ijk(t.master[1])[1]),
+            (2, 1, 0)
+        );
+        assert!(ties[t.master[0]].is_none() && ties[t.master[1]].is_none());
+    }
+    // The block spans x ∈ [0.5, 3]: nodes 0…6 along x touch it.
+    assert!(tied >= 5, "{tied} natural ties");
+    let a = crate::dim::Tensor::<2>::new(0.013, -0.021, 0.008, 0.017);
+    let linear = |g: u32| a * m.grid.node_position(m.grid.node_ijk(g as usize));
+    let exact: Vec<Vector<2>> = sys.map.active.iter().map(|&g| linear(g)).collect();
+    let mut u = exact.clone();
+    sys.dofs.follow_ties(&mut u);
+    let error = u
+        .iter()
+        .zip(&exact)
+        .map(|(x, y)| (x - y).norm())
+        .fold(0.0, f64::max);
+    assert!(
+        error < 1e-14,
+        "linear field off by {error:.1e} after the ties"
+    );
+}
+
 /// The assembled tangent is the same, bit for bit, on one thread and on two
 /// (each column's values are summed by one task in a fixed order), with ties,
 /// absorbing faces and the consistent mass; and the F-bar tangent too.

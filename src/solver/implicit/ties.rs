@@ -11,13 +11,25 @@
 //! line through it, u_a = c₀ u_J + c₁ u_K. Every particle's shape functions
 //! stay a partition of unity and keep reproducing linear fields exactly, and the
 //! tangent stays the exact derivative of the (constrained) residual.
+//!
+//! Cubic B-splines also get the natural end condition u'' = 0 (along the face
+//! normal) at every face with a prescribed velocity: the space of the odd mirror
+//! extension of the basis across the face (ghost control points u_−k = 2 u_w − u_k,
+//! the symmetric extension at a symmetry or roller plane). On the clamped knot
+//! vector 0,0,0,0,1,2,… (cell units) u''(0) = 6 c₀ − 9 c₁ + 3 c₂, so the third
+//! control point of each grid line follows the first two, c₂ = 3 c₁ − 2 c₀ (Piegl
+//! & Tiller, The NURBS Book, eq. 3.9 for the end derivatives). Without it the
+//! particle quadrature fails the constant-stress patch test at the face (the
+//! clamped functions' second derivatives do not vanish there) and the stress of
+//! the first particles is off by O(1), however fine the grid (docs/accuracy.md).
 
 use super::assembly::Tie;
 use crate::dim::Vector;
-use crate::model::conditions::Constraint;
+use crate::model::conditions::{Constraint, FaceCondition};
 use crate::model::grid::Grid;
 use crate::physics::shape::Stencils;
 use crate::physics::transfer::NodeMap;
+use crate::scene::Face;
 
 /// Σ_p V_p S_Ip / (cell volume) at every active node.
 pub fn nodal_support<const D: usize>(
@@ -88,6 +100,104 @@ pub fn ties<const D: usize>(
             ))
         })
         .collect()
+}
+
+/// The natural end ties of a cubic B-spline grid (module docs): node a in the
+/// third layer from a face whose first-layer node on the same grid line has a
+/// prescribed component follows that line's first two nodes, u_a = 3 u₁ − 2 u₀.
+/// Only along axes of at least 3 cells (the lines' ends are then distinct), and
+/// not at nodes in the third layer of two axes (a corner would need four masters).
+pub fn natural_end_ties<const D: usize>(
+    grid: &Grid<D>,
+    faces: &[FaceCondition<D>],
+    map: &NodeMap,
+) -> Vec<(usize, Tie)> {
+    if grid.degree != 3 {
+        return Vec::new();
+    }
+    let mut out = Vec::new();
+    for a in 0..map.len() {
+        let ijk = grid.node_ijk(map.active[a] as usize);
+        let ends: Vec<Face> = (0..D)
+            .filter(|&d| grid.cells[d] >= 3)
+            .flat_map(|axis| [false, true].map(|upper| Face { axis, upper }))
+            .filter(|&face| layer(grid, ijk, face) == 2 && prescribed(grid, faces, ijk, face))
+            .collect();
+        let [face] = ends[..] else { continue };
+        let line = |k: usize| {
+            let mut n = ijk;
+            n[face.axis] = if face.upper {
+                grid.nodes[face.axis] - 1 - k
+            } else {
+                k
+            };
+            map.local[grid.node_index(n)]
+        };
+        let (first, second) = (line(0), line(1));
+        if first != NodeMap::NONE && second != NodeMap::NONE {
+            let tie = Tie {
+                master: [second as usize, first as usize],
+                coef: [3.0, -2.0],
+            };
+            out.push((a, tie));
+        }
+    }
+    out
+}
+
+/// Layer of node ijk counted from `face` (0 on the face).
+fn layer<const D: usize>(grid: &Grid<D>, ijk: [usize; D], face: Face) -> usize {
+    let i = ijk[face.axis];
+    if face.upper {
+        grid.nodes[face.axis] - 1 - i
+    } else {
+        i
+    }
+}
+
+/// Does a face condition prescribe a component at the node of `face` on the grid
+/// line of ijk along the face normal?
+fn prescribed<const D: usize>(
+    grid: &Grid<D>,
+    faces: &[FaceCondition<D>],
+    ijk: [usize; D],
+    face: Face,
+) -> bool {
+    let mut on_face = ijk;
+    on_face[face.axis] = if face.upper {
+        grid.nodes[face.axis] - 1
+    } else {
+        0
+    };
+    faces.iter().any(|fc| {
+        fc.face == face && fc.constraint.fixed.iter().any(|&f| f) && fc.acts_on(grid, on_face)
+    })
+}
+
+/// Weak-support ties and natural end ties together: a natural tie is kept unless
+/// its node or one of its masters is weakly tied or its node is a weak master
+/// (masters stay untied).
+pub fn merge(weak: Vec<Option<Tie>>, natural: Vec<(usize, Tie)>, nodes: usize) -> Vec<Option<Tie>> {
+    if natural.is_empty() {
+        return weak;
+    }
+    let mut all = if weak.is_empty() {
+        vec![None; nodes]
+    } else {
+        weak
+    };
+    let mut master = vec![false; nodes];
+    for t in all.iter().flatten() {
+        t.master.iter().for_each(|&m| master[m] = true);
+    }
+    for (a, tie) in natural {
+        let free = |n: usize| all[n].is_none();
+        if free(a) && !master[a] && tie.master.iter().all(|&m| free(m)) {
+            tie.master.iter().for_each(|&m| master[m] = true);
+            all[a] = Some(tie);
+        }
+    }
+    all
 }
 
 /// Linear extrapolation along the line through x_J and x_K:
