@@ -14,15 +14,16 @@
 //! convergence in `max_iterations` fails the attempt: the caller cuts the step
 //! back. Every iteration is a row of newton.csv.
 
+use super::assembly::Storage;
 use super::export::{Export, Iterate};
 use super::failure::Failure;
 use super::krylov::{Correction, KrylovConfig, KrylovState};
-use super::residual::{inertial_force, ordering, reactions, residual, tangent};
+use super::residual::{inertial_force, ordering, reactions, residual, step_pattern, tangent};
 use super::step::StepSystem;
 use crate::dim::Vector;
 use crate::model::Model;
 use crate::scene::SolverConfig;
-use crate::solver::linear::direct::{DirectSolver, Structure};
+use crate::solver::linear::direct::{DirectSolver, Ordering, Structure};
 use crate::solver::linear::iterative::norm;
 use crate::solver::report::NewtonRow;
 use std::time::Instant;
@@ -263,7 +264,24 @@ fn direct_correction<const D: usize>(
     r_free: &[f64],
     export: Option<(&Export, Iterate)>,
 ) -> Result<Correction, Failure> {
-    let k = tangent(m, sys, false)?;
+    // A new pattern's ordering and symbolic factorization (sequential) run
+    // beside the assembly of K's values (parallel) when K is expected to be
+    // symmetric: no F-bar and the last K was (a material whose tangent turns
+    // unsymmetric wastes one analysis; LU analyses its own pattern).
+    let pattern = step_pattern(sys);
+    let symmetric = sys.trial.fbar.is_none() && solver.structure() != Some(Structure::General);
+    let (k, _) = rayon::join(
+        || tangent(m, sys, false),
+        || {
+            if symmetric {
+                let lower = pattern.csc::<D>(&sys.dofs, Storage::Lower);
+                let order = Ordering::Given(pattern.ordering::<D>(sys.direct_ordering));
+                // An error here comes back from the factorization below.
+                let _ = solver.analyse(lower.as_ref(), order);
+            }
+        },
+    );
+    let k = k?;
     if let Some((e, at)) = export {
         let rhs: Vec<f64> = r_free.iter().map(|x| -x).collect();
         e.write(m, sys, &k, &rhs, at)?;

@@ -102,9 +102,7 @@ pub fn tangent<'s, const D: usize>(
     let (st, map, dofs) = (&sys.stencils, &sys.map, &sys.dofs);
     let a = particle_tangents(m, &sys.trial, numerical)?;
     let fbar = sys.trial.fbar.as_ref();
-    let pattern = sys
-        .pattern
-        .get_or_init(|| Pattern::new(map, st, dofs, fbar.map(|f| &f.cells)));
+    let pattern = step_pattern(sys);
     // Symmetric unless F-bar or a non-associated material breaks it.
     let symmetric = fbar.is_none()
         && (a.values)
@@ -136,6 +134,13 @@ pub fn tangent<'s, const D: usize>(
         }
     }
     Ok(k)
+}
+
+/// The sparsity pattern of the step's tangent (built at the first call of the
+/// step, or kept from the previous step).
+pub fn step_pattern<const D: usize>(sys: &StepSystem<D>) -> &Pattern {
+    let cells = sys.trial.fbar.as_ref().map(|f| &f.cells);
+    (sys.pattern).get_or_init(|| Pattern::new(&sys.map, &sys.stencils, &sys.dofs, cells))
 }
 
 /// The fill-reducing ordering for the factorization of the tangent `k` of

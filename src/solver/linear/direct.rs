@@ -17,7 +17,9 @@ use faer::sparse::linalg::lu::{
     factorize_symbolic_lu, LuRef, LuSymbolicParams, NumericLu, SymbolicLu,
 };
 use faer::sparse::linalg::LuError;
-use faer::sparse::{CreationError, SparseColMat, SparseColMatRef, Triplet};
+use faer::sparse::{
+    CreationError, SparseColMat, SparseColMatRef, SymbolicSparseColMatRef, Triplet,
+};
 use faer::{Conj, MatMut, Par, Side};
 use serde::{Deserialize, Serialize};
 
@@ -189,7 +191,7 @@ impl DirectSolver {
         structure: Structure,
         ordering: Ordering,
     ) -> Result<Method, SolveError> {
-        let kept = std::mem::replace(&mut self.numeric, Numeric::None);
+        self.retire_numeric();
         check_entries(a, structure)?;
         if let Ordering::Given(perm) = ordering {
             if perm.len() != a.nrows() {
@@ -198,7 +200,6 @@ impl DirectSolver {
             }
         }
         self.update_pattern(a.nrows(), structure, a, ordering);
-        self.kept = kept;
         let method = match structure {
             Structure::General => self.factor_lu(a),
             Structure::Symmetric => self.factor_symmetric(a),
@@ -211,6 +212,43 @@ impl DirectSolver {
         let largest = &mut self.statistics.largest_factor_entries;
         *largest = (*largest).max(entries);
         Ok(method)
+    }
+
+    /// The structure of the last pattern factorized or analysed.
+    pub fn structure(&self) -> Option<Structure> {
+        self.pattern.as_ref().map(|p| p.structure)
+    }
+
+    /// The symbolic Cholesky factorization of the lower-triangle pattern
+    /// `lower` with `ordering`, unless the solver already holds it: what the
+    /// next [`Self::factorize`] of a symmetric K with this pattern and ordering
+    /// would compute first, done ahead (e.g. while K's values are assembled).
+    pub fn analyse(
+        &mut self,
+        lower: SymbolicSparseColMatRef<usize>,
+        ordering: Ordering,
+    ) -> Result<(), SolveError> {
+        let values = vec![0.0; lower.row_idx().len()];
+        let a = SparseColMatRef::new(lower, &values);
+        if let Ordering::Given(perm) = ordering {
+            if perm.len() != a.nrows() {
+                let msg = format!("ordering of length {}, expected {}", perm.len(), a.nrows());
+                return Err(SolveError::InvalidInput(msg));
+            }
+        }
+        if !self.update_pattern(a.nrows(), Structure::Symmetric, a, ordering) {
+            self.retire_numeric();
+        }
+        self.ensure_chol(a)
+    }
+
+    /// The current factors become the kept buffers of the next factorization
+    /// (nothing to solve with until then).
+    fn retire_numeric(&mut self) {
+        let factors = std::mem::replace(&mut self.numeric, Numeric::None);
+        if !matches!(factors, Numeric::None) {
+            self.kept = factors;
+        }
     }
 
     /// [`Self::factorize`] of K given as triplets (duplicates summed; with
@@ -1069,6 +1107,36 @@ mod tests {
                 assert_eq!(reused.solve(&b).unwrap(), x, "n = {n} after m = {m}");
             }
         }
+    }
+
+    /// An analysis done ahead is the one the factorization uses: one symbolic
+    /// factorization, the same solution bits, the old factors' buffer kept.
+    #[test]
+    fn an_analysis_ahead_serves_the_factorization() {
+        let (n, t) = (2_500, laplace_2d(50, 1.0, 0.0));
+        let b = apply(n, &t, &x_star(n));
+        let a = csc_from_triplets(n, &t, Structure::Symmetric).unwrap();
+        let mut plain = DirectSolver::new();
+        plain
+            .factorize(a.as_ref(), Structure::Symmetric, Ordering::Amd)
+            .unwrap();
+        let x = plain.solve(&b).unwrap();
+        let mut ahead = DirectSolver::new();
+        // A factorization of another pattern first, whose buffer is then kept.
+        ahead
+            .factorize_triplets(900, &laplace_2d(30, 1.0, 0.0), Structure::Symmetric)
+            .unwrap();
+        ahead.analyse(a.symbolic(), Ordering::Amd).unwrap();
+        assert_eq!(ahead.symbolic_count(), 2);
+        assert!(
+            ahead.solve(&b).is_err(),
+            "no factors of the new pattern yet"
+        );
+        ahead
+            .factorize(a.as_ref(), Structure::Symmetric, Ordering::Amd)
+            .unwrap();
+        assert_eq!(ahead.symbolic_count(), 2, "the analysis was not repeated");
+        assert_eq!(ahead.solve(&b).unwrap(), x);
     }
 
     /// A given ordering is used (the solution agrees with AMD's to round-off)
