@@ -12,8 +12,9 @@
 //!   `numeric_llt_sequential`: the same on one thread;
 //! - `solve`;
 //! - `iteration_first`: the whole path of the first iteration of a step whose
-//!   stencils changed (pattern + ordering + tangent + symbolic and numeric
-//!   factorization into the solver's kept buffers + solve);
+//!   stencils changed, as Newton takes it (`newton::factorized_tangent`:
+//!   pattern, then ordering + symbolic factorization beside the tangent's
+//!   assembly, numeric factorization into the solver's kept buffers; + solve);
 //! - `iteration_later`: a later one, or the first of a step that keeps the
 //!   pattern (tangent + refactorize + solve);
 //! - `iteration_first_of_run`: the first, with a fresh solver.
@@ -43,6 +44,7 @@ use mpm::output::matrix_market::{write_sparse, write_vector};
 use mpm::scene::{DirectOrdering, Scene};
 use mpm::solver::implicit::assembly::stiffness::particle_tangents;
 use mpm::solver::implicit::assembly::{Pattern, Storage};
+use mpm::solver::implicit::newton::factorized_tangent;
 use mpm::solver::implicit::residual::{ordering, residual, tangent};
 use mpm::solver::implicit::step::{StepSettings, StepSystem};
 use mpm::solver::implicit::Implicit;
@@ -299,9 +301,7 @@ fn bench_problem<const D: usize>(c: &mut Criterion, p: &mut Problem<D>) {
         bch.iter(|| {
             fresh.pattern = Default::default();
             kept.forget_pattern();
-            let k = tangent(m, &fresh, false).expect("tangent");
-            kept.factorize(k.matrix(), Structure::Symmetric, ordering(&fresh, &k))
-                .expect("factorize");
+            factorized_tangent(m, &fresh, &mut kept).expect("factorize");
             black_box(kept.solve(&b).expect("solve"))
         })
     });
@@ -309,19 +309,14 @@ fn bench_problem<const D: usize>(c: &mut Criterion, p: &mut Problem<D>) {
     group.bench_function("iteration_first_of_run", |bch| {
         bch.iter(|| {
             fresh.pattern = Default::default();
-            let k = tangent(m, &fresh, false).expect("tangent");
             let mut s = DirectSolver::new();
-            s.factorize(k.matrix(), Structure::Symmetric, ordering(&fresh, &k))
-                .expect("factorize");
+            factorized_tangent(m, &fresh, &mut s).expect("factorize");
             black_box(s.solve(&b).expect("solve"))
         })
     });
     group.bench_function("iteration_later", |bch| {
         bch.iter(|| {
-            let k = tangent(m, sys, false).expect("tangent");
-            solver
-                .factorize(k.matrix(), Structure::Symmetric, ordering(sys, &k))
-                .expect("factorize");
+            factorized_tangent(m, sys, &mut solver).expect("factorize");
             black_box(solver.solve(&b).expect("solve"))
         })
     });

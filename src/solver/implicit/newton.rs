@@ -14,7 +14,7 @@
 //! convergence in `max_iterations` fails the attempt: the caller cuts the step
 //! back. Every iteration is a row of newton.csv.
 
-use super::assembly::Storage;
+use super::assembly::{Storage, Tangent};
 use super::export::{Export, Iterate};
 use super::failure::Failure;
 use super::krylov::{Correction, KrylovConfig, KrylovState};
@@ -23,7 +23,7 @@ use super::step::StepSystem;
 use crate::dim::Vector;
 use crate::model::Model;
 use crate::scene::SolverConfig;
-use crate::solver::linear::direct::{DirectSolver, Ordering, Structure};
+use crate::solver::linear::direct::{DirectSolver, Method, Ordering, SolveError, Structure};
 use crate::solver::linear::iterative::norm;
 use crate::solver::report::NewtonRow;
 use std::time::Instant;
@@ -256,7 +256,7 @@ impl Convergence {
 }
 
 /// δu = −K⁻¹ r with the assembled consistent tangent (2-40), factorized by the
-/// direct solver; with `export`, K and −r are written first.
+/// direct solver; with `export`, K and −r are written too.
 fn direct_correction<const D: usize>(
     m: &Model<D>,
     sys: &StepSystem<D>,
@@ -264,10 +264,30 @@ fn direct_correction<const D: usize>(
     r_free: &[f64],
     export: Option<(&Export, Iterate)>,
 ) -> Result<Correction, Failure> {
-    // A new pattern's ordering and symbolic factorization (sequential) run
-    // beside the assembly of K's values (parallel) when K is expected to be
-    // symmetric: no F-bar and the last K was (a material whose tangent turns
-    // unsymmetric wastes one analysis; LU analyses its own pattern).
+    let (k, used) = factorized_tangent(m, sys, solver)?;
+    let rhs: Vec<f64> = r_free.iter().map(|x| -x).collect();
+    if let Some((e, at)) = export {
+        e.write(m, sys, &k, &rhs, at)?;
+    }
+    let du = solver.solve(&rhs).map_err(linear_failure)?;
+    Ok(Correction {
+        du,
+        method: used.name().to_string(),
+        krylov_iterations: 0,
+        forcing: f64::NAN,
+    })
+}
+
+/// K at the current iterate (2-40), assembled and factorized by `solver`. A new
+/// pattern's ordering and symbolic factorization (sequential) run beside the
+/// assembly of K's values (parallel) when K is expected to be symmetric: no
+/// F-bar and the last K was (a material whose tangent turns unsymmetric wastes
+/// one analysis; LU analyses its own pattern).
+pub fn factorized_tangent<'s, const D: usize>(
+    m: &Model<D>,
+    sys: &'s StepSystem<D>,
+    solver: &mut DirectSolver,
+) -> Result<(Tangent<'s>, Method), Failure> {
     let pattern = step_pattern(sys);
     let symmetric = sys.trial.fbar.is_none() && solver.structure() != Some(Structure::General);
     let (k, _) = rayon::join(
@@ -282,26 +302,18 @@ fn direct_correction<const D: usize>(
         },
     );
     let k = k?;
-    if let Some((e, at)) = export {
-        let rhs: Vec<f64> = r_free.iter().map(|x| -x).collect();
-        e.write(m, sys, &k, &rhs, at)?;
-    }
     let structure = Structure::of(k.symmetric());
-    let failed = |e: String| Failure {
-        particle: None,
-        message: format!("linear solve failed: {e}"),
-    };
     let used = solver
         .factorize(k.matrix(), structure, ordering(sys, &k))
-        .map_err(|e| failed(e.to_string()))?;
-    let rhs: Vec<f64> = r_free.iter().map(|x| -x).collect();
-    let du = solver.solve(&rhs).map_err(|e| failed(e.to_string()))?;
-    Ok(Correction {
-        du,
-        method: used.name().to_string(),
-        krylov_iterations: 0,
-        forcing: f64::NAN,
-    })
+        .map_err(linear_failure)?;
+    Ok((k, used))
+}
+
+fn linear_failure(e: SolveError) -> Failure {
+    Failure {
+        particle: None,
+        message: format!("linear solve failed: {e}"),
+    }
 }
 
 /// Backtracking on ‖r‖: halve the step length until the residual decreases
