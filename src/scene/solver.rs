@@ -66,6 +66,9 @@ pub enum PreconditionerKind {
     BlockJacobi,
     /// The assembled tangent of an earlier iteration, factorized once and reused.
     LaggedDirect,
+    /// Geometric multigrid on the background grid over the assembled tangent,
+    /// which is then also the Krylov operator (`solver::linear::multigrid`).
+    Multigrid,
 }
 
 /// The `[solver]` table (or a `[[stage]]`). The accessors give the documented
