@@ -112,6 +112,9 @@ pub struct SolverConfig {
     pub krylov_tolerance: Option<f64>,
     pub krylov_restart: Option<usize>,
     pub krylov_max_iterations: Option<usize>,
+    /// The multigrid preconditioner coarsens until a level has at most this many
+    /// unknowns.
+    pub multigrid_coarse_unknowns: Option<usize>,
     /// Quasi-static: ramp gravity from zero over the stage (default true); false
     /// applies it in full from the first step (after a geostatic initialisation).
     pub gravity_ramp: Option<bool>,
@@ -243,6 +246,7 @@ pub const SCOPES: &[Scope] = &[
     scope!(krylov_tolerance, IMPLICIT, &[], KRYLOV, SET_KRYLOV),
     scope!(krylov_restart, IMPLICIT, &[], GMRES, RESTART_LENGTH),
     scope!(krylov_max_iterations, IMPLICIT, &[], KRYLOV, SET_KRYLOV),
+    scope!(multigrid_coarse_unknowns, IMPLICIT, &[], KRYLOV, SET_KRYLOV),
 ];
 
 impl SolverConfig {
@@ -331,6 +335,11 @@ impl SolverConfig {
     /// Krylov iterations allowed per Newton correction (default 1000).
     pub fn krylov_max_iterations(&self) -> usize {
         self.krylov_max_iterations.unwrap_or(1000)
+    }
+    /// Largest coarsest level of the multigrid preconditioner (default 3000
+    /// unknowns).
+    pub fn multigrid_coarse_unknowns(&self) -> usize {
+        self.multigrid_coarse_unknowns.unwrap_or(3000)
     }
 
     /// An optional key given where it does not apply (`SCOPES`), with what it

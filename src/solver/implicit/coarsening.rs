@@ -36,9 +36,6 @@ use crate::solver::implicit::assembly::Dofs;
 use crate::solver::linear::multigrid::{Csr, Transfer};
 use nalgebra::DMatrix;
 
-/// Coarsening stops once a level has at most this many unknowns (its operator
-/// is factorized by the direct solver).
-pub const COARSE_UNKNOWNS: usize = 3000;
 /// Coarsening stops when a level would keep more than this fraction of the
 /// unknowns of the finer one.
 const LEAST_REDUCTION: f64 = 0.8;

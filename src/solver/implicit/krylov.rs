@@ -42,7 +42,7 @@
 
 use super::assembly::stiffness::{coupling, particle_tangents, Pk1Derivative};
 use super::assembly::Dofs;
-use super::coarsening::{hierarchy, COARSE_UNKNOWNS};
+use super::coarsening::hierarchy;
 use super::failure::Failure;
 use super::residual::{ordering, residual, tangent};
 use super::step::StepSystem;
@@ -130,6 +130,8 @@ pub struct KrylovConfig {
     pub fixed_tolerance: Option<f64>,
     pub restart: usize,
     pub max_iterations: usize,
+    /// Largest coarsest level of the multigrid preconditioner.
+    pub coarse_unknowns: usize,
 }
 
 impl KrylovConfig {
@@ -141,6 +143,7 @@ impl KrylovConfig {
             fixed_tolerance: s.krylov_tolerance,
             restart: s.krylov_restart(),
             max_iterations: s.krylov_max_iterations(),
+            coarse_unknowns: s.multigrid_coarse_unknowns(),
         })
     }
 
@@ -401,7 +404,12 @@ impl KrylovState {
             *active == sys.map.active && *index == sys.dofs.index
         });
         if !same_unknowns {
-            let h = hierarchy(&m.grid, &sys.map.active, &sys.dofs, COARSE_UNKNOWNS);
+            let h = hierarchy(
+                &m.grid,
+                &sys.map.active,
+                &sys.dofs,
+                self.config.coarse_unknowns,
+            );
             let mg = Multigrid::new(h.transfers);
             self.multigrid = Some((sys.map.active.clone(), sys.dofs.index.clone(), mg));
             self.hierarchies += 1;
