@@ -41,7 +41,7 @@ use rayon::prelude::*;
 /// Degree of the Chebyshev polynomial of each pre- and post-smoothing.
 pub const SMOOTHING_STEPS: usize = 2;
 /// The smoother damps the eigenvalues of D⁻¹A in [λ_max / EIGEN_RATIO, λ_max].
-pub const EIGEN_RATIO: f64 = 30.0;
+pub const EIGEN_RATIO: f64 = 10.0;
 /// Lanczos (CG) steps for λ_max(D⁻¹A).
 pub const ESTIMATE_STEPS: usize = 10;
 /// Rows per parallel task.
