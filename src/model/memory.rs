@@ -77,7 +77,10 @@ impl Estimate {
         };
         let assembles = implicit_stages().any(|s| {
             s.linear_solver() == LinearSolver::Direct
-                || s.preconditioner() == PreconditionerKind::LaggedDirect
+                || matches!(
+                    s.preconditioner(),
+                    PreconditionerKind::LaggedDirect | PreconditionerKind::Multigrid
+                )
         });
         let tangent_bytes = if assembles {
             let width = (support.powf(1.0 / d) * 2.0 - 1.0).powf(d);

@@ -81,6 +81,9 @@ pub enum PreconditionerKind {
     BlockJacobi,
     /// The assembled tangent of an earlier iteration, factorized once and reused.
     LaggedDirect,
+    /// Geometric multigrid on the background grid over the assembled tangent,
+    /// which is then also the Krylov operator (`solver::linear::multigrid`).
+    Multigrid,
 }
 
 /// The `[solver]` table (or a `[[stage]]`). The accessors give the documented
@@ -125,6 +128,9 @@ pub struct SolverConfig {
     pub krylov_restart: Option<usize>,
     pub krylov_max_iterations: Option<usize>,
     pub direct_ordering: Option<DirectOrdering>,
+    /// The multigrid preconditioner coarsens until a level has at most this many
+    /// unknowns.
+    pub multigrid_coarse_unknowns: Option<usize>,
     /// Quasi-static: ramp gravity from zero over the stage (default true); false
     /// applies it in full from the first step (after a geostatic initialisation).
     pub gravity_ramp: Option<bool>,
@@ -274,6 +280,7 @@ pub const SCOPES: &[Scope] = &[
     scope!(krylov_restart, IMPLICIT, &[], GMRES, RESTART_LENGTH),
     scope!(krylov_max_iterations, IMPLICIT, &[], KRYLOV, SET_KRYLOV),
     scope!(direct_ordering, IMPLICIT, &[], &[], ""),
+    scope!(multigrid_coarse_unknowns, IMPLICIT, &[], KRYLOV, SET_KRYLOV),
 ];
 
 impl SolverConfig {
@@ -366,6 +373,11 @@ impl SolverConfig {
     /// Krylov iterations allowed per Newton correction (default 1000).
     pub fn krylov_max_iterations(&self) -> usize {
         self.krylov_max_iterations.unwrap_or(1000)
+    }
+    /// Largest coarsest level of the multigrid preconditioner (default 3000
+    /// unknowns).
+    pub fn multigrid_coarse_unknowns(&self) -> usize {
+        self.multigrid_coarse_unknowns.unwrap_or(3000)
     }
 
     /// An optional key given where it does not apply (`SCOPES`), with what it

@@ -11,6 +11,7 @@ mod ended;
 mod extremes;
 mod implicit_extremes;
 mod krylov;
+mod multigrid;
 mod restart;
 mod signals;
 mod stability;

@@ -210,6 +210,6 @@ max_iterations = 10
             .unwrap();
         assert!(d.set.is_empty());
         assert!(builtin("cholesky", &base.config, NEWMARK, 0.01).is_none());
-        assert_eq!(builtin_names().len(), 10);
+        assert_eq!(builtin_names().len(), 12); // explicit, direct, 2 Krylov methods × 5 preconditioners
     }
 }

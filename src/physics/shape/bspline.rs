@@ -152,6 +152,14 @@ pub fn evaluate_domain<const D: usize>(
     tensor_product(grid, &axes, node, w, grad)
 }
 
+/// The basis functions of degree `p` on `cells` cells that are nonzero at `xi`
+/// (cell units), as (function index, value): one grid direction of the basis,
+/// for the multigrid's two-scale relations.
+pub fn axis_values(xi: f64, p: usize, cells: usize) -> impl Iterator<Item = (usize, f64)> {
+    let f = basis(xi, p, cells);
+    (0..f.count).map(move |r| (f.first + r, f.weight[r]))
+}
+
 /// B-spline weights and gradients of degree `degree` (1 to 3) of a particle at `x`
 /// (at most (degree + 1)^D entries).
 pub fn evaluate<const D: usize>(

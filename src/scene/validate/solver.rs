@@ -4,7 +4,9 @@
 
 use super::check::{ensure, required, Check};
 use crate::material::Material;
-use crate::scene::{Integrator, LinearSolver, SceneConfig, SolverConfig, SolverKind};
+use crate::scene::{
+    Integrator, LinearSolver, PreconditionerKind, SceneConfig, SolverConfig, SolverKind,
+};
 
 /// A material without an analytic tangent cannot run on an implicit stage with
 /// the direct solver.
@@ -199,12 +201,28 @@ fn linear_solver(s: &SolverConfig, prefix: &str) -> Check {
             format!("must lie in (0, 1) (a relative residual of the linear solve); got {eta}"),
         )?;
     }
+    if s.multigrid_coarse_unknowns.is_some() {
+        ensure(
+            s.preconditioner() == PreconditionerKind::Multigrid,
+            key("multigrid_coarse_unknowns"),
+            "applies to preconditioner = \"multigrid\" only",
+        )?;
+        at_most(
+            s.multigrid_coarse_unknowns(),
+            MAX_COARSE_UNKNOWNS,
+            key("multigrid_coarse_unknowns"),
+        )?;
+    }
     at_most(
         s.krylov_max_iterations(),
         MAX_KRYLOV_ITERATIONS,
         key("krylov_max_iterations"),
     )
 }
+
+/// Largest coarsest multigrid level accepted (its factorization is the direct
+/// solver's).
+const MAX_COARSE_UNKNOWNS: usize = 10_000_000;
 
 /// A count in [1, max].
 fn at_most(n: usize, max: usize, key: String) -> Check {

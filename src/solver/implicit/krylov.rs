@@ -32,9 +32,17 @@
 //! diagonal blocks of K summed particle by particle ([`diagonal_blocks`]), never
 //! forming K; or K itself assembled and factorized with the direct solver and
 //! kept while it works (lagged, see [`LAGGED_REFRESH_ITERATIONS`]).
+//!
+//! The multigrid preconditioner (`solver::linear::multigrid`, hierarchy from
+//! `super::coarsening`) needs the assembled tangent K at the current iterate; K
+//! is then also the Krylov operator (no difference products). Its hierarchy
+//! (prolongations) is kept while the active nodes and unknowns are; each Newton
+//! iteration refreshes the operators' values (Galerkin products, smoothers, the
+//! coarse factorization).
 
 use super::assembly::stiffness::{coupling, particle_tangents, ParticleTangents};
 use super::assembly::Dofs;
+use super::coarsening::hierarchy;
 use super::failure::Failure;
 use super::residual::{ordering, residual, tangent};
 use super::step::StepSystem;
@@ -45,6 +53,7 @@ use crate::solver::linear::cg::cg;
 use crate::solver::linear::direct::{DirectSolver, Structure};
 use crate::solver::linear::gmres::gmres;
 use crate::solver::linear::iterative::{norm, Identity, Outcome, Preconditioner, Settings};
+use crate::solver::linear::multigrid::{Csr, Multigrid};
 use crate::solver::linear::preconditioner::{BlockJacobi, Factorized, Jacobi};
 use nalgebra::SMatrix;
 
@@ -121,6 +130,8 @@ pub struct KrylovConfig {
     pub fixed_tolerance: Option<f64>,
     pub restart: usize,
     pub max_iterations: usize,
+    /// Largest coarsest level of the multigrid preconditioner.
+    pub coarse_unknowns: usize,
 }
 
 impl KrylovConfig {
@@ -132,6 +143,7 @@ impl KrylovConfig {
             fixed_tolerance: s.krylov_tolerance,
             restart: s.krylov_restart(),
             max_iterations: s.krylov_max_iterations(),
+            coarse_unknowns: s.multigrid_coarse_unknowns(),
         })
     }
 
@@ -150,6 +162,11 @@ pub struct KrylovState {
     pub lagged: DirectSolver,
     lagged_for: Option<(Vec<u32>, Vec<u32>)>,
     refresh: bool,
+    /// The multigrid hierarchy and the active nodes and unknown numbering it
+    /// belongs to.
+    multigrid: Option<(Vec<u32>, Vec<u32>, Multigrid)>,
+    /// Multigrid hierarchies built so far.
+    pub hierarchies: usize,
     /// Lagged factorizations computed so far.
     pub factorizations: usize,
     /// Krylov iterations over all Newton corrections.
@@ -208,6 +225,8 @@ enum Built {
     Blocks(BlockJacobi),
     /// Use the lagged factorization.
     Lagged,
+    /// Use the multigrid hierarchy, whose fine operator is the Krylov operator.
+    Multigrid,
 }
 
 impl KrylovState {
@@ -218,6 +237,8 @@ impl KrylovState {
             lagged: DirectSolver::new(),
             lagged_for: None,
             refresh: true,
+            multigrid: None,
+            hierarchies: 0,
             factorizations: 0,
             iterations: 0,
         }
@@ -251,7 +272,15 @@ impl KrylovState {
             max_iterations: config.max_iterations,
             restart: config.restart,
         };
+        let assembled = match (&built, &self.multigrid) {
+            (Built::Multigrid, Some((_, _, mg))) => Some(mg),
+            _ => None,
+        };
         let product = |v: &[f64], out: &mut [f64]| -> Result<(), Failure> {
+            if let Some(mg) = assembled {
+                mg.fine_operator().apply(v, out);
+                return Ok(());
+            }
             let v_max = v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
             if v_max == 0.0 {
                 out.iter_mut().for_each(|o| *o = 0.0);
@@ -267,6 +296,7 @@ impl KrylovState {
             Built::Jacobi(j) => j,
             Built::Blocks(b) => b,
             Built::Lagged => &factors,
+            Built::Multigrid => assembled.expect("refreshed by build_preconditioner"),
         };
         let outcome: Outcome = match config.method {
             LinearSolver::Cg => cg(product, pre, &b, &mut du, &settings),
@@ -356,7 +386,43 @@ impl KrylovState {
                 self.refresh_lagged(m, sys)?;
                 Built::Lagged
             }
+            PreconditionerKind::Multigrid => {
+                self.refresh_multigrid(m, sys)?;
+                Built::Multigrid
+            }
         })
+    }
+
+    /// The multigrid for the tangent at the current iterate: the hierarchy
+    /// kept while the active nodes and unknowns are, the operators refreshed.
+    fn refresh_multigrid<const D: usize>(
+        &mut self,
+        m: &Model<D>,
+        sys: &StepSystem<D>,
+    ) -> Result<(), Failure> {
+        let same_unknowns = self.multigrid.as_ref().is_some_and(|(active, index, _)| {
+            *active == sys.map.active && *index == sys.dofs.index
+        });
+        if !same_unknowns {
+            let h = hierarchy(
+                &m.grid,
+                &sys.map.active,
+                &sys.dofs,
+                self.config.coarse_unknowns,
+            );
+            let mg = Multigrid::new(h.transfers);
+            self.multigrid = Some((sys.map.active.clone(), sys.dofs.index.clone(), mg));
+            self.hierarchies += 1;
+        }
+        // Materials without an analytic tangent use a numerical one.
+        let k = tangent(m, sys, true)?;
+        let a = Csr::from_csc(k.matrix(), k.symmetric());
+        let (_, _, mg) = self.multigrid.as_mut().expect("built above");
+        mg.refresh(a, k.symmetric()).map_err(|e| Failure {
+            particle: None,
+            message: format!("multigrid preconditioner: {e}"),
+        })?;
+        Ok(())
     }
 
     /// Assemble and factorize the tangent at the current iterate if the kept

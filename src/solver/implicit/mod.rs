@@ -17,6 +17,7 @@
 //! time.
 
 pub mod assembly;
+pub mod coarsening;
 pub mod export;
 pub mod failure;
 pub mod krylov;

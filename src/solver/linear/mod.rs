@@ -5,5 +5,6 @@ pub mod cg;
 pub mod direct;
 pub mod gmres;
 pub mod iterative;
+pub mod multigrid;
 pub mod ordering;
 pub mod preconditioner;

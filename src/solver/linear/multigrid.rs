@@ -1,0 +1,567 @@
+//! Multigrid V-cycle preconditioner over given prolongations: the algebra of the
+//! geometric multigrid of the implicit solver (its prolongations come from the
+//! background grid, `solver::implicit::coarsening`).
+//!
+//! With prolongations P_l from level l + 1 to level l (rows: unknowns of level l)
+//! and the fine operator A_0, the coarse operators are Galerkin products
+//!
+//!   A_{l+1} = P_lᵀ A_l P_l                   (Trottenberg, Oosterlee & Schüller 2001, §A.2.4)
+//!
+//! and one application of the preconditioner is a V-cycle (ibid. §2.4): on each
+//! level a Chebyshev smoother on the nodal block-Jacobi preconditioned operator
+//! D_l⁻¹ A_l, the residual restricted by P_lᵀ, the coarse correction prolongated
+//! by P_l, the same smoother again; on the coarsest level the sparse direct solver
+//! (LLᵀ, else LBLᵀ, else LU). Pre- and post-smoother are the same polynomial in
+//! D⁻¹A, so for symmetric A the V-cycle is a symmetric operator and CG stays
+//! valid (ibid. §A.2.3).
+//!
+//! Chebyshev smoother (Adams, Brezina, Hu & Tuminaro 2003, J. Comput. Phys.
+//! 188:593–610; the three-term recurrence of Saad 2003, Algorithm 12.1): degree
+//! [`SMOOTHING_STEPS`] on the interval [λ/[`EIGEN_RATIO`], 1.1 λ] of D⁻¹A, λ its
+//! largest eigenvalue estimated by [`ESTIMATE_STEPS`] Lanczos steps from a fixed
+//! vector. It needs only products and block solves, so it is parallel without a
+//! colouring and does not depend on the ordering of the unknowns.
+//!
+//! Why not a crate: the Rust crates with multigrid found on docs.rs
+//! (scirs2-sparse: Ruge–Stüben, smoothed aggregation and AIR AMG on its own CSR
+//! type in a large scientific stack; nalgebra-sparse-linalg 0.1: a small AMG
+//! behind a feature) are algebraic: they choose their own coarse spaces, cannot
+//! take the grid's exact two-scale prolongations with ties and Dirichlet
+//! components, and do not keep a hierarchy while refreshing only values.
+//!
+//! Every product is a row-parallel CSR product and every sum runs in a fixed
+//! order, so the result is the same bits on any number of threads.
+
+use super::direct::{DirectSolver, Ordering, Structure};
+use super::iterative::Preconditioner;
+use super::preconditioner::BlockJacobi;
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
+use rayon::prelude::*;
+
+/// Degree of the Chebyshev polynomial of each pre- and post-smoothing.
+pub const SMOOTHING_STEPS: usize = 2;
+/// The smoother damps the eigenvalues of D⁻¹A in [λ_max / EIGEN_RATIO, λ_max].
+pub const EIGEN_RATIO: f64 = 10.0;
+/// Lanczos (CG) steps for λ_max(D⁻¹A).
+pub const ESTIMATE_STEPS: usize = 10;
+/// Rows per parallel task.
+const ROWS_PER_TASK: usize = 256;
+
+/// A sparse matrix in compressed rows, columns ascending within each row.
+#[derive(Clone, Debug, Default)]
+pub struct Csr {
+    pub rows: usize,
+    pub cols: usize,
+    pub row_ptr: Vec<usize>,
+    pub col: Vec<u32>,
+    pub val: Vec<f64>,
+}
+
+impl Csr {
+    /// The whole matrix of a compressed-column one that stores its lower
+    /// triangle (`symmetric`) or every entry.
+    pub fn from_csc(a: SparseColMatRef<usize, f64>, symmetric: bool) -> Csr {
+        let n = a.nrows();
+        let mut count = vec![0usize; n + 1];
+        for j in 0..a.ncols() {
+            for &i in a.row_idx_of_col_raw(j) {
+                count[i + 1] += 1;
+                if symmetric && i != j {
+                    count[j + 1] += 1;
+                }
+            }
+        }
+        for i in 0..n {
+            count[i + 1] += count[i];
+        }
+        let row_ptr = count.clone();
+        let mut next = count;
+        let nnz = row_ptr[n];
+        let (mut col, mut val) = (vec![0u32; nnz], vec![0.0; nnz]);
+        // Rows fill in column order; a symmetric matrix's mirrored entries can
+        // arrive out of order, so the rows are sorted afterwards.
+        for j in 0..a.ncols() {
+            for (&i, &v) in a.row_idx_of_col_raw(j).iter().zip(a.val_of_col(j)) {
+                col[next[i]] = j as u32;
+                val[next[i]] = v;
+                next[i] += 1;
+                if symmetric && i != j {
+                    col[next[j]] = i as u32;
+                    val[next[j]] = v;
+                    next[j] += 1;
+                }
+            }
+        }
+        let mut m = Csr {
+            rows: n,
+            cols: a.ncols(),
+            row_ptr,
+            col,
+            val,
+        };
+        m.sort_rows();
+        m
+    }
+
+    fn sort_rows(&mut self) {
+        let (ptr, col, val) = (&self.row_ptr, &mut self.col, &mut self.val);
+        let mut pairs: Vec<(u32, f64)> = Vec::new();
+        for r in 0..self.rows {
+            let range = ptr[r]..ptr[r + 1];
+            if col[range.clone()].windows(2).all(|w| w[0] < w[1]) {
+                continue;
+            }
+            pairs.clear();
+            pairs.extend(
+                col[range.clone()]
+                    .iter()
+                    .copied()
+                    .zip(val[range.clone()].iter().copied()),
+            );
+            pairs.sort_by_key(|&(c, _)| c);
+            for (k, (c, v)) in range.zip(&pairs) {
+                col[k] = *c;
+                val[k] = *v;
+            }
+        }
+    }
+
+    pub fn nnz(&self) -> usize {
+        self.col.len()
+    }
+
+    fn row(&self, i: usize) -> (&[u32], &[f64]) {
+        let r = self.row_ptr[i]..self.row_ptr[i + 1];
+        (&self.col[r.clone()], &self.val[r])
+    }
+
+    /// y = A x, rows in parallel (each row summed in column order).
+    pub fn apply(&self, x: &[f64], y: &mut [f64]) {
+        y.par_iter_mut()
+            .enumerate()
+            .with_min_len(ROWS_PER_TASK)
+            .for_each(|(i, yi)| {
+                let (c, v) = self.row(i);
+                *yi = c.iter().zip(v).map(|(&j, a)| a * x[j as usize]).sum();
+            });
+    }
+
+    /// Aᵀ as a matrix of its own.
+    pub fn transpose(&self) -> Csr {
+        let mut count = vec![0usize; self.cols + 1];
+        for &c in &self.col {
+            count[c as usize + 1] += 1;
+        }
+        for j in 0..self.cols {
+            count[j + 1] += count[j];
+        }
+        let row_ptr = count.clone();
+        let mut next = count;
+        let (mut col, mut val) = (vec![0u32; self.nnz()], vec![0.0; self.nnz()]);
+        // Rows in increasing order: each transposed row gets its columns ascending.
+        for i in 0..self.rows {
+            let (c, v) = self.row(i);
+            for (&j, &a) in c.iter().zip(v) {
+                let k = &mut next[j as usize];
+                col[*k] = i as u32;
+                val[*k] = a;
+                *k += 1;
+            }
+        }
+        Csr {
+            rows: self.cols,
+            cols: self.rows,
+            row_ptr,
+            col,
+            val,
+        }
+    }
+
+    /// The diagonal blocks of the unknowns `block` (row-major values).
+    fn block_values(&self, block: &[usize]) -> Vec<f64> {
+        let mut out = Vec::with_capacity(block.len() * block.len());
+        for &i in block {
+            let (c, v) = self.row(i);
+            for &j in block {
+                out.push(c.binary_search(&(j as u32)).map_or(0.0, |k| v[k]));
+            }
+        }
+        out
+    }
+
+    /// The lower triangle (or the whole matrix) in compressed columns, for the
+    /// direct solver. For a symmetric matrix the lower triangle's columns are
+    /// the upper triangle's rows.
+    fn to_csc(&self, symmetric: bool) -> (SymbolicSparseColMat<usize>, Vec<f64>) {
+        let t = if symmetric {
+            self.clone()
+        } else {
+            self.transpose()
+        };
+        // Rows of t are the columns of the matrix; keep rows ≥ column if symmetric.
+        let mut col_ptr = vec![0usize];
+        let (mut rows, mut vals) = (Vec::new(), Vec::new());
+        for j in 0..t.rows {
+            let (c, v) = t.row(j);
+            for (&i, &a) in c.iter().zip(v) {
+                if !symmetric || i as usize >= j {
+                    rows.push(i as usize);
+                    vals.push(a);
+                }
+            }
+            col_ptr.push(rows.len());
+        }
+        let n = self.rows;
+        (
+            SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows),
+            vals,
+        )
+    }
+}
+
+/// A_c = R A P with R = Pᵀ (Galerkin): every coarse row i is Σ_k R_ik Σ_j A_kj P_j·,
+/// summed in the fixed order of k, j and P's columns, into a dense accumulator;
+/// the coarse row's pattern is every column reached (kept when a sum cancels,
+/// so it depends only on the patterns).
+pub fn galerkin(r: &Csr, a: &Csr, p: &Csr) -> Csr {
+    let n = r.rows;
+    let chunks: Vec<(Vec<usize>, Vec<u32>, Vec<f64>)> = (0..n.div_ceil(ROWS_PER_TASK))
+        .into_par_iter()
+        .map_init(
+            || (vec![0.0; p.cols], vec![false; p.cols], Vec::<u32>::new()),
+            |(acc, seen, touched), chunk| {
+                let rows = chunk * ROWS_PER_TASK..((chunk + 1) * ROWS_PER_TASK).min(n);
+                let (mut len, mut cols, mut vals) = (Vec::new(), Vec::new(), Vec::new());
+                for i in rows {
+                    touched.clear();
+                    let (rc, rv) = r.row(i);
+                    for (&k, &rik) in rc.iter().zip(rv) {
+                        let (ac, av) = a.row(k as usize);
+                        for (&j, &akj) in ac.iter().zip(av) {
+                            let ra = rik * akj;
+                            let (pc, pv) = p.row(j as usize);
+                            for (&l, &pjl) in pc.iter().zip(pv) {
+                                let l = l as usize;
+                                if !seen[l] {
+                                    seen[l] = true;
+                                    touched.push(l as u32);
+                                }
+                                acc[l] += ra * pjl;
+                            }
+                        }
+                    }
+                    touched.sort_unstable();
+                    for &l in touched.iter() {
+                        cols.push(l);
+                        vals.push(acc[l as usize]);
+                        acc[l as usize] = 0.0;
+                        seen[l as usize] = false;
+                    }
+                    len.push(touched.len());
+                }
+                (len, cols, vals)
+            },
+        )
+        .collect();
+    let mut out = Csr {
+        rows: n,
+        cols: p.cols,
+        row_ptr: vec![0],
+        ..Default::default()
+    };
+    for (len, cols, vals) in chunks {
+        for l in len {
+            out.row_ptr.push(out.row_ptr.last().unwrap() + l);
+        }
+        out.col.extend(cols);
+        out.val.extend(vals);
+    }
+    out
+}
+
+/// The transfer from one level to the next coarser one, fixed while the active
+/// nodes are.
+#[derive(Clone, Debug)]
+pub struct Transfer {
+    /// P: rows are the unknowns of the finer level, columns those of the coarser.
+    pub prolongation: Csr,
+    /// The unknowns of each node of the finer level (the smoother's blocks).
+    pub fine_blocks: Vec<Vec<usize>>,
+}
+
+/// The smoother of one level above the coarsest: nodal block Jacobi D and the
+/// estimated largest eigenvalue of D⁻¹A, times 1.1.
+struct Smoother {
+    blocks: BlockJacobi,
+    lambda: f64,
+}
+
+/// The V-cycle preconditioner; build it once per hierarchy ([`Multigrid::new`]),
+/// refresh it with each new fine operator ([`Multigrid::refresh`]).
+pub struct Multigrid {
+    transfers: Vec<Transfer>,
+    /// Pᵀ of every transfer.
+    restrictions: Vec<Csr>,
+    /// The operator of every level in use, finest first (the last one factorized).
+    operators: Vec<Csr>,
+    smoothers: Vec<Smoother>,
+    coarse: DirectSolver,
+}
+
+/// Sizes of a refreshed hierarchy, for reports.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Shape {
+    /// Unknowns of every level, finest first.
+    pub unknowns: Vec<usize>,
+    /// Stored entries of every level's operator (both triangles).
+    pub entries: Vec<usize>,
+}
+
+impl Multigrid {
+    /// A hierarchy of the given transfers (finest first).
+    pub fn new(transfers: Vec<Transfer>) -> Multigrid {
+        Multigrid {
+            restrictions: transfers
+                .iter()
+                .map(|t| t.prolongation.transpose())
+                .collect(),
+            transfers,
+            operators: Vec::new(),
+            smoothers: Vec::new(),
+            coarse: DirectSolver::new(),
+        }
+    }
+
+    /// Galerkin operators, smoothers and the coarse factorization for the fine
+    /// operator `a` (both triangles); `symmetric` selects LLᵀ/LBLᵀ or LU on the
+    /// coarsest level. The coarse symbolic factorization is kept while its
+    /// pattern is unchanged (`DirectSolver`). If the coarsest operator cannot be
+    /// factorized (a coarse space that lost its rank at a ragged boundary), the
+    /// next finer level becomes the coarsest.
+    pub fn refresh(&mut self, a: Csr, symmetric: bool) -> Result<Shape, String> {
+        let mut operators = vec![a];
+        for (t, r) in self.transfers.iter().zip(&self.restrictions) {
+            let coarse = galerkin(r, operators.last().unwrap(), &t.prolongation);
+            operators.push(coarse);
+        }
+        let mut used = self.transfers.len();
+        loop {
+            let (pattern, values) = operators[used].to_csc(symmetric);
+            let matrix = SparseColMatRef::new(pattern.as_ref(), &values);
+            match self
+                .coarse
+                .factorize(matrix, Structure::of(symmetric), Ordering::Amd)
+            {
+                Ok(_) => break,
+                Err(e) if used == 0 => return Err(format!("coarse factorization failed: {e}")),
+                Err(_) => used -= 1,
+            }
+        }
+        let shape = Shape {
+            unknowns: operators[..=used].iter().map(|a| a.rows).collect(),
+            entries: operators[..=used].iter().map(|a| a.nnz()).collect(),
+        };
+        operators.truncate(used + 1);
+        self.smoothers = operators[..used]
+            .iter()
+            .zip(&self.transfers)
+            .map(|(a, t)| {
+                let values: Vec<Vec<f64>> =
+                    t.fine_blocks.iter().map(|b| a.block_values(b)).collect();
+                let blocks = BlockJacobi::new(
+                    t.fine_blocks
+                        .iter()
+                        .zip(&values)
+                        .map(|(u, v)| (u.as_slice(), v.as_slice())),
+                );
+                let lambda = 1.1 * largest_eigenvalue(a, &blocks);
+                Smoother { blocks, lambda }
+            })
+            .collect();
+        self.operators = operators;
+        Ok(shape)
+    }
+
+    /// Levels in use (with the coarsest).
+    pub fn depth(&self) -> usize {
+        self.operators.len()
+    }
+
+    /// The fine operator of the last refresh.
+    pub fn fine_operator(&self) -> &Csr {
+        &self.operators[0]
+    }
+
+    /// x = V-cycle(b) from level l on.
+    fn cycle(&self, l: usize, b: &[f64], x: &mut [f64]) {
+        if l == self.smoothers.len() {
+            match self.coarse.solve(b) {
+                Ok(y) => x.copy_from_slice(&y),
+                Err(_) => x.copy_from_slice(b),
+            }
+            return;
+        }
+        let (a, smoother) = (&self.operators[l], &self.smoothers[l]);
+        let (p, restriction) = (&self.transfers[l].prolongation, &self.restrictions[l]);
+        x.iter_mut().for_each(|v| *v = 0.0);
+        chebyshev(a, smoother, b, x);
+        // r = b − A x, restricted.
+        let mut r = vec![0.0; b.len()];
+        a.apply(x, &mut r);
+        r.iter_mut().zip(b).for_each(|(ri, bi)| *ri = bi - *ri);
+        let mut rc = vec![0.0; p.cols];
+        restriction.apply(&r, &mut rc);
+        let mut xc = vec![0.0; p.cols];
+        self.cycle(l + 1, &rc, &mut xc);
+        p.apply(&xc, &mut r);
+        x.iter_mut().zip(&r).for_each(|(xi, ci)| *xi += ci);
+        chebyshev(a, smoother, b, x);
+    }
+}
+
+impl Preconditioner for Multigrid {
+    fn apply(&self, r: &[f64], z: &mut [f64]) {
+        self.cycle(0, r, z);
+    }
+}
+
+/// λ_max(D⁻¹A) from ESTIMATE_STEPS steps of conjugate gradients preconditioned
+/// by D on A x = b with a fixed b: the largest eigenvalue of the Lanczos
+/// tridiagonal matrix that CG's coefficients define (Saad 2003, §6.7.3), a lower
+/// bound that converges fast to the top of the spectrum.
+fn largest_eigenvalue(a: &Csr, d: &BlockJacobi) -> f64 {
+    let n = a.rows;
+    if n == 0 {
+        return 1.0;
+    }
+    let mut r: Vec<f64> = (0..n).map(|i| 1.0 + 0.5 * (i as f64).sin()).collect();
+    let (mut z, mut q) = (vec![0.0; n], vec![0.0; n]);
+    d.apply(&r, &mut z);
+    let mut p = z.clone();
+    let mut rz: f64 = r.iter().zip(&z).map(|(a, b)| a * b).sum();
+    let (mut diagonal, mut off) = (Vec::new(), Vec::new());
+    let (mut alpha_prev, mut beta_prev) = (0.0, 0.0);
+    for k in 0..ESTIMATE_STEPS {
+        a.apply(&p, &mut q);
+        let pq: f64 = p.iter().zip(&q).map(|(a, b)| a * b).sum();
+        if !(pq > 0.0 && rz > 0.0) {
+            break;
+        }
+        let alpha = rz / pq;
+        // T_kk = 1/α_k + β_{k−1}/α_{k−1}, T_{k−1,k} = √β_{k−1}/α_{k−1}.
+        diagonal.push(1.0 / alpha + if k > 0 { beta_prev / alpha_prev } else { 0.0 });
+        if k > 0 {
+            off.push(beta_prev.sqrt() / alpha_prev);
+        }
+        r.iter_mut().zip(&q).for_each(|(ri, qi)| *ri -= alpha * qi);
+        d.apply(&r, &mut z);
+        let rz_next: f64 = r.iter().zip(&z).map(|(a, b)| a * b).sum();
+        let beta = rz_next / rz;
+        p.iter_mut()
+            .zip(&z)
+            .for_each(|(pi, zi)| *pi = zi + beta * *pi);
+        (alpha_prev, beta_prev, rz) = (alpha, beta, rz_next);
+    }
+    let m = diagonal.len();
+    if m == 0 {
+        return 1.0;
+    }
+    let t = nalgebra::DMatrix::<f64>::from_fn(m, m, |i, j| {
+        if i == j {
+            diagonal[i]
+        } else if i + 1 == j {
+            off[i]
+        } else if j + 1 == i {
+            off[j]
+        } else {
+            0.0
+        }
+    });
+    t.symmetric_eigenvalues().max()
+}
+
+/// SMOOTHING_STEPS Chebyshev iterations for A x = b preconditioned by the
+/// level's block Jacobi D, on [λ/EIGEN_RATIO, λ] (Saad 2003, Algorithm 12.1).
+fn chebyshev(a: &Csr, smoother: &Smoother, b: &[f64], x: &mut [f64]) {
+    let n = b.len();
+    let upper = smoother.lambda;
+    let lower = upper / EIGEN_RATIO;
+    let theta = 0.5 * (upper + lower);
+    let delta = 0.5 * (upper - lower);
+    let sigma = theta / delta;
+    let mut rho = 1.0 / sigma;
+    let (mut r, mut z, mut d) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    a.apply(x, &mut r);
+    r.iter_mut().zip(b).for_each(|(ri, bi)| *ri = bi - *ri);
+    smoother.blocks.apply(&r, &mut z);
+    d.iter_mut().zip(&z).for_each(|(di, zi)| *di = zi / theta);
+    for k in 0..SMOOTHING_STEPS {
+        x.iter_mut().zip(&d).for_each(|(xi, di)| *xi += di);
+        if k + 1 == SMOOTHING_STEPS {
+            break;
+        }
+        a.apply(&d, &mut z);
+        r.iter_mut().zip(&z).for_each(|(ri, adi)| *ri -= adi);
+        smoother.blocks.apply(&r, &mut z);
+        let rho_next = 1.0 / (2.0 * sigma - rho);
+        d.iter_mut()
+            .zip(&z)
+            .for_each(|(di, zi)| *di = rho_next * rho * *di + 2.0 * rho_next / delta * zi);
+        rho = rho_next;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The 1D Laplacian tridiag(−1, 2, −1) of order n as CSR.
+    fn laplacian(n: usize) -> Csr {
+        let mut m = Csr {
+            rows: n,
+            cols: n,
+            row_ptr: vec![0],
+            ..Default::default()
+        };
+        for i in 0..n {
+            if i > 0 {
+                m.col.push(i as u32 - 1);
+                m.val.push(-1.0);
+            }
+            m.col.push(i as u32);
+            m.val.push(2.0);
+            if i + 1 < n {
+                m.col.push(i as u32 + 1);
+                m.val.push(-1.0);
+            }
+            m.row_ptr.push(m.col.len());
+        }
+        m
+    }
+
+    #[test]
+    fn galerkin_of_the_identity_prolongation_is_the_operator() {
+        let a = laplacian(7);
+        let p = Csr {
+            rows: 7,
+            cols: 7,
+            row_ptr: (0..=7).collect(),
+            col: (0..7).collect(),
+            val: vec![1.0; 7],
+        };
+        let c = galerkin(&p.transpose(), &a, &p);
+        assert_eq!(c.row_ptr, a.row_ptr);
+        assert_eq!(c.col, a.col);
+        assert_eq!(c.val, a.val);
+    }
+
+    #[test]
+    fn transpose_twice_is_the_matrix() {
+        let mut a = laplacian(5);
+        a.val[1] = 3.0;
+        let t = a.transpose();
+        assert_eq!(t.val[2], 3.0);
+        let tt = t.transpose();
+        assert_eq!((tt.row_ptr, tt.col, tt.val), (a.row_ptr, a.col, a.val));
+    }
+}
