@@ -189,6 +189,7 @@ fn axis_prolongation(fine: usize, coarse: usize, p: usize) -> Vec<Vec<(usize, f6
 
 /// The next coarser level of `fine` and the transfer to it, or None when no
 /// direction can be coarsened.
+#[allow(clippy::needless_range_loop)] // d indexes several per-component arrays at once
 fn coarsen<const D: usize>(fine: &Level<D>, p: usize) -> Option<(Transfer, Level<D>)> {
     let cells: [usize; D] = std::array::from_fn(|d| fine.cells[d].div_ceil(2));
     if cells == fine.cells {

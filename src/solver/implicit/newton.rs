@@ -45,6 +45,7 @@ pub struct Newton {
 }
 
 /// The linear solver of the corrections K δu = −r (2-38).
+#[allow(clippy::large_enum_variant)] // one per solver, not per iteration
 pub enum Linear {
     /// The assembled tangent, factorized.
     Direct(DirectSolver),
