@@ -8,8 +8,9 @@
 //! - `factorize_first` (symbolic + numeric, a fresh solver) and
 //!   `factorize_refactor` (numeric only, the pattern unchanged);
 //! - `numeric_llt`: faer's numeric Cholesky alone, with the solver's ordering,
-//!   parallelism and fresh buffers, the yardstick of the others;
-//!   `numeric_llt_sequential`: the same on one thread;
+//!   parallelism (chosen by the factor's density) and fresh buffers, the
+//!   yardstick of the others; `numeric_llt_sequential` and
+//!   `numeric_llt_two_tasks`: the same on one thread and with two faer tasks;
 //! - `solve`;
 //! - `iteration_first`: the whole path of the first iteration of a step whose
 //!   stencils changed, as Newton takes it (`newton::factorized_tangent`:
@@ -48,7 +49,9 @@ use mpm::solver::implicit::newton::factorized_tangent;
 use mpm::solver::implicit::residual::{ordering, residual, tangent};
 use mpm::solver::implicit::step::{StepSettings, StepSystem};
 use mpm::solver::implicit::Implicit;
-use mpm::solver::linear::direct::{parallelism, DirectSolver, Ordering, Structure};
+use mpm::solver::linear::direct::{
+    cholesky_parallelism, parallelism, DirectSolver, Ordering, Structure,
+};
 use mpm::solver::linear::ordering::{fill_reducing, node_amd, node_metis};
 use mpm::solver::stepper::Stepper;
 use std::hint::black_box;
@@ -138,7 +141,7 @@ impl<const D: usize> Problem<D> {
 }
 
 /// faer's numeric LLᵀ alone into fresh buffers, with the direct solver's
-/// parallelism (`par`: `direct::parallelism()`) or sequential.
+/// parallelism (`par`: `direct::cholesky_parallelism`), sequential or with two tasks.
 fn numeric_llt(
     sym: &SymbolicCholesky<usize>,
     a: faer::sparse::SparseColMatRef<usize, f64>,
@@ -209,7 +212,7 @@ fn bench_problem<const D: usize>(c: &mut Criterion, p: &mut Problem<D>) {
         let sym = symbolic(perm);
         let t_symbolic = clock.elapsed().as_secs_f64();
         let clock = Instant::now();
-        numeric_llt(&sym, k.matrix(), parallelism());
+        numeric_llt(&sym, k.matrix(), cholesky_parallelism(&sym));
         let t_numeric = clock.elapsed().as_secs_f64();
         eprintln!(
             "{}: {label}: ordering {t_order:.3} s, symbolic (incl. ordering for scalar AMD) \
@@ -271,10 +274,13 @@ fn bench_problem<const D: usize>(c: &mut Criterion, p: &mut Problem<D>) {
         })
     });
     group.bench_function("numeric_llt", |bch| {
-        bch.iter(|| black_box(numeric_llt(&sym, k.matrix(), parallelism()).len()))
+        bch.iter(|| black_box(numeric_llt(&sym, k.matrix(), cholesky_parallelism(&sym)).len()))
     });
     group.bench_function("numeric_llt_sequential", |bch| {
         bch.iter(|| black_box(numeric_llt(&sym, k.matrix(), faer::Par::Seq).len()))
+    });
+    group.bench_function("numeric_llt_two_tasks", |bch| {
+        bch.iter(|| black_box(numeric_llt(&sym, k.matrix(), parallelism()).len()))
     });
     group.bench_function("solve", |bch| {
         bch.iter(|| black_box(solver.solve(&b).expect("solve")))

@@ -31,9 +31,29 @@ use serde::{Deserialize, Serialize};
 /// lets two cores share the work.
 const FACTOR_TASKS: usize = 2;
 
-/// faer's parallelism for [`FACTOR_TASKS`] tasks on the current rayon pool.
+/// faer's parallelism for [`FACTOR_TASKS`] tasks on the current rayon pool
+/// (LU; Cholesky-family factors choose by size, [`cholesky_parallelism`]).
 pub fn parallelism() -> Par {
     Par::rayon(FACTOR_TASKS)
+}
+
+/// The mean number of entries per column of L from which a Cholesky-family
+/// factorization runs with [`FACTOR_TASKS`] tasks instead of sequentially.
+/// Measured on 2 cores (docs/performance.md, quiet machine): at 163, 242 and
+/// 580 entries per column (2D blocks 64² and 160², 3D 12³) the second task
+/// made faer's numeric Cholesky 2.5×, 1.35× and 1.15× slower; at 1,199 (3D
+/// 20³) it made it 1.35× faster. Large dense supernodes are what it splits.
+pub const PARALLEL_MEAN_COLUMN: usize = 800;
+
+/// faer's parallelism for the numeric factorization and solves with `sym`:
+/// sequential for sparse factors, [`FACTOR_TASKS`] tasks for dense ones. It
+/// depends on the pattern only, so the results do not depend on the threads.
+pub fn cholesky_parallelism(sym: &SymbolicCholesky<usize>) -> Par {
+    if sym.len_val() >= PARALLEL_MEAN_COLUMN * sym.nrows() {
+        Par::rayon(FACTOR_TASKS)
+    } else {
+        Par::Seq
+    }
 }
 
 /// Largest accepted normwise backward error `‖K y − b‖ / (‖|K||y|‖ + ‖b‖)` of the probe solve.
@@ -275,11 +295,11 @@ impl DirectSolver {
             return Err(SolveError::InvalidInput(msg));
         }
         let mut x = b.to_vec();
-        let par = parallelism();
         let rhs = MatMut::from_column_major_slice_mut(&mut x, n, 1);
-        match &self.numeric {
-            Numeric::Lu(num) => self.solve_lu(num, rhs, par)?,
-            chol => self.solve_chol(chol, rhs, par)?,
+        match (&self.numeric, &self.chol) {
+            (Numeric::Lu(num), _) => self.solve_lu(num, rhs, parallelism())?,
+            (chol, Some(sym)) => self.solve_chol(chol, rhs, cholesky_parallelism(sym))?,
+            (_, None) => return Err(SolveError::NotFactorized),
         }
         Ok(x)
     }
@@ -406,7 +426,7 @@ impl DirectSolver {
     /// factor's buffer when there is one), then the probe check.
     fn try_llt(&mut self, lower: SparseColMatRef<usize, f64>) -> Result<(), SolveError> {
         let sym = self.chol.take().ok_or(SolveError::NotFactorized)?;
-        let par = parallelism();
+        let par = cholesky_parallelism(&sym);
         // faer overwrites every value of the factor, so the old buffer serves
         // (grown if the new pattern needs more).
         // A larger factor gets a buffer of its exact size, the old one freed first.
@@ -446,7 +466,7 @@ impl DirectSolver {
     /// Numeric intranodal LBLᵀ with the cached symbolic factorization, then the probe check.
     fn try_lblt(&mut self, lower: SparseColMatRef<usize, f64>) -> Result<(), SolveError> {
         let sym = self.chol.as_ref().ok_or(SolveError::NotFactorized)?;
-        let (n, par) = (sym.nrows(), parallelism());
+        let (n, par) = (sym.nrows(), cholesky_parallelism(sym));
         let mut values = vec![0.0; sym.len_val()];
         let mut subdiag = vec![0.0; n];
         let (mut fwd, mut inv) = (vec![0usize; n], vec![0usize; n]);
@@ -765,6 +785,31 @@ mod tests {
     }
 
     /// 2D 5-point Laplacian (Dirichlet), diagonal `4 * scale - shift`.
+    /// An SPD matrix shaped like a 3D elastic tangent: the 27-point stencil of
+    /// an m³ node grid (strictly diagonally dominant) ⊗ a 3×3 SPD block coupling
+    /// the components (1, 2, 1 tridiagonal), 3 unknowns per node.
+    fn elastic_like_3d(m: usize) -> Trip {
+        let block = [[2.0, 1.0, 0.0], [1.0, 2.0, 1.0], [0.0, 1.0, 2.0]];
+        let id = |i: usize, j: usize, k: usize| (i * m + j) * m + k;
+        let range = |i: usize| i.saturating_sub(1)..(i + 2).min(m);
+        let mut t = Vec::new();
+        for (i, j, k) in
+            (0..m).flat_map(|i| (0..m).flat_map(move |j| (0..m).map(move |k| (i, j, k))))
+        {
+            for (p, q, r) in
+                range(i).flat_map(|p| range(j).flat_map(move |q| range(k).map(move |r| (p, q, r))))
+            {
+                let w = if (p, q, r) == (i, j, k) { 26.5 } else { -1.0 };
+                for (a, row) in block.iter().enumerate() {
+                    for (b, &v) in row.iter().enumerate().filter(|(_, v)| **v != 0.0) {
+                        t.push((3 * id(i, j, k) + a, 3 * id(p, q, r) + b, w * v));
+                    }
+                }
+            }
+        }
+        t
+    }
+
     fn laplace_2d(m: usize, scale: f64, shift: f64) -> Trip {
         let id = |i: usize, j: usize| i * m + j;
         let mut t = Vec::new();
@@ -1170,7 +1215,29 @@ mod tests {
     /// same solution, bit for bit, on one thread and on two.
     #[test]
     fn factors_do_not_depend_on_the_number_of_threads() {
+        let m = 16;
+        let elastic_like = elastic_like_3d(m);
+        let n3 = 3 * m * m * m;
+        // The elasticity-like block is dense enough for two faer tasks, the
+        // Laplacians are factorized sequentially: both paths are checked.
+        let sym = |n: usize, t: &Trip| {
+            let a = csc_from_triplets(n, t, Structure::Symmetric).unwrap();
+            let params = CholeskySymbolicParams::default();
+            factorize_symbolic_cholesky(a.symbolic(), Side::Lower, SymmetricOrdering::Amd, params)
+                .unwrap()
+        };
+        let two_tasks = sym(n3, &elastic_like);
+        let mean = two_tasks.len_val() / n3;
+        assert!(
+            matches!(cholesky_parallelism(&two_tasks), Par::Rayon(_)),
+            "mean column count {mean} should take two tasks"
+        );
+        assert!(matches!(
+            cholesky_parallelism(&sym(27_000, &laplace_3d(30))),
+            Par::Seq
+        ));
         for (n, t) in [
+            (n3, elastic_like),
             (27_000, laplace_3d(30)),
             (40_000, laplace_2d(200, 1.0, 0.0)),
         ] {
