@@ -26,8 +26,51 @@ fn ratio(num: f64, den: f64) -> f64 {
 
 /// The p + 1 basis functions that are nonzero on the knot span of `xi` (cell units),
 /// with their derivatives per cell; a point on the max face uses the last span.
+/// Spans whose functions see only unrepeated knots take the uniform polynomials.
 fn basis(xi: f64, p: usize, cells: usize) -> AxisFactors {
-    basis_in_span(xi, cell_index(xi, cells), p, cells)
+    let first = cell_index(xi, cells);
+    if p >= 2 && first >= p && first + p < cells {
+        uniform_basis(xi - first as f64, first, p)
+    } else {
+        basis_in_span(xi, first, p, cells)
+    }
+}
+
+/// The uniform (cardinal) B-splines of degree 2 or 3 that are nonzero on a span
+/// at local coordinate t ∈ [0, 1], and their derivatives per cell (the pieces of
+/// Cox–de Boor on equally spaced knots; e.g. Piegl & Tiller, ex. 2.2 for p = 2).
+fn uniform_basis(t: f64, first: usize, p: usize) -> AxisFactors {
+    let s = 1.0 - t;
+    let (weight, slope) = match p {
+        2 => (
+            [0.5 * s * s, 0.5 + t * s, 0.5 * t * t, 0.0],
+            [-s, s - t, t, 0.0],
+        ),
+        _ => {
+            debug_assert_eq!(p, 3);
+            let (t2, s2) = (t * t, s * s);
+            (
+                [
+                    s2 * s / 6.0,
+                    (3.0 * t2 * t - 6.0 * t2 + 4.0) / 6.0,
+                    (3.0 * s2 * s - 6.0 * s2 + 4.0) / 6.0,
+                    t2 * t / 6.0,
+                ],
+                [
+                    -0.5 * s2,
+                    0.5 * t * (3.0 * t - 4.0),
+                    -0.5 * s * (3.0 * s - 4.0),
+                    0.5 * t2,
+                ],
+            )
+        }
+    };
+    AxisFactors {
+        first,
+        count: p + 1,
+        weight,
+        slope,
+    }
 }
 
 /// The p + 1 basis functions of knot span `first` (cell `first`) at `xi`, which
@@ -272,6 +315,46 @@ mod tests {
     #[test]
     fn matches_naive_recursion_3d() {
         (1..=3).for_each(matches_naive_recursion::<3>);
+    }
+
+    /// The uniform pieces agree with Cox–de Boor on every span where they are
+    /// used (to round-off), and the clamped spans next to the faces still go
+    /// through Cox–de Boor (their values differ from the uniform pieces).
+    #[test]
+    fn uniform_pieces_match_cox_de_boor() {
+        let cells = 12;
+        for p in 2..=3 {
+            let mut uniform_spans = 0;
+            for span in 0..cells {
+                for k in 0..=64 {
+                    let xi = span as f64 + k as f64 / 64.0;
+                    let (fast, general) = (
+                        basis(xi, p, cells),
+                        basis_in_span(xi, cell_index(xi, cells), p, cells),
+                    );
+                    assert_eq!((fast.first, fast.count), (general.first, general.count));
+                    for r in 0..=p {
+                        assert!(
+                            (fast.weight[r] - general.weight[r]).abs() < 4e-16,
+                            "p {p} ξ {xi} r {r}"
+                        );
+                        assert!(
+                            (fast.slope[r] - general.slope[r]).abs() < 1e-15,
+                            "p {p} ξ {xi} r {r}"
+                        );
+                    }
+                }
+                let t = 0.3;
+                let clamped = basis_in_span(span as f64 + t, span, p, cells);
+                let cardinal = uniform_basis(t, span, p);
+                let same = (0..=p).all(|r| (clamped.weight[r] - cardinal.weight[r]).abs() < 1e-12);
+                uniform_spans += same as usize;
+                // The spans at the faces see the repeated knots.
+                assert!(!same || (span > 0 && span + 1 < cells), "p {p} span {span}");
+            }
+            // At least spans p .. cells − p − 1, where the fast path is taken.
+            assert!(uniform_spans >= cells - 2 * p, "p {p}");
+        }
     }
 
     /// Central differences away from the knots (where the p-th derivative jumps).
