@@ -11,7 +11,7 @@ use crate::dim::{restrict, Mat3, Tensor, Vector};
 use crate::model::particles::Particles;
 use crate::model::Model;
 use crate::parallel::MIN_PARALLEL_LEN;
-use crate::physics::shape::{ShapeFunction, Stencils};
+use crate::physics::shape::{Owner, ShapeFunction, Stencils};
 use rayon::prelude::*;
 
 /// Active nodes of one step and, for each, the stencil entries that touch it.
@@ -101,13 +101,14 @@ impl NodeMap {
         T: Copy + Send + Sync + std::ops::Add<Output = T>,
         F: Fn(usize, usize) -> T + Sync,
     {
+        let owner = Owner::new(stride);
         (0..self.len())
             .into_par_iter()
             .with_min_len(MIN_PARALLEL_LEN)
             .map(|a| {
                 self.node_entries(a)
                     .iter()
-                    .fold(zero, |acc, &e| acc + f(e as usize / stride, e as usize))
+                    .fold(zero, |acc, &e| acc + f(owner.of(e), e as usize))
             })
             .collect()
     }
@@ -126,14 +127,26 @@ pub fn stencils_and_nodes<const D: usize>(
     map.build(st, m.grid.node_count());
 }
 
-/// Nodal mass (2-24) and momentum (2-25).
+/// Nodal mass (2-24) and momentum (2-25), in one pass over the entries.
 pub fn mass_momentum<const D: usize>(
     map: &NodeMap,
     st: &Stencils<D>,
     p: &Particles<D>,
 ) -> (Vec<f64>, Vec<Vector<D>>) {
-    let mass = map.gather(st.stride, 0.0, |q, e| p.mass[q] * st.weight[e]);
-    (mass, mass_weighted(map, st, p, &p.v))
+    let owner = st.owner();
+    (0..map.len())
+        .into_par_iter()
+        .with_min_len(MIN_PARALLEL_LEN)
+        .map(|a| {
+            let (mut mass, mut momentum) = (0.0, Vector::<D>::zeros());
+            for &e in map.node_entries(a) {
+                let (q, e) = (owner.of(e), e as usize);
+                mass += p.mass[q] * st.weight[e];
+                momentum += p.v[q] * (p.mass[q] * st.weight[e]);
+            }
+            (mass, momentum)
+        })
+        .unzip()
 }
 
 /// Σ_p m_p S_Ip a_p at every active node: the nodal momentum (2-25) of a particle
@@ -224,8 +237,17 @@ pub fn external_force<const D: usize>(
     })
 }
 
+/// What a particle contributes to the nodal force at each of its entries:
+/// the applied force m g + s f, the in-plane stress and the volume.
+#[derive(Clone, Copy)]
+struct ForceSource<const D: usize> {
+    applied: Vector<D>,
+    stress: Tensor<D>,
+    volume: f64,
+}
+
 /// Nodal force f_ext − f_int with the particles' Cauchy stress and current volume
-/// (2-51, 2-52), summed entry by entry (one gather).
+/// (2-51, 2-52), summed entry by entry (one gather over per-particle sources).
 pub fn nodal_force<const D: usize>(
     map: &NodeMap,
     st: &Stencils<D>,
@@ -233,9 +255,18 @@ pub fn nodal_force<const D: usize>(
     gravity: &Vector<D>,
     load_factor: &(impl Fn(usize) -> f64 + Sync),
 ) -> Vec<Vector<D>> {
+    let sources: Vec<ForceSource<D>> = (0..p.len())
+        .into_par_iter()
+        .with_min_len(MIN_PARALLEL_LEN)
+        .map(|q| ForceSource {
+            applied: applied_force(p, q, gravity, load_factor),
+            stress: restrict::<D>(&p.stress[q]),
+            volume: p.volume[q],
+        })
+        .collect();
     map.gather(st.stride, Vector::<D>::zeros(), |q, e| {
-        external_force_at(p, q, st.weight[e], gravity, load_factor)
-            - internal_force_at(&p.stress[q], p.volume[q], &st.grad[e])
+        let s = &sources[q];
+        s.applied * st.weight[e] - s.stress * st.grad[e] * s.volume
     })
 }
 

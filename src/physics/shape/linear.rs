@@ -50,6 +50,7 @@ fn hat_factors<const D: usize>(grid: &Grid<D>, x: &Vector<D>, d: usize) -> AxisF
 
 /// Tensor product S_I = Π_d S_d, ∂S_I/∂x_d = S'_d Π_{e≠d} S_e of per-axis factors.
 /// Skips entries whose weight and gradient are exactly zero; returns the count.
+/// Entries are written x fastest.
 pub(super) fn tensor_product<const D: usize>(
     grid: &Grid<D>,
     axes: &[AxisFactors; D],
@@ -57,16 +58,17 @@ pub(super) fn tensor_product<const D: usize>(
     w: &mut [f64],
     grad: &mut [Vector<D>],
 ) -> usize {
-    let total: usize = axes.iter().map(|a| a.count).product();
+    // Flat node index = Σ_d ijk_d · stride_d (`Grid::node_index`).
+    let mut stride = [1usize; D];
+    for d in 1..D {
+        stride[d] = stride[d - 1] * grid.nodes[d - 1];
+    }
+    if axes.iter().any(|a| a.count == 0) {
+        return 0;
+    }
+    let mut local = [0usize; D];
     let mut n = 0;
-    for flat in 0..total {
-        // Local multi-index, x fastest.
-        let mut rest = flat;
-        let local: [usize; D] = std::array::from_fn(|d| {
-            let k = rest % axes[d].count;
-            rest /= axes[d].count;
-            k
-        });
+    loop {
         let weight: f64 = (0..D).map(|d| axes[d].weight[local[d]]).product();
         let gradient = Vector::<D>::from_fn(|d, _| {
             (0..D)
@@ -79,15 +81,27 @@ pub(super) fn tensor_product<const D: usize>(
                 })
                 .product()
         });
-        if weight == 0.0 && gradient.iter().all(|g| *g == 0.0) {
-            continue;
+        if weight != 0.0 || gradient.iter().any(|g| *g != 0.0) {
+            let index: usize = (0..D).map(|d| (axes[d].first + local[d]) * stride[d]).sum();
+            node[n] = index as u32;
+            w[n] = weight;
+            grad[n] = gradient;
+            n += 1;
         }
-        node[n] = grid.node_index(std::array::from_fn(|d| axes[d].first + local[d])) as u32;
-        w[n] = weight;
-        grad[n] = gradient;
-        n += 1;
+        // Next local multi-index, x fastest.
+        let mut d = 0;
+        loop {
+            local[d] += 1;
+            if local[d] < axes[d].count {
+                break;
+            }
+            local[d] = 0;
+            d += 1;
+            if d == D {
+                return n;
+            }
+        }
     }
-    n
 }
 
 /// Hat-function weights and gradients of a particle at `x` (at most 2^D entries).

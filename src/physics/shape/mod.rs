@@ -108,6 +108,35 @@ impl<const D: usize> Stencils<D> {
     pub fn range(&self, p: usize) -> std::ops::Range<usize> {
         p * self.stride..p * self.stride + self.count[p] as usize
     }
+
+    /// The particle of an entry, for loops over many entries.
+    pub fn owner(&self) -> Owner {
+        Owner::new(self.stride)
+    }
+}
+
+/// The particle that owns stencil entry e, ⌊e / stride⌋, by one multiplication
+/// instead of a division: ⌊e/d⌋ = ⌊c·e / 2⁶⁴⌋ with c = ⌈2⁶⁴/d⌉, exact for every
+/// 32-bit e and 1 < d < 2³² (Lemire, Kaser & Kurz 2019, Softw. Pract. Exp. 49).
+#[derive(Clone, Copy, Debug)]
+pub struct Owner {
+    c: u64,
+}
+
+impl Owner {
+    pub fn new(stride: usize) -> Self {
+        assert!(
+            (2..1 << 32).contains(&stride),
+            "stencil stride {stride} outside 2..2³²"
+        );
+        Owner {
+            c: u64::MAX / stride as u64 + 1,
+        }
+    }
+
+    pub fn of(&self, e: u32) -> usize {
+        ((self.c as u128 * e as u128) >> 64) as usize
+    }
 }
 
 #[cfg(test)]
@@ -341,6 +370,23 @@ pub(crate) mod tests {
             }
         }
         f
+    }
+
+    #[test]
+    fn owner_is_the_integer_quotient() {
+        let mut rng = Rng::new(3);
+        for stride in (2..=130).chain([343, 1000, 4096, 65_537]) {
+            let owner = Owner::new(stride);
+            let near_max = (0..64).map(|k| u32::MAX - k);
+            let multiples = (0..64u32).flat_map(|k| {
+                let m = (k as u64 * stride as u64).min(u32::MAX as u64) as u32;
+                [m.saturating_sub(1), m, m.saturating_add(1)]
+            });
+            let random = (0..2000).map(|_| rng.next_u64() as u32);
+            for e in near_max.chain(multiples).chain(random) {
+                assert_eq!(owner.of(e), e as usize / stride, "{e} / {stride}");
+            }
+        }
     }
 
     /// Every family, through the dispatch, never writes more than `max_support`
