@@ -13,6 +13,8 @@ use crate::model::Model;
 use crate::parallel::MIN_PARALLEL_LEN;
 use crate::physics::shape::{Owner, ShapeFunction, Stencils};
 use rayon::prelude::*;
+use std::sync::atomic::Ordering::Relaxed;
+use std::sync::atomic::{AtomicBool, AtomicU32};
 
 /// Active nodes of one step and, for each, the stencil entries that touch it.
 #[derive(Clone, Debug, Default)]
@@ -25,13 +27,52 @@ pub struct NodeMap {
     pub start: Vec<u32>,
     /// Stencil entry indices (p·stride + k) in increasing order within each node.
     pub entries: Vec<u32>,
+    /// Buffers of `build`, kept between steps.
+    scratch: BuildScratch,
+}
+
+/// The buffers the parallel `NodeMap::build` writes through shared references.
+#[derive(Debug, Default)]
+struct BuildScratch {
+    /// Per grid node: touched by an entry this step (cleared after the build).
+    touched: Vec<AtomicBool>,
+    /// Entries at their sorted positions.
+    placed: Vec<AtomicU32>,
+}
+
+impl Clone for BuildScratch {
+    /// Scratch is not state: a copy starts without it.
+    fn clone(&self) -> Self {
+        BuildScratch::default()
+    }
 }
 
 impl NodeMap {
     pub const NONE: u32 = u32::MAX;
 
-    /// Rebuild for this step's stencils on a grid with `n_nodes` nodes.
+    /// Rebuild for this step's stencils on a grid with `n_nodes` nodes: the
+    /// active nodes in ascending order and, per node, its entries in ascending
+    /// order (a stable counting sort of the entries by node). In parallel over
+    /// chunks of particles; every chunk writes only positions that the counts
+    /// fix, so the map is the same for any number of threads.
     pub fn build<const D: usize>(&mut self, st: &Stencils<D>, n_nodes: usize) {
+        let n_particles = st.count.len();
+        let chunk = n_particles
+            .div_ceil(rayon::current_num_threads())
+            .max(MIN_PARALLEL_LEN);
+        let scratch = &mut self.scratch;
+        if scratch.touched.len() != n_nodes {
+            scratch.touched = (0..n_nodes).map(|_| AtomicBool::new(false)).collect();
+        }
+        let touched = &scratch.touched;
+        (0..n_particles)
+            .into_par_iter()
+            .with_min_len(MIN_PARALLEL_LEN)
+            .for_each(|p| {
+                for e in st.range(p) {
+                    touched[st.node[e] as usize].store(true, Relaxed);
+                }
+            });
         if self.local.len() != n_nodes {
             self.local = vec![Self::NONE; n_nodes];
         } else {
@@ -39,42 +80,67 @@ impl NodeMap {
                 self.local[g as usize] = Self::NONE;
             }
         }
-        self.active.clear();
-        let n_particles = st.count.len();
-        for p in 0..n_particles {
-            for e in st.range(p) {
-                let g = st.node[e] as usize;
-                if self.local[g] == Self::NONE {
-                    self.local[g] = 0;
-                    self.active.push(g as u32);
-                }
-            }
-        }
-        self.active.sort_unstable();
+        self.active = (0..n_nodes as u32)
+            .into_par_iter()
+            .filter(|&g| touched[g as usize].load(Relaxed))
+            .collect();
         for (a, &g) in self.active.iter().enumerate() {
             self.local[g as usize] = a as u32;
+            touched[g as usize].store(false, Relaxed);
         }
-        // Counting sort of entries by node, stable in entry order.
+        // Entries per chunk of particles and node: counts[c · n + a].
+        let n = self.active.len();
+        let chunks = n_particles.div_ceil(chunk).max(1);
+        let mut counts = vec![0u32; chunks * n];
+        counts
+            .par_chunks_mut(n.max(1))
+            .enumerate()
+            .for_each(|(c, count)| {
+                for p in c * chunk..((c + 1) * chunk).min(n_particles) {
+                    for e in st.range(p) {
+                        count[self.local_of(st, e)] += 1;
+                    }
+                }
+            });
+        // Node a's entries start at start[a]; chunk c's at start[a] + Σ_{c'<c} counts[c'][a].
         self.start.clear();
-        self.start.resize(self.active.len() + 1, 0);
-        for p in 0..n_particles {
-            for e in st.range(p) {
-                let a = self.local_of(st, e);
-                self.start[a + 1] += 1;
+        self.start.push(0);
+        for a in 0..n {
+            let total: u32 = (0..chunks).map(|c| counts[c * n + a]).sum();
+            self.start.push(self.start[a] + total);
+        }
+        let mut next = counts;
+        for a in 0..n {
+            let mut at = self.start[a];
+            for c in 0..chunks {
+                let count = next[c * n + a];
+                next[c * n + a] = at;
+                at += count;
             }
         }
-        for a in 0..self.active.len() {
-            self.start[a + 1] += self.start[a];
+        let total = self.start[n] as usize;
+        let placed = &mut self.scratch.placed;
+        if placed.len() < total {
+            placed.resize_with(total, || AtomicU32::new(0));
         }
-        let mut next: Vec<u32> = self.start[..self.active.len()].to_vec();
-        self.entries.resize(*self.start.last().unwrap() as usize, 0);
-        for p in 0..n_particles {
-            for e in st.range(p) {
-                let a = self.local_of(st, e);
-                self.entries[next[a] as usize] = e as u32;
-                next[a] += 1;
-            }
-        }
+        let (placed, local) = (&self.scratch.placed, &self.local);
+        next.par_chunks_mut(n.max(1))
+            .enumerate()
+            .for_each(|(c, next)| {
+                for p in c * chunk..((c + 1) * chunk).min(n_particles) {
+                    for e in st.range(p) {
+                        let a = local[st.node[e] as usize] as usize;
+                        placed[next[a] as usize].store(e as u32, Relaxed);
+                        next[a] += 1;
+                    }
+                }
+            });
+        self.entries.resize(total, 0);
+        self.entries
+            .par_iter_mut()
+            .zip(&placed[..total])
+            .with_min_len(MIN_PARALLEL_LEN)
+            .for_each(|(e, p)| *e = p.load(Relaxed));
     }
 
     pub fn len(&self) -> usize {
@@ -302,4 +368,80 @@ pub fn gradient<const D: usize>(
     st.range(p).fold(Tensor::<D>::zeros(), |acc, e| {
         acc + u[map.local_of(st, e)] * st.grad[e].transpose()
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::grid::Grid;
+    use crate::physics::shape::tests::sample_points;
+
+    /// The map by the definition: nodes in ascending order, each with its
+    /// entries in ascending order.
+    fn by_definition<const D: usize>(st: &Stencils<D>) -> (Vec<u32>, Vec<Vec<u32>>) {
+        let mut pairs: Vec<(u32, u32)> = (0..st.count.len())
+            .flat_map(|p| st.range(p).map(|e| (st.node[e], e as u32)))
+            .collect();
+        pairs.sort_unstable();
+        let mut active: Vec<u32> = pairs.iter().map(|&(g, _)| g).collect();
+        active.dedup();
+        let entries = active
+            .iter()
+            .map(|&g| {
+                pairs
+                    .iter()
+                    .filter(|&&(h, _)| h == g)
+                    .map(|&(_, e)| e)
+                    .collect()
+            })
+            .collect();
+        (active, entries)
+    }
+
+    /// The parallel build gives the map of the definition on 1, 2 and 3 threads,
+    /// also when rebuilt on a map of an earlier step.
+    #[test]
+    fn node_map_is_the_stable_sort_of_entries_by_node() {
+        let grid = Grid::<2>::new(
+            Vector::<2>::new(0.0, 0.0),
+            Vector::<2>::new(3.0, 2.0),
+            [30, 20],
+            2,
+        );
+        let x = sample_points(&grid, 5000);
+        let half = vec![Vector::<2>::repeat(0.025); x.len()];
+        let f = vec![Mat3::identity(); x.len()];
+        let mut st = Stencils::<2>::default();
+        st.compute(
+            ShapeFunction::Bspline2,
+            &grid,
+            &x[..3000],
+            &half[..3000],
+            &f[..3000],
+        );
+        let mut earlier = NodeMap::default();
+        earlier.build(&st, grid.node_count());
+        st.compute(ShapeFunction::Bspline2, &grid, &x, &half, &f);
+        let (active, entries) = by_definition(&st);
+        for threads in 1..=3 {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            for mut map in [NodeMap::default(), earlier.clone()] {
+                pool.install(|| map.build(&st, grid.node_count()));
+                assert_eq!(map.active, active, "{threads} threads");
+                for (a, expected) in entries.iter().enumerate() {
+                    assert_eq!(
+                        map.node_entries(a),
+                        &expected[..],
+                        "{threads} threads, node {a}"
+                    );
+                    assert_eq!(map.local[active[a] as usize] as usize, a);
+                }
+                let inactive = map.local.iter().filter(|&&l| l == NodeMap::NONE).count();
+                assert_eq!(inactive, grid.node_count() - active.len());
+            }
+        }
+    }
 }
