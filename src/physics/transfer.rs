@@ -358,6 +358,22 @@ pub fn interpolate<const D: usize>(
     })
 }
 
+/// (Σ_I S_Ip u_I, Σ_I S_Ip w_I) for particle p: two nodal fields in one pass
+/// (each sum as `interpolate` forms it).
+pub fn interpolate_two<const D: usize>(
+    map: &NodeMap,
+    st: &Stencils<D>,
+    p: usize,
+    u: &[Vector<D>],
+    w: &[Vector<D>],
+) -> (Vector<D>, Vector<D>) {
+    st.range(p)
+        .fold((Vector::<D>::zeros(), Vector::<D>::zeros()), |(su, sw), e| {
+            let (a, weight) = (map.local_of(st, e), st.weight[e]);
+            (su + u[a] * weight, sw + w[a] * weight)
+        })
+}
+
 /// Σ_I u_I ⊗ ∇S_Ip for particle p (gradient of a nodal vector field, e.g. L_p).
 pub fn gradient<const D: usize>(
     map: &NodeMap,

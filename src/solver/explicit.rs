@@ -13,7 +13,7 @@ use crate::physics::deformation::Trial;
 use crate::physics::mirror::Mirror;
 use crate::physics::shape::{ShapeFunction, Stencils};
 use crate::physics::transfer::{
-    applied_force, interpolate, mass_average, mass_momentum, nodal_force, NodeMap,
+    applied_force, interpolate_two, mass_average, mass_momentum, nodal_force, NodeMap,
 };
 use crate::scene::{Scheme, SolverConfig};
 use crate::solver::divergence::{check_state, Divergence};
@@ -167,8 +167,8 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
             .enumerate()
             .with_min_len(MIN_PARALLEL_LEN)
             .for_each(|(q, (v, x))| {
-                let v_flip = *v + interpolate(map, st, q, &accel) * dt;
-                let v_pic = interpolate(map, st, q, &velocity_new);
+                let (a, v_pic) = interpolate_two(map, st, q, &accel, &velocity_new);
+                let v_flip = *v + a * dt;
                 *v = v_flip * flip + v_pic * (1.0 - flip);
                 *x += v_pic * dt;
             });
