@@ -1,12 +1,13 @@
 //! The multigrid preconditioner (`preconditioner = "multigrid"`) against the
 //! direct solver: the same particle state on the column, the two-layer column,
-//! the block (also with F-bar through GMRES, an unsymmetric tangent) and the
-//! cantilever (quadratic B-splines with tied nodes); results independent of the
+//! the block (also with F-bar through GMRES, an unsymmetric tangent), the
+//! cantilever (quadratic B-splines with tied nodes) and a plastic slope
+//! (Mohr–Coulomb, ψ = 0, F-bar: GMRES); results independent of the
 //! thread count; a Krylov failure handled like a Newton failure. The scenes are
 //! small, so `multigrid_coarse_unknowns` is lowered to give them three to five
 //! levels.
 
-use crate::common::{read_newton, read_output, run_cli, run_problem, Table};
+use crate::common::{read_newton, read_output, run_cli, run_problem, run_text, Table};
 use mpm::run::RunError;
 
 fn particles(scene: &str, overrides: &[&str]) -> (Table, usize, usize) {
@@ -91,6 +92,72 @@ fn scenes_same_state_as_direct() {
         assert!(d < 1e-8, "{scene} {base:?}: difference {d:.2e}");
         assert!(krylov > 0);
     }
+}
+
+/// The Griffiths & Lane slope of `problems/slope_griffiths_lane.toml` on a coarse
+/// grid without the strength-reduction search, at F = 1.3 (plastic zones, not yet
+/// failing): Mohr–Coulomb with ψ = 0 and F-bar give an unsymmetric tangent, solved
+/// by GMRES with the multigrid and by the direct solver's LU; the same state to
+/// 1e-8 of the largest displacement and stress (Newton to 1e-10 on both paths).
+#[test]
+fn slope_same_state_as_direct() {
+    let slope = r#"
+dimension = 2
+gravity = [0.0, -10.0]
+[grid]
+min = [0.0, 0.0]
+max = [40.0, 12.0]
+cells = [40, 12]
+[[material]]
+name = "soil"
+model = "mohr_coulomb"
+density = 2.0
+youngs_modulus = 1.0e5
+poisson_ratio = 0.3
+cohesion = 10.0
+friction_angle = 20.0
+dilation_angle = 0.0
+[[body]]
+name = "slope"
+material = "soil"
+shape = "polygon"
+vertices = [[0.0, 0.0], [35.0, 0.0], [15.0, 10.0], [0.0, 10.0]]
+particles_per_cell = 2
+[[boundary]]
+face = "xmin"
+condition = "roller"
+[[boundary]]
+face = "ymin"
+condition = "fixed"
+[geostatic]
+[solver]
+kind = "implicit"
+integrator = "quasi_static"
+end_time = 1.0
+load_steps = 1
+gravity_ramp = false
+residual_tolerance = 1e-10
+line_search = true
+max_iterations = 50
+fbar = true
+strength_reduction_factor = 1.3
+[output]
+frames = 0
+"#;
+    let run = |overrides: &[&str]| {
+        let (result, dir) = run_text(slope, overrides);
+        let summary = result.unwrap_or_else(|e| panic!("slope {overrides:?}: {e}"));
+        let table = Table::read(&dir.path().join("particles_final.csv")).unwrap();
+        (table, summary.solver.krylov_iterations.unwrap_or(0))
+    };
+    let (direct, _) = run(&[]);
+    let mut args = vec!["solver.linear_solver=gmres"];
+    args.extend(MULTIGRID);
+    let (mg, krylov) = run(&args);
+    let d = difference(&direct, &mg, &["sxx", "syy", "sxy"]);
+    println!("slope gmres/multigrid: difference {d:.1e}, {krylov} Krylov iterations");
+    assert!(d < 1e-8, "slope: difference {d:.2e}");
+    assert!(krylov > 0);
 }
 
 /// CG with the multigrid gives byte-identical particles with 1 and 2 threads
