@@ -80,7 +80,7 @@ struct BenchArgs {
     #[arg(long, value_name = "FILE")]
     config: Option<PathBuf>,
     /// Configurations to run, comma-separated (built-in: explicit, direct,
-    /// gmres_P and cg_P for P = none, jacobi, block_jacobi, lagged_direct).
+    /// gmres_P and cg_P for P = none, jacobi, block_jacobi, lagged_direct, multigrid, lagged_multigrid).
     #[arg(long, value_delimiter = ',', value_name = "NAMES")]
     configurations: Option<Vec<String>>,
     /// Time steps to sweep (Newmark; quasi-static scenes without load steps).

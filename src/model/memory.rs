@@ -79,7 +79,9 @@ impl Estimate {
             s.linear_solver() == LinearSolver::Direct
                 || matches!(
                     s.preconditioner(),
-                    PreconditionerKind::LaggedDirect | PreconditionerKind::Multigrid
+                    PreconditionerKind::LaggedDirect
+                        | PreconditionerKind::Multigrid
+                        | PreconditionerKind::LaggedMultigrid
                 )
         });
         let tangent_bytes = if assembles {

@@ -84,6 +84,10 @@ pub enum PreconditionerKind {
     /// Geometric multigrid on the background grid over the assembled tangent,
     /// which is then also the Krylov operator (`solver::linear::multigrid`).
     Multigrid,
+    /// The same multigrid built from the assembled tangent of an earlier
+    /// iteration and kept (as `LaggedDirect` keeps its factorization); the Krylov
+    /// operator stays the matrix-free difference product.
+    LaggedMultigrid,
 }
 
 /// The `[solver]` table (or a `[[stage]]`). The accessors give the documented

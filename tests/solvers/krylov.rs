@@ -63,11 +63,16 @@ fn counts(r: &Run) -> String {
     )
 }
 
-const KRYLOV_CONFIGS: [&[&str]; 4] = [
+const KRYLOV_CONFIGS: [&[&str]; 5] = [
     &["solver.linear_solver=gmres"],
     &[
         "solver.linear_solver=gmres",
         "solver.preconditioner=lagged_direct",
+    ],
+    &[
+        "solver.linear_solver=gmres",
+        "solver.preconditioner=lagged_multigrid",
+        "solver.multigrid_coarse_unknowns=8",
     ],
     &["solver.linear_solver=cg", "solver.preconditioner=jacobi"],
     &["solver.linear_solver=cg", "solver.preconditioner=none"],
@@ -127,6 +132,11 @@ fn cantilever_small_load_same_state_as_direct() {
         &[
             "solver.linear_solver=gmres",
             "solver.preconditioner=lagged_direct",
+        ],
+        &[
+            "solver.linear_solver=gmres",
+            "solver.preconditioner=lagged_multigrid",
+            "solver.multigrid_coarse_unknowns=8",
         ],
     ] {
         let args: Vec<&str> = small.iter().chain(config).copied().collect();
@@ -275,6 +285,11 @@ fn material_without_tangent_runs_on_the_krylov_path() {
         &[
             "solver.linear_solver=gmres",
             "solver.preconditioner=lagged_direct",
+        ],
+        &[
+            "solver.linear_solver=gmres",
+            "solver.preconditioner=lagged_multigrid",
+            "solver.multigrid_coarse_unknowns=8",
         ],
     ] {
         let args: Vec<&str> = large.iter().chain(config).copied().collect();

@@ -4,8 +4,8 @@
 //! - `explicit`: the scene's `[solver]` as an explicit run (implicit keys removed);
 //! - `direct`: the implicit solver with the sparse direct factorisation (the
 //!   default linear solver: `linear_solver` and `preconditioner` removed);
-//! - `gmres_P`, `cg_P` for P in none, jacobi, block_jacobi, lagged_direct: the
-//!   matrix-free Newton–Krylov path (`linear_solver`, `preconditioner` keys).
+//! - `gmres_P`, `cg_P` for P in none, jacobi, block_jacobi, lagged_direct, multigrid,
+//!   lagged_multigrid: the Newton–Krylov path (`linear_solver`, `preconditioner` keys).
 //!
 //! An explicit scene run by an implicit configuration becomes Newmark (trapezoidal)
 //! with Δt = 10 × the explicit critical step at t = 0. In a staged scene the
@@ -210,6 +210,6 @@ max_iterations = 10
             .unwrap();
         assert!(d.set.is_empty());
         assert!(builtin("cholesky", &base.config, NEWMARK, 0.01).is_none());
-        assert_eq!(builtin_names().len(), 12); // explicit, direct, 2 Krylov methods × 5 preconditioners
+        assert_eq!(builtin_names().len(), 14); // explicit, direct, 2 Krylov methods × 6 preconditioners
     }
 }

@@ -203,9 +203,12 @@ fn linear_solver(s: &SolverConfig, prefix: &str) -> Check {
     }
     if s.multigrid_coarse_unknowns.is_some() {
         ensure(
-            s.preconditioner() == PreconditionerKind::Multigrid,
+            matches!(
+                s.preconditioner(),
+                PreconditionerKind::Multigrid | PreconditionerKind::LaggedMultigrid
+            ),
             key("multigrid_coarse_unknowns"),
-            "applies to preconditioner = \"multigrid\" only",
+            "applies to preconditioner = \"multigrid\" or \"lagged_multigrid\" only",
         )?;
         at_most(
             s.multigrid_coarse_unknowns(),

@@ -38,7 +38,10 @@
 //! is then also the Krylov operator (no difference products). Its hierarchy
 //! (prolongations) is kept while the active nodes and unknowns are; each Newton
 //! iteration refreshes the operators' values (Galerkin products, smoothers, the
-//! coarse factorization).
+//! coarse factorization). `lagged_multigrid` keeps the whole multigrid of an
+//! earlier iteration's tangent (refreshed under the rule of `lagged_direct`)
+//! and solves with the difference products, so a material without an analytic
+//! tangent gets it from central differences once per refresh only.
 
 use super::assembly::stiffness::{coupling, particle_tangents, ParticleTangents};
 use super::assembly::Dofs;
@@ -227,6 +230,9 @@ enum Built {
     Lagged,
     /// Use the multigrid hierarchy, whose fine operator is the Krylov operator.
     Multigrid,
+    /// Use the kept multigrid hierarchy of an earlier tangent; the Krylov
+    /// operator is the difference product.
+    LaggedMultigrid,
 }
 
 impl KrylovState {
@@ -297,6 +303,10 @@ impl KrylovState {
             Built::Blocks(b) => b,
             Built::Lagged => &factors,
             Built::Multigrid => assembled.expect("refreshed by build_preconditioner"),
+            Built::LaggedMultigrid => match &self.multigrid {
+                Some((_, _, mg)) => mg,
+                None => unreachable!("refreshed by build_preconditioner"),
+            },
         };
         let outcome: Outcome = match config.method {
             LinearSolver::Cg => cg(product, pre, &b, &mut du, &settings),
@@ -390,6 +400,21 @@ impl KrylovState {
                 self.refresh_multigrid(m, sys)?;
                 Built::Multigrid
             }
+            PreconditionerKind::LaggedMultigrid => {
+                if !self.multigrid_fits(sys) || self.refresh {
+                    self.refresh_multigrid(m, sys)?;
+                    self.refresh = false;
+                }
+                Built::LaggedMultigrid
+            }
+        })
+    }
+
+    /// Does the kept multigrid hierarchy belong to the step system's active nodes
+    /// and unknowns?
+    fn multigrid_fits<const D: usize>(&self, sys: &StepSystem<D>) -> bool {
+        self.multigrid.as_ref().is_some_and(|(active, index, _)| {
+            *active == sys.map.active && *index == sys.dofs.index
         })
     }
 
@@ -400,10 +425,7 @@ impl KrylovState {
         m: &Model<D>,
         sys: &StepSystem<D>,
     ) -> Result<(), Failure> {
-        let same_unknowns = self.multigrid.as_ref().is_some_and(|(active, index, _)| {
-            *active == sys.map.active && *index == sys.dofs.index
-        });
-        if !same_unknowns {
+        if !self.multigrid_fits(sys) {
             let h = hierarchy(
                 &m.grid,
                 &sys.map.active,
