@@ -115,6 +115,13 @@ pub struct Footing<const D: usize> {
 }
 
 impl<const D: usize> Footing<D> {
+    /// The area the load is spread over: the width per unit thickness in 2D, a
+    /// square of side `width` in 3D (a quarter model of a square footing of side
+    /// B has width B/2).
+    pub fn area(&self) -> f64 {
+        self.width.powi(D as i32 - 1)
+    }
+
     /// +1 on an upper face (the footing pushes towards −axis), −1 on a lower one.
     fn outward(&self) -> f64 {
         if self.condition.face.upper {

@@ -367,11 +367,13 @@ pub fn interpolate_two<const D: usize>(
     u: &[Vector<D>],
     w: &[Vector<D>],
 ) -> (Vector<D>, Vector<D>) {
-    st.range(p)
-        .fold((Vector::<D>::zeros(), Vector::<D>::zeros()), |(su, sw), e| {
+    st.range(p).fold(
+        (Vector::<D>::zeros(), Vector::<D>::zeros()),
+        |(su, sw), e| {
             let (a, weight) = (map.local_of(st, e), st.weight[e]);
             (su + u[a] * weight, sw + w[a] * weight)
-        })
+        },
+    )
 }
 
 /// Σ_I u_I ⊗ ∇S_Ip for particle p (gradient of a nodal vector field, e.g. L_p).

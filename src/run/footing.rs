@@ -76,7 +76,7 @@ impl FootingCurve {
         match reaction {
             Some(r) => {
                 let load = f.load(&m.grid, r);
-                self.push([t, self.settlement, load, load / f.width])
+                self.push([t, self.settlement, load, load / f.area()])
             }
             None => Ok(()),
         }

@@ -245,3 +245,72 @@ fn region_selects_the_face_nodes_in_the_box() {
     ];
     assert_eq!(f.load(g, &r), 2.0);
 }
+
+/// The footing pressure of a 3D scene is the load over W² (a square of side W):
+/// a 3D slab W = 0.5 m thick with rollers on both y faces, the footing across
+/// the whole thickness, is the plane-strain problem, so its pressure must equal
+/// the 2D run's load per unit thickness over W (elastic soil, 2 load steps; the
+/// fields are uniform in y, so the two agree to the Newton tolerance; load / W
+/// in 3D would give half the pressure).
+#[test]
+fn footing_pressure_in_3d_is_load_over_width_squared() {
+    let common = |dim: usize| {
+        let (v, lo, hi, cells, max) = if dim == 2 {
+            (
+                "[0.0, -0.012]",
+                "[0.0, 2.5]",
+                "[0.5, 2.5]",
+                "[16, 10]",
+                "[4.0, 2.5]",
+            )
+        } else {
+            (
+                "[0.0, 0.0, -0.012]",
+                "[0.0, 0.0, 2.5]",
+                "[0.5, 0.5, 2.5]",
+                "[16, 2, 10]",
+                "[4.0, 0.5, 2.5]",
+            )
+        };
+        let (top, axis) = if dim == 2 {
+            ("ymax", "y")
+        } else {
+            ("zmax", "z")
+        };
+        let y_rollers = if dim == 3 {
+            "[[boundary]]\nface = \"ymin\"\ncondition = \"roller\"\n[[boundary]]\nface = \"ymax\"\ncondition = \"roller\"\n"
+        } else {
+            ""
+        };
+        let zero = if dim == 2 {
+            "[0.0, 0.0]"
+        } else {
+            "[0.0, 0.0, 0.0]"
+        };
+        let base = if dim == 2 { "ymin" } else { "zmin" };
+        format!(
+            "dimension = {dim}\n[grid]\nmin = {zero}\nmax = {max}\ncells = {cells}\nshape_function = \"bspline2\"\n\
+             [[material]]\nname = \"soil\"\nmodel = \"linear_elastic\"\ndensity = 1.0e3\nyoungs_modulus = 1.0e8\npoisson_ratio = 0.3\n\
+             [[body]]\nmaterial = \"soil\"\nshape = \"{shape}\"\nmin = {zero}\nmax = {max}\nparticles_per_cell = 2\n\
+             [[boundary]]\nface = \"xmin\"\ncondition = \"roller\"\n[[boundary]]\nface = \"xmax\"\ncondition = \"roller\"\n{y_rollers}\
+             [[boundary]]\nface = \"{base}\"\ncondition = \"fixed\"\n\
+             [[boundary]]\nface = \"{top}\"\ncondition = \"velocity\"\nvelocity = {v}\ncomponents = [\"{axis}\"]\n\
+             region_min = {lo}\nregion_max = {hi}\nfooting_width = 0.5\n\
+             [solver]\nkind = \"implicit\"\nintegrator = \"quasi_static\"\nend_time = 1.0\nload_steps = 2\n\
+             residual_tolerance = 1e-10\n[output]\nframes = 0\n",
+            shape = if dim == 2 { "rectangle" } else { "box" },
+        )
+    };
+    let pressure = |dim: usize| {
+        let (result, _dir) = crate::common::run_text(&common(dim), &[]);
+        let summary = result.unwrap_or_else(|e| panic!("{dim}D footing: {e}"));
+        summary.footing.expect("a footing summary").limit_pressure
+    };
+    let (p2, p3) = (pressure(2), pressure(3));
+    println!("footing pressure: 2D {p2:.6e}, 3D slab {p3:.6e}");
+    assert!(p2 > 1e5, "the elastic footing carries a load: {p2}");
+    assert!(
+        (p3 / p2 - 1.0).abs() < 1e-6,
+        "2D {p2:.9e} against 3D {p3:.9e}"
+    );
+}

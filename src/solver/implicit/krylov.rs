@@ -413,9 +413,9 @@ impl KrylovState {
     /// Does the kept multigrid hierarchy belong to the step system's active nodes
     /// and unknowns?
     fn multigrid_fits<const D: usize>(&self, sys: &StepSystem<D>) -> bool {
-        self.multigrid.as_ref().is_some_and(|(active, index, _)| {
-            *active == sys.map.active && *index == sys.dofs.index
-        })
+        self.multigrid
+            .as_ref()
+            .is_some_and(|(active, index, _)| *active == sys.map.active && *index == sys.dofs.index)
     }
 
     /// The multigrid for the tangent at the current iterate: the hierarchy
