@@ -43,6 +43,7 @@ quick_overrides() {
     collapse) echo "--set solver.end_time=0.25" ;;
     limit_slope) echo "--set mesh.refinements=[0]" ;;
     limit_footing_mc) echo "--set mesh.refinements=[0]" ;;
+    footing_3d) echo "--set grid.cells=[8,8,6] --set solver.load_steps=2 --set solver.end_time=0.25" ;;
     *) echo "" ;;
   esac
 }

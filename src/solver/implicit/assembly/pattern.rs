@@ -341,12 +341,16 @@ impl Pattern {
             if !column(q, e2, block) {
                 continue;
             }
+            // The stencil's nodes ascend, so each is found by a short scan on
+            // from the previous one (ties may point back: then a search).
+            let mut hint = 0;
             for (local, e1) in st.range(q).enumerate() {
                 let n1 = map.local_of(st, e1);
                 for (a, cr) in dofs.owners(n1) {
-                    let Ok(j) = neighbours.binary_search(&(a as u32)) else {
+                    let Some(j) = position(neighbours, a as u32, hint) else {
                         continue;
                     };
+                    hint = j;
                     let lo = self.first[a];
                     for i in 0..D {
                         let Some(r) = dofs.of(a, i, D) else { continue };
@@ -366,6 +370,19 @@ impl Pattern {
                 }
             }
         }
+    }
+}
+
+/// Position of `a` in the ascending `sorted`, scanning on from `from` first.
+fn position(sorted: &[u32], a: u32, from: usize) -> Option<usize> {
+    let mut j = from;
+    while j < sorted.len() && sorted[j] < a {
+        j += 1;
+    }
+    if j < sorted.len() && sorted[j] == a {
+        Some(j)
+    } else {
+        sorted.binary_search(&a).ok()
     }
 }
 
