@@ -90,6 +90,7 @@ impl<const D: usize> Model<D> {
             friction,
             footing,
             absorbing,
+            contact: crate::scene::contact::plan(c).map_err(err)?,
             gravity,
             load_ramps: loads.ramps,
             load_ramp_of: loads.ramp_of,

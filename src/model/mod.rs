@@ -18,6 +18,7 @@ use crate::model::conditions::{Absorbing, FaceCondition, Footing, FrictionFace};
 use crate::model::geometry::Geometry;
 use crate::model::grid::Grid;
 use crate::model::particles::Particles;
+use crate::scene::contact::ContactPlan;
 
 /// Everything a solver needs, in dimension D.
 #[derive(Debug)]
@@ -38,6 +39,8 @@ pub struct Model<const D: usize> {
     pub footing: Option<Footing<D>>,
     /// Non-reflecting faces (Lysmer–Kuhlemeyer dashpots, optional springs).
     pub absorbing: Absorbing<D>,
+    /// Contact between bodies: velocity fields and their laws (`[[contact]]`).
+    pub contact: Option<ContactPlan>,
     pub gravity: Vector<D>,
     /// The distinct time histories of the loads (the force is stored on the
     /// particles grouped by history, see `load_scales`).

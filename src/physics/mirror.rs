@@ -70,7 +70,8 @@ impl Mirror {
             if grid.cells[axis] < p {
                 continue;
             }
-            for a in 0..map.len() {
+            // Split nodes (contact) are left out: a line needs one field's nodes.
+            for a in (0..map.len()).filter(|&a| !map.is_split(a)) {
                 let ijk = grid.node_ijk(map.active[a] as usize);
                 if !fc.acts_on(grid, ijk) {
                     continue;

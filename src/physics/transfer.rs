@@ -27,6 +27,10 @@ pub struct NodeMap {
     pub start: Vec<u32>,
     /// Stencil entry indices (p·stride + k) in increasing order within each node.
     pub entries: Vec<u32>,
+    /// Grid node of each split node (`physics::contact`): node ids from
+    /// `local.len() − split.len()` on stand for one velocity field at a grid node
+    /// that several fields share. Empty without contact.
+    pub split: Vec<u32>,
     /// Buffers of `build`, kept between steps.
     scratch: BuildScratch,
 }
@@ -61,8 +65,10 @@ impl NodeMap {
             .div_ceil(rayon::current_num_threads())
             .max(MIN_PARALLEL_LEN);
         let scratch = &mut self.scratch;
-        if scratch.touched.len() != n_nodes {
-            scratch.touched = (0..n_nodes).map(|_| AtomicBool::new(false)).collect();
+        if scratch.touched.len() < n_nodes {
+            scratch
+                .touched
+                .resize_with(n_nodes, || AtomicBool::new(false));
         }
         let touched = &scratch.touched;
         (0..n_particles)
@@ -73,13 +79,12 @@ impl NodeMap {
                     touched[st.node[e] as usize].store(true, Relaxed);
                 }
             });
-        if self.local.len() != n_nodes {
-            self.local = vec![Self::NONE; n_nodes];
-        } else {
-            for &g in &self.active {
-                self.local[g as usize] = Self::NONE;
+        for &g in &self.active {
+            if let Some(l) = self.local.get_mut(g as usize) {
+                *l = Self::NONE;
             }
         }
+        self.local.resize(n_nodes, Self::NONE);
         self.active = (0..n_nodes as u32)
             .into_par_iter()
             .filter(|&g| touched[g as usize].load(Relaxed))
@@ -149,6 +154,22 @@ impl NodeMap {
 
     pub fn is_empty(&self) -> bool {
         self.active.is_empty()
+    }
+
+    /// The grid node of active node a (a split node's grid node).
+    pub fn grid_node(&self, a: usize) -> usize {
+        let g = self.active[a] as usize;
+        let grid_nodes = self.local.len() - self.split.len();
+        if g < grid_nodes {
+            g
+        } else {
+            self.split[g - grid_nodes] as usize
+        }
+    }
+
+    /// Is active node a one field's part of a shared grid node?
+    pub fn is_split(&self, a: usize) -> bool {
+        self.active[a] as usize >= self.local.len() - self.split.len()
     }
 
     /// Active index of the node of stencil entry e (the node must be active).

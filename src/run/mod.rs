@@ -7,6 +7,7 @@
 //! never stopped.
 
 pub mod checkpoint;
+pub mod contact;
 pub mod energy;
 pub mod footing;
 pub mod interrupt;
@@ -251,6 +252,7 @@ impl Timeline {
             }
             let result = stepper.step(model, self.t, dt, self.step);
             self.recorders.newton(&stepper.take_newton_rows())?;
+            self.recorders.contact(&stepper.take_contact());
             match result {
                 Ok(work) => self.external_work += work,
                 Err(d) => return Ok((Err(d), last_dt)),

@@ -6,6 +6,8 @@
 use crate::dim::Vector;
 use crate::model::Model;
 use crate::output::{body_centres, CsvWriter, Field, FrameWriter, HistoryWriter};
+use crate::physics::contact::PairTotal;
+use crate::run::contact::{ContactLog, ContactState};
 use crate::run::energy::{kinetic_energy, strain_energy};
 use crate::run::footing::FootingCurve;
 use crate::run::summary::FootingSummary;
@@ -55,6 +57,9 @@ pub struct RecorderState {
     pub footing_csv: Option<String>,
     pub footing_rows: Vec<[f64; 4]>,
     pub footing_settlement: f64,
+    /// contact.csv and the totals since its last rows, when the scene has contact.
+    #[serde(default)]
+    pub contact: Option<ContactState>,
 }
 
 /// The output files that grow during a run.
@@ -75,6 +80,8 @@ pub struct Recorders {
     newton: Option<CsvWriter>,
     /// footing.csv, when the scene has a footing.
     footing: Option<FootingCurve>,
+    /// contact.csv, when the scene has contact between bodies.
+    contact: Option<ContactLog>,
 }
 
 impl Recorders {
@@ -105,6 +112,10 @@ impl Recorders {
             },
             footing: match &model.footing {
                 Some(_) => Some(FootingCurve::create(&out.join("footing.csv"))?),
+                None => None,
+            },
+            contact: match &model.contact {
+                Some(_) => Some(ContactLog::create(&out.join("contact.csv"), D)?),
                 None => None,
             },
         })
@@ -145,6 +156,9 @@ impl Recorders {
             }
         }
         r.frames = FrameWriter::resume(out, "particles", saved.frames)?;
+        if let (Some(_), Some(state)) = (&r.contact, &saved.contact) {
+            r.contact = Some(ContactLog::resume(&out.join("contact.csv"), D, state)?);
+        }
         if let (Some(_), Some(text)) = (&r.newton, &saved.newton_csv) {
             r.newton = Some(CsvWriter::resume(&out.join("newton.csv"), text)?);
         }
@@ -178,6 +192,10 @@ impl Recorders {
             }
             None => (None, Vec::new(), 0.0),
         };
+        let contact = match &mut self.contact {
+            Some(log) => Some(log.saved(&self.out.join("contact.csv"))?),
+            None => None,
+        };
         Ok(RecorderState {
             history_csv: read("history.csv")?,
             next_history: self.next_history,
@@ -189,6 +207,7 @@ impl Recorders {
             footing_csv,
             footing_rows,
             footing_settlement,
+            contact,
         })
     }
 
@@ -202,6 +221,9 @@ impl Recorders {
             let (kinetic, strain) = (kinetic_energy(m), strain_energy(m));
             self.history
                 .write_row(t, kinetic, strain, now.external_work, &com, &vcom)?;
+            if let Some(log) = &mut self.contact {
+                log.rows(t)?;
+            }
             self.next_history = t + self.history_interval;
         }
         let Some(interval) = self.frame_interval else {
@@ -219,6 +241,13 @@ impl Recorders {
             }
         }
         Ok(())
+    }
+
+    /// What contact did in the last step (rows follow with history.csv's).
+    pub fn contact<const D: usize>(&mut self, totals: &[PairTotal<D>]) {
+        if let Some(log) = &mut self.contact {
+            log.after_step(totals);
+        }
     }
 
     /// The Newton iterations of the last step, into newton.csv.

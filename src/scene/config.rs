@@ -29,6 +29,9 @@ pub struct SceneConfig {
     pub boundaries: Vec<BoundaryConfig>,
     #[serde(default, rename = "load")]
     pub loads: Vec<LoadConfig>,
+    /// Contact between bodies (explicit solver), one table per law.
+    #[serde(default, rename = "contact")]
+    pub contacts: Vec<ContactConfig>,
     /// A single solver for the whole run …
     pub solver: Option<SolverConfig>,
     /// … or a sequence of stages on the same particles, each with its own solver.
@@ -235,6 +238,47 @@ pub struct LoadConfig {
     pub ramp_time: f64,
     /// A pulse instead of a ramp: the load times sin²(π t / T) for t ≤ T, then zero.
     pub pulse_duration: Option<f64>,
+}
+
+/// A `[[contact]]` table: the bodies it pairs and their contact law
+/// (`crate::physics::contact`; docs/contact.md).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactConfig {
+    /// Two body names; none: every pair of bodies of the scene.
+    pub bodies: Option<Vec<String>>,
+    /// Coulomb coefficient μ ≥ 0 (default 0: frictionless).
+    #[serde(default)]
+    pub friction_coefficient: f64,
+    /// Shear strength of the interface per unit area, added to μ times the normal
+    /// traction (default 0).
+    #[serde(default)]
+    pub adhesion: f64,
+    /// λ of the gap criterion D ≤ λ h (default 0.5).
+    #[serde(default = "default_gap_factor")]
+    pub gap_factor: f64,
+    /// How the common normal of a contact node is found (default `max_gradient`).
+    #[serde(default)]
+    pub normal: ContactNormal,
+}
+
+/// The common normal of two fields at a contact node, from their volume gradients
+/// g = Σ_p V_p ∇S_Ip (`crate::physics::contact`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, IntoStaticStr, EnumIter)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum ContactNormal {
+    /// The normal of the field with the larger |g| (Nairn's "maximum volume
+    /// gradient"): the flat side of a contact decides at the other body's corners.
+    #[default]
+    MaxGradient,
+    /// The average of the two unit normals, (ĝ_r − ĝ_s)/|ĝ_r − ĝ_s| (MPM3D's
+    /// "average method").
+    Average,
+}
+
+fn default_gap_factor() -> f64 {
+    0.5
 }
 
 /// The `[geostatic]` table: σ_v = −ρ g d, σ_h = K0 σ_v, with d the depth below

@@ -7,6 +7,7 @@
 //! (`error.rs`). The keys are documented in `docs/scene.md`.
 
 mod config;
+pub mod contact;
 mod error;
 pub mod expr;
 mod grid;

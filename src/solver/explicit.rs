@@ -9,6 +9,7 @@ use crate::model::{load_factor, Model};
 use crate::parallel::{deterministic_sum, MIN_PARALLEL_LEN};
 use crate::physics::absorbing;
 use crate::physics::boundary::{friction_contact, node_constraint, node_friction};
+use crate::physics::contact::{Contact, PairTotal};
 use crate::physics::deformation::Trial;
 use crate::physics::mirror::Mirror;
 use crate::physics::shape::{ShapeFunction, Stencils};
@@ -38,6 +39,8 @@ pub struct Explicit<const D: usize> {
     stencils: Stencils<D>,
     map: NodeMap,
     trial: Trial,
+    /// Contact between bodies (`crate::physics::contact`), when the scene has some.
+    contact: Option<Contact<D>>,
 }
 
 impl<const D: usize> Explicit<D> {
@@ -53,6 +56,7 @@ impl<const D: usize> Explicit<D> {
             stencils: Stencils::default(),
             map: NodeMap::default(),
             trial: Trial::default(),
+            contact: None,
         }
     }
 
@@ -81,22 +85,27 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
     /// Advance the model from t to t + dt. Returns the work done by gravity and
     /// applied loads over the step.
     fn step(&mut self, m: &mut Model<D>, t: f64, dt: f64, step: usize) -> Result<f64, Divergence> {
+        if let (None, Some(plan)) = (&self.contact, &m.contact) {
+            self.contact = Some(Contact::new(plan.clone(), &m.particles));
+        }
         let p = &m.particles;
-        crate::physics::transfer::stencils_and_nodes(
-            m,
-            self.shape,
-            &mut self.stencils,
-            &mut self.map,
-        );
+        match &mut self.contact {
+            None => crate::physics::transfer::stencils_and_nodes(
+                m,
+                self.shape,
+                &mut self.stencils,
+                &mut self.map,
+            ),
+            Some(c) => c.stencils_and_fields(m, self.shape, &mut self.stencils, &mut self.map),
+        }
         if self.fbar {
             self.trial.use_fbar(&m.grid, &p.x);
         }
         let (st, map) = (&self.stencils, &self.map);
-        let constraint: Vec<Constraint<D>> = map
-            .active
-            .par_iter()
+        let constraint: Vec<Constraint<D>> = (0..map.len())
+            .into_par_iter()
             .with_min_len(MIN_PARALLEL_LEN)
-            .map(|&g| node_constraint(&m.grid, &m.faces, g as usize))
+            .map(|a| node_constraint(&m.grid, &m.faces, map.grid_node(a)))
             .collect();
         let contacts = friction_nodes(m, map);
         let tiny = TINY_MASS_FRACTION * p.mass.iter().cloned().fold(f64::INFINITY, f64::min);
@@ -116,6 +125,10 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
         let (mass, momentum) = mass_momentum(map, st, p);
         let mut raw_velocity = mass_average(&mass, &momentum);
         mirror.velocity(&mass, &momentum, &mut raw_velocity);
+        // Contact after P2G: its momentum reaches the particles through the PIC part.
+        if let Some(c) = &mut self.contact {
+            c.correct(&mass, &mut raw_velocity, dt, 1.0 - self.flip);
+        }
         let mut velocity = constrained(&raw_velocity, &constraint);
         apply_friction(&m.friction, &contacts, &constraint, &mut velocity);
         if self.scheme == Scheme::Usf {
@@ -157,6 +170,13 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
         for (a, _) in &contacts {
             accel[*a] = (velocity_new[*a] - raw_velocity[*a]) / dt;
         }
+        // Contact after the grid update; prescribed components win.
+        if let Some(c) = &mut self.contact {
+            for a in c.correct(&mass, &mut velocity_new, dt, 1.0) {
+                constraint[a].apply_velocity(&mut velocity_new[a]);
+                accel[a] = (velocity_new[a] - raw_velocity[a]) / dt;
+            }
+        }
 
         // G2P: particle velocity (PIC/FLIP blend, 2-27) and position (2-26).
         let flip = self.flip;
@@ -187,6 +207,9 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
                 let (_, momentum) = mass_momentum(map, st, &m.particles);
                 let mut remapped = mass_average(&mass, &momentum);
                 mirror.velocity(&mass, &momentum, &mut remapped);
+                if let Some(c) = &mut self.contact {
+                    c.correct(&mass, &mut remapped, dt, 0.0);
+                }
                 let mut velocity = constrained(&remapped, &constraint);
                 apply_friction(&m.friction, &contacts, &constraint, &mut velocity);
                 update_stress(m, &mut self.trial, st, map, &velocity, dt, step, t)?;
@@ -202,6 +225,12 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
 
     fn report(&self) -> SolverReport {
         SolverReport::explicit(self.scheme)
+    }
+
+    fn take_contact(&mut self) -> Vec<PairTotal<D>> {
+        self.contact
+            .as_mut()
+            .map_or_else(Vec::new, |c| c.take_totals())
     }
 }
 
@@ -238,12 +267,7 @@ fn friction_nodes<const D: usize>(m: &Model<D>, map: &NodeMap) -> Vec<(usize, Ve
         return Vec::new();
     }
     (0..map.len())
-        .map(|a| {
-            (
-                a,
-                node_friction(&m.grid, &m.friction, map.active[a] as usize),
-            )
-        })
+        .map(|a| (a, node_friction(&m.grid, &m.friction, map.grid_node(a))))
         .filter(|(_, on)| !on.is_empty())
         .collect()
 }

@@ -3,6 +3,7 @@
 
 use crate::dim::Vector;
 use crate::model::Model;
+use crate::physics::contact::PairTotal;
 use crate::scene::LinearSystems;
 use crate::solver::divergence::Divergence;
 use crate::solver::linear::direct::Statistics;
@@ -54,6 +55,12 @@ pub trait Stepper<const D: usize> {
 
     /// The solver fields of summary.json, counts so far.
     fn report(&self) -> SolverReport;
+
+    /// What contact between bodies did since the last call, per pair of velocity
+    /// fields (explicit runs with `[[contact]]`; empty otherwise).
+    fn take_contact(&mut self) -> Vec<PairTotal<D>> {
+        Vec::new()
+    }
 
     /// The state carried across steps, for a checkpoint.
     fn state(&self) -> SolverState {

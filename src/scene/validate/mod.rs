@@ -57,6 +57,26 @@ pub fn validate(s: &SceneConfig) -> Check {
     for (i, l) in s.loads.iter().enumerate() {
         load(l, i, s)?;
     }
+    if crate::scene::contact::plan(s)?.is_some() {
+        use crate::scene::ShapeFunction::{Bspline2, Bspline3, Cpbspline2};
+        ensure(
+            !matches!(s.grid.shape_function, Bspline2 | Bspline3 | Cpbspline2),
+            "grid.shape_function",
+            "contact works with linear, ugimp, cpgimp and cpdi: B-spline supports span \
+             3-4 cells, so bodies share nodes along faces that do not touch and catch \
+             there (a block that should slide 0.43 m slides 0.01 m; docs/contact.md)",
+        )?;
+        for (k, st) in s.stages().into_iter().enumerate() {
+            ensure(
+                st.kind == SolverKind::Explicit,
+                "contact",
+                format!(
+                    "contact acts in the explicit solver only, and stage {k} is implicit \
+                     (implicit contact is not implemented yet)"
+                ),
+            )?;
+        }
+    }
     needs_krylov(s, &materials)?;
     match (&s.solver, s.stages.is_empty()) {
         (Some(solver_config), true) => {
