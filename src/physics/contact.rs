@@ -69,8 +69,8 @@ pub struct PairTotal<const D: usize> {
     pub bodies: [u32; 2],
     /// Momentum the contact delivered to field r's particles (s got the opposite).
     pub impulse: Vector<D>,
-    /// Kinetic energy the corrections took out of the grid (normal impact and
-    /// friction).
+    /// Energy dissipated by friction: the work of the tangential impulses on the
+    /// slip, −J_t·(w_t + w_t')/2 per correction (w = v_r − v_s before and after).
     pub dissipation: f64,
     /// Nodes in contact in the last step.
     pub nodes: usize,
@@ -322,14 +322,16 @@ impl<const D: usize> Contact<D> {
             let Some(dp) = exchange(mr, ms, &v[mt.r], &v[mt.s], mt, dt) else {
                 continue;
             };
-            let before = kinetic(mr, &v[mt.r]) + kinetic(ms, &v[mt.s]);
             v[mt.r] += dp / mr;
             v[mt.s] -= dp / ms;
             corrected.extend([mt.r, mt.s]);
             if delivered > 0.0 {
                 let total = &mut self.totals[mt.pair];
-                let after = kinetic(mr, &v[mt.r]) + kinetic(ms, &v[mt.s]);
-                total.dissipation += (before - after) * delivered;
+                // Work of the friction impulse on the slip that remains, −J_t·w_t'
+                // (zero where the fields stick).
+                let slip_after = tangential(&(v[mt.r] - v[mt.s]), &mt.normal);
+                let friction = tangential(&dp, &mt.normal);
+                total.dissipation -= friction.dot(&slip_after) * delivered;
                 total.impulse += dp * delivered;
                 total.nodes += 1;
             }
@@ -354,8 +356,9 @@ impl<const D: usize> Contact<D> {
     }
 }
 
-fn kinetic<const D: usize>(m: f64, v: &Vector<D>) -> f64 {
-    0.5 * m * v.norm_squared()
+/// The part of v tangential to the unit normal n.
+fn tangential<const D: usize>(v: &Vector<D>, n: &Vector<D>) -> Vector<D> {
+    v - n * v.dot(n)
 }
 
 /// The momentum change of field r at a meeting (s gets the opposite), or None if

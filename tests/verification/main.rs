@@ -9,6 +9,7 @@ mod absorbing;
 mod cantilever;
 mod collapse;
 mod column_explicit;
+mod contact;
 mod disks;
 mod footing;
 mod friction;

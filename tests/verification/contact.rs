@@ -1,0 +1,265 @@
+//! Contact between bodies in the explicit solver (`[[contact]]`,
+//! `mpm::physics::contact`).
+//!
+//! - A block sliding on an elastic base tilted by rotating gravity,
+//!   g = 9.81 (sin θ, −cos θ), θ = 45° (`problems/contact_incline.toml`): the
+//!   centre of mass moves x(t) = ½ g t² (sin θ − μ cos θ) when tan θ > μ, not at
+//!   all when tan θ ≤ μ. MPM-Geomechanics' terrain contact, on the same test at
+//!   θ = 45°, is 0.009 %, 0.11 % and 0.68 % off at μ = 0, 0.3, 0.5; the issue asks
+//!   1 % at the end time.
+//! - Two elastic disks colliding off-centre with friction
+//!   (`problems/contact_disks.toml`): they bounce off and separate, where one
+//!   shared velocity field keeps them together; momentum is conserved to
+//!   round-off; kinetic + strain energy + the energy friction dissipated stays
+//!   within the explicit method's own energy error of the initial energy.
+
+use crate::common::{problem, read_output, run_cli, run_problem, run_text, Table};
+use mpm::run::summary::Status;
+
+const G: f64 = 9.81;
+
+/// (time, centre-of-mass displacement of the block along the incline, output).
+fn slide(theta_deg: f64, mu: f64, extra: &[&str]) -> (f64, f64, tempfile::TempDir) {
+    let th = theta_deg.to_radians();
+    let gravity = format!("gravity=[{},{}]", G * th.sin(), -G * th.cos());
+    let mu = format!("contact.0.friction_coefficient={mu}");
+    let mut overrides = vec![gravity.as_str(), mu.as_str(), "output.frames=0"];
+    overrides.extend(extra);
+    let (result, dir) = run_problem("contact_incline.toml", &overrides);
+    assert_eq!(result.unwrap().status, Status::Completed);
+    let h = Table::read(&dir.path().join("history.csv")).unwrap();
+    let (t, x) = (h.col("t"), h.col("body1_x"));
+    (*t.last().unwrap(), x.last().unwrap() - x[0], dir)
+}
+
+fn closed_form(theta_deg: f64, mu: f64, t: f64) -> f64 {
+    let th = theta_deg.to_radians();
+    0.5 * G * t * t * (th.sin() - mu * th.cos()).max(0.0)
+}
+
+#[test]
+fn block_slides_on_an_elastic_incline_as_the_closed_form() {
+    // Measured: +0.04 %, +0.14 %, +0.74 % (cpGIMP, 20 cells over the block).
+    for mu in [0.0, 0.3, 0.5] {
+        let (t, x, _) = slide(45.0, mu, &[]);
+        let exact = closed_form(45.0, mu, t);
+        let err = (x / exact - 1.0).abs();
+        println!("mu {mu}: x = {x:.5} m, closed form {exact:.5} m, error {err:.2e}");
+        assert!(err < 0.01, "mu {mu}: x = {x}, exact {exact}");
+    }
+}
+
+#[test]
+fn contact_force_carries_the_block() {
+    // Sliding at μ = 0.3: the block presses on the base with its weight's normal
+    // part m g cos θ and drags it with μ times that. contact.csv holds the mean
+    // force on the base (the pair's first body) between rows; averaged over the
+    // slide after the first 0.1 s (the weight comes on suddenly and rings).
+    let (_, _, dir) = slide(45.0, 0.3, &[]);
+    let c = Table::read(&dir.path().join("contact.csv")).unwrap();
+    let (t, fx, fy) = (c.col("t"), c.col("fx"), c.col("fy"));
+    let (mut ix, mut iy, mut span) = (0.0, 0.0, 0.0);
+    for k in 1..t.len() {
+        if t[k - 1] >= 0.1 {
+            let dt = t[k] - t[k - 1];
+            ix += fx[k] * dt;
+            iy += fy[k] * dt;
+            span += dt;
+        }
+    }
+    let (fx, fy) = (ix / span, iy / span);
+    let weight = 1000.0 * 1.0 * 0.5 * G * 45f64.to_radians().cos();
+    println!(
+        "mean force on the base: ({fx:.1}, {fy:.1}) N/m; m g cos θ = {weight:.1}, μ m g cos θ = {:.1}",
+        0.3 * weight
+    );
+    assert!(
+        (-fy / weight - 1.0).abs() < 0.05,
+        "normal {fy}, weight {weight}"
+    );
+    assert!((fx / (0.3 * weight) - 1.0).abs() < 0.05, "friction {fx}");
+}
+
+#[test]
+fn block_sticks_when_tan_theta_is_below_mu() {
+    // tan 45° = 1 < μ = 1.2. The weight comes on suddenly and the base pressure
+    // rings between 0 and twice the weight, so at its low instants the block
+    // creeps (78 mm undamped); a little local damping (10 %) lets the load come on
+    // gently, as in tests/verification/friction.rs. The damped frictionless run
+    // slides ~0.8 m.
+    let (_, x, _) = slide(45.0, 1.2, &["solver.damping=0.1"]);
+    let (_, free, _) = slide(45.0, 0.0, &["solver.damping=0.1"]);
+    println!("stick: x = {x:.2e} m; frictionless damped: {free:.3} m");
+    assert!(free > 0.7, "frictionless damped run moved only {free}");
+    assert!(x.abs() < 5e-3, "block crept {x} m with tan θ < μ");
+}
+
+/// Particles of the final state: (body, x, y, vx, vy, mass).
+fn final_particles(dir: &tempfile::TempDir) -> Vec<(usize, f64, f64, f64, f64, f64)> {
+    let p = Table::read(&dir.path().join("particles_final.csv")).unwrap();
+    let (b, x, y) = (p.col("body"), p.col("x"), p.col("y"));
+    let (vx, vy, m) = (p.col("vx"), p.col("vy"), p.col("mass"));
+    (0..b.len())
+        .map(|i| (b[i] as usize, x[i], y[i], vx[i], vy[i], m[i]))
+        .collect()
+}
+
+/// The smallest distance between particles of body 0 and body 1.
+fn closest_approach(p: &[(usize, f64, f64, f64, f64, f64)]) -> f64 {
+    let mut d = f64::INFINITY;
+    for a in p.iter().filter(|a| a.0 == 0) {
+        for b in p.iter().filter(|b| b.0 == 1) {
+            d = d.min((a.1 - b.1).hypot(a.2 - b.2));
+        }
+    }
+    d
+}
+
+/// The disks scene without its `[[contact]]` table.
+fn disks_without_contact() -> String {
+    let text = std::fs::read_to_string(problem("contact_disks.toml")).unwrap();
+    text.replace("[[contact]]\nfriction_coefficient = 0.3\n", "")
+}
+
+#[test]
+fn disks_bounce_off_and_separate_with_momentum_conserved() {
+    let (result, dir) = run_problem("contact_disks.toml", &["output.frames=0"]);
+    result.unwrap();
+    let p = final_particles(&dir);
+    let gap = closest_approach(&p);
+    // Momentum: zero at the start (equal disks, opposite velocities).
+    let (px, py) = p
+        .iter()
+        .fold((0.0, 0.0), |(x, y), q| (x + q.5 * q.3, y + q.5 * q.4));
+    let scale: f64 = p.iter().map(|q| q.5 * 0.2).sum();
+    let h = Table::read(&dir.path().join("history.csv")).unwrap();
+    let vx0 = *h.col("body0_vx").last().unwrap();
+    println!(
+        "contact: closest particles {gap:.4} m apart at the end, left disk vx {vx0:.4}, \
+         momentum ({:.1e}, {:.1e}) of m v0",
+        px / scale,
+        py / scale
+    );
+    assert!(gap > 0.1, "the disks did not separate: {gap}");
+    assert!(vx0 < -0.05, "the left disk did not rebound: vx = {vx0}");
+    assert!((px / scale).abs() < 1e-12 && (py / scale).abs() < 1e-12);
+}
+
+/// The spin ω = L/I of body 0 about its centre of mass at the end.
+fn spin(p: &[(usize, f64, f64, f64, f64, f64)]) -> f64 {
+    let q: Vec<_> = p.iter().filter(|q| q.0 == 0).collect();
+    let m: f64 = q.iter().map(|q| q.5).sum();
+    let xc = q.iter().map(|q| q.5 * q.1).sum::<f64>() / m;
+    let yc = q.iter().map(|q| q.5 * q.2).sum::<f64>() / m;
+    let l: f64 = q
+        .iter()
+        .map(|q| q.5 * ((q.1 - xc) * q.4 - (q.2 - yc) * q.3))
+        .sum();
+    let i: f64 = q
+        .iter()
+        .map(|q| q.5 * ((q.1 - xc).powi(2) + (q.2 - yc).powi(2)))
+        .sum();
+    l / i
+}
+
+#[test]
+fn frictionless_disks_do_not_spin_where_one_field_carries_them_along() {
+    // A frictionless contact pushes along the normal only, through the disks'
+    // centres: it leaves them without spin. One shared velocity field (no
+    // contact) grips them tangentially like a rough contact. Measured ω: 0.015
+    // rad/s frictionless, 0.53 with μ = 0.3, 0.44 with one field.
+    let (result, dir) = run_problem(
+        "contact_disks.toml",
+        &["contact.0.friction_coefficient=0", "output.frames=0"],
+    );
+    result.unwrap();
+    let smooth = spin(&final_particles(&dir));
+    let (result, dir) = run_text(&disks_without_contact(), &["output.frames=0"]);
+    result.unwrap();
+    let carried = spin(&final_particles(&dir));
+    println!(
+        "spin of the left disk: frictionless contact {smooth:.4} rad/s, one field {carried:.4}"
+    );
+    assert!(
+        carried.abs() > 0.3,
+        "one field should spin the disks: {carried}"
+    );
+    assert!(
+        smooth.abs() < 0.1 * carried.abs(),
+        "frictionless contact spun the disk: {smooth}"
+    );
+}
+
+#[test]
+fn disks_do_not_interpenetrate() {
+    // At the deepest compression (t = 0.65 s) the particles of the two disks keep
+    // at least half a particle spacing (0.0125 m) apart.
+    let (result, dir) = run_problem(
+        "contact_disks.toml",
+        &["solver.end_time=0.65", "output.frames=0"],
+    );
+    result.unwrap();
+    let d = closest_approach(&final_particles(&dir));
+    println!("closest particles of the two disks at t = 0.65 s: {d:.4} m");
+    assert!(d > 0.5 * 0.0125, "particles of the disks came within {d} m");
+}
+
+#[test]
+fn disks_account_for_their_energy() {
+    // Kinetic + strain + frictional dissipation against the initial kinetic energy,
+    // at every history row. The explicit method's own energy error on this scene
+    // is +3.1 % without friction (μ = 0: nothing dissipated); with μ = 0.3 friction
+    // dissipates 0.14 J of 5.0 J and the balance stays within 2 %.
+    let (result, dir) = run_problem("contact_disks.toml", &["output.frames=0"]);
+    result.unwrap();
+    let h = Table::read(&dir.path().join("history.csv")).unwrap();
+    let c = Table::read(&dir.path().join("contact.csv")).unwrap();
+    let (t, k, s) = (h.col("t"), h.col("kinetic"), h.col("strain"));
+    let (tc, dissipated) = (c.col("t"), c.col("dissipation"));
+    let e0 = k[0] + s[0];
+    let mut worst: f64 = 0.0;
+    for i in 0..t.len() {
+        let d = (0..tc.len())
+            .find(|&j| tc[j] == t[i])
+            .map_or(0.0, |j| dissipated[j]);
+        worst = worst.max(((k[i] + s[i] + d) / e0 - 1.0).abs());
+    }
+    let total = *dissipated.last().unwrap();
+    println!("friction dissipated {total:.4} J of {e0:.4} J; worst balance {worst:.3e}");
+    assert!(
+        total > 0.01 * e0,
+        "friction should dissipate something: {total}"
+    );
+    assert!(worst < 0.03, "energy balance off by {worst}");
+}
+
+#[test]
+fn bodies_that_never_touch_run_bit_for_bit_as_without_contact() {
+    // The disks moving apart: no node is ever shared, so nothing is split.
+    let apart = [
+        "body.0.velocity=[-0.2,0.0]",
+        "body.1.velocity=[0.2,0.0]",
+        "solver.end_time=0.5",
+        "output.frames=0",
+    ];
+    let (with, dir_with) = run_problem("contact_disks.toml", &apart);
+    with.unwrap();
+    let (without, dir_without) = run_text(&disks_without_contact(), &apart);
+    without.unwrap();
+    for f in ["particles_final.csv", "history.csv"] {
+        assert!(
+            read_output(&dir_with, f) == read_output(&dir_without, f),
+            "{f} differs"
+        );
+    }
+}
+
+#[test]
+fn contact_does_not_depend_on_the_number_of_threads() {
+    let set = ["solver.end_time=1.0", "output.frames=0"];
+    let one = run_cli("contact_disks.toml", 1, &set);
+    let two = run_cli("contact_disks.toml", 2, &set);
+    for f in ["particles_final.csv", "contact.csv", "history.csv"] {
+        assert!(read_output(&one, f) == read_output(&two, f), "{f} differs");
+    }
+}
