@@ -6,6 +6,7 @@
 mod common;
 
 mod bench;
+mod contact;
 mod fuzz;
 mod key_paths;
 mod robustness;

@@ -1,0 +1,126 @@
+//! `[[contact]]` tables: every mistake is named by its key, with the line and
+//! column of the file (issue 14 item 4).
+
+use mpm::scene::Scene;
+
+/// problems/contact_disks.toml with `contact` as its contact table(s).
+fn scene(contact: &str) -> String {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/problems/contact_disks.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    text.replace("[[contact]]\nfriction_coefficient = 0.3\n", contact)
+}
+
+/// The error names `key`, and its text holds every one of `parts`.
+fn rejected(text: &str, key: &str, parts: &[&str]) {
+    let e = Scene::parse("scene.toml", text, &[]).expect_err("must be rejected");
+    assert_eq!(e.key.as_deref(), Some(key), "{e}");
+    let s = e.to_string();
+    for part in parts {
+        assert!(s.contains(part), "`{part}` not in: {s}");
+    }
+}
+
+#[test]
+fn the_contact_scenes_are_valid() {
+    Scene::parse("scene.toml", &scene("[[contact]]\nbodies = [\"left\", \"right\"]\nfriction_coefficient = 0.3\nadhesion = 10.0\ngap_factor = 1.0\nnormal = \"average\"\n"), &[]).unwrap();
+    Scene::parse("scene.toml", &scene("[[contact]]\n"), &[]).unwrap();
+}
+
+#[test]
+fn an_unknown_body_is_named() {
+    rejected(
+        &scene("[[contact]]\nbodies = [\"left\", \"rigth\"]\n"),
+        "contact.0.bodies.1",
+        &["scene.toml:44:", "no body is named `rigth`"],
+    );
+}
+
+#[test]
+fn a_body_paired_with_itself_is_rejected() {
+    rejected(
+        &scene("[[contact]]\nbodies = [\"left\", \"left\"]\n"),
+        "contact.0.bodies",
+        &["scene.toml:44:", "pairs body `left` with itself"],
+    );
+}
+
+#[test]
+fn a_pair_needs_two_bodies() {
+    rejected(
+        &scene("[[contact]]\nbodies = [\"left\"]\n"),
+        "contact.0.bodies",
+        &["scene.toml:44:", "names two bodies, has 1"],
+    );
+}
+
+#[test]
+fn negative_friction_and_adhesion_and_a_zero_gap_factor_are_rejected() {
+    rejected(
+        &scene("[[contact]]\nfriction_coefficient = -0.1\n"),
+        "contact.0.friction_coefficient",
+        &["scene.toml:44:", "must be a finite number ≥ 0"],
+    );
+    rejected(
+        &scene("[[contact]]\nadhesion = -5.0\n"),
+        "contact.0.adhesion",
+        &["scene.toml:44:", "must be a finite number ≥ 0"],
+    );
+    rejected(
+        &scene("[[contact]]\ngap_factor = 0.0\n"),
+        "contact.0.gap_factor",
+        &["scene.toml:44:", "must be a finite number > 0"],
+    );
+}
+
+#[test]
+fn an_unknown_normal_and_an_unknown_key_are_named() {
+    rejected(
+        &scene("[[contact]]\nnormal = \"mass_gradient\"\n"),
+        "contact.0.normal",
+        &["scene.toml:44:", "unknown variant `mass_gradient`"],
+    );
+    rejected(
+        &scene("[[contact]]\nfriction = 0.3\n"),
+        "contact.0.friction",
+        &["unknown field `friction`"],
+    );
+}
+
+#[test]
+fn a_pair_declared_twice_is_rejected() {
+    rejected(
+        &scene("[[contact]]\nbodies = [\"left\", \"right\"]\n\n[[contact]]\nbodies = [\"right\", \"left\"]\n"),
+        "contact.1",
+        &["scene.toml:46:", "declares the contact of bodies 0 and 1 again (also in contact.0)"],
+    );
+}
+
+#[test]
+fn contact_needs_the_explicit_solver_and_no_b_splines() {
+    rejected(
+        &scene("[[contact]]\n").replace("kind = \"explicit\"", "kind = \"implicit\"\ndt = 0.1"),
+        "contact",
+        &["contact acts in the explicit solver only"],
+    );
+    rejected(
+        &scene("[[contact]]\n").replace("\"cpgimp\"", "\"bspline2\""),
+        "grid.shape_function",
+        &[
+            "scene.toml:16:",
+            "contact works with linear, ugimp, cpgimp and cpdi",
+        ],
+    );
+}
+
+#[test]
+fn glued_bodies_cannot_also_be_in_contact() {
+    // A third body with no contact to either glues left and right into one field.
+    let third = "[[body]]\nname = \"third\"\nmaterial = \"elastic\"\nshape = \"rectangle\"\nmin = [0.1, 0.8]\nmax = [0.3, 0.9]\n\n";
+    let text = scene("[[contact]]\nbodies = [\"left\", \"right\"]\n")
+        .replace("\n[[contact]]\n", &format!("\n{third}[[contact]]\n"));
+    rejected(
+        &text,
+        "contact.0",
+        &["are declared in contact, but other bodies"],
+    );
+}
