@@ -30,6 +30,7 @@
 //!   of the tangential part P_t at most μ P_n + c A Δt (c the adhesion, A the
 //!   nodal area |Σ_p V_p ∇S_Ip| averaged over r and s); s receives the opposite,
 //!   so momentum is conserved to round-off.
+//!
 //! With three or more fields at a node the pairs are corrected one after another,
 //! in field order.
 
