@@ -167,7 +167,6 @@ impl<const D: usize> Contact<D> {
                     .map(|e| st.node[e])
                     .filter(|&g| shared[g as usize].load(Relaxed))
                     .map(move |g| (g, field[p]))
-                    .collect::<Vec<_>>()
             })
             .collect();
         split.par_sort_unstable();
