@@ -43,8 +43,8 @@ use crate::physics::transfer::NodeMap;
 use crate::scene::contact::{ContactLaw, ContactPlan};
 use crate::scene::ContactNormal;
 use rayon::prelude::*;
+use std::sync::atomic::AtomicU64;
 use std::sync::atomic::Ordering::Relaxed;
-use std::sync::atomic::{AtomicBool, AtomicU32};
 
 /// Two fields meeting at a node in this step.
 #[derive(Clone, Copy, Debug)]
@@ -89,9 +89,10 @@ pub struct Contact<const D: usize> {
     totals: Vec<PairTotal<D>>,
     /// Index into `totals` of field pair (i, j), i < j, at i · fields + j.
     pair_index: Vec<usize>,
-    /// Scratch of `split_shared_nodes`, one entry per grid node.
-    first_field: Vec<AtomicU32>,
-    shared: Vec<AtomicBool>,
+    /// Scratch of `split_shared_nodes`, one entry per grid node: the fields that
+    /// touch it (bit f for field f) and, at a shared node, its first split id.
+    fields_at: Vec<AtomicU64>,
+    offset: Vec<u32>,
 }
 
 impl<const D: usize> Contact<D> {
@@ -128,71 +129,71 @@ impl<const D: usize> Contact<D> {
             meetings: Vec::new(),
             totals,
             pair_index,
-            first_field: Vec::new(),
-            shared: Vec::new(),
+            fields_at: Vec::new(),
+            offset: Vec::new(),
         }
     }
 
     /// Give every field its own node at each grid node that several fields touch:
     /// renumber those stencil entries to split ids (n_grid + k) and return the grid
-    /// node of each split id. The split nodes are the same for any order of the
-    /// particles and any number of threads.
+    /// node of each split id. A bit mask of the fields at each grid node finds the
+    /// shared nodes; the split ids follow grid node and field order, so they are
+    /// the same for any order of the particles and any number of threads.
     fn split_shared_nodes(&mut self, st: &mut Stencils<D>, n_grid: usize) -> Vec<u32> {
-        const NONE: u32 = u32::MAX;
-        if self.first_field.len() != n_grid {
-            self.first_field = (0..n_grid).map(|_| AtomicU32::new(NONE)).collect();
-            self.shared = (0..n_grid).map(|_| AtomicBool::new(false)).collect();
+        if self.fields_at.len() != n_grid {
+            self.fields_at = (0..n_grid).map(|_| AtomicU64::new(0)).collect();
+            self.offset = vec![0; n_grid];
         }
-        let (first, shared, field) = (&self.first_field, &self.shared, &self.field);
+        let (mask, field) = (&self.fields_at, &self.field);
         let n_particles = st.count.len();
         (0..n_particles)
             .into_par_iter()
             .with_min_len(MIN_PARALLEL_LEN)
             .for_each(|p| {
+                let bit = 1u64 << field[p];
                 for e in st.range(p) {
-                    let g = st.node[e] as usize;
-                    if let Err(other) = first[g].compare_exchange(NONE, field[p], Relaxed, Relaxed)
-                    {
-                        if other != field[p] {
-                            shared[g].store(true, Relaxed);
-                        }
+                    let m = &mask[st.node[e] as usize];
+                    if m.load(Relaxed) & bit == 0 {
+                        m.fetch_or(bit, Relaxed);
                     }
                 }
             });
-        let mut split: Vec<(u32, u32)> = (0..n_particles)
+        let several = |m: u64| m & m.wrapping_sub(1) != 0;
+        let shared: Vec<u32> = (0..n_grid as u32)
             .into_par_iter()
             .with_min_len(MIN_PARALLEL_LEN)
-            .flat_map_iter(|p| {
-                st.range(p)
-                    .map(|e| st.node[e])
-                    .filter(|&g| shared[g as usize].load(Relaxed))
-                    .map(move |g| (g, field[p]))
-            })
+            .filter(|&g| several(mask[g as usize].load(Relaxed)))
             .collect();
-        split.par_sort_unstable();
-        split.dedup();
-        let (stride, count, split_ref) = (st.stride, &st.count, &split);
+        self.split.clear();
+        for &g in &shared {
+            self.offset[g as usize] = self.split.len() as u32;
+            let mut m = mask[g as usize].load(Relaxed);
+            while m != 0 {
+                self.split.push((g, m.trailing_zeros()));
+                m &= m - 1;
+            }
+        }
+        let (stride, count, offset) = (st.stride, &st.count, &self.offset);
         st.node
             .par_chunks_mut(stride)
             .zip(count.par_iter())
             .enumerate()
             .with_min_len(MIN_PARALLEL_LEN)
             .for_each(|(p, (nodes, &n))| {
+                let below = (1u64 << field[p]) - 1;
                 for g in &mut nodes[..n as usize] {
-                    if shared[*g as usize].load(Relaxed) {
-                        let k = split_ref.binary_search(&(*g, field[p])).unwrap();
-                        *g = (n_grid + k) as u32;
+                    let m = mask[*g as usize].load(Relaxed);
+                    if several(m) {
+                        let k = offset[*g as usize] + (m & below).count_ones();
+                        *g = (n_grid as u32) + k;
                     }
                 }
             });
-        // Clear the scratch for the next step.
-        first.par_iter().for_each(|f| f.store(NONE, Relaxed));
-        for &(g, _) in &split {
-            shared[g as usize].store(false, Relaxed);
-        }
-        let nodes = split.iter().map(|&(g, _)| g).collect();
-        self.split = split;
-        nodes
+        // Clear the masks for the next step.
+        mask.par_iter()
+            .with_min_len(MIN_PARALLEL_LEN)
+            .for_each(|m| m.store(0, Relaxed));
+        self.split.iter().map(|&(g, _)| g).collect()
     }
 
     /// The meetings of this step: at every split grid node, each pair of fields

@@ -10,6 +10,10 @@
 use super::config::{ContactConfig, ContactNormal, SceneConfig};
 use crate::material::parameters::KeyError;
 
+/// Velocity fields a scene may have (the split of shared nodes keeps the fields at
+/// a node as the bits of a u64).
+pub const MAX_FIELDS: u32 = 64;
+
 /// The law of one contact: Coulomb friction with adhesion, and the gap factor λ.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ContactLaw {
@@ -162,6 +166,15 @@ pub fn plan(s: &SceneConfig) -> Result<Option<ContactPlan>, KeyError> {
             fields += 1;
         }
         field_of_body[b] = field_of_body[r];
+    }
+    if fields > MAX_FIELDS {
+        return Err((
+            "contact".into(),
+            format!(
+                "the contacts make {fields} velocity fields; at most {MAX_FIELDS} are supported \
+                 (bodies without a contact between them share a field)"
+            ),
+        ));
     }
     let mut laws: Vec<Option<(ContactLaw, usize)>> = vec![None; fields as usize * fields as usize];
     let f = fields as usize;

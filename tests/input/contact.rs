@@ -124,3 +124,23 @@ fn glued_bodies_cannot_also_be_in_contact() {
         &["are declared in contact, but other bodies"],
     );
 }
+
+#[test]
+fn more_than_64_velocity_fields_are_refused() {
+    // 65 small bodies, every pair in contact: 65 fields.
+    let bodies: String = (0..65)
+        .map(|k| {
+            let x = 0.02 * k as f64;
+            format!(
+                "[[body]]\nname = \"b{k}\"\nmaterial = \"elastic\"\nshape = \"rectangle\"\n\
+                 min = [{x}, 0.0]\nmax = [{}, 0.01]\n\n",
+                x + 0.01
+            )
+        })
+        .collect();
+    let text = scene("[[contact]]\n");
+    let first = text.find("[[body]]").unwrap();
+    let contact = text.find("\n[[contact]]\n").unwrap();
+    let text = format!("{}{bodies}{}", &text[..first], &text[contact + 1..]);
+    rejected(&text, "contact", &["65 velocity fields; at most 64"]);
+}
