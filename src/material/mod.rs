@@ -46,4 +46,5 @@ models! {
     drucker_prager::DruckerPrager,
     mohr_coulomb::MohrCoulomb,
     ogden::Ogden,
+    rigid::Rigid,
 }

@@ -56,6 +56,8 @@ struct Meeting<const D: usize> {
     pair: usize,
     /// Common normal, from r to s.
     normal: Vector<D>,
+    /// Whether r and s are rigid bodies.
+    rigid: [bool; 2],
     /// Nodal contact area (length per unit thickness in 2D).
     area: f64,
     /// The gap criterion holds.
@@ -86,6 +88,8 @@ pub struct Contact<const D: usize> {
     /// Grid node and field of each split node of this step, ascending.
     split: Vec<(u32, u32)>,
     meetings: Vec<Meeting<D>>,
+    /// Active nodes of rigid fields this step, with the rigid body's velocity.
+    rigid_nodes: Vec<(usize, Vector<D>)>,
     totals: Vec<PairTotal<D>>,
     /// Index into `totals` of field pair (i, j), i < j, at i · fields + j.
     pair_index: Vec<usize>,
@@ -127,6 +131,7 @@ impl<const D: usize> Contact<D> {
             field,
             split: Vec::new(),
             meetings: Vec::new(),
+            rigid_nodes: Vec::new(),
             totals,
             pair_index,
             fields_at: Vec::new(),
@@ -269,6 +274,7 @@ impl<const D: usize> Contact<D> {
                         s,
                         pair: self.pair_index[fr * f + fs],
                         normal,
+                        rigid: [self.plan.rigid[fr], self.plan.rigid[fs]],
                         area: 0.5 * (gr.norm() + gs.norm()),
                         close: gap <= law.gap_factor * h,
                         law,
@@ -294,6 +300,31 @@ impl<const D: usize> Contact<D> {
         map.split = self.split_shared_nodes(st, n_grid);
         map.build(st, n_grid + map.split.len());
         self.prepare(m, st, map);
+        self.rigid_nodes.clear();
+        if self.plan.rigid.iter().any(|&r| r) {
+            // A node of a rigid field holds only that body's particles.
+            let (owner, rigid, field) = (st.owner(), &self.plan.rigid, &self.field);
+            self.rigid_nodes = (0..map.len())
+                .into_par_iter()
+                .with_min_len(MIN_PARALLEL_LEN)
+                .filter_map(|a| {
+                    let q = owner.of(map.node_entries(a)[0]);
+                    rigid[field[q] as usize].then(|| (a, p.v[q]))
+                })
+                .collect();
+        }
+    }
+
+    /// Give the nodes of rigid bodies their body's velocity and no acceleration.
+    pub fn hold_rigid(&self, v: &mut [Vector<D>], accel: Option<&mut [Vector<D>]>) {
+        for &(a, velocity) in &self.rigid_nodes {
+            v[a] = velocity;
+        }
+        if let Some(accel) = accel {
+            for &(a, _) in &self.rigid_nodes {
+                accel[a] = Vector::<D>::zeros();
+            }
+        }
     }
 
     /// Correct the nodal velocities `v` (masses `mass`) at the meetings where the
@@ -320,11 +351,22 @@ impl<const D: usize> Contact<D> {
             if !(mt.close && mr > 0.0 && ms > 0.0) {
                 continue;
             }
-            let Some(dp) = exchange(mr, ms, &v[mt.r], &v[mt.s], mt, dt) else {
+            // A rigid field has infinite mass: it keeps its velocity.
+            let reduced = match mt.rigid {
+                [false, false] => mr * ms / (mr + ms),
+                [false, true] => mr,
+                [true, false] => ms,
+                [true, true] => continue,
+            };
+            let Some(dp) = exchange(reduced, &v[mt.r], &v[mt.s], mt, dt) else {
                 continue;
             };
-            v[mt.r] += dp / mr;
-            v[mt.s] -= dp / ms;
+            if !mt.rigid[0] {
+                v[mt.r] += dp / mr;
+            }
+            if !mt.rigid[1] {
+                v[mt.s] -= dp / ms;
+            }
             corrected.extend([mt.r, mt.s]);
             if delivered > 0.0 {
                 let total = &mut self.totals[mt.pair];
@@ -364,16 +406,16 @@ fn tangential<const D: usize>(v: &Vector<D>, n: &Vector<D>) -> Vector<D> {
 
 /// The momentum change of field r at a meeting (s gets the opposite), or None if
 /// the fields do not approach: −P_n n − min(μ P_n + c A Δt, |P_t|) P_t/|P_t| with
-/// P = m_r m_s/(m_r + m_s) (v_r − v_s) (review 002 eq. 41 with Coulomb's cap).
+/// P = m (v_r − v_s), m the reduced mass m_r m_s/(m_r + m_s) (review 002 eq. 41
+/// with Coulomb's cap; m_r or m_s against a rigid field).
 fn exchange<const D: usize>(
-    mr: f64,
-    ms: f64,
+    reduced: f64,
     vr: &Vector<D>,
     vs: &Vector<D>,
     mt: &Meeting<D>,
     dt: f64,
 ) -> Option<Vector<D>> {
-    let p = (vr - vs) * (mr * ms / (mr + ms));
+    let p = (vr - vs) * reduced;
     let pn = p.dot(&mt.normal);
     if pn <= 0.0 {
         return None;
@@ -395,6 +437,7 @@ mod tests {
             s: 1,
             pair: 0,
             normal,
+            rigid: [false, false],
             area: 1.0,
             close: true,
             law: ContactLaw {
@@ -413,7 +456,7 @@ mod tests {
         let n = Vector::<2>::new(1.0, 0.0);
         let (mr, ms) = (2.0, 1.0);
         let (vr, vs) = (Vector::<2>::new(1.0, 0.5), Vector::<2>::new(-2.0, 0.0));
-        let dp = exchange(mr, ms, &vr, &vs, &meeting(n, 0.0), 1.0).unwrap();
+        let dp = exchange(mr * ms / (mr + ms), &vr, &vs, &meeting(n, 0.0), 1.0).unwrap();
         let (ur, us) = (vr + dp / mr, vs - dp / ms);
         assert!((ur.x - us.x).abs() < 1e-15 && (ur.x - 0.0).abs() < 1e-15);
         assert_eq!((ur.y, us.y), (0.5, 0.0));
@@ -427,10 +470,10 @@ mod tests {
         let n = Vector::<2>::new(0.0, -1.0);
         let (vr, vs) = (Vector::<2>::new(3.0, -1.0), Vector::<2>::zeros());
         // m_r = m_s = 2: P = (3, −1), P_n = 1, P_t = (3, 0).
-        let slip = exchange(2.0, 2.0, &vr, &vs, &meeting(n, 0.5), 1.0).unwrap();
+        let slip = exchange(1.0, &vr, &vs, &meeting(n, 0.5), 1.0).unwrap();
         assert!((slip - Vector::<2>::new(-0.5, 1.0)).norm() < 1e-15);
-        let stick = exchange(2.0, 2.0, &vr, &vs, &meeting(n, 5.0), 1.0).unwrap();
+        let stick = exchange(1.0, &vr, &vs, &meeting(n, 5.0), 1.0).unwrap();
         assert!((stick - Vector::<2>::new(-3.0, 1.0)).norm() < 1e-15);
-        assert!(exchange(2.0, 2.0, &-vr, &vs, &meeting(n, 5.0), 1.0).is_none());
+        assert!(exchange(1.0, &-vr, &vs, &meeting(n, 5.0), 1.0).is_none());
     }
 }

@@ -46,6 +46,8 @@ pub struct ContactPlan {
     /// the diagonal.
     pub laws: Vec<Option<ContactLaw>>,
     pub fields: usize,
+    /// Whether each field is a rigid body (`material::rigid`).
+    pub rigid: Vec<bool>,
 }
 
 impl ContactPlan {
@@ -113,8 +115,20 @@ fn check_law(c: &ContactConfig, i: usize) -> Result<(), KeyError> {
 /// Resolve the `[[contact]]` tables (None when there are none), with the first
 /// problem named by its key.
 pub fn plan(s: &SceneConfig) -> Result<Option<ContactPlan>, KeyError> {
+    let rigid = |b: usize| {
+        let name = &s.bodies[b].material;
+        (s.materials.iter()).any(|m| &m.name == name && m.model == "rigid")
+    };
     if s.contacts.is_empty() {
-        return Ok(None);
+        return match (0..s.bodies.len()).find(|&b| rigid(b)) {
+            Some(b) => Err((
+                format!("body.{b}.material"),
+                "a rigid body meets other bodies only through contact: add a [[contact]] \
+                 between it and every body it may touch"
+                    .into(),
+            )),
+            None => Ok(None),
+        };
     }
     let n = s.bodies.len();
     if n < 2 {
@@ -176,6 +190,18 @@ pub fn plan(s: &SceneConfig) -> Result<Option<ContactPlan>, KeyError> {
             ),
         ));
     }
+    for b in (0..n).filter(|&b| rigid(b)) {
+        if let Some(other) = (0..n).find(|&o| o != b && field_of_body[o] == field_of_body[b]) {
+            return Err((
+                format!("body.{b}.material"),
+                format!(
+                    "rigid body {b} would share a velocity field with body {other} (no \
+                     [[contact]] between them): a rigid body needs a contact with every \
+                     other body"
+                ),
+            ));
+        }
+    }
     let mut laws: Vec<Option<(ContactLaw, usize)>> = vec![None; fields as usize * fields as usize];
     let f = fields as usize;
     for a in 0..n {
@@ -212,9 +238,13 @@ pub fn plan(s: &SceneConfig) -> Result<Option<ContactPlan>, KeyError> {
             }
         }
     }
+    let field_rigid = (0..f)
+        .map(|k| (0..n).any(|b| field_of_body[b] as usize == k && rigid(b)))
+        .collect();
     Ok(Some(ContactPlan {
         field_of_body,
         laws: laws.into_iter().map(|l| l.map(|(law, _)| law)).collect(),
         fields: f,
+        rigid: field_rigid,
     }))
 }

@@ -144,3 +144,23 @@ fn more_than_64_velocity_fields_are_refused() {
     let text = format!("{}{bodies}{}", &text[..first], &text[contact + 1..]);
     rejected(&text, "contact", &["65 velocity fields; at most 64"]);
 }
+
+#[test]
+fn a_rigid_body_needs_contact_with_every_other_body() {
+    let rigid = "[[material]]\nname = \"steel\"\nmodel = \"rigid\"\ndensity = 7800.0\n\n";
+    let with_rigid = |contact: &str| {
+        scene(contact)
+            .replacen("[[body]]", &format!("{rigid}[[body]]"), 1)
+            .replacen(
+                "material = \"elastic\"\nshape = \"disk\"\ncentre = [1.0",
+                "material = \"steel\"\nshape = \"disk\"\ncentre = [1.0",
+                1,
+            )
+    };
+    Scene::parse("scene.toml", &with_rigid("[[contact]]\n"), &[]).unwrap();
+    rejected(
+        &with_rigid(""),
+        "body.1.material",
+        &["a rigid body meets other bodies only through contact"],
+    );
+}
