@@ -405,7 +405,9 @@ fn tangential<const D: usize>(v: &Vector<D>, n: &Vector<D>) -> Vector<D> {
 }
 
 /// The momentum change of field r at a meeting (s gets the opposite), or None if
-/// the fields do not approach: −P_n n − min(μ P_n + c A Δt, |P_t|) P_t/|P_t| with
+/// the fields do not approach and the contact has no adhesion (with adhesion, a
+/// separating node exchanges tangential momentum up to c A Δt only):
+/// −P_n n − min(μ P_n + c A Δt, |P_t|) P_t/|P_t| with
 /// P = m (v_r − v_s), m the reduced mass m_r m_s/(m_r + m_s) (review 002 eq. 41
 /// with Coulomb's cap; m_r or m_s against a rigid field).
 fn exchange<const D: usize>(
@@ -417,12 +419,16 @@ fn exchange<const D: usize>(
 ) -> Option<Vector<D>> {
     let p = (vr - vs) * reduced;
     let pn = p.dot(&mt.normal);
-    if pn <= 0.0 {
+    let adhesion = mt.law.adhesion * mt.area * dt;
+    // Separating fields that touch (the gap criterion holds) keep the interface's
+    // shear strength, but no normal exchange and no friction.
+    if pn <= 0.0 && adhesion == 0.0 {
         return None;
     }
-    let pt = p - mt.normal * pn;
+    let pn = pn.max(0.0);
+    let pt = p - mt.normal * p.dot(&mt.normal);
     let slide = pt.norm();
-    let cap = mt.law.friction * pn + mt.law.adhesion * mt.area * dt;
+    let cap = mt.law.friction * pn + adhesion;
     let tangential = if slide <= cap { pt } else { pt * (cap / slide) };
     Some(-(mt.normal * pn) - tangential)
 }
@@ -475,5 +481,23 @@ mod tests {
         let stick = exchange(1.0, &vr, &vs, &meeting(n, 5.0), 1.0).unwrap();
         assert!((stick - Vector::<2>::new(-3.0, 1.0)).norm() < 1e-15);
         assert!(exchange(1.0, &-vr, &vs, &meeting(n, 5.0), 1.0).is_none());
+    }
+
+    /// Adhesion holds a separating interface in shear (up to c A Δt) but does not
+    /// pull it together.
+    #[test]
+    fn adhesion_acts_in_shear_on_separating_fields() {
+        let n = Vector::<2>::new(0.0, -1.0);
+        let mut mt = meeting(n, 0.0);
+        mt.law.adhesion = 0.5;
+        // Separating (P_n = −1) with P_t = (3, 0): the shear exchange is c A Δt = 0.5.
+        let dp = exchange(
+            1.0,
+            &Vector::<2>::new(3.0, 1.0),
+            &Vector::<2>::zeros(),
+            &mt,
+            1.0,
+        );
+        assert!((dp.unwrap() - Vector::<2>::new(-0.5, 0.0)).norm() < 1e-15);
     }
 }
