@@ -463,3 +463,82 @@ fn adhesion_holds_the_block_in_shear() {
     );
     assert!(stuck.abs() < 5e-3, "the adhesive block slid {stuck} m");
 }
+
+/// The incline in 3D: a 1 × 0.5 × 0.5 m block on an elastic base, rollers on the
+/// z faces, 10 cells along the block.
+const INCLINE_3D: &str = r#"dimension = 3
+gravity = [6.936717523440031, -6.936717523440031, 0.0]
+
+[grid]
+min = [-0.5, 0.0, 0.0]
+max = [3.0, 1.0, 0.5]
+cells = [35, 10, 5]
+shape_function = "cpgimp"
+
+[[material]]
+name = "elastic"
+model = "hencky"
+density = 1000.0
+youngs_modulus = 1.0e7
+poisson_ratio = 0.3
+
+[[body]]
+name = "base"
+material = "elastic"
+shape = "box"
+min = [-0.5, 0.0, 0.0]
+max = [3.0, 0.3, 0.5]
+particles_per_cell = 2
+
+[[body]]
+name = "block"
+material = "elastic"
+shape = "box"
+min = [0.0, 0.3, 0.0]
+max = [1.0, 0.8, 0.5]
+particles_per_cell = 2
+
+[[contact]]
+bodies = ["block", "base"]
+friction_coefficient = 0.3
+
+[[boundary]]
+face = "ymin"
+condition = "fixed"
+
+[[boundary]]
+face = "zmin"
+condition = "roller"
+
+[[boundary]]
+face = "zmax"
+condition = "roller"
+
+[solver]
+kind = "explicit"
+end_time = 0.5
+cfl = 0.5
+
+[output]
+frames = 0
+history_interval = 0.01
+"#;
+
+#[test]
+fn block_slides_on_an_elastic_incline_in_3d() {
+    // The same closed form as in 2D. Measured: +0.09 % (μ = 0), −0.36 % (μ = 0.3).
+    for mu in [0.0, 0.3] {
+        let (result, dir) = run_text(
+            INCLINE_3D,
+            &[&format!("contact.0.friction_coefficient={mu}")],
+        );
+        assert_eq!(result.unwrap().status, Status::Completed);
+        let h = Table::read(&dir.path().join("history.csv")).unwrap();
+        let (t, x) = (h.col("t"), h.col("body1_x"));
+        let (t, x) = (*t.last().unwrap(), x.last().unwrap() - x[0]);
+        let exact = closed_form(45.0, mu, t);
+        let err = (x / exact - 1.0).abs();
+        println!("3D, mu {mu}: x = {x:.5} m, closed form {exact:.5} m, error {err:.2e}");
+        assert!(err < 0.01, "mu {mu}: x = {x}, exact {exact}");
+    }
+}
