@@ -106,12 +106,6 @@ pub trait Material: CloneMaterial + Send + Sync + std::fmt::Debug {
     }
 
     /// Wave speed c = √(M/ρ) at the current Jacobian J (ρ = ρ0/J).
-    /// A rigid body (`rigid::Rigid`): it keeps its velocity and meets others only
-    /// through contact.
-    fn is_rigid(&self) -> bool {
-        false
-    }
-
     fn wave_speed(&self, j: f64) -> f64 {
         (self.p_wave_modulus() * j / self.density()).sqrt()
     }

@@ -45,8 +45,4 @@ impl Material for Rigid {
     fn strain_energy_density(&self, _f: &Mat3, _stress: &Mat3, _history: &[f64]) -> f64 {
         0.0
     }
-
-    fn is_rigid(&self) -> bool {
-        true
-    }
 }

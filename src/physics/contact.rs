@@ -236,6 +236,14 @@ impl<const D: usize> Contact<D> {
                 })
                 .fold(f64::NEG_INFINITY, f64::max)
         };
+        let unit = |v: Vector<D>| {
+            let n = v.norm();
+            if n > 0.0 {
+                v / n
+            } else {
+                v
+            }
+        };
         let h = m.grid.h_min();
         let f = self.plan.fields;
         let mut k = 0;
@@ -251,14 +259,6 @@ impl<const D: usize> Contact<D> {
                         .law(fr as u32, fs as u32)
                         .expect("fields in contact");
                     let (gr, gs) = (gradient[i], gradient[j]);
-                    let unit = |v: Vector<D>| {
-                        let n = v.norm();
-                        if n > 0.0 {
-                            v / n
-                        } else {
-                            v
-                        }
-                    };
                     let normal = match law.normal {
                         ContactNormal::MaxGradient if gr.norm() >= gs.norm() => unit(gr),
                         ContactNormal::MaxGradient => -unit(gs),
@@ -294,8 +294,8 @@ impl<const D: usize> Contact<D> {
         st: &mut Stencils<D>,
         map: &mut NodeMap,
     ) {
+        crate::physics::transfer::stencils(m, shape, st);
         let p = &m.particles;
-        st.compute(shape, &m.grid, &p.x, &p.half_length0, &p.f);
         let n_grid = m.grid.node_count();
         map.split = self.split_shared_nodes(st, n_grid);
         map.build(st, n_grid + map.split.len());
@@ -315,20 +315,14 @@ impl<const D: usize> Contact<D> {
         }
     }
 
-    /// Give the nodes of rigid bodies their body's velocity and no acceleration.
-    pub fn hold_rigid(&self, v: &mut [Vector<D>], accel: Option<&mut [Vector<D>]>) {
-        for &(a, velocity) in &self.rigid_nodes {
-            v[a] = velocity;
-        }
-        if let Some(accel) = accel {
-            for &(a, _) in &self.rigid_nodes {
-                accel[a] = Vector::<D>::zeros();
-            }
-        }
+    /// Whether particle q belongs to a rigid body.
+    pub fn is_rigid_particle(&self, q: usize) -> bool {
+        self.plan.rigid[self.field[q] as usize]
     }
 
-    /// Correct the nodal velocities `v` (masses `mass`) at the meetings where the
-    /// fields approach within the gap, and return the nodes corrected. The
+    /// Give the nodes of rigid bodies their body's velocity, then correct the
+    /// nodal velocities `v` (masses `mass`) at the meetings where the fields
+    /// approach within the gap; return the nodes changed (both). The
     /// fraction `delivered` of the momentum change and of the kinetic energy taken
     /// counts as reaching the particles (`Explicit::step`: 1 − FLIP after P2G, 1
     /// after the grid update, 0 for MUSL's remapped velocities); a pass that
@@ -345,7 +339,11 @@ impl<const D: usize> Contact<D> {
                 t.nodes = 0;
             }
         }
-        let mut corrected = Vec::new();
+        let mut corrected = Vec::with_capacity(self.rigid_nodes.len());
+        for &(a, velocity) in &self.rigid_nodes {
+            v[a] = velocity;
+            corrected.push(a);
+        }
         for mt in &self.meetings {
             let (mr, ms) = (mass[mt.r], mass[mt.s]);
             if !(mt.close && mr > 0.0 && ms > 0.0) {

@@ -201,16 +201,21 @@ impl NodeMap {
     }
 }
 
-/// The particles' shape-function stencils on the grid and the active nodes they
-/// touch: what every step starts from.
+/// The particles' shape-function stencils on the grid.
+pub fn stencils<const D: usize>(m: &Model<D>, shape: ShapeFunction, st: &mut Stencils<D>) {
+    let p = &m.particles;
+    st.compute(shape, &m.grid, &p.x, &p.half_length0, &p.f);
+}
+
+/// The particles' stencils and the active nodes they touch: what every step
+/// starts from (with contact: `physics::contact::Contact::stencils_and_fields`).
 pub fn stencils_and_nodes<const D: usize>(
     m: &Model<D>,
     shape: ShapeFunction,
     st: &mut Stencils<D>,
     map: &mut NodeMap,
 ) {
-    let p = &m.particles;
-    st.compute(shape, &m.grid, &p.x, &p.half_length0, &p.f);
+    stencils(m, shape, st);
     map.build(st, m.grid.node_count());
 }
 

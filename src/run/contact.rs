@@ -18,22 +18,30 @@ pub fn columns(dim: usize) -> Vec<String> {
     c
 }
 
-/// The totals gathered since the last row, for a checkpoint.
+/// One pair of fields between rows.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct PairSince {
+    pub bodies: [u32; 2],
+    /// Impulse on the first field since the last row.
+    pub impulse: Vec<f64>,
+    /// Energy friction dissipated since the start.
+    pub dissipation: f64,
+    /// Nodes in contact in the last step.
+    pub nodes: usize,
+}
+
+/// contact.csv as written and the pairs since its last rows, for a checkpoint.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct ContactState {
     pub csv: String,
-    /// Per pair: impulse components, then the dissipation since the start.
-    pub pending: Vec<Vec<f64>>,
-    pub nodes: Vec<usize>,
+    pub pairs: Vec<PairSince>,
     pub since: f64,
 }
 
 /// contact.csv as it grows.
 pub struct ContactLog {
     csv: CsvWriter,
-    /// Per pair: its bodies, the impulse since the last row, the dissipation so far
-    /// and the nodes in contact in the last step.
-    pairs: Vec<([u32; 2], Vec<f64>, f64, usize)>,
+    pairs: Vec<PairSince>,
     /// Time of the last row.
     since: f64,
 }
@@ -52,15 +60,20 @@ impl ContactLog {
         if self.pairs.is_empty() {
             self.pairs = totals
                 .iter()
-                .map(|t| (t.bodies, vec![0.0; D], 0.0, 0))
+                .map(|t| PairSince {
+                    bodies: t.bodies,
+                    impulse: vec![0.0; D],
+                    dissipation: 0.0,
+                    nodes: 0,
+                })
                 .collect();
         }
         for (pair, t) in self.pairs.iter_mut().zip(totals) {
             for d in 0..D {
-                pair.1[d] += t.impulse[d];
+                pair.impulse[d] += t.impulse[d];
             }
-            pair.2 += t.dissipation;
-            pair.3 = t.nodes;
+            pair.dissipation += t.dissipation;
+            pair.nodes = t.nodes;
         }
     }
 
@@ -70,17 +83,17 @@ impl ContactLog {
         if elapsed <= 0.0 {
             return Ok(());
         }
-        for (bodies, impulse, dissipation, nodes) in &mut self.pairs {
+        for pair in &mut self.pairs {
             let mut row: Vec<Field> = vec![
                 t.into(),
-                bodies[0].into(),
-                bodies[1].into(),
-                (*nodes).into(),
+                pair.bodies[0].into(),
+                pair.bodies[1].into(),
+                pair.nodes.into(),
             ];
-            row.extend(impulse.iter().map(|i| Field::from(i / elapsed)));
-            row.push((*dissipation).into());
+            row.extend(pair.impulse.iter().map(|i| Field::from(i / elapsed)));
+            row.push(pair.dissipation.into());
             self.csv.row(row)?;
-            impulse.iter_mut().for_each(|i| *i = 0.0);
+            pair.impulse.iter_mut().for_each(|i| *i = 0.0);
         }
         self.since = t;
         self.csv.flush()
@@ -91,36 +104,18 @@ impl ContactLog {
         self.csv.flush()?;
         Ok(ContactState {
             csv: std::fs::read_to_string(path)?,
-            pending: (self.pairs.iter())
-                .map(|(b, i, d, _)| {
-                    let mut v = vec![b[0] as f64, b[1] as f64];
-                    v.extend(i);
-                    v.push(*d);
-                    v
-                })
-                .collect(),
-            nodes: self.pairs.iter().map(|p| p.3).collect(),
+            pairs: self.pairs.clone(),
             since: self.since,
         })
     }
 
     /// contact.csv of a checkpoint, written on.
-    pub fn resume(path: &Path, dim: usize, saved: &ContactState) -> io::Result<Self> {
+    pub fn resume(path: &Path, saved: &ContactState) -> io::Result<Self> {
         let mut csv = CsvWriter::resume(path, &saved.csv)?;
         csv.flush()?;
-        let pairs = (saved.pending.iter().zip(&saved.nodes))
-            .map(|(v, &n)| {
-                (
-                    [v[0] as u32, v[1] as u32],
-                    v[2..2 + dim].to_vec(),
-                    v[2 + dim],
-                    n,
-                )
-            })
-            .collect();
         Ok(ContactLog {
             csv,
-            pairs,
+            pairs: saved.pairs.clone(),
             since: saved.since,
         })
     }

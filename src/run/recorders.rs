@@ -157,7 +157,7 @@ impl Recorders {
         }
         r.frames = FrameWriter::resume(out, "particles", saved.frames)?;
         if let (Some(_), Some(state)) = (&r.contact, &saved.contact) {
-            r.contact = Some(ContactLog::resume(&out.join("contact.csv"), D, state)?);
+            r.contact = Some(ContactLog::resume(&out.join("contact.csv"), state)?);
         }
         if let (Some(_), Some(text)) = (&r.newton, &saved.newton_csv) {
             r.newton = Some(CsvWriter::resume(&out.join("newton.csv"), text)?);

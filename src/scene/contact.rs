@@ -8,7 +8,8 @@
 //! groups must carry the same law.
 
 use super::config::{ContactConfig, ContactNormal, SceneConfig};
-use crate::material::parameters::KeyError;
+use crate::material::parameters::{FromParameters, KeyError};
+use crate::material::rigid::Rigid;
 
 /// Velocity fields a scene may have (the split of shared nodes keeps the fields at
 /// a node as the bits of a u64).
@@ -117,7 +118,7 @@ fn check_law(c: &ContactConfig, i: usize) -> Result<(), KeyError> {
 pub fn plan(s: &SceneConfig) -> Result<Option<ContactPlan>, KeyError> {
     let rigid = |b: usize| {
         let name = &s.bodies[b].material;
-        (s.materials.iter()).any(|m| &m.name == name && m.model == "rigid")
+        (s.materials.iter()).any(|m| &m.name == name && m.model == Rigid::NAME)
     };
     if s.contacts.is_empty() {
         return match (0..s.bodies.len()).find(|&b| rigid(b)) {

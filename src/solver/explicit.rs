@@ -127,7 +127,6 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
         mirror.velocity(&mass, &momentum, &mut raw_velocity);
         // Contact after P2G: its momentum reaches the particles through the PIC part.
         if let Some(c) = &mut self.contact {
-            c.hold_rigid(&mut raw_velocity, None);
             c.correct(&mass, &mut raw_velocity, dt, 1.0 - self.flip);
         }
         let mut velocity = constrained(&raw_velocity, &constraint);
@@ -171,9 +170,9 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
         for (a, _) in &contacts {
             accel[*a] = (velocity_new[*a] - raw_velocity[*a]) / dt;
         }
-        // Contact after the grid update; prescribed components win.
+        // Contact after the grid update (rigid bodies' nodes keep their velocity:
+        // zero acceleration); prescribed components win.
         if let Some(c) = &mut self.contact {
-            c.hold_rigid(&mut velocity_new, Some(&mut accel));
             for a in c.correct(&mass, &mut velocity_new, dt, 1.0) {
                 constraint[a].apply_velocity(&mut velocity_new[a]);
                 accel[a] = (velocity_new[a] - raw_velocity[a]) / dt;
@@ -195,10 +194,12 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
                 *x += v_pic * dt;
             });
         let p = &m.particles;
+        let contact = &self.contact;
+        let rigid = |q: usize| contact.as_ref().is_some_and(|c| c.is_rigid_particle(q));
         let work = dt
             * deterministic_sum(p.len(), |q| {
                 // A rigid body's prescribed motion takes the work done on it.
-                if m.materials[p.material[q] as usize].is_rigid() {
+                if rigid(q) {
                     return 0.0;
                 }
                 let f = applied_force(p, q, &m.gravity, &load_factor);
@@ -214,7 +215,6 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
                 let mut remapped = mass_average(&mass, &momentum);
                 mirror.velocity(&mass, &momentum, &mut remapped);
                 if let Some(c) = &mut self.contact {
-                    c.hold_rigid(&mut remapped, None);
                     c.correct(&mass, &mut remapped, dt, 0.0);
                 }
                 let mut velocity = constrained(&remapped, &constraint);

@@ -379,3 +379,19 @@ fn wall_clock_checkpoints_keep_the_last_two_and_restart_exactly() {
     ));
     assert!(same_outputs(whole.path(), again.path()) >= 3);
 }
+
+#[test]
+fn contact_restart_is_byte_identical() {
+    // Checkpoints between history rows: contact.csv's impulse since its last row is
+    // carried in the checkpoint.
+    restarts_are_exact(
+        "contact_disks.toml",
+        &[
+            "solver.end_time=1.0",
+            "output.frames=0",
+            "output.history_interval=0.013",
+        ],
+        0.35,
+        1,
+    );
+}
