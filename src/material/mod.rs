@@ -14,6 +14,7 @@
 //! in docs/scene.md.
 
 pub mod driver;
+pub mod eos;
 pub mod parameters;
 pub mod registry;
 pub mod return_mapping;
@@ -46,5 +47,6 @@ models! {
     drucker_prager::DruckerPrager,
     mohr_coulomb::MohrCoulomb,
     ogden::Ogden,
+    johnson_cook::JohnsonCook,
     rigid::Rigid,
 }

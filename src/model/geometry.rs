@@ -1,5 +1,5 @@
 //! The geometry of a body: an axis-aligned box (rectangle in 2D), a ball (disk,
-//! sphere) or a simple polygon (2D), as given by the `[[body]]` keys. The model
+//! sphere), a cylinder along y (3D) or a simple polygon (2D), as given by the `[[body]]` keys. The model
 //! fills it with particles (`contains`, within `BodyConfig::bounds`, which the
 //! validation also uses) and measures the depth of a particle below its body's
 //! top surface for geostatic stresses (`top`).
@@ -14,6 +14,12 @@ pub enum Geometry {
     Ball { centre: Vec<f64>, radius: f64 },
     /// Vertices in order.
     Polygon(Vec<Vec<f64>>),
+    /// Axis along y from `base` (centre of the bottom face) up by `height`.
+    Cylinder {
+        base: Vec<f64>,
+        radius: f64,
+        height: f64,
+    },
 }
 
 impl Geometry {
@@ -29,6 +35,11 @@ impl Geometry {
                 radius: b.radius.expect("validated"),
             },
             BodyShape::Polygon => Geometry::Polygon(b.vertices.clone().expect("validated")),
+            BodyShape::Cylinder => Geometry::Cylinder {
+                base: b.centre.clone().expect("validated"),
+                radius: b.radius.expect("validated"),
+                height: b.height.expect("validated"),
+            },
         }
     }
 
@@ -41,6 +52,14 @@ impl Geometry {
                 r2 < radius.powi(2)
             }
             Geometry::Polygon(v) => point_in_polygon(x[0], x[1], v),
+            Geometry::Cylinder {
+                base,
+                radius,
+                height,
+            } => {
+                let r2 = (x[0] - base[0]).powi(2) + (x[2] - base[2]).powi(2);
+                r2 < radius.powi(2) && x[1] > base[1] && x[1] < base[1] + height
+            }
         }
     }
 
@@ -57,6 +76,15 @@ impl Geometry {
                 up * centre[v] + (radius.powi(2) - r2).max(0.0).sqrt()
             }
             Geometry::Polygon(vertices) => polygon_top(vertices, x[1 - v], v, up),
+            Geometry::Cylinder { base, height, .. } if v == 1 => {
+                (up * base[1]).max(up * (base[1] + height))
+            }
+            Geometry::Cylinder { base, radius, .. } => {
+                // Across the axis: the circle's top on the line through x.
+                let w = if v == 0 { 2 } else { 0 };
+                let r2 = (x[w] - base[w]).powi(2);
+                up * base[v] + (radius.powi(2) - r2).max(0.0).sqrt()
+            }
         }
     }
 }

@@ -4,6 +4,7 @@
 
 pub mod absorbing;
 pub mod boundary;
+pub mod bulk_viscosity;
 pub mod contact;
 pub mod deformation;
 pub mod fbar;

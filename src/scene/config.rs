@@ -64,6 +64,8 @@ pub enum BodyShape {
     Sphere,
     /// 2D, `vertices` of a simple polygon in order.
     Polygon,
+    /// 3D, axis along y: `centre` of its bottom face, `radius`, `height`.
+    Cylinder,
 }
 
 impl BodyShape {
@@ -84,6 +86,8 @@ pub struct BodyConfig {
     pub centre: Option<Vec<f64>>,
     pub radius: Option<f64>,
     pub vertices: Option<Vec<Vec<f64>>>,
+    /// Length along its axis (cylinder).
+    pub height: Option<f64>,
     /// Particles per cell per direction: one number or one per direction.
     #[serde(default = "default_ppc")]
     pub particles_per_cell: PerDirection,
@@ -108,6 +112,17 @@ impl BodyConfig {
                 (
                     c.iter().map(|x| x - r).collect(),
                     c.iter().map(|x| x + r).collect(),
+                )
+            }
+            BodyShape::Cylinder => {
+                let (c, r, h) = (
+                    self.centre.as_ref().unwrap(),
+                    self.radius.unwrap(),
+                    self.height.unwrap(),
+                );
+                (
+                    vec![c[0] - r, c[1], c[2] - r],
+                    vec![c[0] + r, c[1] + h, c[2] + r],
                 )
             }
             BodyShape::Polygon => {

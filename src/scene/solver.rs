@@ -113,6 +113,10 @@ pub struct SolverConfig {
     pub cfl: Option<f64>,
     pub flip: Option<f64>,
     pub damping: Option<f64>,
+    /// Artificial bulk viscosity C_Q and C_L (`physics::bulk_viscosity`; off
+    /// unless one is given, the other then takes its standard value).
+    pub bulk_viscosity_quadratic: Option<f64>,
+    pub bulk_viscosity_linear: Option<f64>,
     // Implicit keys.
     pub integrator: Option<Integrator>,
     pub beta: Option<f64>,
@@ -266,6 +270,8 @@ pub const SCOPES: &[Scope] = &[
     scope!(cfl, EXPLICIT, &[], &[], ""),
     scope!(flip, EXPLICIT, &[], &[], ""),
     scope!(damping, EXPLICIT, &[], &[], ""),
+    scope!(bulk_viscosity_quadratic, EXPLICIT, &[], &[], ""),
+    scope!(bulk_viscosity_linear, EXPLICIT, &[], &[], ""),
     scope!(integrator, IMPLICIT, &[], &[], ""),
     scope!(beta, IMPLICIT, NEWMARK, &[], ""),
     scope!(gamma, IMPLICIT, NEWMARK, &[], ""),
@@ -298,6 +304,18 @@ impl SolverConfig {
     /// FLIP fraction: 1 = FLIP (default), 0 = PIC.
     pub fn flip(&self) -> f64 {
         self.flip.unwrap_or(1.0)
+    }
+    /// The artificial bulk viscosity, if either coefficient is given (standard
+    /// values C_Q = 1.5, C_L = 0.06 for the other).
+    pub fn bulk_viscosity(&self) -> Option<(f64, f64)> {
+        (self.bulk_viscosity_quadratic.is_some() || self.bulk_viscosity_linear.is_some()).then(
+            || {
+                (
+                    self.bulk_viscosity_quadratic.unwrap_or(1.5),
+                    self.bulk_viscosity_linear.unwrap_or(0.06),
+                )
+            },
+        )
     }
     /// Local damping α (default 0).
     pub fn damping(&self) -> f64 {

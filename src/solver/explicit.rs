@@ -9,6 +9,7 @@ use crate::model::{load_factor, Model};
 use crate::parallel::{deterministic_sum, MIN_PARALLEL_LEN};
 use crate::physics::absorbing;
 use crate::physics::boundary::{friction_contact, node_constraint, node_friction};
+use crate::physics::bulk_viscosity::BulkViscosity;
 use crate::physics::contact::{Contact, PairTotal};
 use crate::physics::deformation::Trial;
 use crate::physics::mirror::Mirror;
@@ -41,6 +42,8 @@ pub struct Explicit<const D: usize> {
     trial: Trial,
     /// Contact between bodies (`crate::physics::contact`), when the scene has some.
     contact: Option<Contact<D>>,
+    /// Artificial bulk viscosity (`crate::physics::bulk_viscosity`), if asked for.
+    pub viscosity: Option<BulkViscosity>,
 }
 
 impl<const D: usize> Explicit<D> {
@@ -57,6 +60,9 @@ impl<const D: usize> Explicit<D> {
             map: NodeMap::default(),
             trial: Trial::default(),
             contact: None,
+            viscosity: s
+                .bulk_viscosity()
+                .map(|(quadratic, linear)| BulkViscosity { quadratic, linear }),
         }
     }
 
@@ -76,10 +82,27 @@ impl<const D: usize> Explicit<D> {
 }
 
 impl<const D: usize> Stepper<D> for Explicit<D> {
-    /// The step to take now: the fixed one, or cfl × the critical one.
+    /// The step to take now: the fixed one, or cfl × the critical one (with bulk
+    /// viscosity, also within its stable step at every particle, its rate from
+    /// the particle's F rate being unknown here: ε̇_v = 0, the linear term only).
     fn dt(&self, m: &Model<D>) -> f64 {
-        self.fixed_dt
-            .unwrap_or_else(|| self.cfl * Self::critical_dt(m))
+        self.fixed_dt.unwrap_or_else(|| {
+            let critical = Self::critical_dt(m);
+            let viscous = self.viscosity.map_or(f64::INFINITY, |v| {
+                let p = &m.particles;
+                let l = m.grid.h_min();
+                (0..p.len())
+                    .into_par_iter()
+                    .with_min_len(MIN_PARALLEL_LEN)
+                    .map(|q| {
+                        let c =
+                            m.materials[p.material[q] as usize].wave_speed(p.f[q].determinant());
+                        v.stable_dt(c, l, 0.0)
+                    })
+                    .reduce(|| f64::INFINITY, f64::min)
+            });
+            self.cfl * critical.min(viscous)
+        })
     }
 
     /// Advance the model from t to t + dt. Returns the work done by gravity and
@@ -140,6 +163,10 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
         let scales = m.load_scales(t);
         let load_factor = |q: usize| load_factor(&m.load_ramp_of, q, &scales);
         let mut force = nodal_force(map, st, p, &m.gravity, &load_factor);
+        if let Some(v) = &self.viscosity {
+            let l = m.grid.h_min();
+            v.add_force(map, st, p, &m.materials, &velocity, l, &mut force);
+        }
         // Absorbing faces: dashpot (and spring) forces on the outer cell layer (2-63).
         absorbing::add_force(&m.absorbing, &m.grid, p, map, st, &velocity, &mut force);
         let mut accel: Vec<Vector<D>> = (0..map.len())

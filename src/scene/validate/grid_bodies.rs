@@ -106,7 +106,7 @@ fn shape_keys(b: &BodyConfig, i: usize, dim: usize) -> Check {
     let what = format!("shape `{}`", b.shape.name());
     let shape_dim = match b.shape {
         BodyShape::Rectangle | BodyShape::Disk | BodyShape::Polygon => 2,
-        BodyShape::Box | BodyShape::Sphere => 3,
+        BodyShape::Box | BodyShape::Sphere | BodyShape::Cylinder => 3,
     };
     ensure(
         shape_dim == dim,
@@ -120,6 +120,7 @@ fn shape_keys(b: &BodyConfig, i: usize, dim: usize) -> Check {
             forbidden(&b.centre, key("centre"), &what)?;
             forbidden(&b.radius, key("radius"), &what)?;
             forbidden(&b.vertices, key("vertices"), &what)?;
+            forbidden(&b.height, key("height"), &what)?;
             let (lo, hi) = (b.min.clone().unwrap(), b.max.clone().unwrap());
             vector(&lo, dim, &key("min"))?;
             vector(&hi, dim, &key("max"))?;
@@ -135,6 +136,7 @@ fn shape_keys(b: &BodyConfig, i: usize, dim: usize) -> Check {
             forbidden(&b.min, key("min"), &what)?;
             forbidden(&b.max, key("max"), &what)?;
             forbidden(&b.vertices, key("vertices"), &what)?;
+            forbidden(&b.height, key("height"), &what)?;
             let c = b.centre.clone().unwrap();
             vector(&c, dim, &key("centre"))?;
             let r = b.radius.unwrap();
@@ -150,6 +152,7 @@ fn shape_keys(b: &BodyConfig, i: usize, dim: usize) -> Check {
             forbidden(&b.max, key("max"), &what)?;
             forbidden(&b.centre, key("centre"), &what)?;
             forbidden(&b.radius, key("radius"), &what)?;
+            forbidden(&b.height, key("height"), &what)?;
             let v = b.vertices.as_ref().unwrap();
             ensure(
                 v.len() >= 3,
@@ -158,6 +161,23 @@ fn shape_keys(b: &BodyConfig, i: usize, dim: usize) -> Check {
             )?;
             for (k, p) in v.iter().enumerate() {
                 vector(p, 2, &format!("body.{i}.vertices.{k}"))?;
+            }
+            Ok(())
+        }
+        BodyShape::Cylinder => {
+            required(&b.centre, key("centre"), &what)?;
+            required(&b.radius, key("radius"), &what)?;
+            required(&b.height, key("height"), &what)?;
+            forbidden(&b.min, key("min"), &what)?;
+            forbidden(&b.max, key("max"), &what)?;
+            forbidden(&b.vertices, key("vertices"), &what)?;
+            vector(b.centre.as_ref().unwrap(), dim, &key("centre"))?;
+            for (k, v) in [("radius", b.radius.unwrap()), ("height", b.height.unwrap())] {
+                ensure(
+                    v > 0.0 && v.is_finite(),
+                    key(k),
+                    "must be a positive number",
+                )?;
             }
             Ok(())
         }

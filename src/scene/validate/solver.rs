@@ -119,7 +119,20 @@ fn explicit(s: &SolverConfig, prefix: &str) -> Check {
         (0.0..1.0).contains(&s.damping()),
         format!("{prefix}.damping"),
         "must lie in [0, 1)",
-    )
+    )?;
+    for (key, value) in [
+        ("bulk_viscosity_quadratic", s.bulk_viscosity_quadratic),
+        ("bulk_viscosity_linear", s.bulk_viscosity_linear),
+    ] {
+        if let Some(c) = value {
+            ensure(
+                (0.0..=10.0).contains(&c),
+                format!("{prefix}.{key}"),
+                format!("must lie in [0, 10] (standard: 1.5 quadratic, 0.06 linear); got {c}"),
+            )?;
+        }
+    }
+    Ok(())
 }
 
 fn implicit(s: &SolverConfig, prefix: &str) -> Check {
