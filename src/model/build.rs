@@ -180,8 +180,11 @@ fn fill_body<const D: usize>(
     // Lattice index range covering the bounding box.
     let first: [usize; D] =
         std::array::from_fn(|d| (((lo[d] - grid.min[d]) / spacing[d]).floor().max(0.0)) as usize);
-    let last: [usize; D] =
-        std::array::from_fn(|d| ((hi[d] - grid.min[d]) / spacing[d]).ceil() as usize);
+    // A body cut at a symmetry plane keeps the part inside the grid.
+    let last: [usize; D] = std::array::from_fn(|d| {
+        let upper = hi[d].min(grid.min[d] + grid.h[d] * grid.cells[d] as f64);
+        ((upper - grid.min[d]) / spacing[d]).ceil() as usize
+    });
     let counts: Vec<usize> = (0..D).map(|d| last[d].saturating_sub(first[d])).collect();
     let total: usize = counts.iter().product();
     let uniform = b

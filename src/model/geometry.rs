@@ -1,5 +1,5 @@
 //! The geometry of a body: an axis-aligned box (rectangle in 2D), a ball (disk,
-//! sphere), a cylinder along y (3D) or a simple polygon (2D), as given by the `[[body]]` keys. The model
+//! sphere), a cylinder along z (3D) or a simple polygon (2D), as given by the `[[body]]` keys. The model
 //! fills it with particles (`contains`, within `BodyConfig::bounds`, which the
 //! validation also uses) and measures the depth of a particle below its body's
 //! top surface for geostatic stresses (`top`).
@@ -14,7 +14,7 @@ pub enum Geometry {
     Ball { centre: Vec<f64>, radius: f64 },
     /// Vertices in order.
     Polygon(Vec<Vec<f64>>),
-    /// Axis along y from `base` (centre of the bottom face) up by `height`.
+    /// Axis along z from `base` (centre of the bottom face) up by `height`.
     Cylinder {
         base: Vec<f64>,
         radius: f64,
@@ -57,8 +57,8 @@ impl Geometry {
                 radius,
                 height,
             } => {
-                let r2 = (x[0] - base[0]).powi(2) + (x[2] - base[2]).powi(2);
-                r2 < radius.powi(2) && x[1] > base[1] && x[1] < base[1] + height
+                let r2 = (x[0] - base[0]).powi(2) + (x[1] - base[1]).powi(2);
+                r2 < radius.powi(2) && x[2] > base[2] && x[2] < base[2] + height
             }
         }
     }
@@ -76,12 +76,12 @@ impl Geometry {
                 up * centre[v] + (radius.powi(2) - r2).max(0.0).sqrt()
             }
             Geometry::Polygon(vertices) => polygon_top(vertices, x[1 - v], v, up),
-            Geometry::Cylinder { base, height, .. } if v == 1 => {
-                (up * base[1]).max(up * (base[1] + height))
+            Geometry::Cylinder { base, height, .. } if v == 2 => {
+                (up * base[2]).max(up * (base[2] + height))
             }
             Geometry::Cylinder { base, radius, .. } => {
                 // Across the axis: the circle's top on the line through x.
-                let w = if v == 0 { 2 } else { 0 };
+                let w = 1 - v;
                 let r2 = (x[w] - base[w]).powi(2);
                 up * base[v] + (radius.powi(2) - r2).max(0.0).sqrt()
             }

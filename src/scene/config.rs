@@ -64,7 +64,7 @@ pub enum BodyShape {
     Sphere,
     /// 2D, `vertices` of a simple polygon in order.
     Polygon,
-    /// 3D, axis along y: `centre` of its bottom face, `radius`, `height`.
+    /// 3D, axis along z: `centre` of its bottom face, `radius`, `height`.
     Cylinder,
 }
 
@@ -121,8 +121,8 @@ impl BodyConfig {
                     self.height.unwrap(),
                 );
                 (
-                    vec![c[0] - r, c[1], c[2] - r],
-                    vec![c[0] + r, c[1] + h, c[2] + r],
+                    vec![c[0] - r, c[1] - r, c[2]],
+                    vec![c[0] + r, c[1] + r, c[2] + h],
                 )
             }
             BodyShape::Polygon => {

@@ -15,6 +15,7 @@ mod footing;
 mod friction;
 mod geomaterial_driver;
 mod geomaterial_mpm;
+mod impact;
 mod implicit_bar;
 mod implicit_column;
 mod limit_analysis;

@@ -2,7 +2,7 @@
 //! material, the keys of its shape, and its extent inside the grid.
 
 use super::check::{ensure, forbidden, required, vector, Check};
-use crate::scene::{BodyConfig, BodyShape, GridConfig, PerDirection, SceneConfig};
+use crate::scene::{BodyConfig, BodyShape, Condition, GridConfig, PerDirection, SceneConfig};
 
 pub fn grid(g: &GridConfig, dim: usize) -> Check {
     vector(&g.min, dim, "grid.min")?;
@@ -57,12 +57,25 @@ pub fn body(b: &BodyConfig, i: usize, s: &SceneConfig) -> Check {
     )?;
     shape_keys(b, i, dim)?;
     let (lo, hi) = b.bounds();
-    let inside = (0..dim).all(|d| lo[d] >= s.grid.min[d] && hi[d] <= s.grid.max[d]);
+    // A body may cross a grid face with a roller (a symmetry plane: the model
+    // keeps the part inside), no other.
+    let symmetry = |face: String| {
+        s.boundaries
+            .iter()
+            .any(|c| c.face == face && c.condition == Condition::Roller)
+    };
+    let axis = ["x", "y", "z"];
+    let inside = (0..dim).all(|d| {
+        (lo[d] >= s.grid.min[d] || symmetry(format!("{}min", axis[d])) && hi[d] > s.grid.min[d])
+            && (hi[d] <= s.grid.max[d]
+                || symmetry(format!("{}max", axis[d])) && lo[d] < s.grid.max[d])
+    });
     ensure(
         inside,
         key("shape"),
         format!(
-            "the body spans {lo:?}..{hi:?}, outside the grid {:?}..{:?}",
+            "the body spans {lo:?}..{hi:?}, outside the grid {:?}..{:?} (a body may cross \
+             only a face with a roller condition, a symmetry plane)",
             s.grid.min, s.grid.max
         ),
     )?;
