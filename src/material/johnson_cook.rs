@@ -35,8 +35,9 @@
 use super::eos::{self, energy_update, Eos};
 use super::parameters::{FromParameters, KeyError, Parameters};
 use super::{Increment, Material};
+use super::deviatoric::{deviator, equivalent_rate, strain_increment, TrialDeviator};
 use crate::dim::Mat3;
-use nalgebra::{SymmetricEigen, Vector3};
+use nalgebra::Vector3;
 
 /// Adiabatic heating and thermal softening.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -169,29 +170,6 @@ impl JohnsonCook {
     }
 }
 
-/// Deviatoric part of a tensor.
-fn deviator(a: &Mat3) -> Mat3 {
-    a - Mat3::identity() * (a.trace() / 3.0)
-}
-
-/// Principal deviatoric logarithmic strains and eigenvectors of the trial
-/// b̄^tr = ΔF̄ b̄_e,old ΔF̄ᵀ, with ε̄_e,old = dev τ_old/(2G).
-fn trial_deviator(strain_old: &Mat3, df: &Mat3) -> (Vector3<f64>, Mat3) {
-    let old = SymmetricEigen::new(*strain_old);
-    let v = old.eigenvectors;
-    let be_old_minus_i =
-        v * Mat3::from_diagonal(&old.eigenvalues.map(|e| (2.0 * e).exp_m1())) * v.transpose();
-    let df_bar = df * df.determinant().cbrt().recip();
-    // b̄^tr − I = ΔF̄ (b̄_e,old − I) ΔF̄ᵀ + (ΔF̄ ΔF̄ᵀ − I), without cancellation.
-    let h = df_bar - Mat3::identity();
-    let btr_minus_i =
-        df_bar * be_old_minus_i * df_bar.transpose() + h + h.transpose() + h * h.transpose();
-    let eig = SymmetricEigen::new(btr_minus_i);
-    let e = eig.eigenvalues.map(|m| 0.5 * m.ln_1p());
-    let mean = e.sum() / 3.0;
-    (e.map(|x| x - mean), eig.eigenvectors)
-}
-
 impl Material for JohnsonCook {
     fn model(&self) -> &'static str {
         Self::NAME
@@ -214,18 +192,13 @@ impl Material for JohnsonCook {
         let damage_old = self.damage_slot().map_or(0.0, |i| h_old[i]);
         let eps_p_old = h_old[PLASTIC_STRAIN];
 
-        // Equivalent deviatoric strain rate of the increment.
-        let strain_increment = deviator(&(0.5 * (inc.df + inc.df.transpose())));
-        let rate = if inc.dt > 0.0 {
-            (2.0 / 3.0 * strain_increment.norm_squared()).sqrt() / inc.dt
-        } else {
-            0.0
-        };
+        let strain_increment = strain_increment(&inc.df);
+        let rate = equivalent_rate(&strain_increment, inc.dt);
 
         // Trial deviator and radial return.
         let tau_dev_old = deviator(&inc.stress_old) * j_old;
-        let (e_trial, n) = trial_deviator(&(tau_dev_old / (2.0 * g)), &inc.df);
-        let s_trial = e_trial * (2.0 * g);
+        let trial = TrialDeviator::of(&tau_dev_old, g, &inc.df);
+        let s_trial = trial.strain * (2.0 * g);
         let q_trial = (1.5 * s_trial.norm_squared()).sqrt();
         let k = self.rate_factor(rate) * self.thermal.map_or(1.0, |t| t.softening(rise_old));
         let failed = damage_old >= 1.0;
@@ -237,7 +210,7 @@ impl Material for JohnsonCook {
         } else {
             (s_trial, 0.0)
         };
-        let tau_dev = n * Mat3::from_diagonal(&s) * n.transpose();
+        let tau_dev = trial.tensor(&s);
         let eps_p = eps_p_old + d_eps_p;
         h_new[PLASTIC_STRAIN] = eps_p;
 

@@ -13,6 +13,7 @@
 //! registers it, so a new model is a new file, one line in that list and its keys
 //! in docs/scene.md.
 
+pub mod deviatoric;
 pub mod driver;
 pub mod eos;
 pub mod parameters;
@@ -48,5 +49,6 @@ models! {
     mohr_coulomb::MohrCoulomb,
     ogden::Ogden,
     johnson_cook::JohnsonCook,
+    jh2::Jh2,
     rigid::Rigid,
 }
