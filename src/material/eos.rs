@@ -193,6 +193,131 @@ impl Eos {
     }
 }
 
+/// The HJC three-regime compaction EOS (thesis `000_…` 4-1…4-10, Holmquist,
+/// Johnson & Cook 1993), whose state is the largest compression reached μ_max and
+/// the plastic volumetric strain μ_p:
+/// - elastic, μ_max ≤ μ_crush: p = K_el μ, K_el = P_crush/μ_crush (4-1, 4-2);
+/// - crushing (loading, μ = μ_max < μ_plock): the straight line
+///   p = (1 − F) P_crush + F P_lock, F = (μ_max − μ_crush)/(μ_plock − μ_crush)
+///   (4-6, 4-7), and μ_p from μ̄ = (μ − μ_p)/(1 + μ_p) = p/((1 − F) K_el + F K1) (4-8);
+/// - unloading or reloading inside the crushing range: with μ̄ from the stored μ_p,
+///   p = (1 − F) K_el μ̄ + F (K1 μ̄ + K2 μ̄² + K3 μ̄³) (K1 μ̄ alone for μ̄ < 0) (4-9);
+/// - locked, μ_max ≥ μ_plock: p = K1 μ̄ + K2 μ̄² + K3 μ̄³ (K1 μ̄ for μ̄ < 0) with
+///   μ̄ = (μ − μ_lock)/(1 + μ_lock) (4-4, 4-5), μ_plock where this reaches P_lock.
+///
+/// The tension cut-off p ≥ −(1 − D) T (4-10) belongs to the strength model.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Compaction {
+    pub crush_pressure: f64,
+    pub crush_strain: f64,
+    pub lock_pressure: f64,
+    pub lock_strain: f64,
+    pub k1: f64,
+    pub k2: f64,
+    pub k3: f64,
+    /// μ at which the locked branch reaches P_lock.
+    pub plock_strain: f64,
+}
+
+/// The compaction state after an update.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CompactionState {
+    pub pressure: f64,
+    pub max_strain: f64,
+    pub plastic_strain: f64,
+}
+
+impl Compaction {
+    /// The EOS, μ_plock found from K1 x + K2 x² + K3 x³ = P_lock (Newton from the
+    /// linear guess). `None` if that has no root in (0, 1] with a rising curve.
+    pub fn new(
+        (crush_pressure, crush_strain): (f64, f64),
+        (lock_pressure, lock_strain): (f64, f64),
+        (k1, k2, k3): (f64, f64, f64),
+    ) -> Option<Compaction> {
+        let poly = |x: f64| x * (k1 + x * (k2 + x * k3));
+        let slope = |x: f64| k1 + x * (2.0 * k2 + 3.0 * x * k3);
+        let mut x = lock_pressure / k1;
+        for _ in 0..100 {
+            let step = (poly(x) - lock_pressure) / slope(x);
+            x -= step;
+            if step.abs() <= 1e-15 * x.abs() {
+                break;
+            }
+        }
+        let ok = x > 0.0 && x <= 1.0 && (poly(x) / lock_pressure - 1.0).abs() < 1e-12;
+        let ok = ok && (0..=100).all(|i| slope(x * i as f64 / 100.0) > 0.0);
+        let plock_strain = x * (1.0 + lock_strain) + lock_strain;
+        (ok && plock_strain > crush_strain).then_some(Compaction {
+            crush_pressure,
+            crush_strain,
+            lock_pressure,
+            lock_strain,
+            k1,
+            k2,
+            k3,
+            plock_strain,
+        })
+    }
+
+    fn elastic_modulus(&self) -> f64 {
+        self.crush_pressure / self.crush_strain
+    }
+
+    /// K1 μ̄ + K2 μ̄² + K3 μ̄³ (μ̄ ≥ 0), K1 μ̄ (μ̄ < 0).
+    fn locked(&self, mu_bar: f64) -> f64 {
+        if mu_bar >= 0.0 {
+            mu_bar * (self.k1 + mu_bar * (self.k2 + mu_bar * self.k3))
+        } else {
+            self.k1 * mu_bar
+        }
+    }
+
+    /// F of the largest compression reached.
+    fn compaction(&self, max_strain: f64) -> f64 {
+        ((max_strain - self.crush_strain) / (self.plock_strain - self.crush_strain)).clamp(0.0, 1.0)
+    }
+
+    /// p, μ_max and μ_p at μ from the state before.
+    pub fn update(&self, mu: f64, max_old: f64, plastic_old: f64) -> CompactionState {
+        let max_strain = max_old.max(mu);
+        let state = |pressure, plastic_strain| CompactionState {
+            pressure,
+            max_strain,
+            plastic_strain,
+        };
+        let k_el = self.elastic_modulus();
+        if max_strain <= self.crush_strain {
+            return state(k_el * mu, 0.0);
+        }
+        if max_strain >= self.plock_strain {
+            let mu_bar = (mu - self.lock_strain) / (1.0 + self.lock_strain);
+            return state(self.locked(mu_bar), self.lock_strain);
+        }
+        let f = self.compaction(max_strain);
+        if mu >= max_old {
+            // Crushing: along the line, μ_p from (4-8).
+            let p = (1.0 - f) * self.crush_pressure + f * self.lock_pressure;
+            let mu_bar = p / ((1.0 - f) * k_el + f * self.k1);
+            let plastic = ((mu - mu_bar) / (1.0 + mu_bar)).max(plastic_old);
+            return state(p, plastic);
+        }
+        let mu_bar = (mu - plastic_old) / (1.0 + plastic_old);
+        state(
+            (1.0 - f) * k_el * mu_bar + f * self.locked(mu_bar),
+            plastic_old,
+        )
+    }
+
+    /// ∂p/∂μ on the current branch (for the wave speed): the largest of the
+    /// elastic, unloading and locked moduli at μ.
+    pub fn stiffness(&self, mu: f64) -> f64 {
+        let h = 1e-7;
+        let locked = (self.locked(mu + h) - self.locked(mu - h)) / (2.0 * h);
+        self.elastic_modulus().max(self.k1).max(locked)
+    }
+}
+
 /// E_new of the energy equation dE = dW_dev − p dJ (per reference volume) with
 /// the trapezoidal rule and p_new = a + b E_new, solved in closed form:
 /// E_new = (E_old + ΔW_dev − ½(p_old + a) ΔJ) / (1 + ½ b ΔJ) (Wilkins' scheme).
@@ -253,6 +378,69 @@ mod tests {
         };
         assert!((poly.tangent(0.1) - (201e9 + 2.0 * 260e9 * 0.1)).abs() < 1e-3 * 201e9);
         assert_eq!(poly.pressure(-0.01, 5.0), -201e9 * 0.01);
+    }
+
+    /// The 48 MPa concrete of the HJC literature (MPa): P_crush 16, μ_crush 0.001,
+    /// P_lock 800, μ_lock 0.1, K1 85e3, K2 −171e3, K3 208e3.
+    fn concrete() -> Compaction {
+        Compaction::new((16.0, 0.001), (800.0, 0.1), (85e3, -171e3, 208e3)).unwrap()
+    }
+
+    #[test]
+    fn compaction_follows_its_three_regimes() {
+        let eos = concrete();
+        let poly = |x: f64| x * (85e3 + x * (-171e3 + x * 208e3));
+        let x = (eos.plock_strain - 0.1) / 1.1;
+        assert!(
+            (poly(x) / 800.0 - 1.0).abs() < 1e-12,
+            "μ_plock {}",
+            eos.plock_strain
+        );
+        // Elastic.
+        let s = eos.update(0.0005, 0.0, 0.0);
+        assert_eq!((s.pressure, s.plastic_strain), (8.0, 0.0));
+        // Crushing: on the line from (μ_crush, P_crush) to (μ_plock, P_lock).
+        let (mut max, mut plastic) = (0.0, 0.0);
+        let mu_load = 0.05;
+        for k in 1..=100 {
+            let mu = mu_load * k as f64 / 100.0;
+            let s = eos.update(mu, max, plastic);
+            if mu > 0.001 {
+                let line = 16.0 + (800.0 - 16.0) * (mu - 0.001) / (eos.plock_strain - 0.001);
+                assert!((s.pressure / line - 1.0).abs() < 1e-12, "μ {mu}");
+                assert!(s.plastic_strain >= plastic, "μ_p falls while crushing");
+            }
+            (max, plastic) = (s.max_strain, s.plastic_strain);
+        }
+        assert!(plastic > 0.0);
+        // Unloading: μ_p kept, the pressure vanishes at μ = μ_p and the
+        // reloading curve passes the crushing point again.
+        let s = eos.update(plastic, max, plastic);
+        assert!(s.pressure.abs() < 1e-12 && s.plastic_strain == plastic);
+        let back = eos.update(mu_load - 1e-12, max, plastic);
+        let line = 16.0 + (800.0 - 16.0) * (mu_load - 0.001) / (eos.plock_strain - 0.001);
+        assert!(
+            (back.pressure / line - 1.0).abs() < 0.05,
+            "{} vs {line}",
+            back.pressure
+        );
+        // Locked.
+        let mu = eos.plock_strain + 0.02;
+        let s = eos.update(mu, max, plastic);
+        assert!((s.pressure - poly((mu - 0.1) / 1.1)).abs() < 1e-9);
+        assert_eq!(s.plastic_strain, 0.1);
+        // With μ_lock = 0 and K_el = K1 (thesis Table 4.1) it is p = K1 μ throughout.
+        let linear = Compaction::new((16.0, 0.001), (800.0, 0.0), (16e3, 0.0, 0.0)).unwrap();
+        let (mut max, mut plastic) = (0.0, 0.0);
+        for mu in [0.0005, 0.01, 0.03, 0.02, -0.001, 0.04, 0.06, 0.01] {
+            let s = linear.update(mu, max, plastic);
+            assert!(
+                (s.pressure - 16e3 * mu).abs() < 1e-9,
+                "μ {mu}: {}",
+                s.pressure
+            );
+            (max, plastic) = (s.max_strain, s.plastic_strain);
+        }
     }
 
     #[test]

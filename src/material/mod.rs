@@ -50,5 +50,6 @@ models! {
     ogden::Ogden,
     johnson_cook::JohnsonCook,
     jh2::Jh2,
+    hjc::Hjc,
     rigid::Rigid,
 }
