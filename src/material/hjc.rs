@@ -311,9 +311,9 @@ mod tests {
         let (yielding, r) = check_path(&m, &path, 1e-4);
         assert!(yielding > 500, "{yielding} yielding steps");
         // Linear EOS: p = 16e3 μ at every step.
-        for k in 0..path.len() {
-            let mu = 1.0 / path[k].determinant() - 1.0;
-            assert!((pressure(&r.stress[k]) - 16e3 * mu).abs() < 1e-9 * (1.0 + 16e3 * mu));
+        for (f, s) in path.iter().zip(&r.stress) {
+            let mu = 1.0 / f.determinant() - 1.0;
+            assert!((pressure(s) - 16e3 * mu).abs() < 1e-9 * (1.0 + 16e3 * mu));
         }
         let d = r.history.last().unwrap()[DAMAGE];
         assert!(d > 0.01 && d < 1.0, "D {d}");
