@@ -8,6 +8,7 @@ mod common;
 mod bench;
 mod contact;
 mod fuzz;
+mod impact;
 mod key_paths;
 mod robustness;
 mod scene_errors;
