@@ -28,10 +28,8 @@ fn replaced(from: &str, to: &str) -> String {
 #[test]
 fn the_impact_scenes_are_valid() {
     Scene::parse("scene.toml", &taylor(), &[]).unwrap();
-    for name in ["shock_plate.toml"] {
-        let path = format!("{}/problems/{name}", env!("CARGO_MANIFEST_DIR"));
-        Scene::load(std::path::Path::new(&path), &[]).unwrap();
-    }
+    let plate = concat!(env!("CARGO_MANIFEST_DIR"), "/problems/shock_plate.toml");
+    Scene::load(std::path::Path::new(plate), &[]).unwrap();
 }
 
 #[test]
