@@ -156,3 +156,96 @@ fn taylor_bar_does_not_depend_on_the_number_of_threads() {
         );
     }
 }
+
+/// A Johnson–Cook block (no analytic tangent) compressed 5 % in uniaxial strain,
+/// implicit quasi-static through matrix-free GMRES, in 10 load steps.
+const JC_BLOCK: &str = r#"
+dimension = 2
+[grid]
+min = [0.0, 0.0]
+max = [1.0, 1.0]
+cells = [2, 2]
+shape_function = "linear"
+[[material]]
+name = "copper"
+model = "johnson_cook"
+density = 8930.0
+youngs_modulus = 117.0e9
+poisson_ratio = 0.35
+yield_stress = 90.0e6
+hardening_modulus = 292.0e6
+hardening_exponent = 0.31
+eos = "mie_gruneisen"
+sound_speed = 3940.0
+hugoniot_slope = 1.49
+gruneisen_gamma = 1.96
+[[body]]
+material = "copper"
+shape = "rectangle"
+min = [0.0, 0.0]
+max = [1.0, 1.0]
+[[boundary]]
+face = "xmin"
+condition = "roller"
+[[boundary]]
+face = "xmax"
+condition = "roller"
+[[boundary]]
+face = "ymin"
+condition = "roller"
+[[boundary]]
+face = "ymax"
+condition = "velocity"
+velocity = [0.0, -0.05]
+components = ["y"]
+[solver]
+kind = "implicit"
+integrator = "quasi_static"
+end_time = 1.0
+load_steps = 10
+linear_solver = "gmres"
+residual_tolerance = 1e-10
+[output]
+frames = 0
+"#;
+
+#[test]
+fn johnson_cook_runs_implicitly_through_the_krylov_path() {
+    use mpm::material::{driver, registry};
+    let (result, dir) = crate::common::run_text(JC_BLOCK, &[]);
+    let summary = result.expect("the implicit Johnson-Cook block runs");
+    assert!(
+        summary.solver.krylov_iterations.unwrap_or(0) > 0,
+        "not through the Krylov path"
+    );
+    let t = Table::read(&dir.path().join("particles_final.csv")).unwrap();
+    // The single point along the same ten increments of uniaxial strain: the top
+    // face's nodes move 0.005 per step while the grid is reset, so each step's
+    // ΔF_yy = 0.995 and F_yy = 0.995^k.
+    let values: toml::Table = toml::from_str(
+        "youngs_modulus = 117.0e9\npoisson_ratio = 0.35\nyield_stress = 90.0e6\nhardening_modulus = 292.0e6\nhardening_exponent = 0.31\neos = \"mie_gruneisen\"\nsound_speed = 3940.0\nhugoniot_slope = 1.49\ngruneisen_gamma = 1.96",
+    )
+    .unwrap();
+    let m = registry::build("material.0", "johnson_cook", 8930.0, &values).unwrap();
+    let path: Vec<_> = (0..=10)
+        .map(|k| {
+            nalgebra::Matrix3::from_diagonal(&nalgebra::Vector3::new(1.0, 0.995f64.powi(k), 1.0))
+        })
+        .collect();
+    let point = driver::run(m.as_ref(), &path, 0.0);
+    let expected = point.stress.last().unwrap();
+    let eps_p = point.history.last().unwrap()[0];
+    assert!(eps_p > 0.01, "the point yields ({eps_p})");
+    for (col, (i, j)) in [("sxx", (0, 0)), ("syy", (1, 1)), ("szz", (2, 2))] {
+        for (q, s) in t.col(col).iter().enumerate() {
+            let e = expected[(i, j)];
+            assert!((s / e - 1.0).abs() < 1e-6, "particle {q} {col}: {s} vs {e}");
+        }
+    }
+    for (q, e) in t.col("eps_p").iter().enumerate() {
+        assert!(
+            (e / eps_p - 1.0).abs() < 1e-6,
+            "particle {q}: ε̄p {e} vs {eps_p}"
+        );
+    }
+}
