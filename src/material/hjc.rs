@@ -48,6 +48,8 @@ pub struct Hjc {
     pub min_fracture_strain: f64,
     pub reference_strain_rate: f64,
     pub rate_form: RateForm,
+    /// Failed points (D = 1) leave the transfers.
+    pub erosion: bool,
 }
 
 const PLASTIC_STRAIN: usize = 0;
@@ -155,6 +157,14 @@ impl Material for Hjc {
         true
     }
 
+    fn failed(&self, history: &[f64]) -> bool {
+        history[DAMAGE] >= 1.0
+    }
+
+    fn erodes(&self) -> bool {
+        self.erosion
+    }
+
     fn equivalent_plastic_strain(&self, history: &[f64]) -> Option<f64> {
         Some(history[PLASTIC_STRAIN])
     }
@@ -183,6 +193,7 @@ impl FromParameters for Hjc {
         "k3",
         "reference_strain_rate",
         "rate_form",
+        "erosion",
     ];
     /// The 48 MPa concrete of the HJC literature in mm, ms, g, MPa (the thesis'
     /// units; digest A1/`impact-data.md` §2.3).
@@ -237,6 +248,7 @@ impl FromParameters for Hjc {
             min_fracture_strain: non_negative("min_fracture_strain", 0.01)?,
             reference_strain_rate,
             rate_form: p.get("rate_form")?.unwrap_or(RateForm::Absolute),
+            erosion: p.get("erosion")?.unwrap_or(false),
         })
     }
 }
@@ -265,6 +277,7 @@ mod tests {
             min_fracture_strain: 0.01,
             reference_strain_rate: 0.001,
             rate_form: RateForm::Absolute,
+            erosion: false,
         }
     }
 

@@ -86,6 +86,8 @@ pub struct JohnsonCook {
     pub thermal: Option<Thermal>,
     /// D1 … D5.
     pub damage: Option<[f64; 5]>,
+    /// Failed points leave the transfers.
+    pub erosion: bool,
 }
 
 /// History slots.
@@ -266,6 +268,14 @@ impl Material for JohnsonCook {
         true
     }
 
+    fn failed(&self, history: &[f64]) -> bool {
+        self.damage_slot().is_some_and(|i| history[i] >= 1.0)
+    }
+
+    fn erodes(&self) -> bool {
+        self.erosion
+    }
+
     fn equivalent_plastic_strain(&self, history: &[f64]) -> Option<f64> {
         Some(history[PLASTIC_STRAIN])
     }
@@ -295,6 +305,7 @@ impl FromParameters for JohnsonCook {
         "damage_d3",
         "damage_d4",
         "damage_d5",
+        "erosion",
         "eos",
         "k1",
         "k2",
@@ -384,7 +395,14 @@ impl FromParameters for JohnsonCook {
         } else {
             None
         };
+        let erosion = p.get("erosion")?.unwrap_or(false);
+        p.ensure(
+            !erosion || damage.is_some(),
+            "erosion",
+            "needs Johnson–Cook damage (damage_d1, damage_d2, damage_d3): nothing fails without it",
+        )?;
         Ok(JohnsonCook {
+            erosion,
             density,
             shear_modulus: g,
             eos,
@@ -422,6 +440,7 @@ mod tests {
             reference_strain_rate: 1.0,
             thermal: None,
             damage: None,
+            erosion: false,
         }
     }
 

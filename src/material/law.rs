@@ -105,6 +105,17 @@ pub trait Material: CloneMaterial + Send + Sync + std::fmt::Debug {
         None
     }
 
+    /// Whether the point has failed (damage D = 1; `None`-like default: never).
+    fn failed(&self, _history: &[f64]) -> bool {
+        false
+    }
+
+    /// Whether failed points are eroded: left out of the particle–grid transfers
+    /// (scene key `erosion`).
+    fn erodes(&self) -> bool {
+        false
+    }
+
     /// Wave speed c = √(M/ρ) at the current Jacobian J (ρ = ρ0/J).
     fn wave_speed(&self, j: f64) -> f64 {
         (self.p_wave_modulus() * j / self.density()).sqrt()

@@ -80,7 +80,9 @@ impl<const D: usize> Model<D> {
             .map_err(|(i, msg)| err((format!("boundary.{i}.face"), msg)))?;
         let gravity = c.gravity.as_deref().map_or(Vector::<D>::zeros(), vec);
         let loads = Loads::apply(c, &mut particles).map_err(err)?;
+        let erosion = base_materials.iter().any(|m| m.erodes());
         Ok(Model {
+            erosion,
             grid,
             particles,
             materials: base_materials.clone(),

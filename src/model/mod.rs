@@ -47,9 +47,33 @@ pub struct Model<const D: usize> {
     pub load_ramps: Vec<LoadTime>,
     /// For each particle, the index into `load_ramps` of its load (u32::MAX: none).
     pub load_ramp_of: Vec<u32>,
+    /// Whether some material erodes its failed points (`Material::erodes`).
+    pub erosion: bool,
 }
 
 impl<const D: usize> Model<D> {
+    /// Whether particle q has failed in a material that erodes: it is left out of
+    /// the transfers (`physics::transfer::stencils`).
+    pub fn eroded(&self, q: usize) -> bool {
+        let p = &self.particles;
+        let mat = &self.materials[p.material[q] as usize];
+        self.erosion && mat.erodes() && mat.failed(p.history.get(q))
+    }
+
+    /// Mass and energy (kinetic + stored) of the eroded particles, which keep the
+    /// velocity and internal energy they failed with (history.csv).
+    pub fn eroded_mass_and_energy(&self) -> (f64, f64) {
+        let p = &self.particles;
+        let eroded: Vec<usize> = (0..p.len()).filter(|&q| self.eroded(q)).collect();
+        let mass = eroded.iter().fold(0.0, |sum, &q| sum + p.mass[q]);
+        let energy = eroded.iter().fold(0.0, |sum, &q| {
+            let mat = &self.materials[p.material[q] as usize];
+            let stored = mat.strain_energy_density(&p.f[q], &p.stress[q], p.history.get(q));
+            sum + 0.5 * p.mass[q] * p.v[q].norm_squared() + p.volume[q] * stored
+        });
+        (mass, energy)
+    }
+
     /// Load factor of each load time history at time t.
     pub fn load_scales(&self, t: f64) -> Vec<f64> {
         self.load_ramps.iter().map(|r| r.factor(t)).collect()

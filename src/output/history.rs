@@ -21,53 +21,70 @@ pub struct HistoryWriter {
     w: CsvWriter,
     dim: usize,
     n_bodies: usize,
+    /// Columns after `external_work` that only some scenes have.
+    extra: usize,
     last_flush: Instant,
 }
 
 impl HistoryWriter {
     /// Create (truncate) `path` and write the header
-    /// `t,kinetic,strain,external_work,body0_x,body0_y[,body0_z],body0_vx,body0_vy[,body0_vz],…`.
-    pub fn create(path: &Path, dim: usize, n_bodies: usize) -> io::Result<Self> {
+    /// `t,kinetic,strain,external_work[,extra…],body0_x,body0_y[,body0_z],body0_vx,body0_vy[,body0_vz],…`.
+    pub fn create(path: &Path, dim: usize, n_bodies: usize, extra: &[&str]) -> io::Result<Self> {
         if !(2..=3).contains(&dim) {
             return Err(io::Error::new(
                 io::ErrorKind::InvalidInput,
                 format!("history: dimension must be 2 or 3, got {dim}"),
             ));
         }
-        let mut w = CsvWriter::create(path, &header(dim, n_bodies))?;
+        let mut w = CsvWriter::create(path, &header(dim, n_bodies, extra))?;
         w.flush()?;
         Ok(Self {
             w,
             dim,
             n_bodies,
+            extra: extra.len(),
             last_flush: Instant::now(),
         })
     }
 
     /// Write on after `text`, the file as an earlier run had written it (header
     /// and rows, from a checkpoint).
-    pub fn resume(path: &Path, dim: usize, n_bodies: usize, text: &str) -> io::Result<Self> {
+    pub fn resume(
+        path: &Path,
+        dim: usize,
+        n_bodies: usize,
+        extra: usize,
+        text: &str,
+    ) -> io::Result<Self> {
         let mut w = CsvWriter::resume(path, text)?;
         w.flush()?;
         Ok(Self {
             w,
             dim,
             n_bodies,
+            extra,
             last_flush: Instant::now(),
         })
     }
 
-    /// Append one row; `com` and `com_velocity` hold one entry per body (see [`body_centres`]).
+    /// Append one row; `extra` holds the values of the extra columns, `com` and
+    /// `com_velocity` one entry per body (see [`body_centres`]).
+    #[allow(clippy::too_many_arguments)]
     pub fn write_row<const D: usize>(
         &mut self,
         t: f64,
         kinetic: f64,
         strain: f64,
         external_work: f64,
+        extra: &[f64],
         com: &[Vector<D>],
         com_velocity: &[Vector<D>],
     ) -> io::Result<()> {
-        if D != self.dim || com.len() != self.n_bodies || com_velocity.len() != self.n_bodies {
+        if D != self.dim
+            || com.len() != self.n_bodies
+            || com_velocity.len() != self.n_bodies
+            || extra.len() != self.extra
+        {
             return Err(io::Error::new(
                 io::ErrorKind::InvalidInput,
                 format!(
@@ -84,8 +101,13 @@ impl HistoryWriter {
             .iter()
             .zip(com_velocity)
             .flat_map(|(c, v)| c.iter().chain(v.iter()).copied());
-        self.w
-            .row(energies.into_iter().chain(centres).map(Field::Number))?;
+        self.w.row(
+            energies
+                .into_iter()
+                .chain(extra.iter().copied())
+                .chain(centres)
+                .map(Field::Number),
+        )?;
         if self.last_flush.elapsed() >= AUTO_FLUSH {
             self.flush()?;
         }
@@ -107,10 +129,11 @@ impl Drop for HistoryWriter {
 }
 
 /// The columns of `history.csv`.
-fn header(dim: usize, n_bodies: usize) -> Vec<String> {
+fn header(dim: usize, n_bodies: usize, extra: &[&str]) -> Vec<String> {
     let mut h: Vec<String> = ["t", "kinetic", "strain", "external_work"]
         .map(String::from)
         .into();
+    h.extend(extra.iter().map(|c| c.to_string()));
     for i in 0..n_bodies {
         for prefix in ["", "v"] {
             for a in &AXES[..dim] {
@@ -165,7 +188,7 @@ mod tests {
     fn header_2d() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("history.csv");
-        drop(HistoryWriter::create(&path, 2, 2).unwrap());
+        drop(HistoryWriter::create(&path, 2, 2, &[]).unwrap());
         let text = std::fs::read_to_string(&path).unwrap();
         assert_eq!(
             text,
@@ -179,7 +202,7 @@ mod tests {
     fn header_3d() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("history.csv");
-        drop(HistoryWriter::create(&path, 3, 1).unwrap());
+        drop(HistoryWriter::create(&path, 3, 1, &[]).unwrap());
         let text = std::fs::read_to_string(&path).unwrap();
         assert_eq!(
             text,
@@ -189,14 +212,18 @@ mod tests {
 
     #[test]
     fn header_without_bodies() {
-        assert_eq!(header(3, 0).join(","), "t,kinetic,strain,external_work");
+        assert_eq!(header(3, 0, &[]).join(","), "t,kinetic,strain,external_work");
+        assert_eq!(
+            header(2, 0, &["eroded_mass"]).join(","),
+            "t,kinetic,strain,external_work,eroded_mass"
+        );
     }
 
     #[test]
     fn rows_count_and_values() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("history.csv");
-        let mut h = HistoryWriter::create(&path, 2, 2).unwrap();
+        let mut h = HistoryWriter::create(&path, 2, 2, &[]).unwrap();
         let com = [Vector::<2>::new(0.1, 0.2), Vector::<2>::new(-3.0, 1e-9)];
         let vel = [
             Vector::<2>::new(1.0 / 3.0, 0.0),
@@ -204,7 +231,8 @@ mod tests {
         ];
         for k in 0..5 {
             let t = k as f64 * 0.1;
-            h.write_row(t, 0.5 * t, 1e-12 * t, -t, &com, &vel).unwrap();
+            h.write_row(t, 0.5 * t, 1e-12 * t, -t, &[], &com, &vel)
+                .unwrap();
         }
         h.flush().unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
@@ -233,7 +261,7 @@ mod tests {
             );
         }
         // Rows written after the explicit flush reach the file on drop.
-        h.write_row(9.0, 0.0, 0.0, 0.0, &com, &vel).unwrap();
+        h.write_row(9.0, 0.0, 0.0, 0.0, &[], &com, &vel).unwrap();
         drop(h);
         let text = std::fs::read_to_string(&path).unwrap();
         assert_eq!(parse_rows(&text).len(), 6);
@@ -243,12 +271,12 @@ mod tests {
     fn row_with_wrong_shape_is_rejected() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("history.csv");
-        let mut h = HistoryWriter::create(&path, 3, 2).unwrap();
+        let mut h = HistoryWriter::create(&path, 3, 2, &[]).unwrap();
         let one = [Vector::<3>::zeros()];
-        assert!(h.write_row(0.0, 0.0, 0.0, 0.0, &one, &one).is_err());
+        assert!(h.write_row(0.0, 0.0, 0.0, 0.0, &[], &one, &one).is_err());
         let two2 = [Vector::<2>::zeros(); 2];
-        assert!(h.write_row(0.0, 0.0, 0.0, 0.0, &two2, &two2).is_err());
-        assert!(HistoryWriter::create(&path, 1, 1).is_err());
+        assert!(h.write_row(0.0, 0.0, 0.0, 0.0, &[], &two2, &two2).is_err());
+        assert!(HistoryWriter::create(&path, 1, 1, &[]).is_err());
     }
 
     #[test]

@@ -205,6 +205,14 @@ impl NodeMap {
 pub fn stencils<const D: usize>(m: &Model<D>, shape: ShapeFunction, st: &mut Stencils<D>) {
     let p = &m.particles;
     st.compute(shape, &m.grid, &p.x, &p.half_length0, &p.f);
+    if m.erosion {
+        // Eroded particles touch no node: no mass, momentum or force reaches the
+        // grid from them, and they take no velocity from it (they stay where
+        // they failed, with the velocity and energy they had).
+        for q in (0..p.len()).filter(|&q| m.eroded(q)) {
+            st.count[q] = 0;
+        }
+    }
 }
 
 /// The particles' stencils and the active nodes they touch: what every step

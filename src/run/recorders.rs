@@ -84,6 +84,11 @@ pub struct Recorders {
     contact: Option<ContactLog>,
 }
 
+/// history.csv's columns of a scene whose materials erode failed points: the
+/// mass of the eroded particles and their kinetic + stored energy (both also
+/// inside `kinetic` and `strain`, which sum over every particle).
+const EROSION_COLUMNS: [&str; 2] = ["eroded_mass", "eroded_energy"];
+
 impl Recorders {
     /// Create the files of a run of `cfg` on `model` in `out`.
     pub fn create<const D: usize>(
@@ -96,7 +101,12 @@ impl Recorders {
         let implicit = cfg.stages().iter().any(|s| s.kind == SolverKind::Implicit);
         Ok(Recorders {
             out: out.to_path_buf(),
-            history: HistoryWriter::create(&out.join("history.csv"), D, n_bodies)?,
+            history: HistoryWriter::create(
+                &out.join("history.csv"),
+                D,
+                n_bodies,
+                if model.erosion { &EROSION_COLUMNS } else { &[] },
+            )?,
             history_interval: cfg.output.history_interval,
             next_history: 0.0,
             last_history: f64::NAN,
@@ -139,8 +149,18 @@ impl Recorders {
             csv.flush()?;
         }
         let n_bodies = r.n_bodies;
-        r.history =
-            HistoryWriter::resume(&out.join("history.csv"), D, n_bodies, &saved.history_csv)?;
+        let extra = if model.erosion {
+            EROSION_COLUMNS.len()
+        } else {
+            0
+        };
+        r.history = HistoryWriter::resume(
+            &out.join("history.csv"),
+            D,
+            n_bodies,
+            extra,
+            &saved.history_csv,
+        )?;
         r.next_history = saved.next_history;
         r.last_history = saved.last_history.unwrap_or(f64::NAN);
         r.next_frame = saved.next_frame;
@@ -219,8 +239,10 @@ impl Recorders {
             self.last_history = t;
             let (com, vcom) = body_centres(&m.particles, self.n_bodies);
             let (kinetic, strain) = (kinetic_energy(m), strain_energy(m));
+            let eroded = m.erosion.then(|| m.eroded_mass_and_energy());
+            let extra: Vec<f64> = eroded.map_or(vec![], |(mass, energy)| vec![mass, energy]);
             self.history
-                .write_row(t, kinetic, strain, now.external_work, &com, &vcom)?;
+                .write_row(t, kinetic, strain, now.external_work, &extra, &com, &vcom)?;
             if let Some(log) = &mut self.contact {
                 log.rows(t)?;
             }

@@ -249,3 +249,81 @@ fn johnson_cook_runs_implicitly_through_the_krylov_path() {
         );
     }
 }
+
+#[test]
+fn eroded_particles_leave_the_transfers_with_their_mass_and_energy_accounted() {
+    let (result, dir) = run_problem("erosion_rod.toml", &[]);
+    result.expect("the rod runs");
+    let p = Table::read(&dir.path().join("particles_final.csv")).unwrap();
+    let h = Table::read(&dir.path().join("history.csv")).unwrap();
+    let (mass, eps_p, x0, vx) = (p.col("mass"), p.col("eps_p"), p.col("X0"), p.col("vx"));
+    // D = ε̄p/D1 with a constant fracture strain: failed ⇔ ε̄p ≥ 0.2.
+    let failed: f64 = (0..mass.len())
+        .filter(|&q| eps_p[q] >= 0.2 * (1.0 - 1e-12))
+        .map(|q| mass[q])
+        .sum();
+    let eroded = *h.col("eroded_mass").last().unwrap();
+    let total: f64 = mass.iter().sum();
+    println!("eroded mass {eroded:.4e} of {total:.4e}");
+    assert!(eroded > 0.0 && eroded < 0.2 * total, "{eroded}");
+    assert!(
+        (eroded / failed - 1.0).abs() < 1e-12,
+        "{eroded} vs {failed}"
+    );
+    // Energy never created; the eroded particles' energy stays in the sums.
+    let (kinetic, strain, lost) = (h.col("kinetic"), h.col("strain"), h.col("eroded_energy"));
+    let e0 = kinetic[0];
+    for i in 0..kinetic.len() {
+        assert!(kinetic[i] + strain[i] <= e0 * (1.0 + 1e-6), "row {i}");
+        assert!(lost[i] <= kinetic[i] + strain[i]);
+    }
+    // The halves separate symmetrically: momentum zero to round-off.
+    let side = |left: bool| {
+        let q: Vec<usize> = (0..x0.len()).filter(|&q| (x0[q] < 6e-3) == left).collect();
+        q.iter().map(|&q| mass[q] * vx[q]).sum::<f64>() / q.iter().map(|&q| mass[q]).sum::<f64>()
+    };
+    let (left, right) = (side(true), side(false));
+    println!("halves at {left:.3} and {right:.3} m/s");
+    assert!(left < -5.0 && right > 5.0);
+    assert!(
+        (left + right).abs() < 1e-9 * right,
+        "momentum {left} + {right}"
+    );
+    // Eroded particles are out of the transfers: those failed by 15 µs (the
+    // eroded mass is constant from 8 µs on) sit at 20 µs where they were, with the
+    // same velocity.
+    let (r15, d15) = run_problem("erosion_rod.toml", &["solver.end_time=1.5e-5"]);
+    r15.expect("runs");
+    let p15 = Table::read(&d15.path().join("particles_final.csv")).unwrap();
+    let h15 = Table::read(&d15.path().join("history.csv")).unwrap();
+    assert_eq!(h15.col("eroded_mass").last(), Some(&eroded));
+    let mut frozen = 0;
+    for q in (0..mass.len()).filter(|&q| p15.col("eps_p")[q] >= 0.2 * (1.0 - 1e-12)) {
+        for c in ["x", "y", "vx", "vy"] {
+            assert_eq!(
+                p15.col(c)[q],
+                p.col(c)[q],
+                "eroded particle {q} moved ({c})"
+            );
+        }
+        frozen += 1;
+    }
+    assert!(frozen > 10, "{frozen}");
+    // Thread independence of the erosion.
+    let one = run_cli("erosion_rod.toml", 1, &["solver.end_time=1.0e-5"]);
+    let two = run_cli("erosion_rod.toml", 2, &["solver.end_time=1.0e-5"]);
+    assert!(read_output(&one, "particles_final.csv") == read_output(&two, "particles_final.csv"));
+    assert!(read_output(&one, "history.csv") == read_output(&two, "history.csv"));
+}
+
+#[test]
+fn a_scene_without_erosion_has_no_erosion_columns() {
+    let (result, dir) = run_problem("shock_plate.toml", &["solver.end_time=1.0e-7"]);
+    result.expect("runs");
+    let text = std::fs::read_to_string(dir.path().join("history.csv")).unwrap();
+    assert!(
+        text.starts_with("t,kinetic,strain,external_work,body0_x"),
+        "{}",
+        &text[..80]
+    );
+}
