@@ -51,5 +51,6 @@ models! {
     johnson_cook::JohnsonCook,
     jh2::Jh2,
     hjc::Hjc,
+    rht::Rht,
     rigid::Rigid,
 }

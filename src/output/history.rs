@@ -212,7 +212,10 @@ mod tests {
 
     #[test]
     fn header_without_bodies() {
-        assert_eq!(header(3, 0, &[]).join(","), "t,kinetic,strain,external_work");
+        assert_eq!(
+            header(3, 0, &[]).join(","),
+            "t,kinetic,strain,external_work"
+        );
         assert_eq!(
             header(2, 0, &["eroded_mass"]).join(","),
             "t,kinetic,strain,external_work,eroded_mass"
