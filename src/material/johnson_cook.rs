@@ -526,6 +526,39 @@ mod tests {
     }
 
     #[test]
+    fn yield_stress_by_hand_at_given_strain_rate_and_temperature() {
+        // OFHC copper (Johnson & Cook 1983 as quoted): A 90, B 292 MPa, n 0.31,
+        // C 0.025, m 1.09, T_r 293 K, T_m 1356 K. At ε̄p = 0.5, ε̇ = 1e4 /s and
+        // T = 500 K by hand: (90 + 292·0.5^0.31)(1 + 0.025 ln 1e4)(1 − 0.19473^1.09)
+        // = 325.539 × 1.230259 × 0.831931 = 333.187 MPa.
+        let mut m = copper(292e6, 0.31);
+        m.rate_coefficient = 0.025;
+        m.thermal = Some(Thermal {
+            room_temperature: 293.0,
+            melting_temperature: 1356.0,
+            exponent: 1.09,
+            specific_heat: 383.0,
+            taylor_quinney: 0.9,
+        });
+        let static_part = 90e6 + 292e6 * 0.5f64.powf(0.31);
+        let rate = m.rate_factor(1e4);
+        let heat = m.thermal.unwrap().softening(500.0 - 293.0);
+        assert!((static_part / 325.539e6 - 1.0).abs() < 2e-6, "{static_part}");
+        assert!((rate - 1.230259).abs() < 1e-6, "{rate}");
+        assert!((heat - 0.831931).abs() < 1e-6, "{heat}");
+        assert!((static_part * rate * heat / 333.187e6 - 1.0).abs() < 2e-6);
+        // The return reaches exactly that stress: a trial far outside it with
+        // ε̄p,old = 0.5, at that rate and temperature, comes back to
+        // k (A + B (0.5 + Δε̄p)ⁿ) with Δε̄p = (q^tr − σ_y)/3G.
+        let k = rate * heat;
+        let q_trial = 2.0 * static_part * k;
+        let d = m.plastic_increment(q_trial, 0.5, k);
+        let sigma_y = k * m.hardening(0.5 + d).0;
+        assert!((q_trial - 3.0 * m.shear_modulus * d - sigma_y).abs() < 1e-6);
+        assert!(sigma_y > 333.187e6 && sigma_y < 1.01 * 333.187e6, "{sigma_y}");
+    }
+
+    #[test]
     fn mie_gruneisen_energy_is_the_work_of_the_pressure() {
         let mut m = copper(0.0, 1.0);
         m.eos = Eos::MieGruneisen {
