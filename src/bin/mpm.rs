@@ -189,7 +189,7 @@ fn main() -> ExitCode {
                 println!(
                     "{}: ok ({}D, {} material(s), {} body(ies), {} boundary condition(s), {} load(s), shape function {}, solver stages: {})",
                     s.file,
-                    c.dimension,
+                    c.dimension.spatial(),
                     c.materials.len(),
                     c.bodies.len(),
                     c.boundaries.len(),
