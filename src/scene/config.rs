@@ -73,6 +73,14 @@ impl Dimension {
     pub fn is_axisymmetric(self) -> bool {
         self == Dimension::Axisymmetric
     }
+
+    /// "2D", "3D" or "axisymmetric" (messages).
+    pub fn label(self) -> String {
+        match self {
+            Dimension::Cartesian(d) => format!("{d}D"),
+            Dimension::Axisymmetric => "axisymmetric".into(),
+        }
+    }
 }
 
 impl<'de> Deserialize<'de> for Dimension {

@@ -47,7 +47,7 @@ fn one_and_two_threads_give_identical_results() {
 fn axisymmetric_runs_give_identical_results_on_one_and_two_threads() {
     for solver in [
         "solver={kind=\"explicit\",scheme=\"musl\",end_time=0.02,damping=0.5}",
-        "solver={kind=\"implicit\",integrator=\"quasi_static\",end_time=1.0,load_steps=2,linear_solver=\"gmres\"}",
+        "solver={kind=\"implicit\",integrator=\"quasi_static\",end_time=1.0,load_steps=2,linear_solver=\"gmres\",preconditioner=\"multigrid\"}",
     ] {
         let run = |threads: usize| {
             let overrides = [
