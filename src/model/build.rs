@@ -18,7 +18,11 @@ use crate::scene::{axis, expr, BodyConfig, BoundaryConfig, Condition, Face, Scen
 impl<const D: usize> Model<D> {
     pub fn build(scene: &Scene) -> Result<Model<D>, SceneError> {
         let c = &scene.config;
-        assert_eq!(c.dimension.spatial(), D, "caller dispatches on the scene dimension");
+        assert_eq!(
+            c.dimension.spatial(),
+            D,
+            "caller dispatches on the scene dimension"
+        );
         let err = |(key, msg): (String, String)| scene.at_key(&key, msg);
         let vec = |v: &[f64]| Vector::<D>::from_fn(|d, _| v[d]);
         let cells = std::array::from_fn(|d| c.grid.cells[d]);

@@ -162,7 +162,9 @@ fn matching_checkpoint(scene: &Scene, path: &Path) -> Result<Checkpoint, RunErro
     if ck.dimension != scene.config.dimension.spatial() {
         return Err(RunError::Checkpoint(format!(
             "checkpoint {name} is of a {}D run, {} is {}D",
-            ck.dimension, scene.file, scene.config.dimension.spatial()
+            ck.dimension,
+            scene.file,
+            scene.config.dimension.spatial()
         )));
     }
     if ck.scene_text != scene.text {

@@ -92,9 +92,9 @@ impl<'de> Deserialize<'de> for Dimension {
                 f.write_str("2, 3 or \"axisymmetric\"")
             }
             fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Dimension, E> {
-                usize::try_from(v)
-                    .map(Dimension::Cartesian)
-                    .map_err(|_| E::custom(format!("dimension {v}: expected 2, 3 or \"axisymmetric\"")))
+                usize::try_from(v).map(Dimension::Cartesian).map_err(|_| {
+                    E::custom(format!("dimension {v}: expected 2, 3 or \"axisymmetric\""))
+                })
             }
             fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Dimension, E> {
                 self.visit_i64(i64::try_from(v).unwrap_or(-1))

@@ -38,23 +38,37 @@ fn dimension_takes_2_3_or_axisymmetric() {
     );
     rejected(
         &GOOD.replace("dimension = 2", "dimension = 4"),
-        &["scene.toml:1:1", "key `dimension`", "must be 2 (plane strain), 3 or \"axisymmetric\""],
+        &[
+            "scene.toml:1:1",
+            "key `dimension`",
+            "must be 2 (plane strain), 3 or \"axisymmetric\"",
+        ],
     );
     rejected(
         &GOOD.replace("dimension = 2", "dimension = -2"),
-        &["scene.toml:1:13", "key `dimension`", "expected 2, 3 or \"axisymmetric\""],
+        &[
+            "scene.toml:1:13",
+            "key `dimension`",
+            "expected 2, 3 or \"axisymmetric\"",
+        ],
     );
     rejected(
         &GOOD.replace("dimension = 2", "dimension = 2.5"),
-        &["scene.toml:1:13", "key `dimension`", "expected 2, 3 or \"axisymmetric\""],
+        &[
+            "scene.toml:1:13",
+            "key `dimension`",
+            "expected 2, 3 or \"axisymmetric\"",
+        ],
     );
 }
 
 #[test]
 fn the_grid_lies_in_r_at_least_zero_and_gravity_along_the_axis() {
     rejected(
-        &axisymmetric()
-            .replace("min = [0.0, 0.0]\nmax = [4.0, 1.0]", "min = [-1.0, 0.0]\nmax = [4.0, 1.0]"),
+        &axisymmetric().replace(
+            "min = [0.0, 0.0]\nmax = [4.0, 1.0]",
+            "min = [-1.0, 0.0]\nmax = [4.0, 1.0]",
+        ),
         &["scene.toml:4:7", "key `grid.min`", "r = x ≥ 0"],
     );
     rejected(
@@ -67,19 +81,34 @@ fn the_grid_lies_in_r_at_least_zero_and_gravity_along_the_axis() {
 fn unsupported_combinations_are_refused_at_their_key() {
     let a = axisymmetric();
     rejected(
-        &a.replace("cells = [4, 1]", "cells = [4, 1]\nshape_function = \"cpdi\""),
-        &["scene.toml:7:1", "key `grid.shape_function`", "cpdi has no axisymmetric form"],
+        &a.replace(
+            "cells = [4, 1]",
+            "cells = [4, 1]\nshape_function = \"cpdi\"",
+        ),
+        &[
+            "scene.toml:7:1",
+            "key `grid.shape_function`",
+            "cpdi has no axisymmetric form",
+        ],
     );
     rejected(
         &a.replace("cfl = 0.5", "cfl = 0.5\nfbar = true"),
-        &["scene.toml:25:8", "key `solver.fbar`", "F-bar is not implemented in axisymmetric mode"],
+        &[
+            "scene.toml:25:8",
+            "key `solver.fbar`",
+            "F-bar is not implemented in axisymmetric mode",
+        ],
     );
     rejected(
         &a.replace(
             "[solver]",
             "[[boundary]]\nface = \"xmax\"\ncondition = \"absorbing\"\n\n[solver]",
         ),
-        &["scene.toml:23:13", "key `boundary.0.condition`", "absorbing faces are not implemented"],
+        &[
+            "scene.toml:23:13",
+            "key `boundary.0.condition`",
+            "absorbing faces are not implemented",
+        ],
     );
     rejected(
         &a.replace(
@@ -104,7 +133,10 @@ fn unsupported_combinations_are_refused_at_their_key() {
     );
     rejected(
         &a.replace("[solver]", "[[contact]]\n\n[solver]"),
-        &["key `contact`", "contact between bodies is not implemented in axisymmetric mode"],
+        &[
+            "key `contact`",
+            "contact between bodies is not implemented in axisymmetric mode",
+        ],
     );
     // A grid away from the axis (a hollow cylinder) may carry any xmin condition
     // the plane-strain scene may.

@@ -359,7 +359,10 @@ fn solid_cylinder_compressed_radially_explicit() {
             );
             let exact = uniform_compression(1.0 - 1.0e-3);
             let (worst, _) = uniform_errors(&format!("explicit {scheme} {shape}"), &s, &r, exact);
-            assert!(worst < max, "explicit {scheme} {shape}: {worst:.2e} (bound {max:e})");
+            assert!(
+                worst < max,
+                "explicit {scheme} {shape}: {worst:.2e} (bound {max:e})"
+            );
         }
     }
 }
@@ -409,7 +412,10 @@ fn vibrating_bar_along_the_axis_has_the_plane_strain_period() {
                 "velocity_expr = [\"0.1*sin(pi*x/50)\", \"0\"]",
                 "velocity_expr = [\"0\", \"0.1*sin(pi*y/50)\"]",
             )
-            .replace("face = \"xmin\"\ncondition = \"fixed\"", "face = \"ymin\"\ncondition = \"fixed\"")
+            .replace(
+                "face = \"xmin\"\ncondition = \"fixed\"",
+                "face = \"ymin\"\ncondition = \"fixed\"",
+            )
             .replace(
                 "face = \"ymin\"\ncondition = \"roller\"\n\n[[boundary]]\nface = \"ymax\"",
                 "face = \"xmin\"\ncondition = \"roller\"\n\n[[boundary]]\nface = \"xmax\"",
@@ -447,7 +453,11 @@ fn thick_cylinder_matrix_free_matches_direct() {
         let (result, dir) = run_problem("axisymmetric_cylinder.toml", &args);
         result.unwrap_or_else(|e| panic!("{extra:?}: {e}"));
         let t = Table::read(&dir.path().join("particles_final.csv")).unwrap();
-        [t.col("sxx").to_vec(), t.col("syy").to_vec(), t.col("szz").to_vec()]
+        [
+            t.col("sxx").to_vec(),
+            t.col("syy").to_vec(),
+            t.col("szz").to_vec(),
+        ]
     };
     let direct = run(&[]);
     for extra in [

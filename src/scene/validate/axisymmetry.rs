@@ -54,7 +54,9 @@ pub fn axisymmetry(s: &SceneConfig) -> Check {
         if on_axis {
             let radial = b.condition == Condition::Velocity
                 && b.velocity.as_ref().is_some_and(|v| v[0] != 0.0)
-                && b.components.as_ref().is_none_or(|c| c.iter().any(|a| a == "x"));
+                && b.components
+                    .as_ref()
+                    .is_none_or(|c| c.iter().any(|a| a == "x"));
             ensure(
                 b.condition != Condition::Friction && !radial,
                 key("condition"),

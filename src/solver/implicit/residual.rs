@@ -15,7 +15,8 @@ use super::assembly::absorbing::add_absorbing;
 use super::assembly::fbar::add_fbar_stiffness;
 use super::assembly::mass::{add_consistent_mass, add_lumped_mass};
 use super::assembly::stiffness::{
-    add_stiffness, hoop_symmetric, major_symmetric, particle_tangents, relative_pk1, ParticleTangents,
+    add_stiffness, hoop_symmetric, major_symmetric, particle_tangents, relative_pk1,
+    ParticleTangents,
 };
 use super::assembly::{Pattern, Storage, Tangent};
 use super::failure::Failure;

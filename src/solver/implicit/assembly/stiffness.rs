@@ -227,7 +227,10 @@ pub fn hoop_coupling<const D: usize>(
         v += h_i * (0..D).map(|l| hoop[k * D + l] * grad_j[l]).sum::<f64>();
     }
     if k == 0 {
-        v += h_j * (0..D).map(|j| grad_i[j] * hoop[D * D + i * D + j]).sum::<f64>();
+        v += h_j
+            * (0..D)
+                .map(|j| grad_i[j] * hoop[D * D + i * D + j])
+                .sum::<f64>();
     }
     if i == 0 && k == 0 {
         v += h_i * h_j * hoop[2 * D * D];
