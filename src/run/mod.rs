@@ -494,6 +494,7 @@ fn run_dim<const D: usize>(
     let mut summary = Summary {
         scene: scene.file.clone(),
         dimension: D,
+        axisymmetric: cfg.dimension.is_axisymmetric(),
         shape_function: cfg.grid.shape_function,
         particles,
         steps: line.step,

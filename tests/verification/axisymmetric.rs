@@ -85,7 +85,8 @@ fn cylinder(shape: &str, n: usize, nz: usize, extra: &[String]) -> LameErrors {
     args.extend(extra.iter().cloned());
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
     let (result, dir) = run_problem("axisymmetric_cylinder.toml", &args);
-    result.unwrap_or_else(|e| panic!("{shape} {n}: {e}"));
+    let summary = result.unwrap_or_else(|e| panic!("{shape} {n}: {e}"));
+    assert!(summary.axisymmetric && summary.dimension == 2);
     lame_errors(&Table::read(&dir.path().join("particles_final.csv")).unwrap())
 }
 
