@@ -593,3 +593,36 @@ fn unconfined_compression_of_a_cylinder_reaches_the_uniaxial_strength() {
         );
     }
 }
+
+/// The level-ground K0 layer of strength_reduction.rs as a cylinder of soil
+/// (radius 2 m, outer wall on rollers): with K0 = ν/(1 − ν) the geostatic state
+/// σ_rr = σ_θθ = K0 σ_zz, σ_zz = −ρ g (H − z) is in equilibrium in r too
+/// (∂σ_rr/∂r + (σ_rr − σ_θθ)/r = 0), so full gravity leaves it in place.
+#[test]
+fn k0_state_of_a_soil_cylinder_is_in_equilibrium() {
+    let text = crate::strength_reduction::LEVEL
+        .replace("dimension = 2", "dimension = \"axisymmetric\"");
+    let (result, dir) = run_text(&text, &[]);
+    result.unwrap();
+    let p = Table::read(&dir.path().join("particles_final.csv")).unwrap();
+    let (x0, y0, x, y) = (p.col("X0"), p.col("Y0"), p.col("x"), p.col("y"));
+    let u = (0..x.len())
+        .map(|i| (x[i] - x0[i]).hypot(y[i] - y0[i]))
+        .fold(0.0, f64::max);
+    // Gravity switched on from zero stress settles the top by ρ g H² / (2M).
+    let settlement = 2.0 * 10.0 * 16.0 / (2.0 * 1.0e4 * 0.75 / (1.25 * 0.5));
+    let mut worst: f64 = 0.0;
+    for i in 0..x.len() {
+        let sv = -20.0 * (4.0 - y0[i]);
+        for (s, exact) in [("syy", sv), ("sxx", sv / 3.0), ("szz", sv / 3.0)] {
+            worst = worst.max((p.col(s)[i] - exact).abs() / 80.0);
+        }
+    }
+    println!(
+        "K0 cylinder: largest displacement {u:.3e} ({:.1e} of the switch-on settlement), \
+         max stress error {worst:.2e} of ρ g H",
+        u / settlement
+    );
+    assert!(u < 1e-3 * settlement, "the K0 state stays put: {u:.3e}");
+    assert!(worst < 1e-3, "geostatic stresses: {worst:.2e}");
+}
