@@ -15,7 +15,8 @@ use crate::model::particles::Particles;
 use crate::scene::Face;
 
 /// Make the last `added` particles' volumes and masses per radian: × r_p
-/// (V = ∫ r dA over the particle's square domain, exactly r_p A_p).
+/// (V = ∫ r dA over the particle's rectangular domain centred at r_p: exactly
+/// r_p A_p).
 pub fn per_radian<const D: usize>(p: &mut Particles<D>, added: usize) {
     let n = p.len();
     for q in n - added..n {

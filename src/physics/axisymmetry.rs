@@ -13,12 +13,15 @@
 //! ∫ σ : δε r dr dz of a particle of volume V_p (per radian), with δε_θθ = δu_r / r,
 //! adds the hoop stress to the radial internal force:
 //!
-//!   f_Ir = Σ_p V_p (σ_rr ∂S_I/∂r + σ_rz ∂S_I/∂z + σ_θθ S_Ip / r_p) The stencils carry S_Ip / r_p per entry
-//! (`Stencils::hoop`), the "hoop gradient" of node I, from which the stress
-//! update, the internal force and the tangent read it. Particles never sit on
-//! the axis (their centres are at r_p ≥ half a particle spacing and the axis
-//! nodes have zero radial velocity), so S_Ip / r_p is finite at every entry,
-//! also of nodes on the axis, whose radial force is a reaction.
+//!   f_Ir = Σ_p V_p (σ_rr ∂S_I/∂r + σ_rz ∂S_I/∂z + σ_θθ S_Ip / r_p).
+//!
+//! The stencils carry S_Ip / r_p per entry (`Stencils::hoop`), the "hoop
+//! gradient" of node I, from which the stress update, the internal force and
+//! the tangent read it. Particles never sit on the axis (their centres start at
+//! half a particle spacing from it and the axis nodes have zero radial
+//! velocity; `solver::divergence` stops a run whose particle reaches r ≤ 0), so
+//! S_Ip / r_p is finite at every entry, also of nodes on the axis, whose radial
+//! force is a reaction.
 
 use crate::dim::Vector;
 use crate::parallel::MIN_PARALLEL_LEN;

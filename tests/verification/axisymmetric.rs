@@ -609,8 +609,8 @@ fn unconfined_compression_of_a_cylinder_reaches_the_uniaxial_strength() {
 /// (∂σ_rr/∂r + (σ_rr − σ_θθ)/r = 0), so full gravity leaves it in place.
 #[test]
 fn k0_state_of_a_soil_cylinder_is_in_equilibrium() {
-    let text = crate::strength_reduction::LEVEL
-        .replace("dimension = 2", "dimension = \"axisymmetric\"");
+    let text =
+        crate::strength_reduction::LEVEL.replace("dimension = 2", "dimension = \"axisymmetric\"");
     let (result, dir) = run_text(&text, &[]);
     result.unwrap();
     let p = Table::read(&dir.path().join("particles_final.csv")).unwrap();
