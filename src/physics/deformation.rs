@@ -87,8 +87,13 @@ impl Trial {
                 .enumerate()
                 .with_min_len(MIN_PARALLEL_LEN)
                 .for_each(|(q, df)| {
-                    let beta = scale_factor::<D>(dj_bar[cells.of[q] as usize], dj[q]);
-                    *df = scaled::<D>(df, beta);
+                    let (dj_bar, dj) = (dj_bar[cells.of[q] as usize], dj[q]);
+                    // Axisymmetric: n = 3, the hoop stretch is scaled too.
+                    *df = if axisymmetric {
+                        scaled::<3>(df, scale_factor::<3>(dj_bar, dj))
+                    } else {
+                        scaled::<D>(df, scale_factor::<D>(dj_bar, dj))
+                    };
                 });
         }
         let history_old = p.history.slots(&p.history.data);

@@ -92,13 +92,22 @@ fn unsupported_combinations_are_refused_at_their_key() {
         ],
     );
     rejected(
-        &a.replace("cfl = 0.5", "cfl = 0.5\nfbar = true"),
+        &a.replace(
+            "kind = \"explicit\"\nend_time = 1.0\ncfl = 0.5",
+            "kind = \"implicit\"\nintegrator = \"quasi_static\"\nend_time = 1.0\nfbar = true",
+        ),
         &[
             "scene.toml:25:8",
             "key `solver.fbar`",
-            "F-bar is not implemented in axisymmetric mode",
+            "F-bar is implemented for the explicit solver only in axisymmetric mode",
         ],
     );
+    Scene::parse(
+        "scene.toml",
+        &a.replace("cfl = 0.5", "cfl = 0.5\nfbar = true"),
+        &[],
+    )
+    .unwrap();
     rejected(
         &a.replace(
             "[solver]",
