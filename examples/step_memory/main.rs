@@ -75,7 +75,7 @@ fn main() {
         .map(|w| w[1].clone())
         .collect();
     let scene = Scene::load(Path::new(scene_path), &sets).unwrap_or_else(|e| panic!("{e}"));
-    match scene.config.dimension {
+    match scene.config.dimension.spatial() {
         3 => run::<3>(&scene, steps),
         _ => run::<2>(&scene, steps),
     }

@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-"""Final shape of a Taylor bar run (quarter model, axis along z, anvil at z = 0)
-from particles_final.csv: length L, impact-face diameter D and the diameter W at
+"""Final shape of a Taylor bar run (3D quarter model with the axis along z, or the
+axisymmetric r-z model with x = r, y = z; anvil at axial coordinate 0) from
+particles_final.csv: length L, impact-face diameter D and the diameter W at
 0.2 L0 above the anvil, in mm.
 
 Usage: measure.py OUT_DIR [L0_mm R_mm]
@@ -18,6 +19,10 @@ import sys
 def measure(out_dir, l0=25.4, radius=3.8):
     rows = list(csv.DictReader(open(f"{out_dir}/particles_final.csv")))
     mm = 1e3
+    if "z" not in rows[0]:
+        # Axisymmetric: radius x, axis y.
+        for r in rows:
+            r["Z0"], r["z"], r["Y0"], r["y"] = r["Y0"], r["y"], "0", "0"
     z0s = sorted({round(float(r["Z0"]) * mm, 9) for r in rows})
     spacing = z0s[1] - z0s[0]
     top = max(rows, key=lambda r: float(r["z"]))

@@ -187,9 +187,9 @@ fn main() -> ExitCode {
                 let c = &s.config;
                 let stages: Vec<&str> = c.stages().iter().map(|st| st.kind.name()).collect();
                 println!(
-                    "{}: ok ({}D, {} material(s), {} body(ies), {} boundary condition(s), {} load(s), shape function {}, solver stages: {})",
+                    "{}: ok ({}, {} material(s), {} body(ies), {} boundary condition(s), {} load(s), shape function {}, solver stages: {})",
                     s.file,
-                    c.dimension,
+                    c.dimension.label(),
                     c.materials.len(),
                     c.bodies.len(),
                     c.boundaries.len(),

@@ -12,13 +12,17 @@ use crate::model::geometry::Geometry;
 use crate::model::grid::Grid;
 use crate::model::loads::Loads;
 use crate::model::particles::Particles;
-use crate::model::Model;
+use crate::model::{axisymmetry, Model};
 use crate::scene::{axis, expr, BodyConfig, BoundaryConfig, Condition, Face, Scene, SceneError};
 
 impl<const D: usize> Model<D> {
     pub fn build(scene: &Scene) -> Result<Model<D>, SceneError> {
         let c = &scene.config;
-        assert_eq!(c.dimension, D, "caller dispatches on the scene dimension");
+        assert_eq!(
+            c.dimension.spatial(),
+            D,
+            "caller dispatches on the scene dimension"
+        );
         let err = |(key, msg): (String, String)| scene.at_key(&key, msg);
         let vec = |v: &[f64]| Vector::<D>::from_fn(|d, _| v[d]);
         let cells = std::array::from_fn(|d| c.grid.cells[d]);
@@ -43,6 +47,9 @@ impl<const D: usize> Model<D> {
             let material = base_materials[m].as_ref();
             let added = fill_body(&mut particles, &grid, b, &bodies[i], i, m as u32, material)
                 .map_err(err)?;
+            if c.dimension.is_axisymmetric() {
+                axisymmetry::per_radian(&mut particles, added);
+            }
             if added == 0 {
                 return Err(err((format!("body.{i}.shape"), "the body holds no particle centre: refine the grid or raise particles_per_cell".into())));
             }
@@ -51,7 +58,7 @@ impl<const D: usize> Model<D> {
         let velocity: Vec<(usize, &BoundaryConfig)> = (c.boundaries.iter().enumerate())
             .filter(|(_, b)| b.condition.prescribes_velocity())
             .collect();
-        let faces: Vec<FaceCondition<D>> = velocity
+        let mut faces: Vec<FaceCondition<D>> = velocity
             .iter()
             .map(|(_, b)| face_condition(b, &vec))
             .collect();
@@ -74,6 +81,10 @@ impl<const D: usize> Model<D> {
             }
         }
         let footing = footing(&velocity, &faces, &grid, &particles, &base_materials);
+        let axisymmetric = c.dimension.is_axisymmetric();
+        if axisymmetric && grid.min[0] == 0.0 {
+            faces.push(axisymmetry::axis_condition());
+        }
         let absorbing = Absorbing::new(&c.boundaries, &base_materials);
         absorbing
             .check_adjacent(&grid, &particles)
@@ -96,6 +107,7 @@ impl<const D: usize> Model<D> {
             gravity,
             load_ramps: loads.ramps,
             load_ramp_of: loads.ramp_of,
+            axisymmetric,
         })
     }
 }

@@ -1,10 +1,12 @@
 //! Loads on particles: a point force shared by the particles of a region, or a
-//! traction on one face of each particle, with its time history (a ramp or a
+//! traction on one face of each particle (axisymmetric: per radian, over the
+//! face's area per radian, `model::axisymmetry`), with its time history (a ramp or a
 //! pulse). The force at full value is stored on the particles (`Particles::load`);
 //! a solver scales it by the factor of the particle's history at time t
 //! (`load_factor`).
 
 use crate::dim::Vector;
+use crate::model::axisymmetry::face_area_per_radian;
 use crate::model::particles::Particles;
 use crate::scene::{Face, LoadConfig, LoadKind, SceneConfig};
 
@@ -107,10 +109,14 @@ impl Loads {
                     LoadKind::Traction => {
                         let face = Face::parse(l.face.as_ref().unwrap(), D).unwrap();
                         let half = particles.half_length0[p];
-                        let area: f64 = (0..D)
-                            .filter(|&d| d != face.axis)
-                            .map(|d| 2.0 * half[d])
-                            .product();
+                        let area: f64 = if c.dimension.is_axisymmetric() {
+                            face_area_per_radian(&particles.x0[p], &half, face)
+                        } else {
+                            (0..D)
+                                .filter(|&d| d != face.axis)
+                                .map(|d| 2.0 * half[d])
+                                .product()
+                        };
                         vec(l.traction.as_ref().unwrap()) * area
                     }
                 };

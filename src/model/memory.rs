@@ -38,7 +38,7 @@ pub struct Estimate {
 
 impl Estimate {
     pub fn of(c: &SceneConfig) -> Estimate {
-        let dim = c.dimension;
+        let dim = c.dimension.spatial();
         let d = dim as f64;
         let shape = c.grid.shape_function;
         let support = shape.max_support(dim) as f64;

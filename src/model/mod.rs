@@ -2,6 +2,7 @@
 //! loads and the geometry of the bodies, built once from a validated scene
 //! (`build.rs`) and then independent of it.
 
+pub mod axisymmetry;
 mod build;
 pub mod conditions;
 pub mod geometry;
@@ -47,6 +48,10 @@ pub struct Model<const D: usize> {
     pub load_ramps: Vec<LoadTime>,
     /// For each particle, the index into `load_ramps` of its load (u32::MAX: none).
     pub load_ramp_of: Vec<u32>,
+    /// `dimension = "axisymmetric"` (D = 2, x = r, y = z): masses, volumes and
+    /// loads are per radian, and the stencils carry the hoop terms
+    /// (`physics::axisymmetry`).
+    pub axisymmetric: bool,
     /// Whether some material erodes its failed points (`Material::erodes`).
     pub erosion: bool,
 }

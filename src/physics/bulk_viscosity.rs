@@ -45,17 +45,28 @@ impl BulkViscosity {
         l / (q + (q * q + c * c).sqrt())
     }
 
-    /// ε̇_v = tr L_p of every particle under the nodal velocities `v`.
+    /// ε̇_v = tr L_p of every particle under the nodal velocities `v` (in
+    /// axisymmetric mode with the hoop rate v_r/r_p = Σ_I v_Ir S_Ip/r_p).
     pub fn volumetric_rates<const D: usize>(
         map: &NodeMap,
         st: &Stencils<D>,
         n: usize,
         v: &[Vector<D>],
     ) -> Vec<f64> {
+        let axisymmetric = !st.hoop.is_empty();
         (0..n)
             .into_par_iter()
             .with_min_len(MIN_PARALLEL_LEN)
-            .map(|q| gradient(map, st, q, v).trace())
+            .map(|q| {
+                let hoop = match axisymmetric {
+                    true => st
+                        .range(q)
+                        .map(|e| v[map.local_of(st, e)][0] * st.hoop[e])
+                        .sum(),
+                    false => 0.0,
+                };
+                gradient(map, st, q, v).trace() + hoop
+            })
             .collect()
     }
 
@@ -83,7 +94,14 @@ impl BulkViscosity {
                 self.pressure(rho, c, l, rates[q]) * p.volume[q]
             })
             .collect();
-        let viscous = map.gather(st.stride, Vector::<D>::zeros(), |q, e| st.grad[e] * qv[q]);
+        // −(−q I) : ∇S V, with the hoop part q V S_Ip/r_p on the radial component.
+        let viscous = map.gather(st.stride, Vector::<D>::zeros(), |q, e| {
+            let mut f = st.grad[e] * qv[q];
+            if let Some(h) = st.hoop.get(e) {
+                f[0] += h * qv[q];
+            }
+            f
+        });
         for (f, dv) in force.iter_mut().zip(&viscous) {
             *f += dv;
         }

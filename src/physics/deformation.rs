@@ -4,13 +4,15 @@
 //! material's stress update from the start-of-increment state. The result is a
 //! trial state, so an implicit solver can evaluate it at every Newton iterate
 //! without drift and commit it once the step has converged. With F-bar (`fbar`)
-//! the particles follow ΔF̄ instead of ΔF.
+//! the particles follow ΔF̄ instead of ΔF. In axisymmetric mode ΔF_θθ is the hoop
+//! stretch of the increment (`physics::axisymmetry`) instead of 1.
 
 use crate::dim::{embed_deformation, Mat3, Tensor, Vector};
 use crate::material::{Increment, Material};
 use crate::model::grid::Grid;
 use crate::model::particles::Particles;
 use crate::parallel::MIN_PARALLEL_LEN;
+use crate::physics::axisymmetry::hoop_stretch;
 use crate::physics::fbar::{scale_factor, scaled, Cells, FBarState};
 use crate::physics::shape::Stencils;
 use crate::physics::transfer::{gradient, NodeMap};
@@ -55,7 +57,8 @@ impl Trial {
         self.stress.resize(n, Mat3::zeros());
         self.volume.resize(n, 0.0);
         self.history.clone_from(&p.history.data);
-        // ΔF_p = I + Σ_I u_I ⊗ ∇S_Ip.
+        // ΔF_p = I + Σ_I u_I ⊗ ∇S_Ip; axisymmetric: ΔF_θθ = 1 + Σ_I u_Ir S_Ip / r_p.
+        let axisymmetric = !st.hoop.is_empty();
         self.df
             .par_iter_mut()
             .enumerate()
@@ -63,6 +66,10 @@ impl Trial {
             .for_each(|(q, df)| {
                 let grad_u: Tensor<D> = gradient(map, st, q, u);
                 *df = embed_deformation::<D>(&(Tensor::<D>::identity() + grad_u));
+                if axisymmetric {
+                    let entries = st.range(q).map(|e| (u[map.local_of(st, e)][0], st.hoop[e]));
+                    df[(2, 2)] = hoop_stretch(entries);
+                }
             });
         if let Some(fbar) = &mut self.fbar {
             // ΔF̄_p = (ΔJ̄_c / ΔJ_p)^{1/n} ΔF_p (Coombs et al. 2018); needs ΔJ_p > 0.
@@ -80,8 +87,13 @@ impl Trial {
                 .enumerate()
                 .with_min_len(MIN_PARALLEL_LEN)
                 .for_each(|(q, df)| {
-                    let beta = scale_factor::<D>(dj_bar[cells.of[q] as usize], dj[q]);
-                    *df = scaled::<D>(df, beta);
+                    let (dj_bar, dj) = (dj_bar[cells.of[q] as usize], dj[q]);
+                    // Axisymmetric: n = 3, the hoop stretch is scaled too.
+                    *df = if axisymmetric {
+                        scaled::<3>(df, scale_factor::<3>(dj_bar, dj))
+                    } else {
+                        scaled::<D>(df, scale_factor::<D>(dj_bar, dj))
+                    };
                 });
         }
         let history_old = p.history.slots(&p.history.data);

@@ -11,7 +11,9 @@
 //!   ΔF̄_p = (ΔJ̄_c / ΔJ_p)^{1/n} ΔF_p,  ΔJ̄_c = Σ_{q∈c} V_q ΔJ_q / Σ_{q∈c} V_q,
 //!
 //! with V_q the step-start volumes and n = D (plane strain: the in-plane block is
-//! scaled, ΔF_zz = 1 stays, so det ΔF̄_p = ΔJ̄_c). The particle then follows ΔF̄
+//! scaled, ΔF_zz = 1 stays, so det ΔF̄_p = ΔJ̄_c), or n = 3 in axisymmetric mode
+//! (ΔF_θθ, the hoop stretch, is scaled with the r–z block; the volumes are per
+//! radian, so the average is over the cell's ring; explicit solver only). The particle then follows ΔF̄
 //! throughout: stress σ(ΔF̄), F ← ΔF̄ F, V = det F V₀, and the implicit internal
 //! force uses the relative first Piola-Kirchhoff stress P̄ = det ΔF̄ σ ΔF̄⁻ᵀ. Cells
 //! are those of the particles' step-start positions.

@@ -11,6 +11,7 @@ use crate::dim::{restrict, Mat3, Tensor, Vector};
 use crate::model::particles::Particles;
 use crate::model::Model;
 use crate::parallel::MIN_PARALLEL_LEN;
+use crate::physics::axisymmetry::hoop_gradients;
 use crate::physics::shape::{Owner, ShapeFunction, Stencils};
 use rayon::prelude::*;
 use std::sync::atomic::Ordering::Relaxed;
@@ -201,10 +202,14 @@ impl NodeMap {
     }
 }
 
-/// The particles' shape-function stencils on the grid.
+/// The particles' shape-function stencils on the grid (with the hoop gradients
+/// S_Ip / r_p in axisymmetric mode).
 pub fn stencils<const D: usize>(m: &Model<D>, shape: ShapeFunction, st: &mut Stencils<D>) {
     let p = &m.particles;
     st.compute(shape, &m.grid, &p.x, &p.half_length0, &p.f);
+    if m.axisymmetric {
+        hoop_gradients(st, &p.x);
+    }
     if m.erosion {
         // Eroded particles touch no node: no mass, momentum or force reaches the
         // grid from them, and they take no velocity from it (they stay where
@@ -293,10 +298,26 @@ pub fn consistent_mass_product<const D: usize>(
 
 /// Internal force of a particle at one stencil entry, V τ ∇S_I: the Cauchy stress
 /// and the current volume (2-51), or the relative first Piola-Kirchhoff stress and
-/// the step-start volume (the implicit step, 2-21 pulled back).
-fn internal_force_at<const D: usize>(stress: &Mat3, volume: f64, grad: &Vector<D>) -> Vector<D> {
+/// the step-start volume (the implicit step, 2-21 pulled back). Axisymmetric:
+/// plus V τ_θθ S_I / r_p on the radial component (`physics::axisymmetry`).
+fn internal_force_at<const D: usize>(
+    stress: &Mat3,
+    volume: f64,
+    grad: &Vector<D>,
+    hoop: Option<f64>,
+) -> Vector<D> {
     let tau: Tensor<D> = restrict::<D>(stress);
-    tau * grad * volume
+    let mut f = tau * grad;
+    if let Some(h) = hoop {
+        // f_Ir += V_p σ_θθ S_Ip / r_p (the hoop term of the virtual work).
+        f[0] += stress[(2, 2)] * h;
+    }
+    f * volume
+}
+
+/// The hoop gradient S_Ip / r_p of entry e in axisymmetric mode (`Stencils::hoop`).
+fn hoop_at<const D: usize>(st: &Stencils<D>, e: usize) -> Option<f64> {
+    st.hoop.get(e).copied()
 }
 
 /// External force of particle q at a stencil entry of weight S_Iq:
@@ -320,7 +341,7 @@ pub fn internal_force<const D: usize>(
     stress: &[Mat3],
 ) -> Vec<Vector<D>> {
     map.gather(st.stride, Vector::<D>::zeros(), |q, e| {
-        internal_force_at(&stress[q], volume[q], &st.grad[e])
+        internal_force_at(&stress[q], volume[q], &st.grad[e], hoop_at(st, e))
     })
 }
 
@@ -338,11 +359,13 @@ pub fn external_force<const D: usize>(
 }
 
 /// What a particle contributes to the nodal force at each of its entries:
-/// the applied force m g + s f, the in-plane stress and the volume.
+/// the applied force m g + s f, the in-plane stress, the hoop stress
+/// (axisymmetric) and the volume.
 #[derive(Clone, Copy)]
 struct ForceSource<const D: usize> {
     applied: Vector<D>,
     stress: Tensor<D>,
+    hoop_stress: f64,
     volume: f64,
 }
 
@@ -361,12 +384,18 @@ pub fn nodal_force<const D: usize>(
         .map(|q| ForceSource {
             applied: applied_force(p, q, gravity, load_factor),
             stress: restrict::<D>(&p.stress[q]),
+            hoop_stress: p.stress[q][(2, 2)],
             volume: p.volume[q],
         })
         .collect();
     map.gather(st.stride, Vector::<D>::zeros(), |q, e| {
         let s = &sources[q];
-        s.applied * st.weight[e] - s.stress * st.grad[e] * s.volume
+        let mut f = s.applied * st.weight[e] - s.stress * st.grad[e] * s.volume;
+        if let Some(h) = hoop_at(st, e) {
+            // f_Ir −= V_p σ_θθ S_Ip / r_p (the hoop term of the internal force).
+            f[0] -= s.hoop_stress * h * s.volume;
+        }
+        f
     })
 }
 

@@ -79,7 +79,7 @@ pub struct RunOptions {
 /// material, …). `mpm check` calls it, so it rejects what `mpm run` would.
 pub fn set_up_check(scene: &Scene, opts: &RunOptions) -> Result<(), SceneError> {
     check_memory(scene, opts)?;
-    match scene.config.dimension {
+    match scene.config.dimension.spatial() {
         2 => check_steps(scene, &Model::<2>::build(scene)?),
         3 => check_steps(scene, &Model::<3>::build(scene)?),
         d => unreachable!("validated dimension {d}"),
@@ -141,7 +141,7 @@ pub fn run(scene: &Scene, out: &Path, opts: &RunOptions) -> Result<Summary, RunE
         None => None,
     };
     std::fs::create_dir_all(out)?;
-    match scene.config.dimension {
+    match scene.config.dimension.spatial() {
         2 => run_dim::<2>(scene, out, opts, resume),
         3 => run_dim::<3>(scene, out, opts, resume),
         d => unreachable!("validated dimension {d}"),
@@ -159,10 +159,12 @@ struct Resume {
 fn matching_checkpoint(scene: &Scene, path: &Path) -> Result<Checkpoint, RunError> {
     let ck = Checkpoint::read(path).map_err(RunError::Checkpoint)?;
     let name = path.display();
-    if ck.dimension != scene.config.dimension {
+    if ck.dimension != scene.config.dimension.spatial() {
         return Err(RunError::Checkpoint(format!(
             "checkpoint {name} is of a {}D run, {} is {}D",
-            ck.dimension, scene.file, scene.config.dimension
+            ck.dimension,
+            scene.file,
+            scene.config.dimension.spatial()
         )));
     }
     if ck.scene_text != scene.text {
@@ -492,6 +494,7 @@ fn run_dim<const D: usize>(
     let mut summary = Summary {
         scene: scene.file.clone(),
         dimension: D,
+        axisymmetric: cfg.dimension.is_axisymmetric(),
         shape_function: cfg.grid.shape_function,
         particles,
         steps: line.step,

@@ -28,6 +28,9 @@ pub enum Status {
 pub struct Summary {
     pub scene: String,
     pub dimension: usize,
+    /// `dimension = "axisymmetric"` (then `dimension` is 2); absent otherwise.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub axisymmetric: bool,
     pub shape_function: ShapeFunction,
     pub particles: usize,
     pub steps: usize,

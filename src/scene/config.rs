@@ -15,8 +15,8 @@ use strum::{EnumIter, IntoStaticStr};
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneConfig {
-    /// 2 (plane strain) or 3.
-    pub dimension: usize,
+    /// 2 (plane strain), 3, or "axisymmetric" (r–z, two components).
+    pub dimension: Dimension,
     /// Gravitational acceleration vector (default zero).
     #[serde(default)]
     pub gravity: Option<Vec<f64>>,
@@ -48,6 +48,68 @@ pub struct SceneConfig {
     pub reference: Option<ReferenceConfig>,
     /// Settings of `mpm bench` for this scene.
     pub bench: Option<BenchConfig>,
+}
+
+/// The `dimension` key: a number of Cartesian dimensions (2: plane strain, 3),
+/// or `"axisymmetric"`: a solid of revolution about the y axis, modelled on the
+/// r–z half plane (x = r ≥ 0, y = z) with two components everywhere, as in 2D.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Dimension {
+    /// 2 or 3 (other numbers are refused by the validation).
+    Cartesian(usize),
+    Axisymmetric,
+}
+
+impl Dimension {
+    /// The number of components of positions, velocities and grid indices: 2
+    /// for the axisymmetric r–z plane.
+    pub fn spatial(self) -> usize {
+        match self {
+            Dimension::Cartesian(d) => d,
+            Dimension::Axisymmetric => 2,
+        }
+    }
+
+    pub fn is_axisymmetric(self) -> bool {
+        self == Dimension::Axisymmetric
+    }
+
+    /// "2D", "3D" or "axisymmetric" (messages).
+    pub fn label(self) -> String {
+        match self {
+            Dimension::Cartesian(d) => format!("{d}D"),
+            Dimension::Axisymmetric => "axisymmetric".into(),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Dimension {
+    fn deserialize<De: serde::Deserializer<'de>>(d: De) -> Result<Self, De::Error> {
+        struct Visitor;
+        impl serde::de::Visitor<'_> for Visitor {
+            type Value = Dimension;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("2, 3 or \"axisymmetric\"")
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Dimension, E> {
+                usize::try_from(v).map(Dimension::Cartesian).map_err(|_| {
+                    E::custom(format!("dimension {v}: expected 2, 3 or \"axisymmetric\""))
+                })
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Dimension, E> {
+                self.visit_i64(i64::try_from(v).unwrap_or(-1))
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<Dimension, E> {
+                match v {
+                    "axisymmetric" => Ok(Dimension::Axisymmetric),
+                    _ => Err(E::custom(format!(
+                        "unknown dimension `{v}`: expected 2, 3 or \"axisymmetric\""
+                    ))),
+                }
+            }
+        }
+        d.deserialize_any(Visitor)
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, IntoStaticStr, EnumIter)]

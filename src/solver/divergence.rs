@@ -29,8 +29,9 @@ impl std::fmt::Display for Divergence {
     }
 }
 
-/// Stop on non-finite state, an inverted or collapsed particle (det F ≤ 0) or
-/// particles outside the grid (first offender).
+/// Stop on non-finite state, an inverted or collapsed particle (det F ≤ 0),
+/// particles outside the grid or, axisymmetric, on or across the axis (first
+/// offender).
 pub fn check_state<const D: usize>(m: &Model<D>, step: usize, time: f64) -> Result<(), Divergence> {
     let p = &m.particles;
     let bad = (0..p.len())
@@ -41,7 +42,8 @@ pub fn check_state<const D: usize>(m: &Model<D>, step: usize, time: f64) -> Resu
                 && p.v[q].iter().all(|v| v.is_finite())
                 && p.stress[q].iter().all(|v| v.is_finite())
                 && p.f[q].determinant() > 0.0
-                && m.grid.contains(&p.x[q]))
+                && m.grid.contains(&p.x[q])
+                && (!m.axisymmetric || p.x[q][0] > 0.0))
         });
     match bad {
         None => Ok(()),
@@ -52,7 +54,12 @@ pub fn check_state<const D: usize>(m: &Model<D>, step: usize, time: f64) -> Resu
                 .chain(p.stress[q].iter())
                 .all(|v| v.is_finite());
             let det = p.f[q].determinant();
-            let message = if finite && (det.is_nan() || det <= 0.0) {
+            let message = if finite && m.axisymmetric && p.x[q][0] <= 0.0 {
+                format!(
+                    "(body {}) reached the axis: r = {:e} (axisymmetric mode)",
+                    p.body[q], p.x[q][0]
+                )
+            } else if finite && (det.is_nan() || det <= 0.0) {
                 format!(
                     "(body {}) is inverted or collapsed: det F = {det:e}",
                     p.body[q]

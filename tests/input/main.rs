@@ -5,6 +5,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod axisymmetric;
 mod bench;
 mod contact;
 mod fuzz;

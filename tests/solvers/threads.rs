@@ -39,3 +39,32 @@ fn one_and_two_threads_give_identical_results() {
         );
     }
 }
+
+/// Axisymmetric (hoop terms in the stencils, the stress update and the nodal
+/// force): the thick cylinder, explicit, with about 4000 particles so that the
+/// parallel loops split, and implicit with a Krylov solver.
+#[test]
+fn axisymmetric_runs_give_identical_results_on_one_and_two_threads() {
+    for solver in [
+        "solver={kind=\"explicit\",scheme=\"musl\",end_time=0.02,damping=0.5}",
+        "solver={kind=\"implicit\",integrator=\"quasi_static\",end_time=1.0,load_steps=2,linear_solver=\"gmres\",preconditioner=\"multigrid\"}",
+    ] {
+        let run = |threads: usize| {
+            let overrides = [
+                solver.to_string(),
+                "grid.cells=[160,4]".to_string(),
+                "load.0.region_max=[1.0078125,0.25]".to_string(),
+                "output.frames=0".to_string(),
+            ];
+            let dir = run_cli("axisymmetric_cylinder.toml", threads, &overrides);
+            (
+                read_output(&dir, "particles_final.csv"),
+                read_output(&dir, "history.csv"),
+            )
+        };
+        let (p1, h1) = run(1);
+        let (p2, h2) = run(2);
+        assert!(p1 == p2, "{solver}: particles_final.csv differs between 1 and 2 threads");
+        assert!(h1 == h2, "{solver}: history.csv differs between 1 and 2 threads");
+    }
+}

@@ -73,15 +73,21 @@ fn bulk_viscosity_removes_the_ringing_behind_the_shock() {
 }
 
 /// Final length L, impact-face diameter D and the diameter W at 0.2 L0 above the
-/// anvil (mm) of a quarter Taylor bar (axis z, anvil z = 0): each particle's
-/// final radius scaled by R/r0, over the outermost ring of particles of a layer;
-/// L is the highest particle plus its initial distance to the top face
+/// anvil (mm) of a Taylor bar: a 3D quarter (axis z, anvil z = 0) or the
+/// axisymmetric r–z model (x = r, y = z). Each particle's final radius is scaled
+/// by R/r0, over the outermost ring of particles of a layer; L is the highest
+/// particle plus its initial distance to the top face
 /// (papers/taylor_bar/measure.py does the same).
 fn taylor_shape(t: &Table) -> (f64, f64, f64) {
     let (l0, radius) = (25.4, 3.8);
     let mm = |v: f64| v * 1e3;
-    let (x0, y0, z0) = (t.col("X0"), t.col("Y0"), t.col("Z0"));
-    let (x, y, z) = (t.col("x"), t.col("y"), t.col("z"));
+    let three_d = t.column("z").is_ok();
+    let zeros = vec![0.0; t.col("x").len()];
+    let (x0, x) = (t.col("X0"), t.col("x"));
+    let (y0, y, z0, z) = match three_d {
+        true => (t.col("Y0"), t.col("y"), t.col("Z0"), t.col("z")),
+        false => (&zeros[..], &zeros[..], t.col("Y0"), t.col("y")),
+    };
     let n = z.len();
     let bottom = z0.iter().cloned().fold(f64::INFINITY, f64::min);
     let spacing = 2.0 * mm(bottom);
@@ -101,6 +107,12 @@ fn taylor_shape(t: &Table) -> (f64, f64, f64) {
     (length, d, w)
 }
 
+/// Errors of (L, D, W) against the test's 16.2, 13.5, 10.1 mm and their mean.
+fn taylor_errors((l, d, w): (f64, f64, f64)) -> ([f64; 3], f64) {
+    let errors = [l / 16.2 - 1.0, d / 13.5 - 1.0, w / 10.1 - 1.0];
+    (errors, errors.iter().map(|e| e.abs()).sum::<f64>() / 3.0)
+}
+
 /// The coarse Taylor bar: h = 0.76 mm (MPM3D's cell), 2 particles per direction.
 const COARSE: &[&str] = &["grid.cells=[11,11,35]"];
 
@@ -110,8 +122,7 @@ fn taylor_bar_matches_the_measured_final_shape() {
     result.expect("the Taylor bar runs");
     let t = Table::read(&dir.path().join("particles_final.csv")).unwrap();
     let (l, d, w) = taylor_shape(&t);
-    let errors = [l / 16.2 - 1.0, d / 13.5 - 1.0, w / 10.1 - 1.0];
-    let mean = errors.iter().map(|e| e.abs()).sum::<f64>() / 3.0;
+    let (errors, mean) = taylor_errors((l, d, w));
     println!(
         "L {l:.2} D {d:.2} W {w:.2} mm against 16.2 13.5 10.1: errors {:.3} {:.3} {:.3}, mean {mean:.3}",
         errors[0], errors[1], errors[2]
@@ -142,6 +153,32 @@ fn taylor_bar_matches_the_measured_final_shape() {
         kinetic.last().unwrap() / e0 < 0.01,
         "the bar is still moving"
     );
+}
+
+#[test]
+fn axisymmetric_taylor_bar_matches_the_test_and_the_3d_quarter() {
+    // h = 0.38 mm: mean error ≤ 3 % against the test.
+    let (result, dir) = run_problem("taylor_bar_axisymmetric.toml", &[]);
+    result.expect("the axisymmetric Taylor bar runs");
+    let fine = taylor_shape(&Table::read(&dir.path().join("particles_final.csv")).unwrap());
+    let (errors, mean) = taylor_errors(fine);
+    println!("axisymmetric h = 0.38 mm: {fine:.2?}, errors {errors:.3?}, mean {mean:.3}");
+    assert!(
+        mean <= 0.03 && errors.iter().all(|e| e.abs() <= 0.05),
+        "{errors:?}"
+    );
+    // h = 0.76 mm against the 3D quarter at the same cell size and particles per
+    // cell direction: the same solid, so within 1 % (L) and 3 % (D, W).
+    let (r_axi, d_axi) = run_problem("taylor_bar_axisymmetric.toml", &["grid.cells=[11,35]"]);
+    r_axi.expect("runs");
+    let (r_3d, d_3d) = run_problem("taylor_bar.toml", COARSE);
+    r_3d.expect("runs");
+    let axi = taylor_shape(&Table::read(&d_axi.path().join("particles_final.csv")).unwrap());
+    let full = taylor_shape(&Table::read(&d_3d.path().join("particles_final.csv")).unwrap());
+    println!("h = 0.76 mm: axisymmetric {axi:.2?}, 3D {full:.2?}");
+    assert!((axi.0 / full.0 - 1.0).abs() < 0.01);
+    assert!((axi.1 / full.1 - 1.0).abs() < 0.03);
+    assert!((axi.2 / full.2 - 1.0).abs() < 0.03);
 }
 
 #[test]

@@ -6,6 +6,7 @@
 mod common;
 
 mod absorbing;
+mod axisymmetric;
 mod cantilever;
 mod collapse;
 mod column_explicit;

@@ -19,7 +19,7 @@ use mpm::analyses::strength_reduction::TrialStatus;
 use mpm::model::Model;
 use mpm::scene::Scene;
 
-const LEVEL: &str = r#"dimension = 2
+pub(crate) const LEVEL: &str = r#"dimension = 2
 gravity = [0.0, -10.0]
 
 [grid]

@@ -518,7 +518,7 @@ fn status(exit: Exit, dir: &Path, timeout: f64) -> String {
 /// for implicit runs (`solver::implicit::unknowns`, of the first implicit stage),
 /// D × active nodes for explicit ones.
 fn unknowns(scene: &Scene) -> Result<(usize, usize), SceneError> {
-    match scene.config.dimension {
+    match scene.config.dimension.spatial() {
         2 => unknowns_dim::<2>(scene),
         _ => unknowns_dim::<3>(scene),
     }
@@ -542,7 +542,7 @@ fn unknowns_dim<const D: usize>(scene: &Scene) -> Result<(usize, usize), SceneEr
 /// The explicit critical step of the base scene at t = 0 (for implicit
 /// configurations of explicit scenes).
 fn critical_dt(scene: &Scene) -> Result<f64, SceneError> {
-    Ok(match scene.config.dimension {
+    Ok(match scene.config.dimension.spatial() {
         2 => Explicit::critical_dt(&Model::<2>::build(scene)?),
         _ => Explicit::critical_dt(&Model::<3>::build(scene)?),
     })

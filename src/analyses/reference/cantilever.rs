@@ -33,7 +33,7 @@ impl CantileverTip {
     /// From the scene: 2D, body 0 a rectangle clamped at its min x, load 0 a
     /// vertical point load.
     pub fn from_scene(s: &SceneConfig) -> Result<CantileverTip, KeyError> {
-        if s.dimension != 2 {
+        if s.dimension != crate::scene::Dimension::Cartesian(2) {
             return Err(("dimension".into(), "the cantilever reference is 2D".into()));
         }
         let (lo, hi) = body0_box(s)?;

@@ -72,6 +72,9 @@ pub struct Stencils<const D: usize> {
     pub node: Vec<u32>,
     pub weight: Vec<f64>,
     pub grad: Vec<Vector<D>>,
+    /// Axisymmetric mode only (else empty): S_Ip / r_p per entry, the hoop
+    /// gradient (`physics::axisymmetry`).
+    pub hoop: Vec<f64>,
 }
 
 impl<const D: usize> Stencils<D> {
@@ -92,6 +95,7 @@ impl<const D: usize> Stencils<D> {
         self.node.resize(n * stride, 0);
         self.weight.resize(n * stride, 0.0);
         self.grad.resize(n * stride, Vector::<D>::zeros());
+        self.hoop.clear();
         self.count
             .par_iter_mut()
             .zip(self.node.par_chunks_mut(stride))

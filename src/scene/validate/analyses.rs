@@ -79,7 +79,7 @@ pub fn strength_reduction(
         "must be at most 200",
     )?;
     if let Some(m) = &r.monitor {
-        vector(m, s.dimension, &format!("{p}.monitor"))?;
+        vector(m, s.dimension.spatial(), &format!("{p}.monitor"))?;
     }
     if let Some(d) = r.max_displacement {
         required(&r.monitor, format!("{p}.monitor"), "max_displacement")?;

@@ -145,7 +145,7 @@ fn absorbing(b: &BoundaryConfig, i: usize) -> Check {
 }
 
 pub fn load(l: &LoadConfig, i: usize, s: &SceneConfig) -> Check {
-    let dim = s.dimension;
+    let dim = s.dimension.spatial();
     let key = |k: &str| format!("load.{i}.{k}");
     vector(&l.region_min, dim, &key("region_min"))?;
     vector(&l.region_max, dim, &key("region_max"))?;

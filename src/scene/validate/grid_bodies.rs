@@ -47,7 +47,7 @@ fn cell_size(g: &GridConfig, d: usize) -> f64 {
 }
 
 pub fn body(b: &BodyConfig, i: usize, s: &SceneConfig) -> Check {
-    let dim = s.dimension;
+    let dim = s.dimension.spatial();
     let key = |k: &str| format!("body.{i}.{k}");
     let known = s.materials.iter().any(|m| m.name == b.material);
     ensure(

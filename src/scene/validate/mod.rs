@@ -6,6 +6,7 @@
 //! strength reduction, bench); `check` holds the checks they share.
 
 mod analyses;
+mod axisymmetry;
 mod check;
 mod conditions;
 mod grid_bodies;
@@ -17,6 +18,7 @@ pub use check::{Check, KeyError};
 
 use crate::scene::{LinearSolver, LinearSystems, SceneConfig, SolverConfig, SolverKind};
 use analyses::{geostatic, strength_reduction};
+use axisymmetry::axisymmetry;
 use check::{ensure, vector};
 use conditions::{boundary, load};
 use grid_bodies::{body, grid};
@@ -25,11 +27,11 @@ use solver::{needs_krylov, solver, stage_strength_factor};
 
 /// Check a parsed scene, table by table; the first failure names its key.
 pub fn validate(s: &SceneConfig) -> Check {
-    let dim = s.dimension;
+    let dim = s.dimension.spatial();
     ensure(
         dim == 2 || dim == 3,
         "dimension",
-        "must be 2 (plane strain) or 3",
+        "must be 2 (plane strain), 3 or \"axisymmetric\"",
     )?;
     if let Some(g) = &s.gravity {
         vector(g, dim, "gravity")?;
@@ -56,6 +58,9 @@ pub fn validate(s: &SceneConfig) -> Check {
     }
     for (i, l) in s.loads.iter().enumerate() {
         load(l, i, s)?;
+    }
+    if s.dimension.is_axisymmetric() {
+        axisymmetry(s)?;
     }
     if crate::scene::contact::plan(s)?.is_some() {
         use crate::scene::ShapeFunction::{Bspline2, Bspline3, Cpbspline2};

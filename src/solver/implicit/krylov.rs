@@ -43,7 +43,7 @@
 //! and solves with the difference products, so a material without an analytic
 //! tangent gets it from central differences once per refresh only.
 
-use super::assembly::stiffness::{coupling, particle_tangents, ParticleTangents};
+use super::assembly::stiffness::{coupling, hoop_coupling, particle_tangents, ParticleTangents};
 use super::assembly::Dofs;
 use super::coarsening::hierarchy;
 use super::failure::Failure;
@@ -191,8 +191,8 @@ pub struct Correction {
 /// The D×D diagonal blocks of the tangent at every active node, summed particle
 /// by particle: K_(Ii)(Ik) = Σ_p V_p ∂S_Ip/∂X_j A_p,ijkl ∂S_Ip/∂X_l (2-41, 2-42)
 /// plus the inertia M_II/(βΔt²) (2-40; lumped, or Σ_p m_p S_Ip² for the consistent
-/// mass). Deterministic (a gather). Components are not yet restricted to the
-/// free unknowns.
+/// mass), with the hoop couplings in axisymmetric mode. Deterministic (a
+/// gather). Components are not yet restricted to the free unknowns.
 pub fn diagonal_blocks<const D: usize>(
     m: &Model<D>,
     sys: &StepSystem<D>,
@@ -205,8 +205,14 @@ pub fn diagonal_blocks<const D: usize>(
         .map
         .gather(st.stride, SMatrix::<f64, D, D>::zeros(), |q, e| {
             let g = &st.grad[e];
-            let mut b =
-                SMatrix::<f64, D, D>::from_fn(|i, k| coupling(g, a.of(q), g, i, k) * p.volume[q]);
+            let hoop = a.hoop_of(q);
+            let mut b = SMatrix::<f64, D, D>::from_fn(|i, k| {
+                let mut v = coupling(g, a.of(q), g, i, k);
+                if !hoop.is_empty() {
+                    v += hoop_coupling(g, st.hoop[e], hoop, g, st.hoop[e], i, k);
+                }
+                v * p.volume[q]
+            });
             if consistent {
                 let w = st.weight[e];
                 b += SMatrix::<f64, D, D>::identity() * (p.mass[q] * w * w * inertia);

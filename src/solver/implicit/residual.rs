@@ -15,7 +15,8 @@ use super::assembly::absorbing::add_absorbing;
 use super::assembly::fbar::add_fbar_stiffness;
 use super::assembly::mass::{add_consistent_mass, add_lumped_mass};
 use super::assembly::stiffness::{
-    add_stiffness, major_symmetric, particle_tangents, relative_pk1, ParticleTangents,
+    add_stiffness, hoop_symmetric, major_symmetric, particle_tangents, relative_pk1,
+    ParticleTangents,
 };
 use super::assembly::{Pattern, Storage, Tangent};
 use super::failure::Failure;
@@ -107,7 +108,11 @@ pub fn tangent<'s, const D: usize>(
     let symmetric = fbar.is_none()
         && (a.values)
             .par_chunks(ParticleTangents::<D>::LEN)
-            .all(major_symmetric::<D>);
+            .enumerate()
+            .all(|(q, a_q)| {
+                major_symmetric::<D>(a_q)
+                    && (a.hoop.is_empty() || hoop_symmetric::<D>(a.hoop_of(q), a_q))
+            });
     let storage = if symmetric {
         Storage::Lower
     } else {

@@ -167,6 +167,40 @@ fn global_tangent_matches_finite_differences_of_the_residual() {
     }
 }
 
+/// The axisymmetric tangent (the hoop couplings of `assembly::stiffness`, the
+/// hoop stretch in ΔF and the hoop force in r) against central differences of
+/// the residual: the block as a solid of revolution about x = 0 (r = x, the axis
+/// nodes held radially), several materials, shape functions, mass matrices and
+/// ties.
+#[test]
+fn axisymmetric_tangent_matches_finite_differences_of_the_residual() {
+    let text = BLOCK.replace("dimension = 2", "dimension = \"axisymmetric\"");
+    for (model, shape, mass, support) in [
+        ("hencky", "linear", "lumped", 0.0),
+        ("neo_hookean", "bspline2", "consistent", 0.01),
+        ("linear_elastic", "ugimp", "lumped", 0.01),
+        ("hencky", "cpgimp", "consistent", 0.3),
+        ("hencky", "bspline3", "lumped", 0.01),
+        ("hencky", "cpbspline2", "lumped", 0.01),
+    ] {
+        let overrides = vec![
+            format!("material.0.model={model}"),
+            format!("grid.shape_function={shape}"),
+            format!("solver.mass={mass}"),
+            format!("solver.min_node_support={support}"),
+        ];
+        let (error, n, tied, _) = tangent_error_of::<2>(&text, &overrides, false);
+        println!(
+            "axisymmetric {model} {shape} {mass}: {n} unknowns, {tied} tied nodes, \
+             max |K − K_fd| / max|K| = {error:.2e}"
+        );
+        assert!(
+            error < 1e-6,
+            "axisymmetric {model} {shape} {mass}: tangent off by {error:.2e} of its largest entry"
+        );
+    }
+}
+
 /// The F-bar tangent (`assembly::fbar::fbar_triplets`: each particle couples to the
 /// nodes of every particle in its cell) against central differences of the
 /// F-bar residual, with linear and smooth shape functions, through ties, and

@@ -67,7 +67,7 @@ pub fn add_fbar_stiffness<const D: usize>(
             })
         })
         .collect();
-    let mut a_tilde = ParticleTangents::<D>::zeros(volume.len());
+    let mut a_tilde = ParticleTangents::<D>::zeros(volume.len(), false);
     a_tilde
         .values
         .par_chunks_mut(ParticleTangents::<D>::LEN)

@@ -7,6 +7,12 @@
 //! K_(Ii)(Jk) = Σ_p V_p ∂S_Ip/∂X_j A_ijkl ∂S_Jp/∂X_l with A = ∂P/∂ΔF. A holds both
 //! the material part (from the exact derivative of the stress update, 2-41) and
 //! the geometric part (2-42).
+//!
+//! Axisymmetric (`physics::axisymmetry`): ΔF_θθ = 1 + Σ_J u_Jr h_Jp with the hoop
+//! gradient h_Jp = S_Jp / R_p (R_p the step-start radius) and f_Ir gains
+//! V_p P_θθ h_Ip, so K gains the hoop couplings (θ = index 2 of A)
+//!
+//!   V_p [δ_i0 h_I A_θθkl ∂S_J/∂X_l + δ_k0 h_J ∂S_I/∂X_j A_ijθθ + δ_i0 δ_k0 h_I h_J A_θθθθ].
 
 use super::{Components, Dofs, Pattern, Tangent};
 use crate::dim::{Mat3, Vector};
@@ -26,21 +32,36 @@ pub type Pk1Derivative = SMatrix<f64, 9, 9>;
 
 /// A_p = ∂P/∂ΔF of every particle, only the D⁴ components A_ijkl with
 /// i, j, k, l < D that a D-dimensional tangent reads (16 numbers a particle in
-/// 2D instead of 81), at [`ParticleTangents::at`].
+/// 2D instead of 81), at [`ParticleTangents::at`]; in axisymmetric mode also the
+/// hoop components (`hoop`).
 #[derive(Clone, Debug)]
 pub struct ParticleTangents<const D: usize> {
     pub values: Vec<f64>,
+    /// Axisymmetric only (else empty): per particle A_θθkl (k, l < D), then
+    /// A_ijθθ (i, j < D), then A_θθθθ ([`ParticleTangents::HOOP_LEN`] numbers).
+    pub hoop: Vec<f64>,
 }
 
 impl<const D: usize> ParticleTangents<D> {
     /// Components per particle.
     pub const LEN: usize = D * D * D * D;
 
-    /// Zero tangents of `n` particles.
-    pub fn zeros(n: usize) -> Self {
+    /// Hoop components per particle (axisymmetric).
+    pub const HOOP_LEN: usize = 2 * D * D + 1;
+
+    /// Zero tangents of `n` particles (with hoop components if `axisymmetric`).
+    pub fn zeros(n: usize, axisymmetric: bool) -> Self {
         ParticleTangents {
             values: vec![0.0; n * Self::LEN],
+            hoop: vec![0.0; if axisymmetric { n * Self::HOOP_LEN } else { 0 }],
         }
+    }
+
+    /// The hoop components of particle q (empty unless axisymmetric).
+    pub fn hoop_of(&self, q: usize) -> &[f64] {
+        self.hoop
+            .get(q * Self::HOOP_LEN..(q + 1) * Self::HOOP_LEN)
+            .unwrap_or(&[])
     }
 
     /// The components of particle q.
@@ -66,21 +87,24 @@ pub fn relative_pk1(df: &Mat3, sigma: &Mat3) -> Mat3 {
 
 /// A_ijkl = ∂P_ij/∂ΔF_kl = J [G_kl (σG)_ij + (∂σ_im/∂ΔF_kl) G_mj − (σG)_il G_kj],
 /// G = ΔF⁻ᵀ (from ∂J/∂ΔF = J G and ∂G_mj/∂ΔF_kl = −G_ml G_kj), for the indices
-/// i, j, k, l < D that the tangent of a D-dimensional problem reads (zero
-/// elsewhere; plane strain has no out-of-plane gradients).
+/// i, j, k, l < n that the tangent of a D-dimensional problem reads (zero
+/// elsewhere; plane strain has no out-of-plane gradients): n = D, or n = 3 when
+/// `hoop` (axisymmetric: ΔF_θθ varies too).
 pub fn pk1_derivative<const D: usize>(
     df: &Mat3,
     sigma: &Mat3,
     dsigma: &StressDerivative,
+    hoop: bool,
 ) -> Pk1Derivative {
     let j = df.determinant();
     let g = df.try_inverse().unwrap_or_else(Mat3::zeros).transpose();
     let sg = sigma * g;
     let mut a = Pk1Derivative::zeros();
-    for i in 0..D {
-        for jj in 0..D {
-            for k in 0..D {
-                for l in 0..D {
+    let n = if hoop { 3 } else { D };
+    for i in 0..n {
+        for jj in 0..n {
+            for k in 0..n {
+                for l in 0..n {
                     let col = 3 * k + l;
                     let material: f64 = (0..3).map(|m| dsigma[(3 * i + m, col)] * g[(m, jj)]).sum();
                     a[(3 * i + jj, col)] =
@@ -102,14 +126,24 @@ pub fn particle_tangents<const D: usize>(
 ) -> Result<ParticleTangents<D>, Failure> {
     let p = &m.particles;
     let history_old = p.history.slots(&p.history.data);
-    let mut a = ParticleTangents::<D>::zeros(p.len());
+    let hoop = m.axisymmetric;
+    let mut a = ParticleTangents::<D>::zeros(p.len(), hoop);
+    let mut hoop_values = std::mem::take(&mut a.hoop);
+    let hoop_slots: Vec<&mut [f64]> = if hoop {
+        hoop_values
+            .chunks_mut(ParticleTangents::<D>::HOOP_LEN)
+            .collect()
+    } else {
+        (0..p.len()).map(|_| <&mut [f64]>::default()).collect()
+    };
     // The first particle without a tangent (the same for any number of threads).
     let failed = a
         .values
         .par_chunks_mut(ParticleTangents::<D>::LEN)
+        .zip(hoop_slots)
         .enumerate()
         .with_min_len(MIN_PARALLEL_LEN)
-        .filter_map(|(q, a_q)| {
+        .filter_map(|(q, (a_q, hoop_q))| {
             let inc = Increment {
                 f_old: p.f[q],
                 df: trial.df[q],
@@ -123,13 +157,17 @@ pub fn particle_tangents<const D: usize>(
                     numerical.then(|| numerical_stress_derivative(mat, &inc, NUMERICAL_STEP))
                 })
                 .map(|ds| {
-                    let full = pk1_derivative::<D>(&trial.df[q], &trial.stress[q], &ds);
-                    compact::<D>(&full, a_q)
+                    let full = pk1_derivative::<D>(&trial.df[q], &trial.stress[q], &ds, hoop);
+                    compact::<D>(&full, a_q);
+                    if hoop {
+                        compact_hoop::<D>(&full, hoop_q);
+                    }
                 })
                 .is_none()
                 .then_some(q)
         })
         .min();
+    a.hoop = hoop_values;
     match failed {
         None => Ok(a),
         Some(q) => {
@@ -157,6 +195,56 @@ fn compact<const D: usize>(full: &Pk1Derivative, out: &mut [f64]) {
             }
         }
     }
+}
+
+/// The hoop components of a 9×9 A (θ = 2), into `out` (`ParticleTangents::hoop`).
+fn compact_hoop<const D: usize>(full: &Pk1Derivative, out: &mut [f64]) {
+    for k in 0..D {
+        for l in 0..D {
+            out[k * D + l] = full[(8, 3 * k + l)];
+            out[D * D + k * D + l] = full[(3 * k + l, 8)];
+        }
+    }
+    out[2 * D * D] = full[(8, 8)];
+}
+
+/// The hoop part of K_(Ii)(Jk)/V_p for one particle (module doc):
+/// δ_i0 h_I A_θθkl ∂S_J/∂X_l + δ_k0 h_J ∂S_I/∂X_j A_ijθθ + δ_i0 δ_k0 h_I h_J A_θθθθ,
+/// with `hoop` the particle's hoop components (`ParticleTangents::hoop_of`)
+/// and h_I, h_J the entries' hoop gradients S / R.
+#[allow(clippy::too_many_arguments)]
+pub fn hoop_coupling<const D: usize>(
+    grad_i: &Vector<D>,
+    h_i: f64,
+    hoop: &[f64],
+    grad_j: &Vector<D>,
+    h_j: f64,
+    i: usize,
+    k: usize,
+) -> f64 {
+    let mut v = 0.0;
+    if i == 0 {
+        v += h_i * (0..D).map(|l| hoop[k * D + l] * grad_j[l]).sum::<f64>();
+    }
+    if k == 0 {
+        v += h_j
+            * (0..D)
+                .map(|j| grad_i[j] * hoop[D * D + i * D + j])
+                .sum::<f64>();
+    }
+    if i == 0 && k == 0 {
+        v += h_i * h_j * hoop[2 * D * D];
+    }
+    v
+}
+
+/// Whether one particle's hoop components (`ParticleTangents::hoop_of`) have
+/// the major symmetry A_θθkl = A_klθθ to round-off of the largest of them and
+/// of its in-plane components `a`.
+pub fn hoop_symmetric<const D: usize>(hoop: &[f64], a: &[f64]) -> bool {
+    let size = (hoop.iter().chain(a)).fold(f64::MIN_POSITIVE, |m, v| m.max(v.abs()));
+    let asymmetry = (0..D * D).fold(0.0f64, |m, n| m.max((hoop[n] - hoop[D * D + n]).abs()));
+    asymmetry <= 1e-10 * size
 }
 
 /// ∇S_I · A · ∇S_J for components (i, k): Σ_jl ∂S_I/∂X_j A_ijkl ∂S_J/∂X_l, with
@@ -195,7 +283,8 @@ pub fn indices<const D: usize>() -> impl Iterator<Item = (usize, usize, usize, u
     (0..ParticleTangents::<D>::LEN).map(|n| (n / (D * D * D), n / (D * D) % D, n / D % D, n % D))
 }
 
-/// Adds Σ_p V_p ∇S_I A_p ∇S_J (2-41, 2-42) to the tangent `k`.
+/// Adds Σ_p V_p ∇S_I A_p ∇S_J (2-41, 2-42), with the hoop couplings in
+/// axisymmetric mode, to the tangent `k`.
 pub fn add_stiffness<const D: usize>(
     k: &mut Tangent,
     pattern: &Pattern,
@@ -226,12 +315,17 @@ pub fn add_stiffness<const D: usize>(
                     }
                 }
             }
+            let hoop = a.hoop_of(q);
             for (local, e1) in st.range(q).enumerate() {
                 let g1 = &st.grad[e1];
                 let out = &mut block[local * D * D..(local + 1) * D * D];
                 for i in 0..D {
                     for kk in 0..D {
-                        let v: f64 = (0..D).map(|j| g1[j] * b[i][j][kk]).sum();
+                        let mut v: f64 = (0..D).map(|j| g1[j] * b[i][j][kk]).sum();
+                        if !hoop.is_empty() {
+                            let (h1, h2) = (st.hoop[e1], st.hoop[e2]);
+                            v += hoop_coupling(g1, h1, hoop, g2, h2, i, kk);
+                        }
                         out[i * D + kk] = v * volume[q];
                     }
                 }
@@ -275,6 +369,7 @@ mod tests {
             &df,
             &m.update(&inc, &mut []),
             &m.stress_derivative(&inc).unwrap(),
+            false,
         );
         let h = 1e-6;
         let mut worst: f64 = 0.0;
