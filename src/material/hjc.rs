@@ -25,6 +25,7 @@
 use super::deviatoric::{deviator, equivalent, equivalent_rate, strain_increment, TrialDeviator};
 use super::eos::Compaction;
 use super::jh2::RateForm;
+use super::erosion::Erosion;
 use super::parameters::{FromParameters, KeyError, Parameters};
 use super::{Increment, Material};
 use crate::dim::Mat3;
@@ -48,8 +49,8 @@ pub struct Hjc {
     pub min_fracture_strain: f64,
     pub reference_strain_rate: f64,
     pub rate_form: RateForm,
-    /// Failed points (D = 1) leave the transfers.
-    pub erosion: bool,
+    /// When points leave the transfers (`erosion.rs`).
+    pub erosion: Option<Erosion>,
 }
 
 const PLASTIC_STRAIN: usize = 0;
@@ -157,12 +158,13 @@ impl Material for Hjc {
         true
     }
 
-    fn failed(&self, history: &[f64]) -> bool {
-        history[DAMAGE] >= 1.0
+    fn erodes(&self) -> bool {
+        self.erosion.is_some()
     }
 
-    fn erodes(&self) -> bool {
+    fn eroded(&self, history: &[f64]) -> bool {
         self.erosion
+            .is_some_and(|e| e.applies(history[DAMAGE], history[PLASTIC_STRAIN]))
     }
 
     fn equivalent_plastic_strain(&self, history: &[f64]) -> Option<f64> {
@@ -194,6 +196,7 @@ impl FromParameters for Hjc {
         "reference_strain_rate",
         "rate_form",
         "erosion",
+        "erosion_plastic_strain",
     ];
     /// The 48 MPa concrete of the HJC literature in mm, ms, g, MPa (the thesis'
     /// units; digest A1/`impact-data.md` §2.3).
@@ -248,7 +251,7 @@ impl FromParameters for Hjc {
             min_fracture_strain: non_negative("min_fracture_strain", 0.01)?,
             reference_strain_rate,
             rate_form: p.get("rate_form")?.unwrap_or(RateForm::Absolute),
-            erosion: p.get("erosion")?.unwrap_or(false),
+            erosion: Erosion::from_parameters(p)?,
         })
     }
 }
@@ -277,7 +280,7 @@ mod tests {
             min_fracture_strain: 0.01,
             reference_strain_rate: 0.001,
             rate_form: RateForm::Absolute,
-            erosion: false,
+            erosion: None,
         }
     }
 

@@ -25,6 +25,7 @@
 
 use super::deviatoric::{deviator, equivalent, equivalent_rate, strain_increment, TrialDeviator};
 use super::eos::Eos;
+use super::erosion::Erosion;
 use super::parameters::{FromParameters, KeyError, Parameters};
 use super::{Increment, Material};
 use crate::dim::Mat3;
@@ -66,8 +67,8 @@ pub struct Jh2 {
     pub d2: f64,
     pub reference_strain_rate: f64,
     pub rate_form: RateForm,
-    /// Failed points (D = 1) leave the transfers.
-    pub erosion: bool,
+    /// When points leave the transfers (`erosion.rs`).
+    pub erosion: Option<Erosion>,
 }
 
 const PLASTIC_STRAIN: usize = 0;
@@ -205,12 +206,13 @@ impl Material for Jh2 {
         true
     }
 
-    fn failed(&self, history: &[f64]) -> bool {
-        history[DAMAGE] >= 1.0
+    fn erodes(&self) -> bool {
+        self.erosion.is_some()
     }
 
-    fn erodes(&self) -> bool {
+    fn eroded(&self, history: &[f64]) -> bool {
         self.erosion
+            .is_some_and(|e| e.applies(history[DAMAGE], history[PLASTIC_STRAIN]))
     }
 
     fn equivalent_plastic_strain(&self, history: &[f64]) -> Option<f64> {
@@ -240,6 +242,7 @@ impl FromParameters for Jh2 {
         "reference_strain_rate",
         "rate_form",
         "erosion",
+        "erosion_plastic_strain",
     ];
     /// Thesis Table 3.3 (AlN) in mm, ms, g, MPa.
     const EXAMPLE: &'static str = "shear_modulus = 127.0e3\nk1 = 201.0e3\nk2 = 260.0e3\nk3 = 0.0\nintact_coefficient = 0.85\nintact_exponent = 0.29\nfractured_coefficient = 0.31\nfractured_exponent = 0.21\nrate_coefficient = 0.013\ntensile_strength = 320.0\nmax_fractured_strength = 1.0e20\nhel_strength = 6.0e3\nhel_pressure = 5.0e3\nbulking_factor = 1.0\ndamage_d1 = 0.02\ndamage_d2 = 1.85\nreference_strain_rate = 0.001";
@@ -293,7 +296,7 @@ impl FromParameters for Jh2 {
             d2: non_negative("damage_d2", 0.0)?,
             reference_strain_rate,
             rate_form: p.get("rate_form")?.unwrap_or(RateForm::Absolute),
-            erosion: p.get("erosion")?.unwrap_or(false),
+            erosion: Erosion::from_parameters(p)?,
         })
     }
 }
@@ -333,7 +336,7 @@ mod tests {
             d2: 1.85,
             reference_strain_rate: 0.001,
             rate_form: RateForm::Absolute,
-            erosion: false,
+            erosion: None,
         }
     }
 

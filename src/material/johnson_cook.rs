@@ -33,6 +33,7 @@
 //! History: ε̄p, E, then T − T_r if the model is thermal, then D if it has damage.
 
 use super::eos::{self, energy_update, Eos};
+use super::erosion::Erosion;
 use super::parameters::{FromParameters, KeyError, Parameters};
 use super::{Increment, Material};
 use super::deviatoric::{deviator, equivalent_rate, strain_increment, TrialDeviator};
@@ -86,8 +87,8 @@ pub struct JohnsonCook {
     pub thermal: Option<Thermal>,
     /// D1 … D5.
     pub damage: Option<[f64; 5]>,
-    /// Failed points leave the transfers.
-    pub erosion: bool,
+    /// When points leave the transfers (`erosion.rs`).
+    pub erosion: Option<Erosion>,
 }
 
 /// History slots.
@@ -268,12 +269,14 @@ impl Material for JohnsonCook {
         true
     }
 
-    fn failed(&self, history: &[f64]) -> bool {
-        self.damage_slot().is_some_and(|i| history[i] >= 1.0)
+    fn erodes(&self) -> bool {
+        self.erosion.is_some()
     }
 
-    fn erodes(&self) -> bool {
+    fn eroded(&self, history: &[f64]) -> bool {
+        let damage = self.damage_slot().map_or(0.0, |i| history[i]);
         self.erosion
+            .is_some_and(|e| e.applies(damage, history[PLASTIC_STRAIN]))
     }
 
     fn equivalent_plastic_strain(&self, history: &[f64]) -> Option<f64> {
@@ -306,6 +309,7 @@ impl FromParameters for JohnsonCook {
         "damage_d4",
         "damage_d5",
         "erosion",
+        "erosion_plastic_strain",
         "eos",
         "k1",
         "k2",
@@ -395,9 +399,9 @@ impl FromParameters for JohnsonCook {
         } else {
             None
         };
-        let erosion = p.get("erosion")?.unwrap_or(false);
+        let erosion = Erosion::from_parameters(p)?;
         p.ensure(
-            !erosion || damage.is_some(),
+            !erosion.is_some_and(|e| e.at_failure) || damage.is_some(),
             "erosion",
             "needs Johnson–Cook damage (damage_d1, damage_d2, damage_d3): nothing fails without it",
         )?;
@@ -440,7 +444,7 @@ mod tests {
             reference_strain_rate: 1.0,
             thermal: None,
             damage: None,
-            erosion: false,
+            erosion: None,
         }
     }
 

@@ -105,14 +105,14 @@ pub trait Material: CloneMaterial + Send + Sync + std::fmt::Debug {
         None
     }
 
-    /// Whether the point has failed (damage D = 1; `None`-like default: never).
-    fn failed(&self, _history: &[f64]) -> bool {
+    /// Whether the model erodes points at all (`material::erosion`).
+    fn erodes(&self) -> bool {
         false
     }
 
-    /// Whether failed points are eroded: left out of the particle–grid transfers
-    /// (scene key `erosion`).
-    fn erodes(&self) -> bool {
+    /// Whether the point with this history is eroded: left out of the
+    /// particle–grid transfers (`material::erosion`).
+    fn eroded(&self, _history: &[f64]) -> bool {
         false
     }
 

@@ -16,6 +16,7 @@
 pub mod deviatoric;
 pub mod driver;
 pub mod eos;
+pub mod erosion;
 pub mod parameters;
 pub mod registry;
 pub mod return_mapping;

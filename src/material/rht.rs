@@ -40,6 +40,7 @@
 
 use super::deviatoric::{deviator, equivalent, equivalent_rate, strain_increment, TrialDeviator};
 use super::eos::energy_update;
+use super::erosion::Erosion;
 use super::parameters::{FromParameters, KeyError, Parameters};
 use super::{Increment, Material};
 use crate::dim::Mat3;
@@ -176,7 +177,8 @@ pub struct Rht {
     /// SHRATD, the fractured shear modulus fraction.
     pub shear_ratio_damaged: f64,
     pub eos: PAlpha,
-    pub erosion: bool,
+    /// When points leave the transfers (`erosion.rs`).
+    pub erosion: Option<Erosion>,
 }
 
 const PLASTIC_STRAIN: usize = 0;
@@ -440,12 +442,13 @@ impl Material for Rht {
         Some(history[PLASTIC_STRAIN])
     }
 
-    fn failed(&self, history: &[f64]) -> bool {
-        history[DAMAGE] >= 1.0
+    fn erodes(&self) -> bool {
+        self.erosion.is_some()
     }
 
-    fn erodes(&self) -> bool {
+    fn eroded(&self, history: &[f64]) -> bool {
         self.erosion
+            .is_some_and(|e| e.applies(history[DAMAGE], history[PLASTIC_STRAIN]))
     }
 }
 
@@ -486,6 +489,7 @@ impl FromParameters for Rht {
         "t1",
         "t2",
         "erosion",
+        "erosion_plastic_strain",
     ];
     /// Thesis Tables 4.4–4.6 (C48 concrete) in mm, ms, g, MPa.
     const EXAMPLE: &'static str = "youngs_modulus = 35.664e3\npoisson_ratio = 0.2\ncompressive_strength = 48.0\ntensile_ratio = 0.0833\nshear_ratio = 0.18\nfailure_coefficient = 1.6\nfailure_exponent = 0.61\nlode_q20 = 0.6805\nlode_bq = 0.0105\nprefact = 2.0\nelastic_compression_ratio = 0.53\nelastic_tension_ratio = 0.7\nresidual_coefficient = 1.6\nresidual_exponent = 0.61\nrate_alpha = 0.0292\nrate_delta = 0.0331\nreference_strain_rate = 0.001\ndamage_d1 = 0.04\ndamage_d2 = 1.0\nmin_fracture_strain = 0.01\ndamaged_shear_ratio = 0.13\ncrush_pressure = 32.0\nlock_pressure = 6.0e3\ncompaction_exponent = 3.0\ninitial_distension = 1.1270491803278688\na1 = 35.27e3\na2 = 39.58e3\na3 = 9.04e3\nb0 = 1.22\nb1 = 1.22\nt1 = 35.27e3";
@@ -552,7 +556,7 @@ impl FromParameters for Rht {
                 alpha0,
                 matrix,
             },
-            erosion: p.get("erosion")?.unwrap_or(false),
+            erosion: Erosion::from_parameters(p)?,
         };
         p.ensure(
             (0.5..=1.0).contains(&model.q20),

@@ -57,12 +57,12 @@ pub struct Model<const D: usize> {
 }
 
 impl<const D: usize> Model<D> {
-    /// Whether particle q has failed in a material that erodes: it is left out of
+    /// Whether particle q is eroded (`Material::eroded`): it is left out of
     /// the transfers (`physics::transfer::stencils`).
     pub fn eroded(&self, q: usize) -> bool {
         let p = &self.particles;
         let mat = &self.materials[p.material[q] as usize];
-        self.erosion && mat.erodes() && mat.failed(p.history.get(q))
+        self.erosion && mat.eroded(p.history.get(q))
     }
 
     /// Mass and energy (kinetic + stored) of the eroded particles, which keep the
