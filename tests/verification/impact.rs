@@ -79,6 +79,11 @@ fn bulk_viscosity_removes_the_ringing_behind_the_shock() {
 /// particle plus its initial distance to the top face
 /// (papers/taylor_bar/measure.py does the same).
 fn taylor_shape(t: &Table) -> (f64, f64, f64) {
+    taylor_shape_of(t, &|_| true)
+}
+
+/// `taylor_shape` over the particles (rows) that `keep` selects.
+fn taylor_shape_of(t: &Table, keep: &dyn Fn(usize) -> bool) -> (f64, f64, f64) {
     let (l0, radius) = (25.4, 3.8);
     let mm = |v: f64| v * 1e3;
     let three_d = t.column("z").is_ok();
@@ -88,13 +93,17 @@ fn taylor_shape(t: &Table) -> (f64, f64, f64) {
         true => (t.col("Y0"), t.col("y"), t.col("Z0"), t.col("z")),
         false => (&zeros[..], &zeros[..], t.col("Y0"), t.col("y")),
     };
-    let n = z.len();
-    let bottom = z0.iter().cloned().fold(f64::INFINITY, f64::min);
+    let rows: Vec<usize> = (0..z.len()).filter(|&i| keep(i)).collect();
+    let bottom = rows.iter().map(|&i| z0[i]).fold(f64::INFINITY, f64::min);
     let spacing = 2.0 * mm(bottom);
-    let top = (0..n).max_by(|&a, &b| z[a].total_cmp(&z[b])).unwrap();
+    let top = *rows
+        .iter()
+        .max_by(|&&a, &&b| z[a].total_cmp(&z[b]))
+        .unwrap();
     let length = mm(z[top]) + l0 - mm(z0[top]);
     let diameter = |select: &dyn Fn(usize) -> bool| {
-        (0..n)
+        rows.iter()
+            .copied()
             .filter(|&i| select(i))
             .filter_map(|i| {
                 let r0 = mm(x0[i].hypot(y0[i]));
@@ -363,4 +372,40 @@ fn a_scene_without_erosion_has_no_erosion_columns() {
         "{}",
         &text[..80]
     );
+}
+
+#[test]
+fn taylor_bar_on_a_rigid_anvil_through_contact_matches_the_grid_face_anvil() {
+    // The anvil as a rigid body below the bar, met through frictionless contact
+    // (issue 14's explicit contact), against the grid face z = 0 as the anvil.
+    let path = crate::common::problem("taylor_bar.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let text = text
+        .replace(
+            "min = [0.0, 0.0, 0.0]\nmax = [8.36e-3, 8.36e-3, 26.6e-3]\ncells = [22, 22, 70]",
+            "min = [0.0, 0.0, -1.52e-3]\nmax = [8.36e-3, 8.36e-3, 26.6e-3]\ncells = [11, 11, 37]",
+        )
+        .replace(
+            "[[body]]\nname = \"bar\"",
+            "[[material]]\nname = \"anvil\"\nmodel = \"rigid\"\ndensity = 7850.0\n\n\
+             [[body]]\nname = \"anvil\"\nmaterial = \"anvil\"\nshape = \"box\"\n\
+             min = [0.0, 0.0, -1.52e-3]\nmax = [8.36e-3, 8.36e-3, 0.0]\n\n\
+             [[contact]]\nfriction_coefficient = 0.0\n\n[[body]]\nname = \"bar\"",
+        );
+    assert!(text.contains("[[contact]]") && text.contains("cells = [11, 11, 37]"));
+    let (result, dir) = crate::common::run_text(&text, &[]);
+    result.expect("the bar on the rigid anvil runs");
+    let t = Table::read(&dir.path().join("particles_final.csv")).unwrap();
+    // The bar's particles (body 1).
+    let body = t.col("body");
+    let contact = taylor_shape_of(&t, &|q| body[q] == 1.0);
+    let (r_face, d_face) = run_problem("taylor_bar.toml", COARSE);
+    r_face.expect("runs");
+    let face = taylor_shape(&Table::read(&d_face.path().join("particles_final.csv")).unwrap());
+    println!("contact anvil {contact:.2?}, grid-face anvil {face:.2?}");
+    assert!((contact.0 / face.0 - 1.0).abs() < 0.02, "L");
+    assert!((contact.1 / face.1 - 1.0).abs() < 0.03, "D");
+    assert!((contact.2 / face.2 - 1.0).abs() < 0.03, "W");
+    let (_, mean) = taylor_errors(contact);
+    assert!(mean <= 0.03, "mean error against the test {mean}");
 }
