@@ -140,13 +140,6 @@ fn unsupported_combinations_are_refused_at_their_key() {
         ),
         &["scene.toml:25:17", "key `boundary.0.footing_width`", "not implemented in axisymmetric mode"],
     );
-    rejected(
-        &a.replace("[solver]", "[[contact]]\n\n[solver]"),
-        &[
-            "key `contact`",
-            "contact between bodies is not implemented in axisymmetric mode",
-        ],
-    );
     // A grid away from the axis (a hollow cylinder) may carry any xmin condition
     // the plane-strain scene may.
     Scene::parse(

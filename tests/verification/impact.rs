@@ -409,3 +409,37 @@ fn taylor_bar_on_a_rigid_anvil_through_contact_matches_the_grid_face_anvil() {
     let (_, mean) = taylor_errors(contact);
     assert!(mean <= 0.03, "mean error against the test {mean}");
 }
+
+#[test]
+fn axisymmetric_contact_with_a_rigid_anvil_matches_the_grid_face_anvil() {
+    // The axisymmetric bar (h = 0.38 mm) on a rigid anvil met through
+    // frictionless contact, against the grid face z = 0 as the anvil: contact
+    // works on the per-radian masses and volume gradients unchanged.
+    let path = crate::common::problem("taylor_bar_axisymmetric.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let text = text
+        .replace(
+            "min = [0.0, 0.0]\nmax = [8.36e-3, 26.6e-3]\ncells = [22, 70]",
+            "min = [0.0, -0.76e-3]\nmax = [8.36e-3, 26.6e-3]\ncells = [22, 72]",
+        )
+        .replace(
+            "[[body]]\nname = \"bar\"",
+            "[[material]]\nname = \"anvil\"\nmodel = \"rigid\"\ndensity = 7850.0\n\n\
+             [[body]]\nname = \"anvil\"\nmaterial = \"anvil\"\nshape = \"rectangle\"\n\
+             min = [0.0, -0.76e-3]\nmax = [8.36e-3, 0.0]\n\n\
+             [[contact]]\nfriction_coefficient = 0.0\n\n[[body]]\nname = \"bar\"",
+        );
+    assert!(text.contains("[[contact]]") && text.contains("cells = [22, 72]"));
+    let (result, dir) = crate::common::run_text(&text, &[]);
+    result.expect("the axisymmetric bar on the rigid anvil runs");
+    let t = Table::read(&dir.path().join("particles_final.csv")).unwrap();
+    let body = t.col("body");
+    let contact = taylor_shape_of(&t, &|q| body[q] == 1.0);
+    let (r_face, d_face) = run_problem("taylor_bar_axisymmetric.toml", &[]);
+    r_face.expect("runs");
+    let face = taylor_shape(&Table::read(&d_face.path().join("particles_final.csv")).unwrap());
+    println!("axisymmetric: contact anvil {contact:.2?}, grid-face anvil {face:.2?}");
+    assert!((contact.0 / face.0 - 1.0).abs() < 0.02, "L");
+    assert!((contact.1 / face.1 - 1.0).abs() < 0.03, "D");
+    assert!((contact.2 / face.2 - 1.0).abs() < 0.03, "W");
+}

@@ -31,11 +31,6 @@ pub fn axisymmetry(s: &SceneConfig) -> Check {
          parallelograms whose hoop integral is not implemented): use linear, ugimp, \
          cpgimp, bspline2, cpbspline2 or bspline3",
     )?;
-    ensure(
-        s.contacts.is_empty(),
-        "contact",
-        "contact between bodies is not implemented in axisymmetric mode",
-    )?;
     let axis = s.grid.min[0] == 0.0;
     for (i, b) in s.boundaries.iter().enumerate() {
         let key = |k: &str| format!("boundary.{i}.{k}");
