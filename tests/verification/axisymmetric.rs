@@ -692,8 +692,8 @@ fn k0_state_of_a_soil_cylinder_is_in_equilibrium() {
     // Gravity switched on from zero stress settles the top by ρ g H² / (2M).
     let settlement = 2.0 * 10.0 * 16.0 / (2.0 * 1.0e4 * 0.75 / (1.25 * 0.5));
     let mut worst: f64 = 0.0;
-    for i in 0..x.len() {
-        let sv = -20.0 * (4.0 - y0[i]);
+    for (i, y0) in y0.iter().enumerate() {
+        let sv = -20.0 * (4.0 - y0);
         for (s, exact) in [("syy", sv), ("sxx", sv / 3.0), ("szz", sv / 3.0)] {
             worst = worst.max((p.col(s)[i] - exact).abs() / 80.0);
         }
