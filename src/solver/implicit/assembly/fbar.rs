@@ -151,14 +151,14 @@ pub fn add_fbar_stiffness<const D: usize>(
                     let hoop = st.hoop.get(e).copied().unwrap_or(0.0);
                     let av = Vector::<D>::from_fn(|i, _| {
                         let mut s: f64 = (0..D).map(|j| grad[j] * m[q][(i, j)]).sum();
-                        if i == 0 {
+                        if axisymmetric && i == 0 {
                             s += hoop * m[q][(2, 2)];
                         }
                         s * coef_a
                     });
                     let hv = Vector::<D>::from_fn(|k, _| {
                         let mut s: f64 = (0..D).map(|l| inv_t[q][(k, l)] * grad[l]).sum();
-                        if k == 0 {
+                        if axisymmetric && k == 0 {
                             s += inv_t[q][(2, 2)] * hoop;
                         }
                         s * coef_h
