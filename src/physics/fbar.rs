@@ -13,7 +13,7 @@
 //! with V_q the step-start volumes and n = D (plane strain: the in-plane block is
 //! scaled, ΔF_zz = 1 stays, so det ΔF̄_p = ΔJ̄_c), or n = 3 in axisymmetric mode
 //! (ΔF_θθ, the hoop stretch, is scaled with the r–z block; the volumes are per
-//! radian, so the average is over the cell's ring; explicit solver only). The particle then follows ΔF̄
+//! radian, so the average is over the cell's ring). The particle then follows ΔF̄
 //! throughout: stress σ(ΔF̄), F ← ΔF̄ F, V = det F V₀, and the implicit internal
 //! force uses the relative first Piola-Kirchhoff stress P̄ = det ΔF̄ σ ΔF̄⁻ᵀ. Cells
 //! are those of the particles' step-start positions.

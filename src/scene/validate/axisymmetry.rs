@@ -3,7 +3,7 @@
 //! form yet, refused at their key.
 
 use super::check::{ensure, Check};
-use crate::scene::{Condition, Face, SceneConfig, ShapeFunction, SolverKind};
+use crate::scene::{Condition, Face, SceneConfig, ShapeFunction};
 
 /// The checks of an axisymmetric scene (its grid, bodies and conditions
 /// validated as 2D ones).
@@ -60,19 +60,6 @@ pub fn axisymmetry(s: &SceneConfig) -> Check {
                  with x component 0 may act there",
             )?;
         }
-    }
-    for (k, st) in s.stages().into_iter().enumerate() {
-        let prefix = if s.solver.is_some() {
-            "solver".to_string()
-        } else {
-            format!("stage.{k}")
-        };
-        ensure(
-            !st.fbar() || st.kind == SolverKind::Explicit,
-            format!("{prefix}.fbar"),
-            "F-bar is implemented for the explicit solver only in axisymmetric mode \
-             (the implicit F-bar tangent has no hoop terms yet)",
-        )?;
     }
     Ok(())
 }

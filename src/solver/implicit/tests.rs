@@ -201,6 +201,48 @@ fn axisymmetric_tangent_matches_finite_differences_of_the_residual() {
     }
 }
 
+/// The axisymmetric F-bar tangent (n = 3, the hoop stretch in ΔJ and in the
+/// scaled ΔF̄) against central differences of the residual, elastic and plastic.
+#[test]
+fn axisymmetric_fbar_tangent_matches_finite_differences_of_the_residual() {
+    let text = BLOCK.replace("dimension = 2", "dimension = \"axisymmetric\"");
+    for (name, shape, support, extra) in [
+        ("hencky", "linear", 0.0, vec![]),
+        ("hencky", "bspline2", 0.01, vec![]),
+        (
+            "mohr_coulomb ψ=0",
+            "ugimp",
+            0.3,
+            vec![
+                "material.0.model=mohr_coulomb".to_string(),
+                "material.0.cohesion=200.0".to_string(),
+                "material.0.friction_angle=20.0".to_string(),
+                "material.0.dilation_angle=0.0".to_string(),
+            ],
+        ),
+    ] {
+        let mut overrides = extra;
+        overrides.extend([
+            format!("grid.shape_function={shape}"),
+            format!("solver.min_node_support={support}"),
+            "solver.fbar=true".to_string(),
+            "body.0.particles_per_cell=2".to_string(),
+        ]);
+        let (error, n, tied, plastic) = tangent_error_of::<2>(&text, &overrides, false);
+        println!(
+            "axisymmetric F-bar {name} {shape}: {n} unknowns, {tied} tied nodes, {plastic} \
+             plastic particles, max |K − K_fd| / max|K| = {error:.2e}"
+        );
+        if name.starts_with("mohr") {
+            assert!(plastic > 0, "{name}: no plastic particle");
+        }
+        assert!(
+            error < 1e-6,
+            "axisymmetric F-bar {name} {shape}: {error:.2e}"
+        );
+    }
+}
+
 /// The F-bar tangent (`assembly::fbar::fbar_triplets`: each particle couples to the
 /// nodes of every particle in its cell) against central differences of the
 /// F-bar residual, with linear and smooth shape functions, through ties, and

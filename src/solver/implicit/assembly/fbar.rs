@@ -1,6 +1,7 @@
 //! The tangent of the F-bar internal force (Coombs et al. 2018, `physics::fbar`):
 //! each particle follows ΔF̄_p = (ΔJ̄_c / ΔJ_p)^{1/n} ΔF_p, so it couples to the
-//! nodes of every particle in its cell.
+//! nodes of every particle in its cell. Axisymmetric: n = 3 and the hoop
+//! components join every contraction (`assembly::stiffness`).
 
 use super::pattern::slot;
 use super::stiffness::{add_stiffness, indices, ParticleTangents};
@@ -37,37 +38,61 @@ pub fn add_fbar_stiffness<const D: usize>(
     a: &ParticleTangents<D>,
 ) {
     let at = ParticleTangents::<D>::at;
-    let n = D as f64;
+    // Axisymmetric: ΔF_θθ is scaled too (n = 3) and every sum over the gradient's
+    // components gains the hoop component (θθ, with the hoop gradient h_J =
+    // S_J/R on the radial displacement: ∂ΔF_θθ/∂u_Jk = δ_k0 h_J).
+    let axisymmetric = !st.hoop.is_empty();
+    let n = if axisymmetric { 3.0 } else { D as f64 };
     let cells = &state.cells;
     let dj = &state.dj;
     let beta: Vec<f64> = (0..volume.len())
-        .map(|q| scale_factor::<D>(state.dj_bar[cells.of[q] as usize], dj[q]))
+        .map(|q| {
+            let (dj_bar, dj) = (state.dj_bar[cells.of[q] as usize], dj[q]);
+            if axisymmetric {
+                scale_factor::<3>(dj_bar, dj)
+            } else {
+                scale_factor::<D>(dj_bar, dj)
+            }
+        })
         .collect();
     let inv_t: Vec<Mat3> = state
         .df
         .iter()
         .map(|f| f.try_inverse().unwrap_or_else(Mat3::zeros).transpose())
         .collect();
-    // M_p,ij = Σ_{a,b<D} A_p,ijab ΔF_p,ab.
+    // M_p,ij = Σ_{a,b<D} A_p,ijab ΔF_p,ab (+ A_p,ijθθ ΔF_p,θθ axisymmetric), for
+    // i, j < D and (axisymmetric) ij = θθ.
+    let hoop_len = ParticleTangents::<D>::HOOP_LEN;
     let m: Vec<Mat3> = (0..volume.len())
         .into_par_iter()
         .with_min_len(MIN_PARALLEL_LEN)
         .map(|q| {
+            let (aq, hq, df) = (a.of(q), a.hoop_of(q), &state.df[q]);
             Mat3::from_fn(|i, j| {
                 let mut s = 0.0;
-                if i >= D || j >= D {
-                    return s; // A has no such components in D dimensions.
-                }
-                for a2 in 0..D {
-                    for b in 0..D {
-                        s += a.of(q)[at(i, j, a2, b)] * state.df[q][(a2, b)];
+                if i < D && j < D {
+                    for a2 in 0..D {
+                        for b in 0..D {
+                            s += aq[at(i, j, a2, b)] * df[(a2, b)];
+                        }
                     }
+                    if axisymmetric {
+                        s += hq[D * D + i * D + j] * df[(2, 2)];
+                    }
+                } else if axisymmetric && i == 2 && j == 2 {
+                    for a2 in 0..D {
+                        for b in 0..D {
+                            s += hq[a2 * D + b] * df[(a2, b)];
+                        }
+                    }
+                    s += hq[2 * D * D] * df[(2, 2)];
                 }
+                // Otherwise A has no such components in D dimensions.
                 s
             })
         })
         .collect();
-    let mut a_tilde = ParticleTangents::<D>::zeros(volume.len(), false);
+    let mut a_tilde = ParticleTangents::<D>::zeros(volume.len(), axisymmetric);
     a_tilde
         .values
         .par_chunks_mut(ParticleTangents::<D>::LEN)
@@ -79,6 +104,25 @@ pub fn add_fbar_stiffness<const D: usize>(
                 out[n_ijkl] = beta[q] * (a.of(q)[n_ijkl] - local);
             }
         });
+    if axisymmetric {
+        // Ã_θθkl, Ã_ijθθ, Ã_θθθθ by the same rule.
+        a_tilde
+            .hoop
+            .par_chunks_mut(hoop_len)
+            .enumerate()
+            .with_min_len(MIN_PARALLEL_LEN)
+            .for_each(|(q, out)| {
+                let (hq, g) = (a.hoop_of(q), &inv_t[q]);
+                for k in 0..D {
+                    for l in 0..D {
+                        out[k * D + l] = beta[q] * (hq[k * D + l] - m[q][(2, 2)] * g[(k, l)] / n);
+                        out[D * D + k * D + l] =
+                            beta[q] * (hq[D * D + k * D + l] - m[q][(k, l)] * g[(2, 2)] / n);
+                    }
+                }
+                out[2 * D * D] = beta[q] * (hq[2 * D * D] - m[q][(2, 2)] * g[(2, 2)] / n);
+            });
+    }
     add_stiffness(k, pattern, map, st, dofs, volume, &a_tilde);
 
     // Adds v at `node` of a short list of (node, vector) pairs.
@@ -104,11 +148,20 @@ pub fn add_fbar_stiffness<const D: usize>(
                 let coef_h = volume[q] / v_cell * dj[q];
                 for e in st.range(q) {
                     let grad = &st.grad[e];
+                    let hoop = st.hoop.get(e).copied().unwrap_or(0.0);
                     let av = Vector::<D>::from_fn(|i, _| {
-                        (0..D).map(|j| grad[j] * m[q][(i, j)]).sum::<f64>() * coef_a
+                        let mut s: f64 = (0..D).map(|j| grad[j] * m[q][(i, j)]).sum();
+                        if axisymmetric && i == 0 {
+                            s += hoop * m[q][(2, 2)];
+                        }
+                        s * coef_a
                     });
                     let hv = Vector::<D>::from_fn(|k, _| {
-                        (0..D).map(|l| inv_t[q][(k, l)] * grad[l]).sum::<f64>() * coef_h
+                        let mut s: f64 = (0..D).map(|l| inv_t[q][(k, l)] * grad[l]).sum();
+                        if axisymmetric && k == 0 {
+                            s += inv_t[q][(2, 2)] * hoop;
+                        }
+                        s * coef_h
                     });
                     add(&mut a_c, map.local_of(st, e), av);
                     add(&mut h_c, map.local_of(st, e), hv);
