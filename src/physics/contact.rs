@@ -208,14 +208,22 @@ impl<const D: usize> Contact<D> {
         let first_split = map.len() - self.split.len();
         let p = &m.particles;
         let owner = st.owner();
-        // Volume gradient of each split node, Σ_p V_p ∇S_Ip.
+        // Volume gradient of each split node, Σ_p V_p ∇S_Ip. In axisymmetric mode
+        // the r–z area A_p = V_p/r_p weighs it: Σ_p r_p A_p ∇S_Ip would be the
+        // gradient of r × the body's indicator, tilted towards the axis by about
+        // h/r at a flat face.
+        let axisymmetric = m.axisymmetric;
+        let weight = |q: usize| match axisymmetric {
+            true => p.volume[q] / p.x[q][0],
+            false => p.volume[q],
+        };
         let gradient: Vec<Vector<D>> = (first_split..map.len())
             .into_par_iter()
             .map(|a| {
                 map.node_entries(a)
                     .iter()
                     .fold(Vector::<D>::zeros(), |acc, &e| {
-                        acc + st.grad[e as usize] * p.volume[owner.of(e)]
+                        acc + st.grad[e as usize] * weight(owner.of(e))
                     })
             })
             .collect();
@@ -269,13 +277,15 @@ impl<const D: usize> Contact<D> {
                     }
                     let (r, s) = (first_split + i, first_split + j);
                     let gap = -extent(r, &x_node, &normal) - extent(s, &x_node, &-normal);
+                    // The contact area (adhesion), per radian in axisymmetric mode.
+                    let ring = if axisymmetric { x_node[0] } else { 1.0 };
                     self.meetings.push(Meeting {
                         r,
                         s,
                         pair: self.pair_index[fr * f + fs],
                         normal,
                         rigid: [self.plan.rigid[fr], self.plan.rigid[fs]],
-                        area: 0.5 * (gr.norm() + gs.norm()),
+                        area: 0.5 * (gr.norm() + gs.norm()) * ring,
                         close: gap <= law.gap_factor * h,
                         law,
                     });
