@@ -7,8 +7,8 @@ set -e
 cd "$(dirname "$0")/../.."
 cargo build --release --quiet
 out=${OUT:-out/penetration_hanchak}
-cells="[78,215]"
-[ -n "$H2" ] && cells="$cells [155,430]"
+cells="[83,215]"
+[ -n "$H2" ] && cells="$cells [166,430]"
 for scene in hanchak hanchak_rht; do
   for c in $cells; do
     dir="$out/$scene-$(echo "$c" | tr -d '[],')"
