@@ -75,21 +75,7 @@ impl Eos {
             }
             "polynomial" => {
                 only_for(&["k1", "k2", "k3"], "polynomial")?;
-                let what = "eos = \"polynomial\"";
-                let k1: f64 = p.required_for("k1", what)?;
-                p.ensure(k1 > 0.0 && k1.is_finite(), "k1", "must be a positive number")?;
-                let k2: f64 = p.get("k2")?.unwrap_or(0.0);
-                let k3: f64 = p.get("k3")?.unwrap_or(0.0);
-                let eos = Eos::Polynomial { k1, k2, k3 };
-                // The compression branch must stiffen or soften without turning back
-                // over the range a run reaches (μ ≤ 1).
-                let monotone = (0..=100).all(|i| eos.tangent(i as f64 / 100.0) > 0.0);
-                p.ensure(
-                    monotone,
-                    "k2",
-                    "with these k1, k2, k3 the pressure falls with compression for some μ in [0, 1]",
-                )?;
-                Ok(eos)
+                Eos::polynomial(p)
             }
             "mie_gruneisen" => {
                 only_for(
@@ -127,6 +113,22 @@ impl Eos {
                 ),
             )),
         }
+    }
+
+    /// The polynomial EOS of keys k1 (required, > 0), k2, k3 (default 0), whose
+    /// compression branch must rise over the range a run reaches (μ ≤ 1).
+    pub fn polynomial(p: &Parameters) -> Result<Eos, KeyError> {
+        let k1 = p.positive("k1")?;
+        let k2: f64 = p.get("k2")?.unwrap_or(0.0);
+        let k3: f64 = p.get("k3")?.unwrap_or(0.0);
+        let eos = Eos::Polynomial { k1, k2, k3 };
+        let monotone = (0..=100).all(|i| eos.tangent(i as f64 / 100.0) > 0.0);
+        p.ensure(
+            monotone,
+            "k2",
+            "with these k1, k2, k3 the pressure falls with compression for some μ in [0, 1]",
+        )?;
+        Ok(eos)
     }
 
     /// (a, b) with p(μ, E) = a + b E.

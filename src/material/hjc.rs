@@ -61,12 +61,7 @@ const PLASTIC_VOLUME: usize = 3;
 impl Hjc {
     /// F of the strain rate.
     pub fn rate_factor(&self, rate: f64) -> f64 {
-        let r = rate / self.reference_strain_rate;
-        match self.rate_form {
-            RateForm::Absolute => (1.0 + self.c * r.max(1e-6).ln()).abs(),
-            RateForm::Clamped if r > 1.0 => 1.0 + self.c * r.ln(),
-            RateForm::Clamped => 1.0,
-        }
+        self.rate_form.factor(self.c, rate / self.reference_strain_rate)
     }
 
     /// σ_y at pressure p, damage D and rate factor F (4-11).
@@ -203,16 +198,7 @@ impl FromParameters for Hjc {
     const EXAMPLE: &'static str = "shear_modulus = 14.86e3\nintact_coefficient = 0.79\npressure_coefficient = 1.6\npressure_exponent = 0.61\nrate_coefficient = 0.007\ncompressive_strength = 48.0\ntensile_strength = 4.0\nmax_strength = 7.0\ndamage_d1 = 0.04\ndamage_d2 = 1.0\nmin_fracture_strain = 0.01\ncrush_pressure = 16.0\ncrush_strain = 0.001\nlock_pressure = 800.0\nlock_strain = 0.1\nk1 = 85.0e3\nk2 = -171.0e3\nk3 = 208.0e3\nreference_strain_rate = 0.001";
 
     fn from_parameters(density: f64, p: &Parameters) -> Result<Self, KeyError> {
-        let positive = |k: &str| -> Result<f64, KeyError> {
-            let v: f64 = p.required(k)?;
-            p.ensure(v > 0.0 && v.is_finite(), k, format!("must be a positive number; got {v}"))?;
-            Ok(v)
-        };
-        let non_negative = |k: &str, default: f64| -> Result<f64, KeyError> {
-            let v: f64 = p.get(k)?.unwrap_or(default);
-            p.ensure(v >= 0.0 && v.is_finite(), k, format!("must be a number ≥ 0; got {v}"))?;
-            Ok(v)
-        };
+        let (positive, non_negative) = (|k| p.positive(k), |k, d| p.non_negative(k, d));
         let crush = (positive("crush_pressure")?, positive("crush_strain")?);
         let lock = (positive("lock_pressure")?, non_negative("lock_strain", 0.0)?);
         p.ensure(
@@ -229,12 +215,7 @@ impl FromParameters for Hjc {
                     .to_string(),
             )
         })?;
-        let reference_strain_rate = non_negative("reference_strain_rate", 1.0)?;
-        p.ensure(
-            reference_strain_rate > 0.0,
-            "reference_strain_rate",
-            "must be positive (ε̇₀ in the scene's time unit)",
-        )?;
+        let reference_strain_rate = p.positive_or("reference_strain_rate", 1.0)?;
         Ok(Hjc {
             density,
             shear_modulus: positive("shear_modulus")?,

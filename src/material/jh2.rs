@@ -42,6 +42,17 @@ pub enum RateForm {
     Clamped,
 }
 
+impl RateForm {
+    /// F = 1 + C ln ε̇* in this form, at ε̇* = `ratio`.
+    pub fn factor(self, c: f64, ratio: f64) -> f64 {
+        match self {
+            RateForm::Absolute => (1.0 + c * ratio.max(1e-6).ln()).abs(),
+            RateForm::Clamped if ratio > 1.0 => 1.0 + c * ratio.ln(),
+            RateForm::Clamped => 1.0,
+        }
+    }
+}
+
 #[derive(Clone, Debug)]
 pub struct Jh2 {
     pub density: f64,
@@ -78,12 +89,7 @@ const BULKING: usize = 2;
 impl Jh2 {
     /// F of the strain rate.
     pub fn rate_factor(&self, rate: f64) -> f64 {
-        let r = rate / self.reference_strain_rate;
-        match self.rate_form {
-            RateForm::Absolute => (1.0 + self.c * r.max(1e-6).ln()).abs(),
-            RateForm::Clamped if r > 1.0 => 1.0 + self.c * r.ln(),
-            RateForm::Clamped => 1.0,
-        }
+        self.rate_form.factor(self.c, rate / self.reference_strain_rate)
     }
 
     /// Intact and fractured strengths σ_i, σ_f at pressure p and rate factor F.
@@ -248,33 +254,11 @@ impl FromParameters for Jh2 {
     const EXAMPLE: &'static str = "shear_modulus = 127.0e3\nk1 = 201.0e3\nk2 = 260.0e3\nk3 = 0.0\nintact_coefficient = 0.85\nintact_exponent = 0.29\nfractured_coefficient = 0.31\nfractured_exponent = 0.21\nrate_coefficient = 0.013\ntensile_strength = 320.0\nmax_fractured_strength = 1.0e20\nhel_strength = 6.0e3\nhel_pressure = 5.0e3\nbulking_factor = 1.0\ndamage_d1 = 0.02\ndamage_d2 = 1.85\nreference_strain_rate = 0.001";
 
     fn from_parameters(density: f64, p: &Parameters) -> Result<Self, KeyError> {
-        let positive = |k: &str| -> Result<f64, KeyError> {
-            let v: f64 = p.required(k)?;
-            p.ensure(v > 0.0 && v.is_finite(), k, format!("must be a positive number; got {v}"))?;
-            Ok(v)
-        };
-        let non_negative = |k: &str, default: f64| -> Result<f64, KeyError> {
-            let v: f64 = p.get(k)?.unwrap_or(default);
-            p.ensure(v >= 0.0 && v.is_finite(), k, format!("must be a number ≥ 0; got {v}"))?;
-            Ok(v)
-        };
+        let (positive, non_negative) = (|k| p.positive(k), |k, d| p.non_negative(k, d));
         let shear_modulus = positive("shear_modulus")?;
+        let eos = Eos::polynomial(p)?;
         let k1 = positive("k1")?;
-        let k2: f64 = p.get("k2")?.unwrap_or(0.0);
-        let k3: f64 = p.get("k3")?.unwrap_or(0.0);
-        let eos = Eos::Polynomial { k1, k2, k3 };
-        let monotone = (0..=100).all(|i| eos.tangent(i as f64 / 100.0) > 0.0);
-        p.ensure(
-            monotone,
-            "k2",
-            "with these k1, k2, k3 the pressure falls with compression for some μ in [0, 1]",
-        )?;
-        let reference_strain_rate = non_negative("reference_strain_rate", 1.0)?;
-        p.ensure(
-            reference_strain_rate > 0.0,
-            "reference_strain_rate",
-            "must be positive (ε̇₀ in the scene's time unit)",
-        )?;
+        let reference_strain_rate = p.positive_or("reference_strain_rate", 1.0)?;
         let bulking = non_negative("bulking_factor", 0.0)?;
         p.ensure(bulking <= 1.0, "bulking_factor", "must lie in [0, 1]")?;
         Ok(Jh2 {

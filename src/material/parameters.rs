@@ -121,6 +121,39 @@ impl<'a> Parameters<'a> {
         }
     }
 
+    /// Key k, required, a positive number.
+    pub fn positive(&self, k: &str) -> Result<f64, KeyError> {
+        let v: f64 = self.required(k)?;
+        self.ensure(
+            v > 0.0 && v.is_finite(),
+            k,
+            format!("must be a positive number; got {v}"),
+        )?;
+        Ok(v)
+    }
+
+    /// Key k, a positive number, `default` when not given.
+    pub fn positive_or(&self, k: &str, default: f64) -> Result<f64, KeyError> {
+        let v: f64 = self.get(k)?.unwrap_or(default);
+        self.ensure(
+            v > 0.0 && v.is_finite(),
+            k,
+            format!("must be a positive number; got {v}"),
+        )?;
+        Ok(v)
+    }
+
+    /// Key k, a number ≥ 0, `default` when not given.
+    pub fn non_negative(&self, k: &str, default: f64) -> Result<f64, KeyError> {
+        let v: f64 = self.get(k)?.unwrap_or(default);
+        self.ensure(
+            v >= 0.0 && v.is_finite(),
+            k,
+            format!("must be a number ≥ 0; got {v}"),
+        )?;
+        Ok(v)
+    }
+
     /// Young's modulus E > 0.
     pub fn youngs_modulus(&self) -> Result<f64, KeyError> {
         let e: f64 = self.required("youngs_modulus")?;

@@ -495,23 +495,14 @@ impl FromParameters for Rht {
     const EXAMPLE: &'static str = "youngs_modulus = 35.664e3\npoisson_ratio = 0.2\ncompressive_strength = 48.0\ntensile_ratio = 0.0833\nshear_ratio = 0.18\nfailure_coefficient = 1.6\nfailure_exponent = 0.61\nlode_q20 = 0.6805\nlode_bq = 0.0105\nprefact = 2.0\nelastic_compression_ratio = 0.53\nelastic_tension_ratio = 0.7\nresidual_coefficient = 1.6\nresidual_exponent = 0.61\nrate_alpha = 0.0292\nrate_delta = 0.0331\nreference_strain_rate = 0.001\ndamage_d1 = 0.04\ndamage_d2 = 1.0\nmin_fracture_strain = 0.01\ndamaged_shear_ratio = 0.13\ncrush_pressure = 32.0\nlock_pressure = 6.0e3\ncompaction_exponent = 3.0\ninitial_distension = 1.1270491803278688\na1 = 35.27e3\na2 = 39.58e3\na3 = 9.04e3\nb0 = 1.22\nb1 = 1.22\nt1 = 35.27e3";
 
     fn from_parameters(density: f64, p: &Parameters) -> Result<Self, KeyError> {
-        let positive = |k: &str| -> Result<f64, KeyError> {
-            let v: f64 = p.required(k)?;
-            p.ensure(v > 0.0 && v.is_finite(), k, format!("must be a positive number; got {v}"))?;
-            Ok(v)
-        };
-        let non_negative = |k: &str, default: f64| -> Result<f64, KeyError> {
-            let v: f64 = p.get(k)?.unwrap_or(default);
-            p.ensure(v >= 0.0 && v.is_finite(), k, format!("must be a number ≥ 0; got {v}"))?;
-            Ok(v)
-        };
+        let (positive, non_negative) = (|k| p.positive(k), |k, d| p.non_negative(k, d));
         let e = p.youngs_modulus()?;
         let nu = p.poisson_ratio()?;
         let (_, g) = super::lame(e, nu);
         let crush = positive("crush_pressure")?;
         let lock = positive("lock_pressure")?;
         p.ensure(lock > crush, "lock_pressure", format!("must exceed crush_pressure = {crush}"))?;
-        let alpha0 = positive_or("initial_distension", 1.0, p)?;
+        let alpha0 = p.positive_or("initial_distension", 1.0)?;
         p.ensure(
             alpha0 >= 1.0,
             "initial_distension",
@@ -544,7 +535,7 @@ impl FromParameters for Rht {
             max_residual: non_negative("max_residual_strength", 1e20)?,
             rate_alpha: non_negative("rate_alpha", 0.0)?,
             rate_delta: non_negative("rate_delta", 0.0)?,
-            reference_strain_rate: positive_or("reference_strain_rate", 1.0, p)?,
+            reference_strain_rate: p.positive_or("reference_strain_rate", 1.0)?,
             d1: positive("damage_d1")?,
             d2: non_negative("damage_d2", 1.0)?,
             min_fracture_strain: non_negative("min_fracture_strain", 0.01)?,
@@ -552,7 +543,7 @@ impl FromParameters for Rht {
             eos: PAlpha {
                 crush_pressure: crush,
                 lock_pressure: lock,
-                exponent: positive_or("compaction_exponent", 3.0, p)?,
+                exponent: p.positive_or("compaction_exponent", 3.0)?,
                 alpha0,
                 matrix,
             },
@@ -579,13 +570,6 @@ impl FromParameters for Rht {
         )?;
         Ok(model)
     }
-}
-
-/// A positive key with a default.
-fn positive_or(k: &str, default: f64, p: &Parameters) -> Result<f64, KeyError> {
-    let v: f64 = p.get(k)?.unwrap_or(default);
-    p.ensure(v > 0.0 && v.is_finite(), k, format!("must be a positive number; got {v}"))?;
-    Ok(v)
 }
 
 #[cfg(test)]
