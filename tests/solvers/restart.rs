@@ -395,3 +395,19 @@ fn contact_restart_is_byte_identical() {
         1,
     );
 }
+
+#[test]
+fn impact_restart_is_byte_identical() {
+    // Bulk viscosity (q from the step-start grid velocity: no state of its own),
+    // Johnson-Cook with damage and erosion (history.csv's eroded columns).
+    restarts_are_exact(
+        "erosion_rod.toml",
+        &[
+            "solver.end_time=1.2e-5",
+            "output.history_interval=0.7e-6",
+            "output.frames=3",
+        ],
+        5.0e-6,
+        1,
+    );
+}
