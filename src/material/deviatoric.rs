@@ -56,6 +56,22 @@ impl TrialDeviator {
     }
 }
 
+/// The trial state of the models whose strength is a Cauchy stress (JH-2, HJC,
+/// RHT): the trial deviator from the step-start Kirchhoff deviator `tau_dev_old`
+/// at shear modulus G, its principal Cauchy values 2G ē_a / J at the end
+/// Jacobian J, and their equivalent stress q = √(3/2)|s|.
+pub fn cauchy_trial(
+    tau_dev_old: &Mat3,
+    shear_modulus: f64,
+    df: &Mat3,
+    j: f64,
+) -> (TrialDeviator, Vector3<f64>, f64) {
+    let trial = TrialDeviator::of(tau_dev_old, shear_modulus, df);
+    let s = trial.strain * (2.0 * shear_modulus / j);
+    let q = (1.5 * s.norm_squared()).sqrt();
+    (trial, s, q)
+}
+
 /// The deviatoric strain increment dev sym(ΔF − I) of an increment.
 pub fn strain_increment(df: &Mat3) -> Mat3 {
     deviator(&(0.5 * (df + df.transpose())))

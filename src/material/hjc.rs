@@ -22,7 +22,7 @@
 //! skips the damage where D1 (p* + T*)^{D2} < ε_f,min; the equation's floor is
 //! used here. History: ε̄p, D, μ_max, μ_p.
 
-use super::deviatoric::{deviator, equivalent, equivalent_rate, strain_increment, TrialDeviator};
+use super::deviatoric::{cauchy_trial, deviator, equivalent, equivalent_rate, strain_increment};
 use super::eos::Compaction;
 use super::jh2::RateForm;
 use super::erosion::Erosion;
@@ -111,9 +111,8 @@ impl Material for Hjc {
         let p = eos.pressure.max(-(1.0 - damage_old) * self.tensile_strength);
 
         // Trial Cauchy deviator and radial return at the step start's damage.
-        let trial = TrialDeviator::of(&(deviator(&inc.stress_old) * j_old), g, &inc.df);
-        let s_trial = trial.strain * (2.0 * g / j);
-        let q_trial = (1.5 * s_trial.norm_squared()).sqrt();
+        let tau_dev_old = deviator(&inc.stress_old) * j_old;
+        let (trial, s_trial, q_trial) = cauchy_trial(&tau_dev_old, g, &inc.df, j);
         let rate = equivalent_rate(&strain_increment(&inc.df), inc.dt);
         let sigma_y = self.yield_stress(p, damage_old, self.rate_factor(rate));
         let (s, d_eps_p) = if q_trial > sigma_y {

@@ -23,7 +23,7 @@
 //! The deviatoric kinematics are `deviatoric.rs`'s (isochoric Hencky); the model
 //! has no analytic tangent. History: ε̄p, D, Δp.
 
-use super::deviatoric::{deviator, equivalent, equivalent_rate, strain_increment, TrialDeviator};
+use super::deviatoric::{cauchy_trial, deviator, equivalent, equivalent_rate, strain_increment};
 use super::eos::Eos;
 use super::erosion::Erosion;
 use super::parameters::{FromParameters, KeyError, Parameters};
@@ -150,9 +150,8 @@ impl Material for Jh2 {
         }
 
         // Trial Cauchy deviator at the end of the increment.
-        let trial = TrialDeviator::of(&(deviator(&inc.stress_old) * j_old), g, &inc.df);
-        let s_trial = trial.strain * (2.0 * g / j);
-        let q_trial = (1.5 * s_trial.norm_squared()).sqrt();
+        let tau_dev_old = deviator(&inc.stress_old) * j_old;
+        let (trial, s_trial, q_trial) = cauchy_trial(&tau_dev_old, g, &inc.df, j);
         let rate = equivalent_rate(&strain_increment(&inc.df), inc.dt);
         let (intact, fractured) = self.strengths(p, self.rate_factor(rate));
         let yield_stress = |d: f64| intact + d * (fractured - intact);

@@ -38,7 +38,7 @@
 //! deviator, `deviatoric.rs` kinematics), damage, shear modulus.
 //! History: ε̄p, D, α, E.
 
-use super::deviatoric::{deviator, equivalent, equivalent_rate, strain_increment, TrialDeviator};
+use super::deviatoric::{cauchy_trial, deviator, equivalent, equivalent_rate, strain_increment};
 use super::eos::energy_update;
 use super::erosion::Erosion;
 use super::parameters::{FromParameters, KeyError, Parameters};
@@ -351,9 +351,7 @@ impl Material for Rht {
 
         // Trial deviator (Cauchy) at the old damage's shear modulus.
         let tau_dev_old = deviator(&inc.stress_old) * j_old;
-        let trial = TrialDeviator::of(&tau_dev_old, g_old, &inc.df);
-        let s_trial = trial.strain * (2.0 * g_old / j);
-        let q_trial = (1.5 * s_trial.norm_squared()).sqrt();
+        let (trial, s_trial, q_trial) = cauchy_trial(&tau_dev_old, g_old, &inc.df, j);
         let strain_increment = strain_increment(&inc.df);
         let rate = equivalent_rate(&strain_increment, inc.dt);
 
