@@ -42,6 +42,20 @@ impl Erosion {
     }
 }
 
+/// The Jacobian that sets a point's wave speed (c² ∝ J through ρ = ρ₀/J): a
+/// failed point (D = 1) carries no stress in tension in JC, JH-2, HJC and RHT,
+/// and it carries stress again only once recompressed to about J = 1, so its
+/// stiffness then belongs to ρ₀, not to the diluted density of a point that
+/// has opened (ejecta reach J of several hundred and would otherwise set the
+/// step of the whole run).
+pub fn failed_jacobian(j: f64, damage: f64) -> f64 {
+    if damage >= 1.0 {
+        j.min(1.0)
+    } else {
+        j
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

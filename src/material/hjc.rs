@@ -25,7 +25,7 @@
 use super::deviatoric::{cauchy_trial, deviator, equivalent, equivalent_rate, strain_increment};
 use super::eos::Compaction;
 use super::jh2::RateForm;
-use super::erosion::Erosion;
+use super::erosion::{failed_jacobian, Erosion};
 use super::parameters::{FromParameters, KeyError, Parameters};
 use super::{Increment, Material};
 use crate::dim::Mat3;
@@ -135,8 +135,10 @@ impl Material for Hjc {
         self.eos.stiffness(0.0) + 4.0 / 3.0 * self.shear_modulus
     }
 
-    fn wave_speed(&self, j: f64) -> f64 {
+    /// c² = (∂p/∂μ + 4GJ/3)/ρ₀, J ≤ 1 for a failed point (`failed_jacobian`).
+    fn wave_speed(&self, j: f64, history: &[f64]) -> f64 {
         let bulk = self.eos.stiffness(1.0 / j - 1.0);
+        let j = failed_jacobian(j, history[DAMAGE]);
         ((bulk + 4.0 / 3.0 * self.shear_modulus * j) / self.density).sqrt()
     }
 
@@ -357,5 +359,21 @@ mod tests {
         assert_eq!(m.yield_stress(48.0 * 20.0, 0.0, 1.0), 48.0 * 7.0);
         let below = 48.0 * (0.79 + 1.6 * 2f64.powf(0.61));
         assert!((m.yield_stress(96.0, 0.0, 1.0) - below).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_failed_point_opened_in_tension_keeps_the_wave_speed_of_the_intact_density() {
+        let m = thesis();
+        let (intact, failed) = ([0.0, 0.5, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0]);
+        // Intact: c² = (K + 4GJ/3)/ρ₀ grows with J through ρ = ρ₀/J.
+        let c1 = m.wave_speed(1.0, &intact);
+        let k = m.eos.stiffness(0.0);
+        assert!((c1 * c1 * m.density / (k + 4.0 / 3.0 * m.shear_modulus) - 1.0).abs() < 1e-12);
+        assert!(m.wave_speed(1.2, &intact) > c1);
+        // Failed (D = 1) ejecta opened to J = 400 carry no stress: not c ∝ √J.
+        let opened = m.wave_speed(400.0, &failed);
+        assert!((opened / m.wave_speed(1.0, &failed) - 1.0).abs() < 1e-12, "{opened} {c1}");
+        // Compressed, a failed point stiffens like an intact one.
+        assert_eq!(m.wave_speed(0.9, &failed), m.wave_speed(0.9, &intact));
     }
 }

@@ -25,7 +25,7 @@
 
 use super::deviatoric::{cauchy_trial, deviator, equivalent, equivalent_rate, strain_increment};
 use super::eos::Eos;
-use super::erosion::Erosion;
+use super::erosion::{failed_jacobian, Erosion};
 use super::parameters::{FromParameters, KeyError, Parameters};
 use super::{Increment, Material};
 use crate::dim::Mat3;
@@ -187,9 +187,11 @@ impl Material for Jh2 {
         self.k1 + 4.0 / 3.0 * self.shear_modulus
     }
 
-    /// c² = (∂p/∂μ + 4GJ/3)/ρ₀ at μ = 1/J − 1.
-    fn wave_speed(&self, j: f64) -> f64 {
+    /// c² = (∂p/∂μ + 4GJ/3)/ρ₀ at μ = 1/J − 1, J ≤ 1 for a failed point
+    /// (`failed_jacobian`).
+    fn wave_speed(&self, j: f64, history: &[f64]) -> f64 {
         let bulk = self.eos.tangent(1.0 / j - 1.0).max(self.k1);
+        let j = failed_jacobian(j, history[DAMAGE]);
         ((bulk + 4.0 / 3.0 * self.shear_modulus * j) / self.density).sqrt()
     }
 

@@ -33,7 +33,7 @@
 //! History: ε̄p, E, then T − T_r if the model is thermal, then D if it has damage.
 
 use super::eos::{self, energy_update, Eos};
-use super::erosion::Erosion;
+use super::erosion::{failed_jacobian, Erosion};
 use super::parameters::{FromParameters, KeyError, Parameters};
 use super::{Increment, Material};
 use super::deviatoric::{deviator, equivalent_rate, strain_increment, TrialDeviator};
@@ -254,9 +254,12 @@ impl Material for JohnsonCook {
         self.eos.tangent(0.0) + 4.0 / 3.0 * self.shear_modulus
     }
 
-    /// c² = (∂p/∂μ + 4GJ/3)/ρ₀ at μ = 1/J − 1: the EOS stiffens under compression.
-    fn wave_speed(&self, j: f64) -> f64 {
+    /// c² = (∂p/∂μ + 4GJ/3)/ρ₀ at μ = 1/J − 1: the EOS stiffens under compression;
+    /// J ≤ 1 for a failed point (`failed_jacobian`).
+    fn wave_speed(&self, j: f64, history: &[f64]) -> f64 {
         let bulk = self.eos.tangent(1.0 / j - 1.0).max(0.0);
+        let damage = self.damage_slot().map_or(0.0, |i| history[i]);
+        let j = failed_jacobian(j, damage);
         ((bulk + 4.0 / 3.0 * self.shear_modulus * j) / self.density).sqrt()
     }
 

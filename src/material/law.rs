@@ -116,8 +116,8 @@ pub trait Material: CloneMaterial + Send + Sync + std::fmt::Debug {
         false
     }
 
-    /// Wave speed c = √(M/ρ) at the current Jacobian J (ρ = ρ0/J).
-    fn wave_speed(&self, j: f64) -> f64 {
+    /// Wave speed c = √(M/ρ) at the current Jacobian J (ρ = ρ0/J) and history.
+    fn wave_speed(&self, j: f64, _history: &[f64]) -> f64 {
         (self.p_wave_modulus() * j / self.density()).sqrt()
     }
 }

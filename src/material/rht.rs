@@ -40,7 +40,7 @@
 
 use super::deviatoric::{cauchy_trial, deviator, equivalent, equivalent_rate, strain_increment};
 use super::eos::energy_update;
-use super::erosion::Erosion;
+use super::erosion::{failed_jacobian, Erosion};
 use super::parameters::{FromParameters, KeyError, Parameters};
 use super::{Increment, Material};
 use crate::dim::Mat3;
@@ -143,6 +143,15 @@ impl PAlpha {
     /// ∂p/∂μ of the matrix at zero (the bulk stiffness for the wave speed).
     fn stiffness(&self) -> f64 {
         self.matrix.a1.max(self.matrix.t1)
+    }
+
+    /// ∂p/∂μ of the porous material at distension α and Jacobian J (α fixed):
+    /// the matrix tangent at μ_s times ∂μ_s/∂μ = α/α₀, at least `stiffness`.
+    fn tangent(&self, alpha: f64, j: f64) -> f64 {
+        let mu = self.matrix_strain(alpha, j);
+        let h = 1e-7 * (1.0 + mu.abs());
+        let slope = (self.matrix.affine(mu + h).0 - self.matrix.affine(mu - h).0) / (2.0 * h);
+        (slope * alpha / self.alpha0).max(self.stiffness())
     }
 }
 
@@ -423,6 +432,14 @@ impl Material for Rht {
 
     fn p_wave_modulus(&self) -> f64 {
         self.eos.stiffness() + 4.0 / 3.0 * self.shear_modulus
+    }
+
+    /// c² = (∂p/∂μ + 4GJ/3)/ρ₀ with the P-α tangent at the current distension,
+    /// J ≤ 1 for a failed point (`failed_jacobian`).
+    fn wave_speed(&self, j: f64, history: &[f64]) -> f64 {
+        let bulk = self.eos.tangent(self.eos.alpha0 + history[DISTENSION], j);
+        let j = failed_jacobian(j, history[DAMAGE]);
+        ((bulk + 4.0 / 3.0 * self.shear_modulus * j) / self.density).sqrt()
     }
 
     /// Stored energy: σ̄²/(6G) plus p²/(2 A1) (recoverable part only).

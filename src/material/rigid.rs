@@ -1,26 +1,56 @@
-//! A rigid body: it keeps the velocity it starts with (a footing, a pile, a plate,
-//! a projectile at constant speed) and carries no stress. It meets deformable
-//! bodies only through contact (`crate::physics::contact`, where it acts as a
-//! field of infinite mass), so a scene check requires a `[[contact]]` between it and
-//! every other body, and the explicit solver. Its density gives the particles a
-//! mass for the outputs; the reaction the contact exerts on it is in contact.csv.
+//! A rigid body: it carries no stress and meets deformable bodies only through
+//! contact (`crate::physics::contact`, where it acts as a field of infinite mass
+//! within a step), so a scene check requires a `[[contact]]` between it and every
+//! other body, and the explicit solver. With `motion = "prescribed"` (the default)
+//! it keeps the velocity it starts with (a footing, a pile, a plate, a projectile
+//! at constant speed); with `motion = "free"` it translates under the contact
+//! impulses, gravity and loads with the mass of its particles (a projectile whose
+//! residual velocity is wanted, a falling block; no rotation). Its density gives
+//! the particles their mass; the reaction the contact exerts on it is in
+//! contact.csv.
 
 use super::parameters::{FromParameters, KeyError, Parameters};
 use super::{Increment, Material};
 use crate::dim::Mat3;
+use serde::Deserialize;
+
+/// How a rigid body moves.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Motion {
+    /// At its initial velocity throughout.
+    #[default]
+    Prescribed,
+    /// Translation under the forces on it: M dV/dt = J/Δt + Σ f_ext.
+    Free,
+}
+
+impl Motion {
+    /// The motion a rigid material table asks for (its `motion` key, checked
+    /// when the material is built).
+    pub fn of(parameters: &toml::Table) -> Motion {
+        (parameters.get("motion"))
+            .and_then(|v| Motion::deserialize(v.clone()).ok())
+            .unwrap_or_default()
+    }
+}
 
 #[derive(Clone, Debug)]
 pub struct Rigid {
     density: f64,
+    pub motion: Motion,
 }
 
 impl FromParameters for Rigid {
     const NAME: &'static str = "rigid";
-    const KEYS: &'static [&'static str] = &[];
+    const KEYS: &'static [&'static str] = &["motion"];
     const EXAMPLE: &'static str = "";
 
-    fn from_parameters(density: f64, _p: &Parameters) -> Result<Self, KeyError> {
-        Ok(Rigid { density })
+    fn from_parameters(density: f64, p: &Parameters) -> Result<Self, KeyError> {
+        Ok(Rigid {
+            density,
+            motion: p.get("motion")?.unwrap_or_default(),
+        })
     }
 }
 

@@ -13,7 +13,9 @@ use crate::model::grid::Grid;
 use crate::model::loads::Loads;
 use crate::model::particles::Particles;
 use crate::model::{axisymmetry, Model};
-use crate::scene::{axis, expr, BodyConfig, BoundaryConfig, Condition, Face, Scene, SceneError};
+use crate::scene::{
+    axis, expr, BodyConfig, BoundaryConfig, Condition, Face, ParticlesOutside, Scene, SceneError,
+};
 
 impl<const D: usize> Model<D> {
     pub fn build(scene: &Scene) -> Result<Model<D>, SceneError> {
@@ -94,6 +96,7 @@ impl<const D: usize> Model<D> {
         let erosion = base_materials.iter().any(|m| m.erodes());
         Ok(Model {
             erosion,
+            remove_outside: c.grid.particles_outside == ParticlesOutside::Remove,
             grid,
             particles,
             materials: base_materials.clone(),

@@ -54,22 +54,33 @@ pub struct Model<const D: usize> {
     pub axisymmetric: bool,
     /// Whether some material erodes its failed points (`Material::erodes`).
     pub erosion: bool,
+    /// Whether particles that leave the grid are removed from the transfers
+    /// (`[grid] particles_outside = "remove"`) instead of stopping the run.
+    pub remove_outside: bool,
 }
 
 impl<const D: usize> Model<D> {
-    /// Whether particle q is eroded (`Material::eroded`): it is left out of
-    /// the transfers (`physics::transfer::stencils`).
-    pub fn eroded(&self, q: usize) -> bool {
-        let p = &self.particles;
-        let mat = &self.materials[p.material[q] as usize];
-        self.erosion && mat.eroded(p.history.get(q))
+    /// Whether the scene can remove particles from the transfers: by erosion or
+    /// when they leave the grid.
+    pub fn removes_particles(&self) -> bool {
+        self.erosion || self.remove_outside
     }
 
-    /// Mass and energy (kinetic + stored) of the eroded particles, which keep the
-    /// velocity and internal energy they failed with (history.csv).
+    /// Whether particle q is removed: eroded (`Material::eroded`) or, with
+    /// `remove_outside`, outside the grid. It is left out of the transfers
+    /// (`physics::transfer::stencils`) and of the critical time step.
+    pub fn removed(&self, q: usize) -> bool {
+        let p = &self.particles;
+        let mat = &self.materials[p.material[q] as usize];
+        (self.erosion && mat.eroded(p.history.get(q)))
+            || (self.remove_outside && !self.grid.contains(&p.x[q]))
+    }
+
+    /// Mass and energy (kinetic + stored) of the removed particles, which keep the
+    /// velocity and internal energy they had when removed (history.csv).
     pub fn eroded_mass_and_energy(&self) -> (f64, f64) {
         let p = &self.particles;
-        let eroded: Vec<usize> = (0..p.len()).filter(|&q| self.eroded(q)).collect();
+        let eroded: Vec<usize> = (0..p.len()).filter(|&q| self.removed(q)).collect();
         let mass = eroded.iter().fold(0.0, |sum, &q| sum + p.mass[q]);
         let energy = eroded.iter().fold(0.0, |sum, &q| {
             let mat = &self.materials[p.material[q] as usize];

@@ -54,6 +54,8 @@ struct Meeting<const D: usize> {
     s: usize,
     /// Index of the field pair in `Contact::totals`.
     pair: usize,
+    /// The fields r < s.
+    fields: [usize; 2],
     /// Common normal, from r to s.
     normal: Vector<D>,
     /// Whether r and s are rigid bodies.
@@ -91,6 +93,10 @@ pub struct Contact<const D: usize> {
     /// Active nodes of rigid fields this step, with the rigid body's velocity.
     rigid_nodes: Vec<(usize, Vector<D>)>,
     totals: Vec<PairTotal<D>>,
+    /// Momentum the contact delivered to each field in this step, and the mass of
+    /// each free rigid field (0 for the others): `move_free_bodies`.
+    step_impulse: Vec<Vector<D>>,
+    free_mass: Vec<f64>,
     /// Index into `totals` of field pair (i, j), i < j, at i · fields + j.
     pair_index: Vec<usize>,
     /// Scratch of `split_shared_nodes`, one entry per grid node: the fields that
@@ -101,7 +107,7 @@ pub struct Contact<const D: usize> {
 
 impl<const D: usize> Contact<D> {
     pub fn new(plan: ContactPlan, particles: &Particles<D>) -> Self {
-        let field = particles
+        let field: Vec<u32> = particles
             .body
             .iter()
             .map(|&b| plan.field_of_body[b as usize])
@@ -126,7 +132,15 @@ impl<const D: usize> Contact<D> {
                 });
             }
         }
+        let mut free_mass = vec![0.0; f];
+        for (q, &k) in field.iter().enumerate() {
+            if plan.free[k as usize] {
+                free_mass[k as usize] += particles.mass[q];
+            }
+        }
         Contact {
+            step_impulse: vec![Vector::<D>::zeros(); f],
+            free_mass,
             plan,
             field,
             split: Vec::new(),
@@ -283,6 +297,7 @@ impl<const D: usize> Contact<D> {
                         r,
                         s,
                         pair: self.pair_index[fr * f + fs],
+                        fields: [fr, fs],
                         normal,
                         rigid: [self.plan.rigid[fr], self.plan.rigid[fs]],
                         area: 0.5 * (gr.norm() + gs.norm()) * ring,
@@ -325,9 +340,57 @@ impl<const D: usize> Contact<D> {
         }
     }
 
-    /// Whether particle q belongs to a rigid body.
-    pub fn is_rigid_particle(&self, q: usize) -> bool {
-        self.plan.rigid[self.field[q] as usize]
+    /// Whether particle q belongs to a rigid body of prescribed motion.
+    pub fn is_prescribed_particle(&self, q: usize) -> bool {
+        let k = self.field[q] as usize;
+        self.plan.rigid[k] && !self.plan.free[k]
+    }
+
+    /// Translate the free rigid bodies over the step just taken:
+    /// ΔV = (J + Δt Σ_p f_p)/M (Newton's second law for the body; J the momentum
+    /// the contact delivered to it in the step, f_p the applied force on its
+    /// particles, M their mass), radial component zero in axisymmetric mode (a
+    /// body of revolution on the axis). The particles, which G2P moved with V,
+    /// take V + ΔV and the position x + ΔV Δt (symplectic Euler). Momentum is
+    /// conserved: the other fields received −J.
+    /// (`free_body_increments` computes ΔV per field, `None` without free
+    /// bodies; `move_free_bodies` applies it.)
+    pub fn free_body_increments(
+        &mut self,
+        applied: &dyn Fn(usize) -> Vector<D>,
+        axisymmetric: bool,
+        dt: f64,
+    ) -> Option<Vec<Vector<D>>> {
+        let zero = vec![Vector::<D>::zeros(); self.plan.fields];
+        let mut momentum = std::mem::replace(&mut self.step_impulse, zero);
+        if !self.plan.free.iter().any(|&f| f) {
+            return None;
+        }
+        for (q, &k) in self.field.iter().enumerate() {
+            if self.plan.free[k as usize] {
+                momentum[k as usize] += applied(q) * dt;
+            }
+        }
+        let dv = (momentum.iter().zip(&self.free_mass))
+            .map(|(j, &mass)| {
+                let mut dv = if mass > 0.0 { j / mass } else { Vector::<D>::zeros() };
+                if axisymmetric {
+                    dv[0] = 0.0;
+                }
+                dv
+            })
+            .collect();
+        Some(dv)
+    }
+
+    /// Give the free rigid bodies' particles their increments `dv` (per field).
+    pub fn move_free_bodies(&self, p: &mut Particles<D>, dv: &[Vector<D>], dt: f64) {
+        for (q, &k) in self.field.iter().enumerate() {
+            if self.plan.free[k as usize] {
+                p.v[q] += dv[k as usize];
+                p.x[q] += dv[k as usize] * dt;
+            }
+        }
     }
 
     /// Give the nodes of rigid bodies their body's velocity, then correct the
@@ -377,6 +440,8 @@ impl<const D: usize> Contact<D> {
             }
             corrected.extend([mt.r, mt.s]);
             if delivered > 0.0 {
+                self.step_impulse[mt.fields[0]] += dp * delivered;
+                self.step_impulse[mt.fields[1]] -= dp * delivered;
                 let total = &mut self.totals[mt.pair];
                 // Work of the friction impulse on the slip that remains, −J_t·w_t'
                 // (zero where the fields stick).
@@ -450,6 +515,7 @@ mod tests {
             r: 0,
             s: 1,
             pair: 0,
+            fields: [0, 1],
             normal,
             rigid: [false, false],
             area: 1.0,

@@ -210,11 +210,12 @@ pub fn stencils<const D: usize>(m: &Model<D>, shape: ShapeFunction, st: &mut Ste
     if m.axisymmetric {
         hoop_gradients(st, &p.x);
     }
-    if m.erosion {
-        // Eroded particles touch no node: no mass, momentum or force reaches the
-        // grid from them, and they take no velocity from it (they stay where
-        // they failed, with the velocity and energy they had).
-        for q in (0..p.len()).filter(|&q| m.eroded(q)) {
+    if m.removes_particles() {
+        // Eroded particles and those outside the grid touch no node: no mass,
+        // momentum or force reaches the grid from them, and they take no
+        // velocity from it (they stay where they were removed, with the
+        // velocity and energy they had).
+        for q in (0..p.len()).filter(|&q| m.removed(q)) {
             st.count[q] = 0;
         }
     }

@@ -84,9 +84,10 @@ pub struct Recorders {
     contact: Option<ContactLog>,
 }
 
-/// history.csv's columns of a scene whose materials erode failed points: the
-/// mass of the eroded particles and their kinetic + stored energy (both also
-/// inside `kinetic` and `strain`, which sum over every particle).
+/// history.csv's columns of a scene whose materials erode failed points or that
+/// removes particles leaving the grid: the mass of the removed particles and
+/// their kinetic + stored energy (both also inside `kinetic` and `strain`, which
+/// sum over every particle).
 const EROSION_COLUMNS: [&str; 2] = ["eroded_mass", "eroded_energy"];
 
 impl Recorders {
@@ -105,7 +106,7 @@ impl Recorders {
                 &out.join("history.csv"),
                 D,
                 n_bodies,
-                if model.erosion { &EROSION_COLUMNS } else { &[] },
+                if model.removes_particles() { &EROSION_COLUMNS } else { &[] },
             )?,
             history_interval: cfg.output.history_interval,
             next_history: 0.0,
@@ -149,7 +150,7 @@ impl Recorders {
             csv.flush()?;
         }
         let n_bodies = r.n_bodies;
-        let extra = if model.erosion {
+        let extra = if model.removes_particles() {
             EROSION_COLUMNS.len()
         } else {
             0
@@ -239,7 +240,7 @@ impl Recorders {
             self.last_history = t;
             let (com, vcom) = body_centres(&m.particles, self.n_bodies);
             let (kinetic, strain) = (kinetic_energy(m), strain_energy(m));
-            let eroded = m.erosion.then(|| m.eroded_mass_and_energy());
+            let eroded = m.removes_particles().then(|| m.eroded_mass_and_energy());
             let extra: Vec<f64> = eroded.map_or(vec![], |(mass, energy)| vec![mass, energy]);
             self.history
                 .write_row(t, kinetic, strain, now.external_work, &extra, &com, &vcom)?;

@@ -9,7 +9,7 @@
 
 use super::config::{ContactConfig, ContactNormal, SceneConfig};
 use crate::material::parameters::{FromParameters, KeyError};
-use crate::material::rigid::Rigid;
+use crate::material::rigid::{Motion, Rigid};
 
 /// Velocity fields a scene may have (the split of shared nodes keeps the fields at
 /// a node as the bits of a u64).
@@ -49,6 +49,8 @@ pub struct ContactPlan {
     pub fields: usize,
     /// Whether each field is a rigid body (`material::rigid`).
     pub rigid: Vec<bool>,
+    /// Whether each field is a free rigid body (`motion = "free"`).
+    pub free: Vec<bool>,
 }
 
 impl ContactPlan {
@@ -116,10 +118,12 @@ fn check_law(c: &ContactConfig, i: usize) -> Result<(), KeyError> {
 /// Resolve the `[[contact]]` tables (None when there are none), with the first
 /// problem named by its key.
 pub fn plan(s: &SceneConfig) -> Result<Option<ContactPlan>, KeyError> {
-    let rigid = |b: usize| {
+    let rigid_material = |b: usize| {
         let name = &s.bodies[b].material;
-        (s.materials.iter()).any(|m| &m.name == name && m.model == Rigid::NAME)
+        (s.materials.iter()).find(|m| &m.name == name && m.model == Rigid::NAME)
     };
+    let rigid = |b: usize| rigid_material(b).is_some();
+    let free = |b: usize| rigid_material(b).is_some_and(|m| Motion::of(&m.parameters) == Motion::Free);
     if s.contacts.is_empty() {
         return match (0..s.bodies.len()).find(|&b| rigid(b)) {
             Some(b) => Err((
@@ -242,10 +246,14 @@ pub fn plan(s: &SceneConfig) -> Result<Option<ContactPlan>, KeyError> {
     let field_rigid = (0..f)
         .map(|k| (0..n).any(|b| field_of_body[b] as usize == k && rigid(b)))
         .collect();
+    let field_free = (0..f)
+        .map(|k| (0..n).any(|b| field_of_body[b] as usize == k && free(b)))
+        .collect();
     Ok(Some(ContactPlan {
         field_of_body,
         laws: laws.into_iter().map(|l| l.map(|(law, _)| law)).collect(),
         fields: f,
         rigid: field_rigid,
+        free: field_free,
     }))
 }

@@ -13,6 +13,22 @@ pub struct GridConfig {
     pub cells: Vec<usize>,
     #[serde(default = "default_shape")]
     pub shape_function: ShapeFunction,
+    /// What a particle that leaves the grid box does to the run.
+    #[serde(default)]
+    pub particles_outside: ParticlesOutside,
+}
+
+/// `particles_outside`: a particle that leaves the grid stops the run
+/// (`"stop"`, the default: it usually means the grid is too small), or it is
+/// removed from the transfers where it left, its mass and energy counted as
+/// lost in history.csv (`"remove"`: ejecta and spall in impact runs, as
+/// impact codes delete them).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ParticlesOutside {
+    #[default]
+    Stop,
+    Remove,
 }
 
 fn default_shape() -> ShapeFunction {

@@ -42,7 +42,7 @@ pub fn check_state<const D: usize>(m: &Model<D>, step: usize, time: f64) -> Resu
                 && p.v[q].iter().all(|v| v.is_finite())
                 && p.stress[q].iter().all(|v| v.is_finite())
                 && p.f[q].determinant() > 0.0
-                && m.grid.contains(&p.x[q])
+                && (m.grid.contains(&p.x[q]) || m.remove_outside)
                 && (!m.axisymmetric || p.x[q][0] > 0.0))
         });
     match bad {

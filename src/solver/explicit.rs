@@ -72,15 +72,30 @@ impl<const D: usize> Explicit<D> {
     }
 
     /// The critical step, and with bulk viscosity also its stable step
-    /// h/(C_L c + √(C_L² c² + c²)) at every particle, in one pass.
+    /// h/(C_L c + √(C_L² c² + c²)) at every particle, in one pass. Removed
+    /// particles (eroded, or outside the grid) do not count, unless all are.
     fn critical_dt_with(m: &Model<D>, viscosity: Option<&BulkViscosity>) -> f64 {
+        let removes = m.removes_particles();
+        let active = Self::critical_dt_over(m, viscosity, &|q| !(removes && m.removed(q)));
+        match active.is_finite() {
+            true => active,
+            false => Self::critical_dt_over(m, viscosity, &|_| true),
+        }
+    }
+
+    fn critical_dt_over(
+        m: &Model<D>,
+        viscosity: Option<&BulkViscosity>,
+        counts: &(dyn Fn(usize) -> bool + Sync),
+    ) -> f64 {
         let p = &m.particles;
         let h = m.grid.h_min();
         (0..p.len())
             .into_par_iter()
             .with_min_len(MIN_PARALLEL_LEN)
+            .filter(|&q| counts(q))
             .map(|q| {
-                let c = m.materials[p.material[q] as usize].wave_speed(p.f[q].determinant());
+                let c = m.materials[p.material[q] as usize].wave_speed(p.f[q].determinant(), p.history.get(q));
                 let dt = h / (c + p.v[q].norm());
                 viscosity.map_or(dt, |v| dt.min(v.stable_dt(c, h, 0.0)))
             })
@@ -212,9 +227,15 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
                 *v = v_flip * flip + v_pic * (1.0 - flip);
                 *x += v_pic * dt;
             });
+        if let Some(c) = &mut self.contact {
+            let applied = |q: usize| applied_force(&m.particles, q, &m.gravity, &load_factor);
+            if let Some(dv) = c.free_body_increments(&applied, m.axisymmetric, dt) {
+                c.move_free_bodies(&mut m.particles, &dv, dt);
+            }
+        }
         let p = &m.particles;
         let contact = &self.contact;
-        let rigid = |q: usize| contact.as_ref().is_some_and(|c| c.is_rigid_particle(q));
+        let rigid = |q: usize| contact.as_ref().is_some_and(|c| c.is_prescribed_particle(q));
         let work = dt
             * deterministic_sum(p.len(), |q| {
                 // A rigid body's prescribed motion takes the work done on it.

@@ -2,7 +2,7 @@
 //! the artificial bulk viscosity) and the Taylor bar against the measured final
 //! shape (Johnson & Holmquist 1988, review `002_…` Table 1).
 
-use crate::common::{read_output, run_cli, run_problem, Table};
+use crate::common::{read_output, run_cli, run_problem, run_text, Table};
 
 /// Copper Hugoniot at u_p = 500 m/s: U_s = c0 + S u_p, p_H = ρ0 U_s u_p.
 const U_P: f64 = 500.0;
@@ -442,4 +442,63 @@ fn axisymmetric_contact_with_a_rigid_anvil_matches_the_grid_face_anvil() {
     assert!((contact.0 / face.0 - 1.0).abs() < 0.02, "L");
     assert!((contact.1 / face.1 - 1.0).abs() < 0.03, "D");
     assert!((contact.2 / face.2 - 1.0).abs() < 0.03, "W");
+}
+
+/// A free elastic block flying at 10 m/s towards the x = 1 face of the grid
+/// (no boundary conditions, no gravity): it leaves the grid at t ≈ 0.05 s.
+const FLYING_BLOCK: &str = r#"dimension = 2
+[grid]
+min = [0.0, 0.0]
+max = [1.0, 1.0]
+cells = [10, 10]
+shape_function = "cpgimp"
+[[material]]
+name = "m"
+model = "linear_elastic"
+density = 1000.0
+youngs_modulus = 1.0e6
+poisson_ratio = 0.3
+[[body]]
+material = "m"
+shape = "rectangle"
+min = [0.3, 0.3]
+max = [0.5, 0.5]
+velocity = [10.0, 0.0]
+[solver]
+kind = "explicit"
+end_time = 0.1
+[output]
+frames = 0
+history_interval = 0.005
+"#;
+
+#[test]
+fn particles_leaving_the_grid_stop_the_run_or_are_removed_with_their_mass_and_energy() {
+    // Default: the first particle out stops the run, naming it.
+    let (result, _dir) = run_text(FLYING_BLOCK, &[]);
+    let message = result.expect_err("a particle leaves the grid").to_string();
+    assert!(message.contains("left the grid"), "{message}");
+
+    // "remove": the run ends; every particle is out, frozen within one step's
+    // travel of the face (v Δt < v h/(2(c + v)) = 0.011 m), with its velocity,
+    // and history.csv counts all the mass and the kinetic energy as removed.
+    let (result, dir) = run_text(FLYING_BLOCK, &["grid.particles_outside=\"remove\""]);
+    result.expect("the run ends");
+    let p = Table::read(&dir.path().join("particles_final.csv")).unwrap();
+    let (x, vx, mass) = (p.col("x"), p.col("vx"), p.col("mass"));
+    let total: f64 = mass.iter().sum();
+    for q in 0..x.len() {
+        assert!(x[q] > 1.0 && x[q] < 1.0 + 0.011, "particle {q} at x = {}", x[q]);
+        assert!((vx[q] / 10.0 - 1.0).abs() < 1e-9, "particle {q}: vx = {}", vx[q]);
+    }
+    let h = Table::read(&dir.path().join("history.csv")).unwrap();
+    let (removed, lost, kinetic) = (h.col("eroded_mass"), h.col("eroded_energy"), h.col("kinetic"));
+    assert_eq!(removed[0], 0.0);
+    assert!((removed.last().unwrap() / total - 1.0).abs() < 1e-12);
+    let e0 = 0.5 * total * 100.0;
+    assert!((kinetic[0] / e0 - 1.0).abs() < 1e-12);
+    assert!((lost.last().unwrap() / e0 - 1.0).abs() < 1e-9, "{}", lost.last().unwrap());
+    // Partly out at t = 0.06 s: the mass removed grows monotonically.
+    assert!(removed.windows(2).all(|w| w[1] >= w[0]));
+    assert!(removed.iter().any(|&m| m > 0.0 && m < total));
 }

@@ -104,7 +104,11 @@ impl<const D: usize> Stencils<D> {
             .enumerate()
             .with_min_len(crate::parallel::MIN_PARALLEL_LEN)
             .for_each(|(p, (((c, nd), w), g))| {
-                *c = evaluate(shape, grid, &x[p], &half_length0[p], &f[p], nd, w, g) as u32;
+                // A particle outside the grid (removed, `Model::removed`) has no nodes.
+                *c = match grid.contains(&x[p]) {
+                    true => evaluate(shape, grid, &x[p], &half_length0[p], &f[p], nd, w, g) as u32,
+                    false => 0,
+                };
             });
     }
 
