@@ -323,8 +323,40 @@ impl Compaction {
 /// E_new of the energy equation dE = dW_dev − p dJ (per reference volume) with
 /// the trapezoidal rule and p_new = a + b E_new, solved in closed form:
 /// E_new = (E_old + ΔW_dev − ½(p_old + a) ΔJ) / (1 + ½ b ΔJ) (Wilkins' scheme).
+/// The rule is singular at ΔJ = −2/b, which only a point opened far beyond its
+/// reference volume and recompressed fast can reach (fragments at J ≫ 1); where
+/// 1 + ½ b ΔJ < ½ the exact solution of dE/dJ = −(a + bE) for a, b fixed over
+/// the step is used instead: E_new = (E_old + ΔW_dev + a/b) e^{−bΔJ} − a/b.
 pub fn energy_update(e_old: f64, dw_dev: f64, p_old: f64, dj: f64, (a, b): (f64, f64)) -> f64 {
-    (e_old + dw_dev - 0.5 * (p_old + a) * dj) / (1.0 + 0.5 * b * dj)
+    let denominator = 1.0 + 0.5 * b * dj;
+    if denominator >= 0.5 {
+        (e_old + dw_dev - 0.5 * (p_old + a) * dj) / denominator
+    } else {
+        (e_old + dw_dev + a / b) * (-b * dj).exp() - a / b
+    }
+}
+
+/// E_new and p_new for a point whose pressure is bounded below by `p_min` (a
+/// tension cut-off): the EOS pressure at `energy_update`'s E_new where it is at
+/// least p_min; otherwise the point carries p_min, and its energy takes the
+/// work of the pressure it carries, E_new = E_old + ΔW_dev − ½(p_old + p_min) ΔJ
+/// (with the EOS pressure there, a point cut off in tension would gain the
+/// energy its uncut EOS gives it, and release it as pressure on recompaction).
+pub fn energy_and_pressure(
+    e_old: f64,
+    dw_dev: f64,
+    p_old: f64,
+    dj: f64,
+    (a, b): (f64, f64),
+    p_min: f64,
+) -> (f64, f64) {
+    let energy = energy_update(e_old, dw_dev, p_old, dj, (a, b));
+    let p = a + b * energy;
+    if p >= p_min {
+        (energy, p)
+    } else {
+        (e_old + dw_dev - 0.5 * (p_old + p_min) * dj, p_min)
+    }
 }
 
 #[cfg(test)]
@@ -455,5 +487,42 @@ mod tests {
         let p_new = eos.pressure(mu_new, e_new);
         let expected = e_old + dw - 0.5 * (p_old + p_new) * dj;
         assert!((e_new - expected).abs() < 1e-9 * e_new.abs());
+    }
+
+    #[test]
+    fn a_fast_recompaction_takes_the_exact_solution_instead_of_the_singular_rule() {
+        // dE/dJ = −(a + bE) with a, b fixed: E = (E₀ + a/b) e^{−bΔJ} − a/b.
+        let (a, b) = (-3.0e4, 1.22);
+        let exact = |e0: f64, dj: f64| (e0 + a / b) * (-b * dj).exp() - a / b;
+        // ΔJ = −2/b makes the trapezoidal denominator vanish: finite, exact.
+        let dj = -2.0 / b;
+        let e = energy_update(50.0, 0.0, 0.0, dj, (a, b));
+        assert!(
+            e.is_finite() && (e / exact(50.0, dj) - 1.0).abs() < 1e-12,
+            "{e}"
+        );
+        // Small steps keep the trapezoidal rule, second-order close to exact.
+        for dj in [-1e-2, -1e-3] {
+            let e = energy_update(50.0, 0.0, a + b * 50.0, dj, (a, b));
+            let error = (e - exact(50.0, dj)).abs() / (a.abs() * dj.abs());
+            assert!(error < 0.1 * (b * dj).powi(2), "ΔJ {dj}: {error}");
+        }
+    }
+
+    #[test]
+    fn a_point_cut_off_in_tension_takes_the_work_of_the_pressure_it_carries() {
+        let (a, b) = (-3.0e4 * 0.2, 1.22);
+        let (e_old, p_old, dj) = (100.0, 0.0, 0.05);
+        // The EOS would give a + bE ≪ 0: the point carries p_min = 0 and no work.
+        let (e, p) = energy_and_pressure(e_old, 0.0, p_old, dj, (a, b), 0.0);
+        assert_eq!((e, p), (e_old, 0.0));
+        // Above the cut-off: the EOS pressure and the trapezoidal energy.
+        let (e, p) = energy_and_pressure(e_old, 0.0, p_old, dj, (a, b), f64::NEG_INFINITY);
+        assert_eq!(e, energy_update(e_old, 0.0, p_old, dj, (a, b)));
+        assert_eq!(p, a + b * e);
+        // A cut-off at −T: the energy of p = −T over ΔJ.
+        let (e, p) = energy_and_pressure(e_old, 0.0, -4.0, dj, (a, b), -4.0);
+        assert_eq!(p, -4.0);
+        assert!((e - (e_old + 4.0 * dj)).abs() < 1e-12);
     }
 }

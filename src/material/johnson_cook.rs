@@ -32,7 +32,7 @@
 //!
 //! History: ε̄p, E, then T − T_r if the model is thermal, then D if it has damage.
 
-use super::eos::{self, energy_update, Eos};
+use super::eos::{self, energy_and_pressure, Eos};
 use super::erosion::{failed_jacobian, Erosion};
 use super::parameters::{FromParameters, KeyError, Parameters};
 use super::{Increment, Material};
@@ -239,12 +239,11 @@ impl Material for JohnsonCook {
         // Energy and pressure (trapezoidal, p_new from the EOS at E_new).
         let dw_dev = 0.5 * (tau_dev_old + tau_dev).component_mul(&strain_increment).sum();
         let affine = self.eos.affine(1.0 / j - 1.0);
-        let energy = energy_update(h_old[ENERGY], dw_dev, p_old, j - j_old, affine);
+        // Failed: no shear, no tension.
+        let p_min = if damage >= 1.0 { 0.0 } else { f64::NEG_INFINITY };
+        let (energy, p) = energy_and_pressure(h_old[ENERGY], dw_dev, p_old, j - j_old, affine, p_min);
         h_new[ENERGY] = energy;
-        let mut p = affine.0 + affine.1 * energy;
         if damage >= 1.0 {
-            // Failed: no shear, no tension.
-            p = p.max(0.0);
             return -Mat3::identity() * p;
         }
         tau_dev / j - Mat3::identity() * p

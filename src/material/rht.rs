@@ -39,7 +39,7 @@
 //! History: ε̄p, D, α, E.
 
 use super::deviatoric::{cauchy_trial, deviator, equivalent, equivalent_rate, strain_increment};
-use super::eos::energy_update;
+use super::eos::{energy_and_pressure, energy_update};
 use super::erosion::{failed_jacobian, Erosion};
 use super::parameters::{FromParameters, KeyError, Parameters};
 use super::{Increment, Material};
@@ -373,11 +373,11 @@ impl Material for Rht {
             alpha = self.eos.distension(alpha_old, j, energy);
             energy = energy_update(h_old[ENERGY], dw_dev, p_old, j - j_old, self.eos.affine(alpha, j));
         }
-        let (a, b) = self.eos.affine(alpha, j);
-        let mut p = a + b * energy;
-        // Tension cut-off (4-29).
+        // Tension cut-off (4-29), the energy from the pressure carried.
         let f_tension = self.rate_factor(-self.tensile_strength(), rate);
-        p = p.max(-(1.0 - damage) * self.tension_zero() * f_tension);
+        let p_min = -(1.0 - damage) * self.tension_zero() * f_tension;
+        let affine = self.eos.affine(alpha, j);
+        let (energy, p) = energy_and_pressure(h_old[ENERGY], dw_dev, p_old, j - j_old, affine, p_min);
 
         // Surfaces at the trial Lode angle.
         let theta = lode_angle(&s_trial);

@@ -346,15 +346,14 @@ impl<const D: usize> Contact<D> {
         self.plan.rigid[k] && !self.plan.free[k]
     }
 
-    /// Translate the free rigid bodies over the step just taken:
+    /// The velocity increments of the free rigid bodies over the step just taken,
+    /// per field (`None` without free bodies; `move_free_bodies` applies them):
     /// ΔV = (J + Δt Σ_p f_p)/M (Newton's second law for the body; J the momentum
     /// the contact delivered to it in the step, f_p the applied force on its
     /// particles, M their mass), radial component zero in axisymmetric mode (a
     /// body of revolution on the axis). The particles, which G2P moved with V,
     /// take V + ΔV and the position x + ΔV Δt (symplectic Euler). Momentum is
-    /// conserved: the other fields received −J.
-    /// (`free_body_increments` computes ΔV per field, `None` without free
-    /// bodies; `move_free_bodies` applies it.)
+    /// conserved: the other fields received −J. Resets the step's impulses.
     pub fn free_body_increments(
         &mut self,
         applied: &dyn Fn(usize) -> Vector<D>,
@@ -373,7 +372,11 @@ impl<const D: usize> Contact<D> {
         }
         let dv = (momentum.iter().zip(&self.free_mass))
             .map(|(j, &mass)| {
-                let mut dv = if mass > 0.0 { j / mass } else { Vector::<D>::zeros() };
+                let mut dv = if mass > 0.0 {
+                    j / mass
+                } else {
+                    Vector::<D>::zeros()
+                };
                 if axisymmetric {
                     dv[0] = 0.0;
                 }

@@ -106,7 +106,11 @@ impl Recorders {
                 &out.join("history.csv"),
                 D,
                 n_bodies,
-                if model.removes_particles() { &EROSION_COLUMNS } else { &[] },
+                if model.removes_particles() {
+                    &EROSION_COLUMNS
+                } else {
+                    &[]
+                },
             )?,
             history_interval: cfg.output.history_interval,
             next_history: 0.0,

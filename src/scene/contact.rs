@@ -123,7 +123,8 @@ pub fn plan(s: &SceneConfig) -> Result<Option<ContactPlan>, KeyError> {
         (s.materials.iter()).find(|m| &m.name == name && m.model == Rigid::NAME)
     };
     let rigid = |b: usize| rigid_material(b).is_some();
-    let free = |b: usize| rigid_material(b).is_some_and(|m| Motion::of(&m.parameters) == Motion::Free);
+    let free =
+        |b: usize| rigid_material(b).is_some_and(|m| Motion::of(&m.parameters) == Motion::Free);
     if s.contacts.is_empty() {
         return match (0..s.bodies.len()).find(|&b| rigid(b)) {
             Some(b) => Err((

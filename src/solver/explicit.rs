@@ -95,7 +95,8 @@ impl<const D: usize> Explicit<D> {
             .with_min_len(MIN_PARALLEL_LEN)
             .filter(|&q| counts(q))
             .map(|q| {
-                let c = m.materials[p.material[q] as usize].wave_speed(p.f[q].determinant(), p.history.get(q));
+                let c = m.materials[p.material[q] as usize]
+                    .wave_speed(p.f[q].determinant(), p.history.get(q));
                 let dt = h / (c + p.v[q].norm());
                 viscosity.map_or(dt, |v| dt.min(v.stable_dt(c, h, 0.0)))
             })
@@ -235,7 +236,11 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
         }
         let p = &m.particles;
         let contact = &self.contact;
-        let rigid = |q: usize| contact.as_ref().is_some_and(|c| c.is_prescribed_particle(q));
+        let rigid = |q: usize| {
+            contact
+                .as_ref()
+                .is_some_and(|c| c.is_prescribed_particle(q))
+        };
         let work = dt
             * deterministic_sum(p.len(), |q| {
                 // A rigid body's prescribed motion takes the work done on it.

@@ -164,3 +164,15 @@ fn a_rigid_body_needs_contact_with_every_other_body() {
         &["a rigid body meets other bodies only through contact"],
     );
 }
+
+#[test]
+fn a_rigid_motion_other_than_prescribed_or_free_is_named() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/problems/rigid_striker.toml"
+    ))
+    .unwrap();
+    Scene::parse("scene.toml", &text, &[]).unwrap();
+    let bad = text.replace("motion = \"free\"", "motion = \"spinning\"");
+    rejected(&bad, "material.1.motion", &["scene.toml:", "spinning"]);
+}

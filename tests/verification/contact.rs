@@ -587,10 +587,19 @@ fn free_rigid_striker_decelerates_as_the_closed_form_and_conserves_momentum() {
     for i in 0..t.len() {
         if t[i] <= 0.019 {
             let exact = (-100.0 * t[i]).exp();
-            assert!((striker[i] / exact - 1.0).abs() < 0.02, "t = {}: {} vs {exact}", t[i], striker[i]);
+            assert!(
+                (striker[i] / exact - 1.0).abs() < 0.02,
+                "t = {}: {} vs {exact}",
+                t[i],
+                striker[i]
+            );
         }
         // Equal masses: V_striker + V_bar = V0, up to the nodes of tiny mass.
-        assert!((striker[i] + bar[i] - 1.0).abs() < 1e-9, "momentum at t = {}", t[i]);
+        assert!(
+            (striker[i] + bar[i] - 1.0).abs() < 1e-9,
+            "momentum at t = {}",
+            t[i]
+        );
     }
     let last = *striker.last().unwrap();
     assert!((last / (-2f64).exp() - 1.0).abs() < 0.08, "final {last}");
@@ -616,11 +625,26 @@ fn free_rigid_body_falls_under_gravity() {
     );
     result.expect("the fall runs");
     let h = Table::read(&dir.path().join("history.csv")).unwrap();
-    let (t, y, vx, vy) = (h.col("t"), h.col("body0_y"), h.col("body0_vx"), h.col("body0_vy"));
+    let (t, y, vx, vy) = (
+        h.col("t"),
+        h.col("body0_y"),
+        h.col("body0_vx"),
+        h.col("body0_vy"),
+    );
     for i in 0..t.len() {
         assert_eq!(vx[i], 0.0);
-        assert!((vy[i] + G * t[i]).abs() <= 1e-12 * G * t[i].max(1.0), "t = {}: {}", t[i], vy[i]);
+        assert!(
+            (vy[i] + G * t[i]).abs() <= 1e-12 * G * t[i].max(1.0),
+            "t = {}: {}",
+            t[i],
+            vy[i]
+        );
         let exact = 0.05 - 0.5 * G * t[i] * t[i];
-        assert!((y[i] - exact).abs() <= 0.5 * G * 1e-3 * t[i] + 1e-12, "t = {}: {} vs {exact}", t[i], y[i]);
+        assert!(
+            (y[i] - exact).abs() <= 0.5 * G * 1e-3 * t[i] + 1e-12,
+            "t = {}: {} vs {exact}",
+            t[i],
+            y[i]
+        );
     }
 }

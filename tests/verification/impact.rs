@@ -488,16 +488,32 @@ fn particles_leaving_the_grid_stop_the_run_or_are_removed_with_their_mass_and_en
     let (x, vx, mass) = (p.col("x"), p.col("vx"), p.col("mass"));
     let total: f64 = mass.iter().sum();
     for q in 0..x.len() {
-        assert!(x[q] > 1.0 && x[q] < 1.0 + 0.011, "particle {q} at x = {}", x[q]);
-        assert!((vx[q] / 10.0 - 1.0).abs() < 1e-9, "particle {q}: vx = {}", vx[q]);
+        assert!(
+            x[q] > 1.0 && x[q] < 1.0 + 0.011,
+            "particle {q} at x = {}",
+            x[q]
+        );
+        assert!(
+            (vx[q] / 10.0 - 1.0).abs() < 1e-9,
+            "particle {q}: vx = {}",
+            vx[q]
+        );
     }
     let h = Table::read(&dir.path().join("history.csv")).unwrap();
-    let (removed, lost, kinetic) = (h.col("eroded_mass"), h.col("eroded_energy"), h.col("kinetic"));
+    let (removed, lost, kinetic) = (
+        h.col("eroded_mass"),
+        h.col("eroded_energy"),
+        h.col("kinetic"),
+    );
     assert_eq!(removed[0], 0.0);
     assert!((removed.last().unwrap() / total - 1.0).abs() < 1e-12);
     let e0 = 0.5 * total * 100.0;
     assert!((kinetic[0] / e0 - 1.0).abs() < 1e-12);
-    assert!((lost.last().unwrap() / e0 - 1.0).abs() < 1e-9, "{}", lost.last().unwrap());
+    assert!(
+        (lost.last().unwrap() / e0 - 1.0).abs() < 1e-9,
+        "{}",
+        lost.last().unwrap()
+    );
     // Partly out at t = 0.06 s: the mass removed grows monotonically.
     assert!(removed.windows(2).all(|w| w[1] >= w[0]));
     assert!(removed.iter().any(|&m| m > 0.0 && m < total));
