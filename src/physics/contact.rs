@@ -38,6 +38,7 @@ use crate::dim::Vector;
 use crate::model::particles::Particles;
 use crate::model::Model;
 use crate::parallel::MIN_PARALLEL_LEN;
+use crate::physics::rigid_body::FreeBodies;
 use crate::physics::shape::{ShapeFunction, Stencils};
 use crate::physics::transfer::NodeMap;
 use crate::scene::contact::{ContactLaw, ContactPlan};
@@ -56,6 +57,8 @@ struct Meeting<const D: usize> {
     pair: usize,
     /// The fields r < s.
     fields: [usize; 2],
+    /// The grid node's position.
+    position: Vector<D>,
     /// Common normal, from r to s.
     normal: Vector<D>,
     /// Whether r and s are rigid bodies.
@@ -93,10 +96,8 @@ pub struct Contact<const D: usize> {
     /// Active nodes of rigid fields this step, with the rigid body's velocity.
     rigid_nodes: Vec<(usize, Vector<D>)>,
     totals: Vec<PairTotal<D>>,
-    /// Momentum the contact delivered to each field in this step, and the mass of
-    /// each free rigid field (0 for the others): `move_free_bodies`.
-    step_impulse: Vec<Vector<D>>,
-    free_mass: Vec<f64>,
+    /// The free rigid bodies (`physics::rigid_body`), if any.
+    free: Option<FreeBodies<D>>,
     /// Index into `totals` of field pair (i, j), i < j, at i · fields + j.
     pair_index: Vec<usize>,
     /// Scratch of `split_shared_nodes`, one entry per grid node: the fields that
@@ -132,15 +133,8 @@ impl<const D: usize> Contact<D> {
                 });
             }
         }
-        let mut free_mass = vec![0.0; f];
-        for (q, &k) in field.iter().enumerate() {
-            if plan.free[k as usize] {
-                free_mass[k as usize] += particles.mass[q];
-            }
-        }
         Contact {
-            step_impulse: vec![Vector::<D>::zeros(); f],
-            free_mass,
+            free: FreeBodies::new(&plan.free, &field),
             plan,
             field,
             split: Vec::new(),
@@ -298,6 +292,7 @@ impl<const D: usize> Contact<D> {
                         s,
                         pair: self.pair_index[fr * f + fs],
                         fields: [fr, fs],
+                        position: x_node,
                         normal,
                         rigid: [self.plan.rigid[fr], self.plan.rigid[fs]],
                         area: 0.5 * (gr.norm() + gs.norm()) * ring,
@@ -326,15 +321,26 @@ impl<const D: usize> Contact<D> {
         map.build(st, n_grid + map.split.len());
         self.prepare(m, st, map);
         self.rigid_nodes.clear();
+        if let Some(free) = &mut self.free {
+            free.start(p, m.axisymmetric);
+        }
         if self.plan.rigid.iter().any(|&r| r) {
-            // A node of a rigid field holds only that body's particles.
+            // A node of a rigid field holds only that body's particles: it moves
+            // with the body (a free body's velocity there, or the prescribed one).
             let (owner, rigid, field) = (st.owner(), &self.plan.rigid, &self.field);
+            let free = &self.free;
+            let grid = &m.grid;
             self.rigid_nodes = (0..map.len())
                 .into_par_iter()
                 .with_min_len(MIN_PARALLEL_LEN)
                 .filter_map(|a| {
                     let q = owner.of(map.node_entries(a)[0]);
-                    rigid[field[q] as usize].then(|| (a, p.v[q]))
+                    let k = field[q] as usize;
+                    rigid[k].then(|| {
+                        let x = || grid.node_position(grid.node_ijk(map.grid_node(a)));
+                        let v = free.as_ref().and_then(|f| f.node_velocity(k, &x()));
+                        (a, v.unwrap_or(p.v[q]))
+                    })
                 })
                 .collect();
         }
@@ -346,54 +352,9 @@ impl<const D: usize> Contact<D> {
         self.plan.rigid[k] && !self.plan.free[k]
     }
 
-    /// The velocity increments of the free rigid bodies over the step just taken,
-    /// per field (`None` without free bodies; `move_free_bodies` applies them):
-    /// ΔV = (J + Δt Σ_p f_p)/M (Newton's second law for the body; J the momentum
-    /// the contact delivered to it in the step, f_p the applied force on its
-    /// particles, M their mass), radial component zero in axisymmetric mode (a
-    /// body of revolution on the axis). The particles, which G2P moved with V,
-    /// take V + ΔV and the position x + ΔV Δt (symplectic Euler). Momentum is
-    /// conserved: the other fields received −J. Resets the step's impulses.
-    pub fn free_body_increments(
-        &mut self,
-        applied: &dyn Fn(usize) -> Vector<D>,
-        axisymmetric: bool,
-        dt: f64,
-    ) -> Option<Vec<Vector<D>>> {
-        let zero = vec![Vector::<D>::zeros(); self.plan.fields];
-        let mut momentum = std::mem::replace(&mut self.step_impulse, zero);
-        if !self.plan.free.iter().any(|&f| f) {
-            return None;
-        }
-        for (q, &k) in self.field.iter().enumerate() {
-            if self.plan.free[k as usize] {
-                momentum[k as usize] += applied(q) * dt;
-            }
-        }
-        let dv = (momentum.iter().zip(&self.free_mass))
-            .map(|(j, &mass)| {
-                let mut dv = if mass > 0.0 {
-                    j / mass
-                } else {
-                    Vector::<D>::zeros()
-                };
-                if axisymmetric {
-                    dv[0] = 0.0;
-                }
-                dv
-            })
-            .collect();
-        Some(dv)
-    }
-
-    /// Give the free rigid bodies' particles their increments `dv` (per field).
-    pub fn move_free_bodies(&self, p: &mut Particles<D>, dv: &[Vector<D>], dt: f64) {
-        for (q, &k) in self.field.iter().enumerate() {
-            if self.plan.free[k as usize] {
-                p.v[q] += dv[k as usize];
-                p.x[q] += dv[k as usize] * dt;
-            }
-        }
+    /// The free rigid bodies, if the scene has any.
+    pub fn free_bodies(&mut self) -> Option<&mut FreeBodies<D>> {
+        self.free.as_mut()
     }
 
     /// Give the nodes of rigid bodies their body's velocity, then correct the
@@ -443,8 +404,10 @@ impl<const D: usize> Contact<D> {
             }
             corrected.extend([mt.r, mt.s]);
             if delivered > 0.0 {
-                self.step_impulse[mt.fields[0]] += dp * delivered;
-                self.step_impulse[mt.fields[1]] -= dp * delivered;
+                if let Some(free) = &mut self.free {
+                    free.receive(mt.fields[0], &mt.position, &(dp * delivered));
+                    free.receive(mt.fields[1], &mt.position, &(-dp * delivered));
+                }
                 let total = &mut self.totals[mt.pair];
                 // Work of the friction impulse on the slip that remains, −J_t·w_t'
                 // (zero where the fields stick).
@@ -519,6 +482,7 @@ mod tests {
             s: 1,
             pair: 0,
             fields: [0, 1],
+            position: Vector::<2>::zeros(),
             normal,
             rigid: [false, false],
             area: 1.0,

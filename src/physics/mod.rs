@@ -11,5 +11,6 @@ pub mod deformation;
 pub mod fbar;
 pub mod geostatic;
 pub mod mirror;
+pub mod rigid_body;
 pub mod shape;
 pub mod transfer;

@@ -228,11 +228,13 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
                 *v = v_flip * flip + v_pic * (1.0 - flip);
                 *x += v_pic * dt;
             });
-        if let Some(c) = &mut self.contact {
-            let applied = |q: usize| applied_force(&m.particles, q, &m.gravity, &load_factor);
-            if let Some(dv) = c.free_body_increments(&applied, m.axisymmetric, dt) {
-                c.move_free_bodies(&mut m.particles, &dv, dt);
-            }
+        // Free rigid bodies: Newton–Euler under the step's contact impulses and
+        // the applied forces (`physics::rigid_body`).
+        if let Some(free) = self.contact.as_mut().and_then(|c| c.free_bodies()) {
+            let force: Vec<Vector<D>> = (free.particles())
+                .map(|q| applied_force(&m.particles, q, &m.gravity, &load_factor))
+                .collect();
+            free.advance(&mut m.particles, &force, m.axisymmetric, dt);
         }
         let p = &m.particles;
         let contact = &self.contact;
