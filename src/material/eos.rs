@@ -336,27 +336,30 @@ pub fn energy_update(e_old: f64, dw_dev: f64, p_old: f64, dj: f64, (a, b): (f64,
     }
 }
 
-/// E_new and p_new for a point whose pressure is bounded below by `p_min` (a
-/// tension cut-off): the EOS pressure at `energy_update`'s E_new where it is at
-/// least p_min; otherwise the point carries p_min, and its energy takes the
-/// work of the pressure it carries, E_new = E_old + ΔW_dev − ½(p_old + p_min) ΔJ
-/// (with the EOS pressure there, a point cut off in tension would gain the
-/// energy its uncut EOS gives it, and release it as pressure on recompaction).
+/// E_new and p_new for a point whose pressure is bounded, p_min ≤ p ≤ p_max (a
+/// tension cut-off below; above, zero for failed material opened beyond its
+/// solid density, rubble whose fragments do not touch): the EOS pressure at
+/// `energy_update`'s E_new where it is within the bounds; otherwise the point
+/// carries the bound, and its energy takes the work of the pressure it carries,
+/// E_new = E_old + ΔW_dev − ½(p_old + p_bound) ΔJ (with the EOS pressure there, a
+/// point cut off in tension would gain the energy its uncut EOS gives it, and
+/// release it as pressure on recompaction; rubble would push itself apart with
+/// its Grüneisen term Γ E, which grows without bound as it is recompacted).
 pub fn energy_and_pressure(
     e_old: f64,
     dw_dev: f64,
     p_old: f64,
     dj: f64,
     (a, b): (f64, f64),
-    p_min: f64,
+    (p_min, p_max): (f64, f64),
 ) -> (f64, f64) {
     let energy = energy_update(e_old, dw_dev, p_old, dj, (a, b));
     let p = a + b * energy;
-    if p >= p_min {
-        (energy, p)
-    } else {
-        (e_old + dw_dev - 0.5 * (p_old + p_min) * dj, p_min)
+    if (p_min..=p_max).contains(&p) {
+        return (energy, p);
     }
+    let bound = p.clamp(p_min, p_max);
+    (e_old + dw_dev - 0.5 * (p_old + bound) * dj, bound)
 }
 
 #[cfg(test)]
@@ -514,15 +517,26 @@ mod tests {
         let (a, b) = (-3.0e4 * 0.2, 1.22);
         let (e_old, p_old, dj) = (100.0, 0.0, 0.05);
         // The EOS would give a + bE ≪ 0: the point carries p_min = 0 and no work.
-        let (e, p) = energy_and_pressure(e_old, 0.0, p_old, dj, (a, b), 0.0);
+        let (e, p) = energy_and_pressure(e_old, 0.0, p_old, dj, (a, b), (0.0, f64::INFINITY));
         assert_eq!((e, p), (e_old, 0.0));
         // Above the cut-off: the EOS pressure and the trapezoidal energy.
-        let (e, p) = energy_and_pressure(e_old, 0.0, p_old, dj, (a, b), f64::NEG_INFINITY);
+        let (e, p) = energy_and_pressure(
+            e_old,
+            0.0,
+            p_old,
+            dj,
+            (a, b),
+            (f64::NEG_INFINITY, f64::INFINITY),
+        );
         assert_eq!(e, energy_update(e_old, 0.0, p_old, dj, (a, b)));
         assert_eq!(p, a + b * e);
         // A cut-off at −T: the energy of p = −T over ΔJ.
-        let (e, p) = energy_and_pressure(e_old, 0.0, -4.0, dj, (a, b), -4.0);
+        let (e, p) = energy_and_pressure(e_old, 0.0, -4.0, dj, (a, b), (-4.0, f64::INFINITY));
         assert_eq!(p, -4.0);
         assert!((e - (e_old + 4.0 * dj)).abs() < 1e-12);
+        // Rubble (p_max = 0) with a large Grüneisen energy: no pressure, and the
+        // energy keeps the work of the pressure it had.
+        let (e, p) = energy_and_pressure(1e5, 0.0, 0.0, -0.5, (a, b), (0.0, 0.0));
+        assert_eq!((e, p), (1e5, 0.0));
     }
 }

@@ -22,12 +22,14 @@
 //! Damage (Johnson & Cook 1985): D += Δε̄p/ε_f,
 //! ε_f = [D1 + D2 exp(D3 σ*)][1 + D4 ln ε̇*][1 + D5 T*], σ* = −p/q the triaxiality
 //! at the step start. At D = 1 the particle has failed: it carries no shear
-//! (s = 0) and no tension (p ≥ 0).
+//! (s = 0) and no tension (p ≥ 0), and no pressure at all while opened (J > 1:
+//! rubble whose Grüneisen term would otherwise push it apart).
 //!
 //! Energy: E (per reference volume) follows dE = τ_dev : dε − p dJ by the
 //! trapezoidal rule, with p_new from the EOS at E_new (closed form,
 //! `eos::energy_update`), so an EOS with Γ ≠ 0 heats under compression; the
-//! plastic work is part of E. The model has no analytic tangent (implicit runs
+//! plastic work is part of E. Where the pressure is cut off, E takes the work of
+//! the pressure carried (`eos::energy_and_pressure`). The model has no analytic tangent (implicit runs
 //! use the matrix-free path).
 //!
 //! History: ε̄p, E, then T − T_r if the model is thermal, then D if it has damage.
@@ -239,9 +241,13 @@ impl Material for JohnsonCook {
         // Energy and pressure (trapezoidal, p_new from the EOS at E_new).
         let dw_dev = 0.5 * (tau_dev_old + tau_dev).component_mul(&strain_increment).sum();
         let affine = self.eos.affine(1.0 / j - 1.0);
-        // Failed: no shear, no tension.
-        let p_min = if damage >= 1.0 { 0.0 } else { f64::NEG_INFINITY };
-        let (energy, p) = energy_and_pressure(h_old[ENERGY], dw_dev, p_old, j - j_old, affine, p_min);
+        // Failed: no shear, no tension, and no pressure while opened (J > 1).
+        let bounds = match (damage >= 1.0, j > 1.0) {
+            (false, _) => (f64::NEG_INFINITY, f64::INFINITY),
+            (true, false) => (0.0, f64::INFINITY),
+            (true, true) => (0.0, 0.0),
+        };
+        let (energy, p) = energy_and_pressure(h_old[ENERGY], dw_dev, p_old, j - j_old, affine, bounds);
         h_new[ENERGY] = energy;
         if damage >= 1.0 {
             return -Mat3::identity() * p;

@@ -24,7 +24,11 @@
 //! ε_p^f = max(D1 (p* + (1 − D) T*)^{D2}, ε_f,min), T* = T_s F_rate/f_c (4-38,
 //! 4-39), and the strength is (1 − D) σ_fail + D σ_res (4-37). The shear modulus
 //! falls with damage, G_D = (1 − D) G + D SHRATD G (4-40…4-42). Tension cut-off
-//! p ≥ −(1 − D) T_s F_rate (4-29).
+//! p ≥ −(1 − D) T_s F_rate (4-29). A failed point (D = 1) whose matrix is in
+//! tension (μ_s < 0) is rubble and carries no pressure (our addition: with
+//! T1 μ + B0 E it would push itself apart by its internal energy, and that
+//! energy grows without bound as the rubble is recompacted); the energy takes the
+//! work of the pressure carried (`eos::energy_and_pressure`).
 //!
 //! P-α (Herrmann; 4-43…4-49): the distension α = ρ_s/ρ follows the crush curve
 //! α = 1 + (α₀ − 1)((P_lock − p)/(P_lock − P_crush))ⁿ for P_crush < p < P_lock on
@@ -376,8 +380,11 @@ impl Material for Rht {
         // Tension cut-off (4-29), the energy from the pressure carried.
         let f_tension = self.rate_factor(-self.tensile_strength(), rate);
         let p_min = -(1.0 - damage) * self.tension_zero() * f_tension;
+        // Failed and opened beyond the solid density (μ_s < 0): rubble, p = 0.
+        let rubble = damage >= 1.0 && self.eos.matrix_strain(alpha, j) < 0.0;
+        let p_max = if rubble { 0.0 } else { f64::INFINITY };
         let affine = self.eos.affine(alpha, j);
-        let (energy, p) = energy_and_pressure(h_old[ENERGY], dw_dev, p_old, j - j_old, affine, p_min);
+        let (energy, p) = energy_and_pressure(h_old[ENERGY], dw_dev, p_old, j - j_old, affine, (p_min, p_max));
 
         // Surfaces at the trial Lode angle.
         let theta = lode_angle(&s_trial);
@@ -753,5 +760,33 @@ mod tests {
         let r = driver::run(&m, &hydrostatic(1.002, 100), 0.0);
         let p = -r.stress.last().unwrap().trace() / 3.0;
         assert!((p + m.tension_zero()).abs() < 1e-9, "p {p} vs −T_s {}", m.tension_zero());
+    }
+
+    #[test]
+    fn failed_rubble_opened_beyond_the_solid_density_carries_no_pressure() {
+        let m = case(1);
+        // Failed (D = 1), fully compacted (α = 1), with a large internal energy,
+        // opened to J = 1.2 (μ_s < 0) and then opened further: B0 E would give
+        // 1.22 × 500 MPa of pressure; rubble carries none, and takes no work.
+        let history = [2.0, 1.0, 1.0 - m.eos.alpha0, 500.0];
+        let f_old = Mat3::identity() * 1.2f64.cbrt();
+        let df = Mat3::identity() * (1.3f64 / 1.2).cbrt();
+        let inc = Increment {
+            f_old,
+            df,
+            dt: 1e-3,
+            stress_old: Mat3::zeros(),
+            history_old: &history,
+        };
+        let mut h_new = [0.0; 4];
+        let stress = m.update(&inc, &mut h_new);
+        assert_eq!(stress, Mat3::zeros());
+        assert_eq!(h_new[ENERGY], 500.0);
+        // Recompacted past the solid density (J < 1/α₀ = 0.887 at α = 1), it
+        // carries pressure again.
+        let df = Mat3::identity() * (0.85f64 / 1.2).cbrt();
+        let inc = Increment { df, ..inc };
+        let stress = m.update(&inc, &mut h_new);
+        assert!(-stress.trace() / 3.0 > 0.0, "{stress}");
     }
 }
