@@ -520,29 +520,23 @@ fn particles_leaving_the_grid_stop_the_run_or_are_removed_with_their_mass_and_en
 }
 
 #[test]
-fn hanchak_perforation_at_the_thesis_resolution_keeps_its_residual_velocity() {
-    // papers/penetration_hanchak: RHT + P-α eroded at ε̄p = 2, a free rigid rod,
-    // h = 4 mm (the thesis' cell; measured 584.4 m/s, −5.0 % against the test's
-    // 615; 613.3 and 628.3 at h = 2.84 and 2 mm). A regression guard within 6 %,
-    // with the energy never created and the removed ejecta counted.
+fn hanchak_perforation_is_within_5_percent_of_the_test() {
+    // papers/penetration_hanchak: RHT + P-α, a free rigid rod, contact within one
+    // cell, h = 2.84 mm (measured 602.3 m/s, −2.1 % against the test's 615;
+    // 567.4 and 611.6 at h = 4 and 2 mm, 615.0 extrapolated; the rod's
+    // velocity is constant to 0.1 m/s from 0.38 ms on), with the energy never
+    // created.
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/papers/penetration_hanchak/hanchak_rht.toml"
     );
     let text = std::fs::read_to_string(path).unwrap();
-    let (result, dir) = run_text(
-        &text,
-        &[
-            "grid.cells=[83,215]",
-            "material.0.erosion_plastic_strain=2.0",
-            "solver.end_time=0.45",
-        ],
-    );
+    let (result, dir) = run_text(&text, &["grid.cells=[117,304]", "solver.end_time=0.45"]);
     result.expect("the perforation runs");
     let h = Table::read(&dir.path().join("history.csv")).unwrap();
     let v = -h.col("body1_vy").last().unwrap();
     println!("residual velocity {v:.1} m/s against 615");
-    assert!((v / 615.0 - 1.0).abs() < 0.06, "{v}");
+    assert!((v / 615.0 - 1.0).abs() < 0.05, "{v}");
     let (kinetic, strain) = (h.col("kinetic"), h.col("strain"));
     for i in 1..kinetic.len() {
         assert!(
@@ -550,5 +544,4 @@ fn hanchak_perforation_at_the_thesis_resolution_keeps_its_residual_velocity() {
             "energy created at row {i}"
         );
     }
-    assert!(*h.col("eroded_mass").last().unwrap() > 0.0);
 }
