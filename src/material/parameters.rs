@@ -123,18 +123,16 @@ impl<'a> Parameters<'a> {
 
     /// Key k, required, a positive number.
     pub fn positive(&self, k: &str) -> Result<f64, KeyError> {
-        let v: f64 = self.required(k)?;
-        self.ensure(
-            v > 0.0 && v.is_finite(),
-            k,
-            format!("must be a positive number; got {v}"),
-        )?;
-        Ok(v)
+        self.checked_positive(k, self.required(k)?)
     }
 
     /// Key k, a positive number, `default` when not given.
     pub fn positive_or(&self, k: &str, default: f64) -> Result<f64, KeyError> {
-        let v: f64 = self.get(k)?.unwrap_or(default);
+        self.checked_positive(k, self.get(k)?.unwrap_or(default))
+    }
+
+    /// v, the value of key k, if it is a positive number.
+    fn checked_positive(&self, k: &str, v: f64) -> Result<f64, KeyError> {
         self.ensure(
             v > 0.0 && v.is_finite(),
             k,

@@ -372,11 +372,10 @@ impl Material for Rht {
         let p_old = -inc.stress_old.trace() / 3.0;
         let dw_dev = tau_dev_old.component_mul(&strain_increment).sum();
         let mut energy = h_old[ENERGY] + dw_dev - p_old * (j - j_old);
-        let mut alpha = alpha_old;
-        for _ in 0..2 {
-            alpha = self.eos.distension(alpha_old, j, energy);
-            energy = energy_update(h_old[ENERGY], dw_dev, p_old, j - j_old, self.eos.affine(alpha, j));
-        }
+        // The second pass's energy is `energy_and_pressure`'s below.
+        let alpha = self.eos.distension(alpha_old, j, energy);
+        energy = energy_update(h_old[ENERGY], dw_dev, p_old, j - j_old, self.eos.affine(alpha, j));
+        let alpha = self.eos.distension(alpha_old, j, energy);
         // Tension cut-off (4-29), the energy from the pressure carried.
         let f_tension = self.rate_factor(-self.tensile_strength(), rate);
         let p_min = -(1.0 - damage) * self.tension_zero() * f_tension;

@@ -78,7 +78,7 @@ impl<const D: usize> Model<D> {
 
     /// Mass and energy (kinetic + stored) of the removed particles, which keep the
     /// velocity and internal energy they had when removed (history.csv).
-    pub fn eroded_mass_and_energy(&self) -> (f64, f64) {
+    pub fn removed_mass_and_energy(&self) -> (f64, f64) {
         let p = &self.particles;
         let eroded: Vec<usize> = (0..p.len()).filter(|&q| self.removed(q)).collect();
         let mass = eroded.iter().fold(0.0, |sum, &q| sum + p.mass[q]);

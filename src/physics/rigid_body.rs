@@ -152,7 +152,7 @@ impl<const D: usize> FreeBodies<D> {
             moment[k] += self.offsets[i].cross(&f);
         }
         let mut motion = Vec::with_capacity(n);
-        for (k, b) in self.bodies.iter_mut().enumerate() {
+        for (k, b) in self.bodies.iter().enumerate() {
             let mut velocity = b.velocity + (b.impulse + impulse[k]) / b.mass;
             if axisymmetric {
                 velocity[0] = 0.0;
@@ -161,8 +161,6 @@ impl<const D: usize> FreeBodies<D> {
             let spin = spin::<D>(&b.inertia, &l, axisymmetric);
             let rotation = Rotation3::new(spin * dt);
             motion.push((b.centre + velocity * dt, velocity, spin, rotation));
-            b.impulse = Vector3::zeros();
-            b.moment = Vector3::zeros();
         }
         for (i, &(q, k)) in self.particles.iter().enumerate() {
             let (centre, velocity, spin, rotation) = &motion[k];

@@ -244,7 +244,7 @@ impl Recorders {
             self.last_history = t;
             let (com, vcom) = body_centres(&m.particles, self.n_bodies);
             let (kinetic, strain) = (kinetic_energy(m), strain_energy(m));
-            let eroded = m.removes_particles().then(|| m.eroded_mass_and_energy());
+            let eroded = m.removes_particles().then(|| m.removed_mass_and_energy());
             let extra: Vec<f64> = eroded.map_or(vec![], |(mass, energy)| vec![mass, energy]);
             self.history
                 .write_row(t, kinetic, strain, now.external_work, &extra, &com, &vcom)?;
