@@ -87,6 +87,142 @@ impl Geometry {
             }
         }
     }
+
+    /// The axis-aligned bounds (min, max) of the body.
+    pub fn bounds(&self) -> (Vec<f64>, Vec<f64>) {
+        match self {
+            Geometry::Box { min, max } => (min.clone(), max.clone()),
+            Geometry::Ball { centre, radius } => (
+                centre.iter().map(|c| c - radius).collect(),
+                centre.iter().map(|c| c + radius).collect(),
+            ),
+            Geometry::Polygon(v) => (
+                (0..2)
+                    .map(|d| v.iter().map(|p| p[d]).fold(f64::INFINITY, f64::min))
+                    .collect(),
+                (0..2)
+                    .map(|d| v.iter().map(|p| p[d]).fold(f64::NEG_INFINITY, f64::max))
+                    .collect(),
+            ),
+            Geometry::Cylinder {
+                base,
+                radius,
+                height,
+            } => (
+                vec![base[0] - radius, base[1] - radius, base[2]],
+                vec![base[0] + radius, base[1] + radius, base[2] + height],
+            ),
+        }
+    }
+
+    /// The point of the body's surface nearest to x (a point inside the body) and
+    /// the outward unit normal there. A face on a plane x_d = c for which
+    /// `on_boundary(d, c)` holds (a symmetry plane, the axis) is not surface;
+    /// `None` if no face is.
+    pub fn nearest_surface(
+        &self,
+        x: &[f64],
+        on_boundary: &dyn Fn(usize, f64) -> bool,
+    ) -> Option<(Vec<f64>, Vec<f64>)> {
+        let unit = |d: usize, sign: f64| -> Vec<f64> {
+            (0..x.len())
+                .map(|i| if i == d { sign } else { 0.0 })
+                .collect()
+        };
+        let on_plane = |d: usize, c: f64, sign: f64| {
+            let mut y = x.to_vec();
+            y[d] = c;
+            ((x[d] - c).abs(), y, unit(d, sign))
+        };
+        // Candidates (distance, point, normal); the nearest wins.
+        let mut faces: Vec<(f64, Vec<f64>, Vec<f64>)> = Vec::new();
+        match self {
+            Geometry::Box { min, max } => {
+                for d in 0..x.len() {
+                    if !on_boundary(d, min[d]) {
+                        faces.push(on_plane(d, min[d], -1.0));
+                    }
+                    if !on_boundary(d, max[d]) {
+                        faces.push(on_plane(d, max[d], 1.0));
+                    }
+                }
+            }
+            Geometry::Ball { centre, radius } => {
+                let r: Vec<f64> = (0..x.len()).map(|d| x[d] - centre[d]).collect();
+                let n = radial(&r);
+                let y = (0..x.len()).map(|d| centre[d] + radius * n[d]).collect();
+                faces.push((radius - norm(&r), y, n));
+            }
+            Geometry::Polygon(v) => faces.extend(polygon_faces(v, x, on_boundary)),
+            Geometry::Cylinder {
+                base,
+                radius,
+                height,
+            } => {
+                let r = [x[0] - base[0], x[1] - base[1], 0.0];
+                let n = radial(&r);
+                let y = vec![base[0] + radius * n[0], base[1] + radius * n[1], x[2]];
+                faces.push((radius - norm(&r), y, n));
+                for (c, sign) in [(base[2], -1.0), (base[2] + height, 1.0)] {
+                    if !on_boundary(2, c) {
+                        faces.push(on_plane(2, c, sign));
+                    }
+                }
+            }
+        }
+        faces
+            .into_iter()
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .map(|(_, y, n)| (y, n))
+    }
+}
+
+fn norm(r: &[f64]) -> f64 {
+    r.iter().map(|c| c * c).sum::<f64>().sqrt()
+}
+
+/// r/|r|, or the first axis for r = 0 (the centre of a ball: any direction).
+fn radial(r: &[f64]) -> Vec<f64> {
+    let l = norm(r);
+    match l > 0.0 {
+        true => r.iter().map(|c| c / l).collect(),
+        false => (0..r.len())
+            .map(|i| if i == 0 { 1.0 } else { 0.0 })
+            .collect(),
+    }
+}
+
+/// The nearest point of each edge of a polygon to x with the edge's outward
+/// normal, leaving out edges on a boundary plane (both ends on it).
+fn polygon_faces(
+    v: &[Vec<f64>],
+    x: &[f64],
+    on_boundary: &dyn Fn(usize, f64) -> bool,
+) -> Vec<(f64, Vec<f64>, Vec<f64>)> {
+    let n = v.len();
+    // Twice the signed area: > 0 for counter-clockwise vertices.
+    let area: f64 = (0..n)
+        .map(|k| v[k][0] * v[(k + 1) % n][1] - v[(k + 1) % n][0] * v[k][1])
+        .sum();
+    let out = area.signum();
+    let mut faces = Vec::with_capacity(n);
+    for k in 0..n {
+        let (a, b) = (&v[k], &v[(k + 1) % n]);
+        if (0..2).any(|d| a[d] == b[d] && on_boundary(d, a[d])) {
+            continue;
+        }
+        let e = [b[0] - a[0], b[1] - a[1]];
+        let l2 = e[0] * e[0] + e[1] * e[1];
+        if l2 == 0.0 {
+            continue;
+        }
+        let t = (((x[0] - a[0]) * e[0] + (x[1] - a[1]) * e[1]) / l2).clamp(0.0, 1.0);
+        let y = vec![a[0] + t * e[0], a[1] + t * e[1]];
+        let l = l2.sqrt();
+        let normal = vec![out * e[1] / l, -out * e[0] / l];
+        faces.push((norm(&[x[0] - y[0], x[1] - y[1]]), y, normal));
+    }
+    faces
 }
 
 /// Even-odd rule (ray crossing to +x).
@@ -135,6 +271,44 @@ mod tests {
         let tri = vec![vec![0.0, 0.0], vec![2.0, 0.0], vec![0.0, 2.0]];
         assert!(point_in_polygon(0.5, 0.5, &tri));
         assert!(!point_in_polygon(1.5, 1.5, &tri));
+    }
+
+    #[test]
+    fn nearest_surface_of_each_shape() {
+        let none = |_: usize, _: f64| false;
+        // A clockwise square: the normal still points out.
+        let square = Geometry::Polygon(vec![
+            vec![0.0, 0.0],
+            vec![0.0, 2.0],
+            vec![2.0, 2.0],
+            vec![2.0, 0.0],
+        ]);
+        let (y, n) = square.nearest_surface(&[1.9, 0.5], &none).unwrap();
+        assert_eq!((y, n), (vec![2.0, 0.5], vec![1.0, 0.0]));
+        // The face on the axis x = 0 is not surface: the bottom is nearest.
+        let axis = |d: usize, c: f64| d == 0 && c == 0.0;
+        let (y, n) = square.nearest_surface(&[0.1, 0.5], &axis).unwrap();
+        assert_eq!((y, n), (vec![0.1, 0.0], vec![0.0, -1.0]));
+        let disk = Geometry::Ball {
+            centre: vec![1.0, 1.0],
+            radius: 2.0,
+        };
+        let (y, n) = disk.nearest_surface(&[1.0, 2.5], &none).unwrap();
+        assert!((y[1] - 3.0).abs() < 1e-15 && (n[1] - 1.0).abs() < 1e-15);
+        let bx = Geometry::Box {
+            min: vec![0.0, 0.0, 0.0],
+            max: vec![1.0, 1.0, 4.0],
+        };
+        let (y, n) = bx.nearest_surface(&[0.5, 0.5, 3.8], &none).unwrap();
+        assert_eq!((y, n), (vec![0.5, 0.5, 4.0], vec![0.0, 0.0, 1.0]));
+        let cyl = Geometry::Cylinder {
+            base: vec![0.0, 0.0, 0.0],
+            radius: 1.0,
+            height: 4.0,
+        };
+        let (y, n) = cyl.nearest_surface(&[0.0, 0.9, 2.0], &none).unwrap();
+        assert_eq!((y, n), (vec![0.0, 1.0, 2.0], vec![0.0, 1.0, 0.0]));
+        assert_eq!(cyl.bounds(), (vec![-1.0, -1.0, 0.0], vec![1.0, 1.0, 4.0]));
     }
 
     #[test]

@@ -35,10 +35,10 @@
 //! in field order.
 
 use crate::dim::Vector;
-use crate::model::particles::Particles;
 use crate::model::Model;
 use crate::parallel::MIN_PARALLEL_LEN;
 use crate::physics::rigid_body::FreeBodies;
+use crate::physics::rigid_surface::{Push, Surface};
 use crate::physics::shape::{ShapeFunction, Stencils};
 use crate::physics::transfer::NodeMap;
 use crate::scene::contact::{ContactLaw, ContactPlan};
@@ -98,6 +98,9 @@ pub struct Contact<const D: usize> {
     totals: Vec<PairTotal<D>>,
     /// The free rigid bodies (`physics::rigid_body`), if any.
     free: Option<FreeBodies<D>>,
+    /// The rigid fields that keep deformable particles out
+    /// (`physics::rigid_surface`).
+    surfaces: Vec<Surface>,
     /// Index into `totals` of field pair (i, j), i < j, at i · fields + j.
     pair_index: Vec<usize>,
     /// Scratch of `split_shared_nodes`, one entry per grid node: the fields that
@@ -107,7 +110,9 @@ pub struct Contact<const D: usize> {
 }
 
 impl<const D: usize> Contact<D> {
-    pub fn new(plan: ContactPlan, particles: &Particles<D>) -> Self {
+    /// The contact state of a run of model m with `plan`.
+    pub fn new(plan: ContactPlan, m: &Model<D>) -> Self {
+        let particles = &m.particles;
         let field: Vec<u32> = particles
             .body
             .iter()
@@ -135,6 +140,7 @@ impl<const D: usize> Contact<D> {
         }
         Contact {
             free: FreeBodies::new(&plan.free, &field),
+            surfaces: surfaces(&plan, m, &field),
             plan,
             field,
             split: Vec::new(),
@@ -423,6 +429,82 @@ impl<const D: usize> Contact<D> {
         corrected
     }
 
+    /// Put the deformable particles that entered a rigid body back on its
+    /// surface, without inward velocity relative to it, and give the body the
+    /// opposite momentum (`physics::rigid_surface`). After G2P and the free
+    /// bodies' advance.
+    pub fn keep_out_of_rigid_bodies(&mut self, m: &mut Model<D>) {
+        if self.surfaces.is_empty() {
+            return;
+        }
+        if let Some(free) = &mut self.free {
+            free.start(&m.particles, m.axisymmetric);
+        }
+        let pushes = self.pushes(m);
+        let mut kicks = Vec::new();
+        for push in &pushes {
+            let k = push.field as usize;
+            let surface = self.surfaces.iter().find(|s| s.field == push.field);
+            let prescribed = m.particles.v[surface.expect("a rigid field").particle()];
+            let free = self.free.as_ref().and_then(|f| f.node_velocity(k, &push.x));
+            let body_velocity = free.unwrap_or(prescribed);
+            let (q, p) = (push.particle, &mut m.particles);
+            p.x[q] = push.x;
+            let approach = (p.v[q] - body_velocity).dot(&push.normal);
+            if approach >= 0.0 {
+                continue;
+            }
+            let dv = -push.normal * approach;
+            p.v[q] += dv;
+            let dp = dv * p.mass[q];
+            let fq = self.field[q] as usize;
+            let total = &mut self.totals[self.pair_index[fq.min(k) * self.plan.fields + fq.max(k)]];
+            total.impulse += if fq < k { dp } else { -dp };
+            if self.plan.free[k] {
+                kicks.push((k, push.x, -dp));
+            }
+        }
+        if let (Some(free), false) = (&mut self.free, kicks.is_empty()) {
+            free.kick(&mut m.particles, &kicks, m.axisymmetric);
+        }
+    }
+
+    /// The deformable particles inside a rigid body they are in contact with,
+    /// in particle order, with where they go.
+    fn pushes(&self, m: &Model<D>) -> Vec<Push<D>> {
+        let placements: Vec<_> = (self.surfaces.iter())
+            .map(|s| s.placement(&m.particles))
+            .collect();
+        let grid = &m.grid;
+        let tolerance = 1e-9 * grid.h_min();
+        let on_boundary = |d: usize, c: f64| {
+            (c - grid.min[d]).abs() <= tolerance || (c - grid.max[d]).abs() <= tolerance
+        };
+        let (plan, field, removes) = (&self.plan, &self.field, m.removes_particles());
+        (0..m.particles.len())
+            .into_par_iter()
+            .with_min_len(MIN_PARALLEL_LEN)
+            .filter_map(|q| {
+                let f = field[q];
+                if plan.rigid[f as usize] || (removes && m.removed(q)) {
+                    return None;
+                }
+                let x = &m.particles.x[q];
+                (self.surfaces.iter().zip(&placements))
+                    .filter(|(s, _)| plan.law(f, s.field).is_some_and(|l| l.rigid_projection))
+                    .find_map(|(s, at)| {
+                        let (x, normal) = s.push_out(at, x, &on_boundary)?;
+                        Some(Push {
+                            particle: q,
+                            field: s.field,
+                            x,
+                            normal,
+                        })
+                    })
+            })
+            .collect()
+    }
+
     /// The totals since the last call, reset.
     pub fn take_totals(&mut self) -> Vec<PairTotal<D>> {
         let out = self.totals.clone();
@@ -436,6 +518,33 @@ impl<const D: usize> Contact<D> {
     pub fn plan(&self) -> &ContactPlan {
         &self.plan
     }
+}
+
+/// The rigid fields whose contact with some other field keeps that field's
+/// particles out (`rigid_projection`), with their particles and geometries.
+fn surfaces<const D: usize>(plan: &ContactPlan, m: &Model<D>, field: &[u32]) -> Vec<Surface> {
+    let keeps_out = |k: usize| {
+        (0..plan.fields).any(|j| {
+            j != k
+                && plan
+                    .law(k as u32, j as u32)
+                    .is_some_and(|l| l.rigid_projection)
+        })
+    };
+    (0..plan.fields)
+        .filter(|&k| plan.rigid[k] && keeps_out(k))
+        .map(|k| {
+            let members = (0..field.len())
+                .filter(|&q| field[q] as usize == k)
+                .collect();
+            let shapes = (plan.field_of_body.iter().enumerate())
+                .filter(|&(_, &f)| f as usize == k)
+                .map(|(b, _)| m.bodies[b].clone())
+                .collect();
+            let rotates = plan.free[k] && !m.axisymmetric;
+            Surface::new(k as u32, members, shapes, &m.particles, rotates)
+        })
+        .collect()
 }
 
 /// The part of v tangential to the unit normal n.
@@ -492,6 +601,7 @@ mod tests {
                 adhesion: 0.0,
                 gap_factor: 0.5,
                 normal: ContactNormal::MaxGradient,
+                rigid_projection: true,
             },
         }
     }

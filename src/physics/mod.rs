@@ -12,5 +12,6 @@ pub mod fbar;
 pub mod geostatic;
 pub mod mirror;
 pub mod rigid_body;
+pub mod rigid_surface;
 pub mod shape;
 pub mod transfer;

@@ -169,6 +169,33 @@ impl<const D: usize> FreeBodies<D> {
             p.v[q] = from3(&(velocity + spin.cross(&r)));
         }
     }
+
+    /// After `advance`, give the bodies the impulses `kicks` (field, point, Δp)
+    /// and set their particles' velocities: V' = V + J/M, Ω' = I⁻¹(IΩ + H).
+    pub fn kick(
+        &mut self,
+        p: &mut Particles<D>,
+        kicks: &[(usize, Vector<D>, Vector<D>)],
+        axisymmetric: bool,
+    ) {
+        self.start(p, axisymmetric);
+        for (field, x, dp) in kicks {
+            self.receive(*field, x, dp);
+        }
+        for b in &mut self.bodies {
+            b.velocity += b.impulse / b.mass;
+            if axisymmetric {
+                b.velocity[0] = 0.0;
+            }
+            let l = b.inertia * b.spin + b.moment;
+            b.spin = spin::<D>(&b.inertia, &l, axisymmetric);
+            (b.impulse, b.moment) = (Vector3::zeros(), Vector3::zeros());
+        }
+        for (i, &(q, k)) in self.particles.iter().enumerate() {
+            let b = &self.bodies[k];
+            p.v[q] = from3(&(b.velocity + b.spin.cross(&self.offsets[i])));
+        }
+    }
 }
 
 /// Ω = I⁻¹ L: about z in 2D (L_z/I_zz), none in axisymmetric mode, the full

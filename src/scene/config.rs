@@ -337,6 +337,14 @@ pub struct ContactConfig {
     /// How the common normal of a contact node is found (default `max_gradient`).
     #[serde(default)]
     pub normal: ContactNormal,
+    /// Put deformable particles that enter a rigid body back on its surface
+    /// (`crate::physics::rigid_surface`; default true).
+    #[serde(default = "yes")]
+    pub rigid_projection: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 /// The common normal of two fields at a contact node, from their volume gradients

@@ -24,6 +24,8 @@ pub struct ContactLaw {
     /// Contact needs the gap D ≤ λ h.
     pub gap_factor: f64,
     pub normal: ContactNormal,
+    /// Deformable particles that enter a rigid body are put back on its surface.
+    pub rigid_projection: bool,
 }
 
 impl ContactLaw {
@@ -33,6 +35,7 @@ impl ContactLaw {
             adhesion: c.adhesion,
             gap_factor: c.gap_factor,
             normal: c.normal,
+            rigid_projection: c.rigid_projection,
         }
     }
 }

@@ -117,7 +117,7 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
     /// applied loads over the step.
     fn step(&mut self, m: &mut Model<D>, t: f64, dt: f64, step: usize) -> Result<f64, Divergence> {
         if let (None, Some(plan)) = (&self.contact, &m.contact) {
-            self.contact = Some(Contact::new(plan.clone(), &m.particles));
+            self.contact = Some(Contact::new(plan.clone(), m));
         }
         let p = &m.particles;
         match &mut self.contact {
@@ -236,6 +236,10 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
                 .collect();
             free.advance(&mut m.particles, &force, m.axisymmetric, dt);
         }
+        if let Some(c) = &mut self.contact {
+            c.keep_out_of_rigid_bodies(m);
+        }
+        let load_factor = |q: usize| crate::model::load_factor(&m.load_ramp_of, q, &scales);
         let p = &m.particles;
         let contact = &self.contact;
         let rigid = |q: usize| {

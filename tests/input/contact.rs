@@ -22,7 +22,7 @@ fn rejected(text: &str, key: &str, parts: &[&str]) {
 
 #[test]
 fn the_contact_scenes_are_valid() {
-    Scene::parse("scene.toml", &scene("[[contact]]\nbodies = [\"left\", \"right\"]\nfriction_coefficient = 0.3\nadhesion = 10.0\ngap_factor = 1.0\nnormal = \"average\"\n"), &[]).unwrap();
+    Scene::parse("scene.toml", &scene("[[contact]]\nbodies = [\"left\", \"right\"]\nfriction_coefficient = 0.3\nadhesion = 10.0\ngap_factor = 1.0\nnormal = \"average\"\nrigid_projection = false\n"), &[]).unwrap();
     Scene::parse("scene.toml", &scene("[[contact]]\n"), &[]).unwrap();
 }
 
@@ -69,6 +69,15 @@ fn negative_friction_and_adhesion_and_a_zero_gap_factor_are_rejected() {
         &scene("[[contact]]\ngap_factor = 0.0\n"),
         "contact.0.gap_factor",
         &["scene.toml:44:", "must be a finite number > 0"],
+    );
+}
+
+#[test]
+fn a_rigid_projection_that_is_not_a_bool_is_named() {
+    rejected(
+        &scene("[[contact]]\nrigid_projection = \"yes\"\n"),
+        "contact.0.rigid_projection",
+        &["scene.toml:44:", "expected a boolean"],
     );
 }
 

@@ -1,0 +1,222 @@
+//! Rigid bodies are impenetrable (explicit solver; `[[contact]]` key
+//! `rigid_projection`, on by default).
+//!
+//! Node-based contact (`physics::contact`) acts at grid nodes, so a deformable
+//! particle can enter a rigid body by up to about a cell before the nodes it
+//! touches stop it: in a penetration, concrete that the nose carries along the
+//! axis ends up inside the shank and is crushed there
+//! (papers/penetration_hanchak). A rigid body's shape is known exactly, its
+//! `[[body]]` geometry carried by its rigid motion, so after G2P a deformable
+//! particle whose centre lies inside a rigid body it is in contact with is put
+//! on the body's nearest surface point, and its velocity relative to the body
+//! loses its inward normal part: w·n < 0 ⇒ v ← v − (w·n) n, w = v − u_body(x).
+//! Frictionless: friction acts at the nodes. The particle's momentum change goes
+//! to the body, equal and opposite (a free body takes it as an impulse at that
+//! point, `FreeBodies::kick`; a prescribed one absorbs it), and to the pair's
+//! contact force.
+//!
+//! The placement of a rigid body comes from its particles: centre
+//! c = Σ m x / M, reference centre c⁰ = Σ m X / M, and the rotation Q taking the
+//! reference offsets to the current ones, the polar factor of
+//! A = Σ m (x − c)(X − c⁰)ᵀ (in 2D θ = atan2(A₁₀ − A₀₁, A₀₀ + A₁₁); none for a
+//! prescribed motion or in axisymmetric mode). A point x is then at
+//! X = c⁰ + Qᵀ(x − c) in the body's `[[body]]` geometry. Faces on a plane of the
+//! grid's boundary (the axis, a symmetry plane) are not surface.
+
+use crate::dim::{Mat3, Vector};
+use crate::model::geometry::Geometry;
+use crate::model::particles::Particles;
+use nalgebra::Vector3;
+
+/// One rigid velocity field: its particles and the geometries of its bodies.
+#[derive(Clone, Debug)]
+pub struct Surface {
+    pub field: u32,
+    members: Vec<usize>,
+    shapes: Vec<Geometry>,
+    /// Bounds of the union of `shapes`, reference configuration.
+    lower: Vector3<f64>,
+    upper: Vector3<f64>,
+    mass: f64,
+    centre0: Vector3<f64>,
+    rotates: bool,
+}
+
+/// Where a rigid field is now: x = c + Q (X − c⁰).
+#[derive(Clone, Copy, Debug)]
+pub struct Placement {
+    centre: Vector3<f64>,
+    centre0: Vector3<f64>,
+    rotation: Mat3,
+}
+
+/// A particle to put back on a rigid body's surface.
+#[derive(Clone, Copy, Debug)]
+pub struct Push<const D: usize> {
+    pub particle: usize,
+    /// The rigid field.
+    pub field: u32,
+    /// The surface point (new position) and the outward normal there.
+    pub x: Vector<D>,
+    pub normal: Vector<D>,
+}
+
+fn to3<const D: usize>(v: &Vector<D>) -> Vector3<f64> {
+    Vector3::from_fn(|i, _| if i < D { v[i] } else { 0.0 })
+}
+
+fn from3<const D: usize>(v: &Vector3<f64>) -> Vector<D> {
+    Vector::<D>::from_fn(|i, _| v[i])
+}
+
+impl Surface {
+    /// The rigid field `field` made of `members` (particles) and `shapes`
+    /// (its bodies' geometries); `rotates` for a free body outside axisymmetry.
+    pub fn new<const D: usize>(
+        field: u32,
+        members: Vec<usize>,
+        shapes: Vec<Geometry>,
+        p: &Particles<D>,
+        rotates: bool,
+    ) -> Self {
+        let mass: f64 = members.iter().map(|&q| p.mass[q]).sum();
+        let centre0 = members
+            .iter()
+            .fold(Vector3::zeros(), |c, &q| c + to3(&p.x0[q]) * p.mass[q])
+            / mass;
+        let (mut lower, mut upper) = (Vector3::zeros(), Vector3::zeros());
+        for d in 0..D {
+            lower[d] = shapes
+                .iter()
+                .map(|s| s.bounds().0[d])
+                .fold(f64::INFINITY, f64::min);
+            upper[d] = (shapes.iter().map(|s| s.bounds().1[d])).fold(f64::NEG_INFINITY, f64::max);
+        }
+        Surface {
+            field,
+            members,
+            shapes,
+            lower,
+            upper,
+            mass,
+            centre0,
+            rotates,
+        }
+    }
+
+    /// One of the field's particles.
+    pub fn particle(&self) -> usize {
+        self.members[0]
+    }
+
+    /// The field's placement now, from its particles.
+    pub fn placement<const D: usize>(&self, p: &Particles<D>) -> Placement {
+        let centre = (self.members.iter())
+            .fold(Vector3::zeros(), |c, &q| c + to3(&p.x[q]) * p.mass[q])
+            / self.mass;
+        let mut rotation = Mat3::identity();
+        if self.rotates {
+            // A = Σ m (x − c)(X − c⁰)ᵀ = Q S, S symmetric.
+            let a = self.members.iter().fold(Mat3::zeros(), |a, &q| {
+                let r = to3(&p.x[q]) - centre;
+                let r0 = to3(&p.x0[q]) - self.centre0;
+                a + r * r0.transpose() * p.mass[q]
+            });
+            rotation = polar_rotation::<D>(&a);
+        }
+        Placement {
+            centre,
+            centre0: self.centre0,
+            rotation,
+        }
+    }
+
+    /// Where to put a particle at x that is inside the field's bodies: the
+    /// nearest surface point and its outward normal (`None` outside).
+    pub fn push_out<const D: usize>(
+        &self,
+        at: &Placement,
+        x: &Vector<D>,
+        on_boundary: &dyn Fn(usize, f64) -> bool,
+    ) -> Option<(Vector<D>, Vector<D>)> {
+        let xr = at.centre0 + at.rotation.transpose() * (to3(x) - at.centre);
+        if (0..D).any(|d| xr[d] <= self.lower[d] || xr[d] >= self.upper[d]) {
+            return None;
+        }
+        let xs = &xr.as_slice()[..D];
+        let (y, n) = (self.shapes.iter())
+            .find(|s| s.contains(xs))?
+            .nearest_surface(xs, on_boundary)?;
+        let y = Vector3::from_fn(|i, _| if i < D { y[i] } else { 0.0 });
+        let n = Vector3::from_fn(|i, _| if i < D { n[i] } else { 0.0 });
+        let y = at.centre + at.rotation * (y - at.centre0);
+        Some((from3(&y), from3(&(at.rotation * n))))
+    }
+}
+
+/// The rotation of the polar decomposition A = Q S.
+fn polar_rotation<const D: usize>(a: &Mat3) -> Mat3 {
+    if D == 2 {
+        let theta = (a[(1, 0)] - a[(0, 1)]).atan2(a[(0, 0)] + a[(1, 1)]);
+        let (s, c) = theta.sin_cos();
+        return Mat3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0);
+    }
+    let svd = a.svd(true, true);
+    let (Some(mut u), Some(v_t)) = (svd.u, svd.v_t) else {
+        return Mat3::identity();
+    };
+    if (u * v_t).determinant() < 0.0 {
+        let last = u.column(2) * -1.0;
+        u.set_column(2, &last);
+    }
+    u * v_t
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dim::Vector;
+    use nalgebra::{Rotation3, Vector2};
+
+    fn particles(x0: &[[f64; 2]], x: &[[f64; 2]]) -> Particles<2> {
+        let mut p = Particles::<2>::default();
+        for (a, b) in x0.iter().zip(x) {
+            p.x0.push(Vector2::new(a[0], a[1]));
+            p.x.push(Vector2::new(b[0], b[1]));
+            p.mass.push(1.0);
+        }
+        p
+    }
+
+    #[test]
+    fn a_turned_and_moved_square_pushes_a_point_out_through_its_nearest_face() {
+        // The square [0, 2]² turned by 30° about its centre and moved by (5, 1).
+        let theta: f64 = 30f64.to_radians();
+        let q = Rotation3::from_axis_angle(&Vector3::z_axis(), theta);
+        let corners = [[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]];
+        let moved: Vec<[f64; 2]> = (corners.iter())
+            .map(|c| {
+                let r = q * Vector3::new(c[0] - 1.0, c[1] - 1.0, 0.0);
+                [6.0 + r[0], 2.0 + r[1]]
+            })
+            .collect();
+        let p = particles(&corners, &moved);
+        let square = Geometry::Box {
+            min: vec![0.0, 0.0],
+            max: vec![2.0, 2.0],
+        };
+        let s = Surface::new(0, vec![0, 1, 2, 3], vec![square], &p, true);
+        let at = s.placement(&p);
+        assert!((at.rotation - q.matrix()).norm() < 1e-14);
+        // Reference point (1.9, 1.2): nearest face x = 2, normal (1, 0) turned.
+        let place = |x: [f64; 2]| {
+            let r = q * Vector3::new(x[0] - 1.0, x[1] - 1.0, 0.0);
+            Vector::<2>::new(6.0 + r[0], 2.0 + r[1])
+        };
+        let none = |_: usize, _: f64| false;
+        let (y, n) = s.push_out(&at, &place([1.9, 1.2]), &none).unwrap();
+        assert!((y - place([2.0, 1.2])).norm() < 1e-13);
+        assert!((n - Vector::<2>::new(theta.cos(), theta.sin())).norm() < 1e-14);
+        assert!(s.push_out(&at, &place([2.1, 1.2]), &none).is_none());
+    }
+}
