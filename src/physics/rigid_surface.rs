@@ -219,4 +219,37 @@ mod tests {
         assert!((n - Vector::<2>::new(theta.cos(), theta.sin())).norm() < 1e-14);
         assert!(s.push_out(&at, &place([2.1, 1.2]), &none).is_none());
     }
+
+    #[test]
+    fn the_placement_of_a_turned_box_in_3d_is_its_rotation() {
+        use nalgebra::Vector3 as V3;
+        let q = Rotation3::from_axis_angle(&V3::y_axis(), 0.4)
+            * Rotation3::from_axis_angle(&V3::x_axis(), -0.7);
+        let mut p = Particles::<3>::default();
+        for c in [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 2.0, 0.0],
+            [0.0, 0.0, 3.0],
+        ] {
+            let x0 = V3::new(c[0], c[1], c[2]);
+            p.x0.push(x0);
+            p.x.push(q * x0 + V3::new(1.0, 2.0, 3.0));
+            p.mass.push(1.0);
+        }
+        let bx = Geometry::Box {
+            min: vec![0.0, 0.0, 0.0],
+            max: vec![1.0, 2.0, 3.0],
+        };
+        let s = Surface::new(0, vec![0, 1, 2, 3], vec![bx], &p, true);
+        let at = s.placement(&p);
+        assert!((at.rotation - q.matrix()).norm() < 1e-13);
+        // (0.5, 1.0, 2.9) is nearest the face z = 3.
+        let x = q * V3::new(0.5, 1.0, 2.9) + V3::new(1.0, 2.0, 3.0);
+        let none = |_: usize, _: f64| false;
+        let (y, n) = s.push_out(&at, &x, &none).unwrap();
+        let expected = q * V3::new(0.5, 1.0, 3.0) + V3::new(1.0, 2.0, 3.0);
+        assert!((y - expected).norm() < 1e-13);
+        assert!((n - q * V3::z()).norm() < 1e-14);
+    }
 }
