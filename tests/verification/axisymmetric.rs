@@ -137,7 +137,7 @@ fn lame_study(shape: &str, nz: usize) -> Vec<LameErrors> {
 
 #[test]
 fn thick_cylinder_matches_lame_linear_and_gimp() {
-    for shape in ["linear", "cpgimp"] {
+    for shape in ["linear", "cpgimp", "cpdi"] {
         let e = lame_study(shape, 1);
         let (c, f) = (&e[0], &e[3]);
         assert!(
@@ -395,6 +395,7 @@ fn solid_cylinder_compressed_radially_is_uniform_up_to_the_axis() {
         ("linear", 2, 1e-12, 1e-12),
         ("ugimp", 2, 1e-12, 1e-12),
         ("cpgimp", 2, 1e-12, 1e-12),
+        ("cpdi", 2, 1e-12, 1e-12),
         ("bspline2", 2, 0.11, 1e-2),
         ("bspline2", 4, 0.035, 3e-3),
         ("cpbspline2", 2, 0.11, 1e-2),

@@ -191,6 +191,24 @@ fn axisymmetric_taylor_bar_matches_the_test_and_the_3d_quarter() {
 }
 
 #[test]
+fn axisymmetric_taylor_bar_with_cpdi_matches_the_test() {
+    // CPDI in axisymmetric mode (plane r–z domain weights, the hoop terms at the
+    // particle's centre, as for GIMP): h = 0.38 mm, mean error ≤ 3 %.
+    let (result, dir) = run_problem(
+        "taylor_bar_axisymmetric.toml",
+        &["grid.shape_function=\"cpdi\""],
+    );
+    result.expect("the axisymmetric Taylor bar runs with CPDI");
+    let shape = taylor_shape(&Table::read(&dir.path().join("particles_final.csv")).unwrap());
+    let (errors, mean) = taylor_errors(shape);
+    println!("axisymmetric CPDI h = 0.38 mm: {shape:.2?}, errors {errors:.3?}, mean {mean:.3}");
+    assert!(
+        mean <= 0.03 && errors.iter().all(|e| e.abs() <= 0.05),
+        "{errors:?}"
+    );
+}
+
+#[test]
 fn taylor_bar_does_not_depend_on_the_number_of_threads() {
     let set = ["grid.cells=[11,11,35]", "solver.end_time=1.0e-5"];
     let one = run_cli("taylor_bar.toml", 1, &set);

@@ -3,7 +3,7 @@
 //! form yet, refused at their key.
 
 use super::check::{ensure, Check};
-use crate::scene::{Condition, Face, SceneConfig, ShapeFunction};
+use crate::scene::{Condition, Face, SceneConfig};
 
 /// The checks of an axisymmetric scene (its grid, bodies and conditions
 /// validated as 2D ones).
@@ -24,13 +24,6 @@ pub fn axisymmetry(s: &SceneConfig) -> Check {
              component 0",
         )?;
     }
-    ensure(
-        s.grid.shape_function != ShapeFunction::Cpdi,
-        "grid.shape_function",
-        "cpdi has no axisymmetric form here (its particle domains deform into \
-         parallelograms whose hoop integral is not implemented): use linear, ugimp, \
-         cpgimp, bspline2, cpbspline2 or bspline3",
-    )?;
     let axis = s.grid.min[0] == 0.0;
     for (i, b) in s.boundaries.iter().enumerate() {
         let key = |k: &str| format!("boundary.{i}.{k}");
