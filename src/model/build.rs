@@ -14,7 +14,8 @@ use crate::model::loads::Loads;
 use crate::model::particles::Particles;
 use crate::model::{axisymmetry, Model};
 use crate::scene::{
-    axis, expr, BodyConfig, BoundaryConfig, Condition, Face, ParticlesOutside, Scene, SceneError,
+    axis, expr, BodyConfig, BoundaryConfig, Condition, Face, Fill, ParticlesOutside, Scene,
+    SceneError,
 };
 
 impl<const D: usize> Model<D> {
@@ -190,35 +191,17 @@ fn fill_body<const D: usize>(
     material: u32,
     model: &dyn Material,
 ) -> Result<usize, (String, String)> {
-    let (lo, hi) = b.bounds();
     let spacing = Vector::<D>::from_fn(|d, _| grid.h[d] / b.particles_per_cell.get(d) as f64);
-    let volume = spacing.product();
-    let mass = model.density() * volume;
-    // Lattice index range covering the bounding box.
-    let first: [usize; D] =
-        std::array::from_fn(|d| (((lo[d] - grid.min[d]) / spacing[d]).floor().max(0.0)) as usize);
-    // A body cut at a symmetry plane keeps the part inside the grid.
-    let last: [usize; D] = std::array::from_fn(|d| {
-        let upper = hi[d].min(grid.min[d] + grid.h[d] * grid.cells[d] as f64);
-        ((upper - grid.min[d]) / spacing[d]).ceil() as usize
-    });
-    let counts: Vec<usize> = (0..D).map(|d| last[d].saturating_sub(first[d])).collect();
-    let total: usize = counts.iter().product();
+    let points = match b.fill {
+        Fill::Lattice => lattice(grid, b, geometry, &spacing),
+        Fill::Polar => polar(b, spacing.min()),
+    };
     let uniform = b
         .velocity
         .as_deref()
         .map_or(Vector::<D>::zeros(), |v| Vector::<D>::from_fn(|d, _| v[d]));
     let mut added = 0;
-    for flat in 0..total {
-        let mut rem = flat;
-        let x = Vector::<D>::from_fn(|d, _| {
-            let k = first[d] + rem % counts[d];
-            rem /= counts[d];
-            grid.min[d] + (k as f64 + 0.5) * spacing[d]
-        });
-        if !geometry.contains(x.as_slice()) {
-            continue;
-        }
+    for (x, volume, half) in points {
         let mut v = uniform;
         if let Some(exprs) = &b.velocity_expr {
             let mut pos = [0.0; 3];
@@ -231,9 +214,9 @@ fn fill_body<const D: usize>(
         particles.push(
             x,
             v,
-            mass,
+            model.density() * volume,
             volume,
-            spacing / 2.0,
+            half,
             i as u32,
             material,
             model.n_history(),
@@ -241,4 +224,68 @@ fn fill_body<const D: usize>(
         added += 1;
     }
     Ok(added)
+}
+
+/// A particle of a fill: position, volume and the half-lengths of its domain.
+type Point<const D: usize> = (Vector<D>, f64, Vector<D>);
+
+/// The lattice points with the given spacing that lie inside the body.
+fn lattice<const D: usize>(
+    grid: &Grid<D>,
+    b: &BodyConfig,
+    geometry: &Geometry,
+    spacing: &Vector<D>,
+) -> Vec<Point<D>> {
+    let (lo, hi) = b.bounds();
+    let volume = spacing.product();
+    // Lattice index range covering the bounding box.
+    let first: [usize; D] =
+        std::array::from_fn(|d| (((lo[d] - grid.min[d]) / spacing[d]).floor().max(0.0)) as usize);
+    // A body cut at a symmetry plane keeps the part inside the grid.
+    let last: [usize; D] = std::array::from_fn(|d| {
+        let upper = hi[d].min(grid.min[d] + grid.h[d] * grid.cells[d] as f64);
+        ((upper - grid.min[d]) / spacing[d]).ceil() as usize
+    });
+    let counts: Vec<usize> = (0..D).map(|d| last[d].saturating_sub(first[d])).collect();
+    let total: usize = counts.iter().product();
+    (0..total)
+        .filter_map(|flat| {
+            let mut rem = flat;
+            let x = Vector::<D>::from_fn(|d, _| {
+                let k = first[d] + rem % counts[d];
+                rem /= counts[d];
+                grid.min[d] + (k as f64 + 0.5) * spacing[d]
+            });
+            geometry
+                .contains(x.as_slice())
+                .then(|| (x, volume, spacing / 2.0))
+        })
+        .collect()
+}
+
+/// A disk in n = round(R/δ) rings of width Δ = R/n about its centre: ring k
+/// (area π(2k + 1)Δ²) holds N_k = round(π(2k + 1)) particles of equal area at its
+/// mid radius (k + ½)Δ, every other ring turned by half a pitch; each particle's
+/// domain is the square of its area.
+fn polar<const D: usize>(b: &BodyConfig, spacing: f64) -> Vec<Point<D>> {
+    let (c, radius) = (
+        b.centre.as_ref().expect("validated"),
+        b.radius.expect("validated"),
+    );
+    let rings = (radius / spacing).round().max(1.0) as usize;
+    let width = radius / rings as f64;
+    let mut points = Vec::new();
+    for k in 0..rings {
+        let band = std::f64::consts::PI * (2 * k + 1) as f64;
+        let count = band.round().max(1.0) as usize;
+        let area = band * width * width / count as f64;
+        let r = (k as f64 + 0.5) * width;
+        for j in 0..count {
+            let turn = (j as f64 + 0.5 * (k % 2) as f64) / count as f64;
+            let (sin, cos) = (2.0 * std::f64::consts::PI * turn).sin_cos();
+            let x = Vector::<D>::from_fn(|d, _| c[d] + r * if d == 0 { cos } else { sin });
+            points.push((x, area, Vector::<D>::repeat(0.5 * area.sqrt())));
+        }
+    }
+    points
 }

@@ -160,6 +160,23 @@ pub struct BodyConfig {
     /// pi, sin, cos, exp, sqrt, abs), one per component; added to `velocity`.
     #[serde(default)]
     pub velocity_expr: Option<Vec<String>>,
+    /// How the body is filled with particles (default `lattice`).
+    #[serde(default)]
+    pub fill: Fill,
+}
+
+/// The particle fill of a body.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, IntoStaticStr, EnumIter)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum Fill {
+    /// The grid-aligned lattice, `particles_per_cell` per cell and direction,
+    /// keeping the points inside the shape (its curved faces become steps).
+    #[default]
+    Lattice,
+    /// A disk in rings of equal width about its centre, each ring's particles
+    /// of equal area (about the lattice's spacing): a smooth outer surface.
+    Polar,
 }
 
 impl BodyConfig {

@@ -98,6 +98,22 @@ fn an_unknown_enum_value_names_its_key() {
 }
 
 #[test]
+fn a_polar_fill_of_a_rectangle_is_refused_at_its_key() {
+    at(
+        &GOOD.replace("max = [2.0, 1.0]\n", "max = [2.0, 1.0]\nfill = \"polar\"\n"),
+        "body.0.fill",
+        (20, 8),
+        "`polar` fills a disk only",
+    );
+    at(
+        &GOOD.replace("max = [2.0, 1.0]\n", "max = [2.0, 1.0]\nfill = \"rings\"\n"),
+        "body.0.fill",
+        (20, 8),
+        "unknown variant `rings`",
+    );
+}
+
+#[test]
 fn a_wrong_vector_length_names_its_key() {
     at(
         &GOOD.replace("max = [2.0, 1.0]", "max = [2.0, 1.0, 3.0]"),

@@ -2,7 +2,7 @@
 //! material, the keys of its shape, and its extent inside the grid.
 
 use super::check::{ensure, forbidden, required, vector, Check};
-use crate::scene::{BodyConfig, BodyShape, Condition, GridConfig, PerDirection, SceneConfig};
+use crate::scene::{BodyConfig, BodyShape, Condition, Fill, GridConfig, PerDirection, SceneConfig};
 
 pub fn grid(g: &GridConfig, dim: usize) -> Check {
     vector(&g.min, dim, "grid.min")?;
@@ -117,6 +117,11 @@ pub fn body(b: &BodyConfig, i: usize, s: &SceneConfig) -> Check {
 fn shape_keys(b: &BodyConfig, i: usize, dim: usize) -> Check {
     let key = |k: &str| format!("body.{i}.{k}");
     let what = format!("shape `{}`", b.shape.name());
+    ensure(
+        b.fill == Fill::Lattice || b.shape == BodyShape::Disk,
+        key("fill"),
+        format!("`polar` fills a disk only, not {what}"),
+    )?;
     let shape_dim = match b.shape {
         BodyShape::Rectangle | BodyShape::Disk | BodyShape::Polygon => 2,
         BodyShape::Box | BodyShape::Sphere | BodyShape::Cylinder => 3,
