@@ -763,47 +763,24 @@ fn rigid_cylinder_rolls_and_slips_as_the_closed_form_up_to_its_stepped_bottom() 
     assert!(e2 < 0.13 && (e1 / e2).log2() > 0.8, "errors {e1}, {e2}");
 }
 
-/// The disks scene with the left disk a free rigid body fired at `speed` into the
-/// soft right one (c ≈ 1.2 m/s), on a grid long enough to keep both.
-fn rigid_disk_into_soft_disk(
-    speed: f64,
-    projection: bool,
-) -> Vec<(usize, f64, f64, f64, f64, f64)> {
-    let text = std::fs::read_to_string(problem("contact_disks.toml")).unwrap();
-    let text = text
-        .replace(
-            "[[body]]\nname = \"left\"\nmaterial = \"elastic\"",
-            "[[material]]\nname = \"steel\"\nmodel = \"rigid\"\nmotion = \"free\"\n\
-             density = 1000.0\n\n[[body]]\nname = \"left\"\nmaterial = \"steel\"",
-        )
-        .replace(
-            "velocity = [0.2, 0.0]",
-            &format!("velocity = [{speed}, 0.0]"),
-        );
-    let (result, dir) = run_text(
-        &text,
-        &[
-            "output.frames=0",
-            "solver.end_time=0.1",
-            "grid.max=[2.5, 1.0]",
-            "grid.cells=[100, 40]",
-            &format!("contact.0.rigid_projection={projection}"),
-        ],
-    );
+/// problems/rigid_disk_impact.toml with or without the rigid projection.
+fn rigid_disk_into_soft_disk(projection: bool) -> Vec<(usize, f64, f64, f64, f64, f64)> {
+    let set = format!("contact.0.rigid_projection={projection}");
+    let (result, dir) = run_problem("rigid_disk_impact.toml", &[&set]);
     result.expect("the impact runs");
     final_particles(&dir)
 }
 
 #[test]
 fn rigid_bodies_keep_deformable_particles_out_and_conserve_momentum() {
-    // A free rigid disk (R = 0.2) at 5 m/s into a soft elastic disk, four times its
-    // wave speed, h = R/8: node-based contact alone lets 12 particle centres
+    // problems/rigid_disk_impact.toml: a free rigid disk (R = 0.2) at 5 m/s into a
+    // soft elastic disk, four times its wave speed, h = R/8: node-based contact alone lets 12 particle centres
     // into the rigid disk by up to 0.16 h at t = 0.1; with the projection onto
     // its surface none is inside. Linear momentum is conserved to round-off
     // either way (the body takes the opposite of what it gives the particles).
     let radius = 0.2;
     for projection in [true, false] {
-        let p = rigid_disk_into_soft_disk(5.0, projection);
+        let p = rigid_disk_into_soft_disk(projection);
         let rigid: Vec<_> = p.iter().filter(|a| a.0 == 0).collect();
         let mass: f64 = rigid.iter().map(|a| a.5).sum();
         let cx = rigid.iter().map(|a| a.5 * a.1).sum::<f64>() / mass;
@@ -828,5 +805,17 @@ fn rigid_bodies_keep_deformable_particles_out_and_conserve_momentum() {
                 "node contact alone keeps all out: the test is moot"
             ),
         }
+    }
+}
+
+#[test]
+fn a_rigid_body_impact_does_not_depend_on_the_number_of_threads() {
+    let one = run_cli("rigid_disk_impact.toml", 1, &[] as &[&str]);
+    let two = run_cli("rigid_disk_impact.toml", 2, &[] as &[&str]);
+    for file in ["particles_final.csv", "history.csv", "contact.csv"] {
+        assert!(
+            read_output(&one, file) == read_output(&two, file),
+            "{file} differs between 1 and 2 threads"
+        );
     }
 }
