@@ -50,11 +50,13 @@ pub struct FreeBodies<const D: usize> {
     bodies: Vec<Body>,
 }
 
-fn to3<const D: usize>(v: &Vector<D>) -> Vector3<f64> {
+/// A D-vector embedded in 3D (zero beyond D).
+pub fn to3<const D: usize>(v: &Vector<D>) -> Vector3<f64> {
     Vector3::from_fn(|i, _| if i < D { v[i] } else { 0.0 })
 }
 
-fn from3<const D: usize>(v: &Vector3<f64>) -> Vector<D> {
+/// The first D components of a 3-vector.
+pub fn from3<const D: usize>(v: &Vector3<f64>) -> Vector<D> {
     Vector::<D>::from_fn(|i, _| v[i])
 }
 

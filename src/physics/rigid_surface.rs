@@ -26,6 +26,7 @@
 use crate::dim::{Mat3, Vector};
 use crate::model::geometry::Geometry;
 use crate::model::particles::Particles;
+use crate::physics::rigid_body::{from3, to3};
 use nalgebra::Vector3;
 
 /// One rigid velocity field: its particles and the geometries of its bodies.
@@ -59,14 +60,6 @@ pub struct Push<const D: usize> {
     /// The surface point (new position) and the outward normal there.
     pub x: Vector<D>,
     pub normal: Vector<D>,
-}
-
-fn to3<const D: usize>(v: &Vector<D>) -> Vector3<f64> {
-    Vector3::from_fn(|i, _| if i < D { v[i] } else { 0.0 })
-}
-
-fn from3<const D: usize>(v: &Vector3<f64>) -> Vector<D> {
-    Vector::<D>::from_fn(|i, _| v[i])
 }
 
 impl Surface {
