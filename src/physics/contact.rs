@@ -444,13 +444,9 @@ impl<const D: usize> Contact<D> {
         let mut kicks = Vec::new();
         for push in &pushes {
             let k = push.field as usize;
-            let surface = self.surfaces.iter().find(|s| s.field == push.field);
-            let prescribed = m.particles.v[surface.expect("a rigid field").particle()];
-            let free = self.free.as_ref().and_then(|f| f.node_velocity(k, &push.x));
-            let body_velocity = free.unwrap_or(prescribed);
             let (q, p) = (push.particle, &mut m.particles);
             p.x[q] = push.x;
-            let approach = (p.v[q] - body_velocity).dot(&push.normal);
+            let approach = (p.v[q] - push.body_velocity).dot(&push.normal);
             if approach >= 0.0 {
                 continue;
             }
@@ -470,7 +466,8 @@ impl<const D: usize> Contact<D> {
     }
 
     /// The deformable particles inside a rigid body they are in contact with,
-    /// in particle order, with where they go.
+    /// in particle order, with where they go and the body's velocity there (a
+    /// free body's from its last `start`).
     fn pushes(&self, m: &Model<D>) -> Vec<Push<D>> {
         let placements: Vec<_> = (self.surfaces.iter())
             .map(|s| s.placement(&m.particles))
@@ -481,6 +478,7 @@ impl<const D: usize> Contact<D> {
             (c - grid.min[d]).abs() <= tolerance || (c - grid.max[d]).abs() <= tolerance
         };
         let (plan, field, removes) = (&self.plan, &self.field, m.removes_particles());
+        let free = self.free.as_ref();
         (0..m.particles.len())
             .into_par_iter()
             .with_min_len(MIN_PARALLEL_LEN)
@@ -494,11 +492,13 @@ impl<const D: usize> Contact<D> {
                     .filter(|(s, _)| plan.law(f, s.field).is_some_and(|l| l.rigid_projection))
                     .find_map(|(s, at)| {
                         let (x, normal) = s.push_out(at, x, &on_boundary)?;
+                        let free = free.and_then(|f| f.node_velocity(s.field as usize, &x));
                         Some(Push {
                             particle: q,
                             field: s.field,
                             x,
                             normal,
+                            body_velocity: free.unwrap_or(m.particles.v[s.particle()]),
                         })
                     })
             })

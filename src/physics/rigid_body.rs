@@ -155,12 +155,7 @@ impl<const D: usize> FreeBodies<D> {
         }
         let mut motion = Vec::with_capacity(n);
         for (k, b) in self.bodies.iter().enumerate() {
-            let mut velocity = b.velocity + (b.impulse + impulse[k]) / b.mass;
-            if axisymmetric {
-                velocity[0] = 0.0;
-            }
-            let l = b.inertia * b.spin + b.moment + moment[k];
-            let spin = spin::<D>(&b.inertia, &l, axisymmetric);
+            let (velocity, spin) = b.kicked::<D>(&impulse[k], &moment[k], axisymmetric);
             let rotation = Rotation3::new(spin * dt);
             motion.push((b.centre + velocity * dt, velocity, spin, rotation));
         }
@@ -172,31 +167,46 @@ impl<const D: usize> FreeBodies<D> {
         }
     }
 
-    /// After `advance`, give the bodies the impulses `kicks` (field, point, Δp)
-    /// and set their particles' velocities: V' = V + J/M, Ω' = I⁻¹(IΩ + H).
+    /// After `advance` and a `start` on the particles it moved, give the bodies
+    /// the impulses `kicks` (field, point, Δp) and set their particles'
+    /// velocities: V' = V + J/M, Ω' = I⁻¹(IΩ + H).
     pub fn kick(
         &mut self,
         p: &mut Particles<D>,
         kicks: &[(usize, Vector<D>, Vector<D>)],
         axisymmetric: bool,
     ) {
-        self.start(p, axisymmetric);
         for (field, x, dp) in kicks {
             self.receive(*field, x, dp);
         }
+        let none = Vector3::zeros();
         for b in &mut self.bodies {
-            b.velocity += b.impulse / b.mass;
-            if axisymmetric {
-                b.velocity[0] = 0.0;
-            }
-            let l = b.inertia * b.spin + b.moment;
-            b.spin = spin::<D>(&b.inertia, &l, axisymmetric);
-            (b.impulse, b.moment) = (Vector3::zeros(), Vector3::zeros());
+            (b.velocity, b.spin) = b.kicked::<D>(&none, &none, axisymmetric);
+            (b.impulse, b.moment) = (none, none);
         }
         for (i, &(q, k)) in self.particles.iter().enumerate() {
             let b = &self.bodies[k];
             p.v[q] = from3(&(b.velocity + b.spin.cross(&self.offsets[i])));
         }
+    }
+}
+
+impl Body {
+    /// Velocity and spin after the received impulse and moment and `extra` ones:
+    /// V + (J + J')/M and I⁻¹(IΩ + H + H') (along the axis only, no spin, in
+    /// axisymmetric mode).
+    fn kicked<const D: usize>(
+        &self,
+        extra_impulse: &Vector3<f64>,
+        extra_moment: &Vector3<f64>,
+        axisymmetric: bool,
+    ) -> (Vector3<f64>, Vector3<f64>) {
+        let mut velocity = self.velocity + (self.impulse + extra_impulse) / self.mass;
+        if axisymmetric {
+            velocity[0] = 0.0;
+        }
+        let l = self.inertia * self.spin + self.moment + extra_moment;
+        (velocity, spin::<D>(&self.inertia, &l, axisymmetric))
     }
 }
 

@@ -60,6 +60,8 @@ pub struct Push<const D: usize> {
     /// The surface point (new position) and the outward normal there.
     pub x: Vector<D>,
     pub normal: Vector<D>,
+    /// The body's velocity at x.
+    pub body_velocity: Vector<D>,
 }
 
 impl Surface {
@@ -77,13 +79,14 @@ impl Surface {
             .iter()
             .fold(Vector3::zeros(), |c, &q| c + to3(&p.x0[q]) * p.mass[q])
             / mass;
-        let (mut lower, mut upper) = (Vector3::zeros(), Vector3::zeros());
-        for d in 0..D {
-            lower[d] = shapes
-                .iter()
-                .map(|s| s.bounds().0[d])
-                .fold(f64::INFINITY, f64::min);
-            upper[d] = (shapes.iter().map(|s| s.bounds().1[d])).fold(f64::NEG_INFINITY, f64::max);
+        let (mut lower, mut upper) = (
+            Vector3::repeat(f64::INFINITY),
+            Vector3::repeat(f64::NEG_INFINITY),
+        );
+        for (lo, hi) in shapes.iter().map(Geometry::bounds) {
+            for d in 0..D {
+                (lower[d], upper[d]) = (lower[d].min(lo[d]), upper[d].max(hi[d]));
+            }
         }
         Surface {
             field,
