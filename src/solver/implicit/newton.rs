@@ -265,12 +265,11 @@ fn direct_correction<const D: usize>(
     r_free: &[f64],
     export: Option<(&Export, Iterate)>,
 ) -> Result<Correction, Failure> {
-    let (k, used) = factorized_tangent(m, sys, solver)?;
     let rhs: Vec<f64> = r_free.iter().map(|x| -x).collect();
+    let (k, used, du) = factorized_tangent(m, sys, solver, &rhs)?;
     if let Some((e, at)) = export {
         e.write(m, sys, &k, &rhs, at)?;
     }
-    let du = solver.solve(&rhs).map_err(linear_failure)?;
     Ok(Correction {
         du,
         method: used.name().to_string(),
@@ -279,7 +278,8 @@ fn direct_correction<const D: usize>(
     })
 }
 
-/// K at the current iterate (2-40), assembled and factorized by `solver`. A new
+/// K at the current iterate (2-40), assembled and factorized by `solver`, and
+/// the solution x of K x = b (solved with the factorization's check). A new
 /// pattern's ordering and symbolic factorization (sequential) run beside the
 /// assembly of K's values (parallel) when K is expected to be symmetric: no
 /// F-bar and the last K was (a material whose tangent turns unsymmetric wastes
@@ -288,7 +288,8 @@ pub fn factorized_tangent<'s, const D: usize>(
     m: &Model<D>,
     sys: &'s StepSystem<D>,
     solver: &mut DirectSolver,
-) -> Result<(Tangent<'s>, Method), Failure> {
+    b: &[f64],
+) -> Result<(Tangent<'s>, Method, Vec<f64>), Failure> {
     let pattern = step_pattern(sys);
     let symmetric = sys.trial.fbar.is_none() && solver.structure() != Some(Structure::General);
     let (k, _) = rayon::join(
@@ -304,10 +305,10 @@ pub fn factorized_tangent<'s, const D: usize>(
     );
     let k = k?;
     let structure = Structure::of(k.symmetric());
-    let used = solver
-        .factorize(k.matrix(), structure, ordering(sys, &k))
+    let (used, x) = solver
+        .factorize_and_solve(k.matrix(), structure, ordering(sys, &k), b)
         .map_err(linear_failure)?;
-    Ok((k, used))
+    Ok((k, used, x))
 }
 
 fn linear_failure(e: SolveError) -> Failure {

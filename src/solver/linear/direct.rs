@@ -211,6 +211,37 @@ impl DirectSolver {
         structure: Structure,
         ordering: Ordering,
     ) -> Result<Method, SolveError> {
+        self.factorize_with(a, structure, ordering, None)
+            .map(|(method, _)| method)
+    }
+
+    /// [`Self::factorize`], then the solution of `K x = b`: the right-hand
+    /// side rides along with the probe check's solve (two columns in one pass
+    /// over the factor instead of two passes), so a Newton correction pays for
+    /// the check with a second column only.
+    pub fn factorize_and_solve(
+        &mut self,
+        a: SparseColMatRef<usize, f64>,
+        structure: Structure,
+        ordering: Ordering,
+        b: &[f64],
+    ) -> Result<(Method, Vec<f64>), SolveError> {
+        if b.len() != a.nrows() {
+            let msg = format!("right-hand side has length {}, expected {}", b.len(), a.nrows());
+            return Err(SolveError::InvalidInput(msg));
+        }
+        let (method, x) = self.factorize_with(a, structure, ordering, Some(b))?;
+        Ok((method, x.ok_or(SolveError::NotFactorized)?))
+    }
+
+    /// The factorization with its check; with `b`, also the solution of K x = b.
+    fn factorize_with(
+        &mut self,
+        a: SparseColMatRef<usize, f64>,
+        structure: Structure,
+        ordering: Ordering,
+        b: Option<&[f64]>,
+    ) -> Result<(Method, Option<Vec<f64>>), SolveError> {
         self.retire_numeric();
         check_entries(a, structure)?;
         if let Ordering::Given(perm) = ordering {
@@ -220,9 +251,9 @@ impl DirectSolver {
             }
         }
         self.update_pattern(a.nrows(), structure, a, ordering);
-        let method = match structure {
-            Structure::General => self.factor_lu(a),
-            Structure::Symmetric => self.factor_symmetric(a),
+        let (method, x) = match structure {
+            Structure::General => self.factor_lu(a, b),
+            Structure::Symmetric => self.factor_symmetric(a, b),
         }?;
         self.statistics.factorizations += 1;
         let entries = match &self.numeric {
@@ -231,7 +262,7 @@ impl DirectSolver {
         };
         let largest = &mut self.statistics.largest_factor_entries;
         *largest = (*largest).max(entries);
-        Ok(method)
+        Ok((method, x))
     }
 
     /// The structure of the last pattern factorized or analysed.
@@ -295,13 +326,18 @@ impl DirectSolver {
             return Err(SolveError::InvalidInput(msg));
         }
         let mut x = b.to_vec();
-        let rhs = MatMut::from_column_major_slice_mut(&mut x, n, 1);
-        match (&self.numeric, &self.chol) {
-            (Numeric::Lu(num), _) => self.solve_lu(num, rhs, parallelism())?,
-            (chol, Some(sym)) => self.solve_chol(chol, rhs, cholesky_parallelism(sym))?,
-            (_, None) => return Err(SolveError::NotFactorized),
-        }
+        self.solve_columns(&mut x, n, 1)?;
         Ok(x)
+    }
+
+    /// Solve in place for `ncols` right-hand sides stored column after column in `x`.
+    fn solve_columns(&self, x: &mut [f64], n: usize, ncols: usize) -> Result<(), SolveError> {
+        let rhs = MatMut::from_column_major_slice_mut(x, n, ncols);
+        match (&self.numeric, &self.chol) {
+            (Numeric::Lu(num), _) => self.solve_lu(num, rhs, parallelism()),
+            (chol, Some(sym)) => self.solve_chol(chol, rhs, cholesky_parallelism(sym)),
+            (_, None) => Err(SolveError::NotFactorized),
+        }
     }
 
     /// Drop the symbolic factorizations but keep the buffers: the next
@@ -367,16 +403,17 @@ impl DirectSolver {
     fn factor_symmetric(
         &mut self,
         lower: SparseColMatRef<usize, f64>,
-    ) -> Result<Method, SolveError> {
+        b: Option<&[f64]>,
+    ) -> Result<(Method, Option<Vec<f64>>), SolveError> {
         self.ensure_chol(lower)?;
-        if self.try_llt(lower).is_ok() {
-            return Ok(Method::Llt);
+        if let Ok(x) = self.try_llt(lower, b) {
+            return Ok((Method::Llt, x));
         }
-        if self.try_lblt(lower).is_ok() {
-            return Ok(Method::Ldlt);
+        if let Ok(x) = self.try_lblt(lower, b) {
+            return Ok((Method::Ldlt, x));
         }
         let full = mirror_lower(lower)?;
-        self.factor_lu(full.as_ref())
+        self.factor_lu(full.as_ref(), b)
     }
 
     /// Compute the symbolic Cholesky of the lower triangle unless cached (with
@@ -424,7 +461,11 @@ impl DirectSolver {
 
     /// Numeric LLᵀ with the cached symbolic factorization (into the kept
     /// factor's buffer when there is one), then the probe check.
-    fn try_llt(&mut self, lower: SparseColMatRef<usize, f64>) -> Result<(), SolveError> {
+    fn try_llt(
+        &mut self,
+        lower: SparseColMatRef<usize, f64>,
+        b: Option<&[f64]>,
+    ) -> Result<Option<Vec<f64>>, SolveError> {
         let sym = self.chol.take().ok_or(SolveError::NotFactorized)?;
         let par = cholesky_parallelism(&sym);
         // faer overwrites every value of the factor, so the old buffer serves
@@ -460,11 +501,15 @@ impl DirectSolver {
         self.chol = Some(sym);
         result.map_err(|e| SolveError::Singular(format!("LLT: {e:?}")))?;
         self.numeric = Numeric::Llt(values);
-        self.check(lower, true)
+        self.check(lower, true, b)
     }
 
     /// Numeric intranodal LBLᵀ with the cached symbolic factorization, then the probe check.
-    fn try_lblt(&mut self, lower: SparseColMatRef<usize, f64>) -> Result<(), SolveError> {
+    fn try_lblt(
+        &mut self,
+        lower: SparseColMatRef<usize, f64>,
+        b: Option<&[f64]>,
+    ) -> Result<Option<Vec<f64>>, SolveError> {
         let sym = self.chol.as_ref().ok_or(SolveError::NotFactorized)?;
         let (n, par) = (sym.nrows(), cholesky_parallelism(sym));
         let mut values = vec![0.0; sym.len_val()];
@@ -490,11 +535,15 @@ impl DirectSolver {
             fwd,
             inv,
         };
-        self.check(lower, true)
+        self.check(lower, true, b)
     }
 
     /// Symbolic (cached) + numeric LU of the full matrix `a`, then the probe check.
-    fn factor_lu(&mut self, a: SparseColMatRef<usize, f64>) -> Result<Method, SolveError> {
+    fn factor_lu(
+        &mut self,
+        a: SparseColMatRef<usize, f64>,
+        b: Option<&[f64]>,
+    ) -> Result<(Method, Option<Vec<f64>>), SolveError> {
         self.ensure_lu(a)?;
         let sym = self.lu.as_ref().ok_or(SolveError::NotFactorized)?;
         let par = parallelism();
@@ -504,14 +553,14 @@ impl DirectSolver {
         sym.factorize_numeric_lu(&mut num, a, par, stack, Default::default())
             .map_err(lu_error)?;
         self.numeric = Numeric::Lu(Box::new(num));
-        self.check(a, false)?;
-        Ok(Method::Lu)
+        let x = self.check(a, false, b)?;
+        Ok((Method::Lu, x))
     }
 
     /// Solve in place with the Cholesky-family factors (LLᵀ or LBLᵀ).
     fn solve_chol(&self, num: &Numeric, rhs: MatMut<f64>, par: Par) -> Result<(), SolveError> {
         let sym = self.chol.as_ref().ok_or(SolveError::NotFactorized)?;
-        let mut mem = buffer(sym.solve_in_place_scratch::<f64>(1, par))?;
+        let mut mem = buffer(sym.solve_in_place_scratch::<f64>(rhs.ncols(), par))?;
         let stack = MemStack::new(&mut mem);
         match num {
             Numeric::Llt(values) => {
@@ -544,7 +593,7 @@ impl DirectSolver {
         par: Par,
     ) -> Result<(), SolveError> {
         let sym = self.lu.as_ref().ok_or(SolveError::NotFactorized)?;
-        let mut mem = buffer(sym.solve_in_place_scratch::<f64>(1, par))?;
+        let mut mem = buffer(sym.solve_in_place_scratch::<f64>(rhs.ncols(), par))?;
         LuRef::new_unchecked(sym, num).solve_in_place_with_conj(
             Conj::No,
             rhs,
@@ -555,9 +604,15 @@ impl DirectSolver {
     }
 
     /// Probe check of the current factors: solve `K y = K v` for a fixed `v`; reject
-    /// non-finite results, a large backward error (unstable) or a large forward error (singular).
-    fn check(&mut self, a: SparseColMatRef<usize, f64>, sym: bool) -> Result<(), SolveError> {
-        let result = self.probe(a, sym);
+    /// non-finite results, a large backward error (unstable) or a large forward error
+    /// (singular). With `b`, `K x = b` is solved in the same pass and x returned.
+    fn check(
+        &mut self,
+        a: SparseColMatRef<usize, f64>,
+        sym: bool,
+        b: Option<&[f64]>,
+    ) -> Result<Option<Vec<f64>>, SolveError> {
+        let result = self.probe(a, sym, b);
         if result.is_err() {
             self.numeric = Numeric::None;
         }
@@ -565,17 +620,27 @@ impl DirectSolver {
     }
 
     /// The probe solve of [`Self::check`], without the cleanup.
-    fn probe(&self, a: SparseColMatRef<usize, f64>, sym: bool) -> Result<(), SolveError> {
-        let v: Vec<f64> = (0..a.nrows()).map(probe_entry).collect();
-        let b = spmv(a, sym, &v, false);
-        let y = self.solve(&b)?;
-        if y.iter().any(|t| !t.is_finite()) {
+    fn probe(
+        &self,
+        a: SparseColMatRef<usize, f64>,
+        sym: bool,
+        b: Option<&[f64]>,
+    ) -> Result<Option<Vec<f64>>, SolveError> {
+        let n = a.nrows();
+        let v: Vec<f64> = (0..n).map(probe_entry).collect();
+        let kv = spmv(a, sym, &v, false);
+        // Columns [K v | b], solved together.
+        let mut columns = kv.clone();
+        columns.extend_from_slice(b.unwrap_or_default());
+        self.solve_columns(&mut columns, n, 1 + usize::from(b.is_some()))?;
+        let x = b.map(|_| columns.split_off(n));
+        let y = columns;
+        if y.iter().chain(x.iter().flatten()).any(|t| !t.is_finite()) {
             return Err(SolveError::Singular("non-finite probe solution".into()));
         }
-        let ky = spmv(a, sym, &y, false);
-        let abs_ky = spmv(a, sym, &y.iter().map(|t| t.abs()).collect::<Vec<_>>(), true);
-        let res = max_abs_diff(&ky, &b);
-        let backward = res / (max_abs(&abs_ky) + max_abs(&b)).max(f64::MIN_POSITIVE);
+        let (ky, abs_ky) = spmv_and_abs(a, sym, &y);
+        let res = max_abs_diff(&ky, &kv);
+        let backward = res / (max_abs(&abs_ky) + max_abs(&kv)).max(f64::MIN_POSITIVE);
         if backward > CHECK_BACKWARD_TOL {
             return Err(SolveError::Singular(format!(
                 "probe backward error {backward:.2e}"
@@ -587,7 +652,7 @@ impl DirectSolver {
                 "probe forward error {forward:.2e}"
             )));
         }
-        Ok(())
+        Ok(x)
     }
 }
 
@@ -618,6 +683,23 @@ pub fn spmv(a: SparseColMatRef<usize, f64>, sym: bool, x: &[f64], abs: bool) -> 
         }
     }
     y
+}
+
+/// `(A y, |A| |y|)` in one pass over `a` (the lower triangle of a symmetric
+/// matrix with `sym`).
+fn spmv_and_abs(a: SparseColMatRef<usize, f64>, sym: bool, y: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    let (mut ay, mut abs) = (vec![0.0; a.nrows()], vec![0.0; a.nrows()]);
+    for j in 0..a.ncols() {
+        for (&i, &v) in a.row_idx_of_col_raw(j).iter().zip(a.val_of_col(j)) {
+            ay[i] += v * y[j];
+            abs[i] += v.abs() * y[j].abs();
+            if sym && i != j {
+                ay[j] += v * y[i];
+                abs[j] += v.abs() * y[i].abs();
+            }
+        }
+    }
+    (ay, abs)
 }
 
 /// `max_i |a_i|`.
@@ -1070,6 +1152,47 @@ mod tests {
         let r = s.factorize_triplets(m * m, &t, Structure::Symmetric);
         eprintln!("pure Neumann 2D: {r:?}");
         assert!(matches!(r, Err(SolveError::Singular(_))));
+    }
+
+    /// The Newton path (`factorize_and_solve`: the right-hand side solved
+    /// with the probe as a second column) gives the solution of factorize +
+    /// solve to round-off, with the same method, for each method; a singular
+    /// matrix is refused as by `factorize`.
+    #[test]
+    fn factorize_and_solve_agrees_with_factorize_then_solve() {
+        let cases: Vec<(usize, Trip, Structure, Method)> = vec![
+            (10_000, laplace_2d(100, 1.0, 0.0), Structure::Symmetric, Method::Llt),
+            (900, laplace_2d(30, 1.0, 1.2345), Structure::Symmetric, Method::Ldlt),
+            (300, convection_diffusion(300, 0.01, 1.0), Structure::General, Method::Lu),
+        ];
+        for (n, t, structure, expected) in cases {
+            let b = apply(n, &t, &x_star(n));
+            let a = csc_from_triplets(n, &t, structure).unwrap();
+            let mut plain = DirectSolver::new();
+            let method = plain.factorize(a.as_ref(), structure, Ordering::Amd).unwrap();
+            let x = plain.solve(&b).unwrap();
+            let mut fused = DirectSolver::new();
+            let (method_fused, x_fused) = fused
+                .factorize_and_solve(a.as_ref(), structure, Ordering::Amd, &b)
+                .unwrap();
+            assert_eq!(method, expected);
+            assert_eq!(method_fused, expected);
+            let d = rel_diff(&x_fused, &x);
+            eprintln!("{expected:?}, n = {n}: fused against plain {d:.2e}");
+            assert!(d < 1e-13, "{expected:?}: {d:.2e}");
+            assert!(rel_diff(&x_fused, &x_star(n)) < 1e-8);
+            // The fused solver can also solve again.
+            assert!(rel_diff(&fused.solve(&b).unwrap(), &x) < 1e-13);
+        }
+        let m = 40;
+        let t: Trip = laplace_1d(m, false);
+        let a = csc_from_triplets(m, &t, Structure::Symmetric).unwrap();
+        let mut s = DirectSolver::new();
+        let r = s.factorize_and_solve(a.as_ref(), Structure::Symmetric, Ordering::Amd, &[1.0; 40]);
+        assert!(matches!(r, Err(SolveError::Singular(_))), "{r:?}");
+        assert!(matches!(s.solve(&[1.0; 40]), Err(SolveError::NotFactorized)));
+        let r = s.factorize_and_solve(a.as_ref(), Structure::Symmetric, Ordering::Amd, &[1.0; 3]);
+        assert!(matches!(r, Err(SolveError::InvalidInput(_))), "{r:?}");
     }
 
     #[test]

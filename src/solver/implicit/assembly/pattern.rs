@@ -216,31 +216,61 @@ impl Pattern {
 
     /// Rows of column c of node b: the unknowns of b's neighbours (all
     /// components: the stiffness couples every pair), ascending; with `Lower`,
-    /// those ≥ c.
+    /// those ≥ c. Unknowns are numbered node by node, so the rows of neighbour
+    /// a are `first[a]..first[a + 1]`. Counted, then filled, in parallel over
+    /// the nodes (each node writes its own columns: the same result on any
+    /// number of threads).
     fn build_csc<const D: usize>(
         &self,
         dofs: &Dofs,
         storage: Storage,
     ) -> SymbolicSparseColMat<usize> {
         let n = dofs.free;
+        debug_assert_eq!(self.first[self.nodes()], n);
+        let lowest = |c: usize| if storage == Storage::Lower { c } else { 0 };
+        let rows_of = |a: u32, c: usize| {
+            let (lo, hi) = (self.first[a as usize], self.first[a as usize + 1]);
+            lo.max(lowest(c))..hi.max(lo.max(lowest(c)))
+        };
+        let lengths: Vec<usize> = (0..self.nodes())
+            .into_par_iter()
+            .with_min_len(256)
+            .flat_map_iter(|b| {
+                self.columns(b).map(move |c| {
+                    let neighbours = self.neighbours(b).iter();
+                    neighbours.map(|&a| rows_of(a, c).len()).sum::<usize>()
+                })
+            })
+            .collect();
         let mut col_ptr = Vec::with_capacity(n + 1);
-        let mut rows = Vec::new();
         col_ptr.push(0);
+        for len in lengths {
+            col_ptr.push(col_ptr.last().unwrap() + len);
+        }
+        let mut rows = vec![0usize; col_ptr[n]];
+        let mut per_node: Vec<&mut [usize]> = Vec::with_capacity(self.nodes());
+        let mut rest = rows.as_mut_slice();
         for b in 0..self.nodes() {
-            for k in 0..D {
-                let Some(c) = dofs.of(b, k, D) else { continue };
-                for &a in self.neighbours(b) {
-                    for i in 0..D {
-                        if let Some(r) = dofs.of(a as usize, i, D) {
-                            if storage == Storage::Full || r >= c {
-                                rows.push(r);
-                            }
+            let cols = self.columns(b);
+            let (head, tail) = rest.split_at_mut(col_ptr[cols.end] - col_ptr[cols.start]);
+            per_node.push(head);
+            rest = tail;
+        }
+        per_node
+            .into_par_iter()
+            .enumerate()
+            .with_min_len(256)
+            .for_each(|(b, out)| {
+                let mut at = 0;
+                for c in self.columns(b) {
+                    for &a in self.neighbours(b) {
+                        for r in rows_of(a, c) {
+                            out[at] = r;
+                            at += 1;
                         }
                     }
                 }
-                col_ptr.push(rows.len());
-            }
-        }
+            });
         // Rows ascending within each column: neighbours ascending and unknowns
         // numbered node by node.
         SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows)
