@@ -29,6 +29,9 @@
 //! `MPM_BENCH_LARGE=1` for 160² and 20³ (several minutes); `MPM_BENCH_DIM=2`
 //! (or 3) for one dimension only.
 //!
+//! `MPM_BENCH_ALTERNATE=R` first prints the targets' ratios from R interleaved
+//! rounds of the yardstick, a first and a later iteration (medians).
+//!
 //! Run: `cargo bench --bench implicit -- --noplot` (see docs/performance.md).
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
@@ -44,7 +47,7 @@ use mpm::model::Model;
 use mpm::output::matrix_market::{write_sparse, write_vector};
 use mpm::scene::{DirectOrdering, Scene};
 use mpm::solver::implicit::assembly::stiffness::particle_tangents;
-use mpm::solver::implicit::assembly::{Pattern, Storage};
+use mpm::solver::implicit::assembly::{Pattern, Storage, Tangent};
 use mpm::solver::implicit::newton::factorized_tangent;
 use mpm::solver::implicit::residual::{ordering, residual, tangent};
 use mpm::solver::implicit::step::{StepSettings, StepSystem};
@@ -237,6 +240,12 @@ fn bench_problem<const D: usize>(c: &mut Criterion, p: &mut Problem<D>) {
     if let Some(dir) = std::env::var_os("MPM_EXPORT_TANGENTS") {
         export(std::path::Path::new(&dir), &p.name, k.matrix(), &b).expect("export");
     }
+    if let Some(rounds) = std::env::var("MPM_BENCH_ALTERNATE")
+        .ok()
+        .and_then(|r| r.parse::<usize>().ok())
+    {
+        alternate(p, &k, &b, rounds);
+    }
     let mut group = c.benchmark_group(format!("implicit/{}", p.name));
     group.sample_size(10);
     group.throughput(Throughput::Elements(n as u64));
@@ -307,7 +316,11 @@ fn bench_problem<const D: usize>(c: &mut Criterion, p: &mut Problem<D>) {
         bch.iter(|| {
             fresh.pattern = Default::default();
             kept.forget_pattern();
-            black_box(factorized_tangent(m, &fresh, &mut kept, &b).expect("factorize").2)
+            black_box(
+                factorized_tangent(m, &fresh, &mut kept, &b)
+                    .expect("factorize")
+                    .2,
+            )
         })
     });
     // The first iteration of a run: fresh buffers too.
@@ -315,15 +328,113 @@ fn bench_problem<const D: usize>(c: &mut Criterion, p: &mut Problem<D>) {
         bch.iter(|| {
             fresh.pattern = Default::default();
             let mut s = DirectSolver::new();
-            black_box(factorized_tangent(m, &fresh, &mut s, &b).expect("factorize").2)
+            black_box(
+                factorized_tangent(m, &fresh, &mut s, &b)
+                    .expect("factorize")
+                    .2,
+            )
         })
     });
     group.bench_function("iteration_later", |bch| {
         bch.iter(|| {
-            black_box(factorized_tangent(m, sys, &mut solver, &b).expect("factorize").2)
+            black_box(
+                factorized_tangent(m, sys, &mut solver, &b)
+                    .expect("factorize")
+                    .2,
+            )
         })
     });
     group.finish();
+}
+
+/// The targets' ratios from interleaved timings (a noisy machine moves whole
+/// criterion groups): `rounds` times in turn faer's numeric LLᵀ into fresh
+/// buffers (the yardstick), the first iteration of a step whose stencils
+/// changed and a later iteration; prints the medians and the ratios.
+fn alternate<const D: usize>(p: &Problem<D>, k: &Tangent, b: &[f64], rounds: usize) {
+    let (m, sys) = (&p.model, &p.sys);
+    let order = ordering(sys, k);
+    let perm = match order {
+        Ordering::Given(perm) => perm.to_vec(),
+        Ordering::Amd => panic!("the bench's tangent has a node ordering"),
+    };
+    let inv = {
+        let mut inv = vec![0; perm.len()];
+        perm.iter()
+            .enumerate()
+            .for_each(|(new, &old)| inv[old] = new);
+        inv
+    };
+    let n = perm.len();
+    let sym = factorize_symbolic_cholesky(
+        k.matrix().symbolic(),
+        Side::Lower,
+        SymmetricOrdering::Custom(PermRef::new_checked(&perm, &inv, n)),
+        CholeskySymbolicParams::default(),
+    )
+    .expect("symbolic");
+    let mut fresh = sys.clone();
+    let mut solver = DirectSolver::new();
+    factorized_tangent(m, sys, &mut solver, b).expect("factorize");
+    let mut kept = DirectSolver::new();
+    factorized_tangent(m, sys, &mut kept, b).expect("factorize");
+    let time = |f: &mut dyn FnMut()| {
+        let clock = Instant::now();
+        f();
+        clock.elapsed().as_secs_f64()
+    };
+    // The yardstick also into kept buffers (faer at its fastest, no page faults).
+    let par = cholesky_parallelism(&sym);
+    let mut values = vec![0.0; sym.len_val()];
+    let mut mem = MemBuffer::new(sym.factorize_numeric_llt_scratch::<f64>(par, Default::default()));
+    let (mut yard, mut yard_kept) = (Vec::new(), Vec::new());
+    let (mut first, mut later) = (Vec::new(), Vec::new());
+    for _ in 0..rounds {
+        yard.push(time(&mut || {
+            black_box(numeric_llt(&sym, k.matrix(), par));
+        }));
+        yard_kept.push(time(&mut || {
+            sym.factorize_numeric_llt(
+                &mut values,
+                k.matrix(),
+                Side::Lower,
+                Default::default(),
+                par,
+                MemStack::new(&mut mem),
+                Default::default(),
+            )
+            .expect("positive definite");
+            black_box(&values);
+        }));
+        first.push(time(&mut || {
+            fresh.pattern = Default::default();
+            kept.forget_pattern();
+            black_box(factorized_tangent(m, &fresh, &mut kept, b).expect("first"));
+        }));
+        later.push(time(&mut || {
+            black_box(factorized_tangent(m, sys, &mut solver, b).expect("later"));
+        }));
+    }
+    let median = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let (y, f, l) = (median(&mut yard), median(&mut first), median(&mut later));
+    let yk = median(&mut yard_kept);
+    eprintln!(
+        "{}: {rounds} alternating rounds, medians: numeric LLT {:.1} ms (kept buffers {:.1} \
+         ms), first iteration {:.1} ms ({:.2}x; {:.2}x kept), later iteration {:.1} ms \
+         ({:.2}x; {:.2}x kept)",
+        p.name,
+        y * 1e3,
+        yk * 1e3,
+        f * 1e3,
+        f / y,
+        f / yk,
+        l * 1e3,
+        l / y,
+        l / yk
+    );
 }
 
 /// Writes the lower triangle of K as a symmetric Matrix Market file

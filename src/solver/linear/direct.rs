@@ -227,7 +227,11 @@ impl DirectSolver {
         b: &[f64],
     ) -> Result<(Method, Vec<f64>), SolveError> {
         if b.len() != a.nrows() {
-            let msg = format!("right-hand side has length {}, expected {}", b.len(), a.nrows());
+            let msg = format!(
+                "right-hand side has length {}, expected {}",
+                b.len(),
+                a.nrows()
+            );
             return Err(SolveError::InvalidInput(msg));
         }
         let (method, x) = self.factorize_with(a, structure, ordering, Some(b))?;
@@ -250,7 +254,7 @@ impl DirectSolver {
                 return Err(SolveError::InvalidInput(msg));
             }
         }
-        self.update_pattern(a.nrows(), structure, a, ordering);
+        self.update_pattern(a.nrows(), structure, a.symbolic(), ordering);
         let (method, x) = match structure {
             Structure::General => self.factor_lu(a, b),
             Structure::Symmetric => self.factor_symmetric(a, b),
@@ -279,18 +283,20 @@ impl DirectSolver {
         lower: SymbolicSparseColMatRef<usize>,
         ordering: Ordering,
     ) -> Result<(), SolveError> {
-        let values = vec![0.0; lower.row_idx().len()];
-        let a = SparseColMatRef::new(lower, &values);
         if let Ordering::Given(perm) = ordering {
-            if perm.len() != a.nrows() {
-                let msg = format!("ordering of length {}, expected {}", perm.len(), a.nrows());
+            if perm.len() != lower.nrows() {
+                let msg = format!(
+                    "ordering of length {}, expected {}",
+                    perm.len(),
+                    lower.nrows()
+                );
                 return Err(SolveError::InvalidInput(msg));
             }
         }
-        if !self.update_pattern(a.nrows(), Structure::Symmetric, a, ordering) {
+        if !self.update_pattern(lower.nrows(), Structure::Symmetric, lower, ordering) {
             self.retire_numeric();
         }
-        self.ensure_chol(a)
+        self.ensure_chol(lower)
     }
 
     /// The current factors become the kept buffers of the next factorization
@@ -370,10 +376,10 @@ impl DirectSolver {
         &mut self,
         n: usize,
         structure: Structure,
-        a: SparseColMatRef<usize, f64>,
+        a: SymbolicSparseColMatRef<usize>,
         ordering: Ordering,
     ) -> bool {
-        let (col_ptr, row_idx) = (a.symbolic().col_ptr(), a.symbolic().row_idx());
+        let (col_ptr, row_idx) = (a.col_ptr(), a.row_idx());
         let perm = match ordering {
             Ordering::Amd => None,
             Ordering::Given(p) => Some(p),
@@ -405,7 +411,7 @@ impl DirectSolver {
         lower: SparseColMatRef<usize, f64>,
         b: Option<&[f64]>,
     ) -> Result<(Method, Option<Vec<f64>>), SolveError> {
-        self.ensure_chol(lower)?;
+        self.ensure_chol(lower.symbolic())?;
         if let Ok(x) = self.try_llt(lower, b) {
             return Ok((Method::Llt, x));
         }
@@ -418,7 +424,7 @@ impl DirectSolver {
 
     /// Compute the symbolic Cholesky of the lower triangle unless cached (with
     /// the given ordering, else AMD).
-    fn ensure_chol(&mut self, lower: SparseColMatRef<usize, f64>) -> Result<(), SolveError> {
+    fn ensure_chol(&mut self, lower: SymbolicSparseColMatRef<usize>) -> Result<(), SolveError> {
         if self.chol.is_none() {
             let params = CholeskySymbolicParams::default();
             let perm = self.pattern.as_ref().and_then(|p| p.perm.as_ref());
@@ -429,7 +435,7 @@ impl DirectSolver {
                 }
                 _ => SymmetricOrdering::Amd,
             };
-            let sym = factorize_symbolic_cholesky(lower.symbolic(), Side::Lower, ordering, params)
+            let sym = factorize_symbolic_cholesky(lower, Side::Lower, ordering, params)
                 .map_err(backend)?;
             self.chol = Some(sym);
             self.statistics.symbolic_analyses += 1;
@@ -1161,15 +1167,32 @@ mod tests {
     #[test]
     fn factorize_and_solve_agrees_with_factorize_then_solve() {
         let cases: Vec<(usize, Trip, Structure, Method)> = vec![
-            (10_000, laplace_2d(100, 1.0, 0.0), Structure::Symmetric, Method::Llt),
-            (900, laplace_2d(30, 1.0, 1.2345), Structure::Symmetric, Method::Ldlt),
-            (300, convection_diffusion(300, 0.01, 1.0), Structure::General, Method::Lu),
+            (
+                10_000,
+                laplace_2d(100, 1.0, 0.0),
+                Structure::Symmetric,
+                Method::Llt,
+            ),
+            (
+                900,
+                laplace_2d(30, 1.0, 1.2345),
+                Structure::Symmetric,
+                Method::Ldlt,
+            ),
+            (
+                300,
+                convection_diffusion(300, 0.01, 1.0),
+                Structure::General,
+                Method::Lu,
+            ),
         ];
         for (n, t, structure, expected) in cases {
             let b = apply(n, &t, &x_star(n));
             let a = csc_from_triplets(n, &t, structure).unwrap();
             let mut plain = DirectSolver::new();
-            let method = plain.factorize(a.as_ref(), structure, Ordering::Amd).unwrap();
+            let method = plain
+                .factorize(a.as_ref(), structure, Ordering::Amd)
+                .unwrap();
             let x = plain.solve(&b).unwrap();
             let mut fused = DirectSolver::new();
             let (method_fused, x_fused) = fused
@@ -1190,7 +1213,10 @@ mod tests {
         let mut s = DirectSolver::new();
         let r = s.factorize_and_solve(a.as_ref(), Structure::Symmetric, Ordering::Amd, &[1.0; 40]);
         assert!(matches!(r, Err(SolveError::Singular(_))), "{r:?}");
-        assert!(matches!(s.solve(&[1.0; 40]), Err(SolveError::NotFactorized)));
+        assert!(matches!(
+            s.solve(&[1.0; 40]),
+            Err(SolveError::NotFactorized)
+        ));
         let r = s.factorize_and_solve(a.as_ref(), Structure::Symmetric, Ordering::Amd, &[1.0; 3]);
         assert!(matches!(r, Err(SolveError::InvalidInput(_))), "{r:?}");
     }

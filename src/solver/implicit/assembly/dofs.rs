@@ -37,6 +37,29 @@ impl Terms {
     }
 }
 
+/// The nodes that one node's terms go to ([`Dofs::owners`]): itself with
+/// coefficient 1, or the two masters of its tie with theirs. (A plain struct:
+/// it is built for every stencil entry of every assembly.)
+pub struct Owners<'a> {
+    node: usize,
+    tie: Option<&'a Tie>,
+    next: usize,
+}
+
+impl Iterator for Owners<'_> {
+    type Item = (usize, f64);
+
+    fn next(&mut self) -> Option<(usize, f64)> {
+        let i = self.next;
+        self.next += 1;
+        match self.tie {
+            None if i == 0 => Some((self.node, 1.0)),
+            Some(t) if i < 2 => Some((t.master[i], t.coef[i])),
+            _ => None,
+        }
+    }
+}
+
 impl Dofs {
     pub const NONE: u32 = u32::MAX;
 
@@ -69,12 +92,12 @@ impl Dofs {
 
     /// The nodes whose unknowns node a's terms go to, with their coefficients:
     /// a itself, or its masters if it is tied.
-    pub fn owners(&self, a: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
-        let (nodes, coefs, len) = match self.tie(a) {
-            None => ([a, 0], [1.0, 0.0], 1),
-            Some(t) => (t.master, t.coef, 2),
-        };
-        nodes.into_iter().zip(coefs).take(len)
+    pub fn owners(&self, a: usize) -> Owners<'_> {
+        Owners {
+            node: a,
+            tie: self.tie(a),
+            next: 0,
+        }
     }
 
     fn tie(&self, a: usize) -> Option<&Tie> {

@@ -496,12 +496,20 @@ where
     let count = group.iter().max().map_or(0, |&g| g as usize + 1);
     let lists: Vec<Vec<u32>> = (0..n)
         .into_par_iter()
-        .with_min_len(64)
+        // Few tasks: each one fills two marker arrays of n and `count` entries.
+        .with_min_len((n / 32).max(64))
         .map_init(
             // Per task: which nodes and groups node b has met (marked with b).
-            || (vec![u32::MAX; n], vec![u32::MAX; count], Vec::new()),
-            |(seen, visited, scratch), b| {
-                let mut out = Vec::new();
+            || {
+                (
+                    vec![u32::MAX; n],
+                    vec![u32::MAX; count],
+                    Vec::new(),
+                    Vec::new(),
+                )
+            },
+            |(seen, visited, scratch, out), b| {
+                out.clear();
                 for &(e, _) in &sources[source_start[b]..source_start[b + 1]] {
                     let q = e as usize / stride;
                     let g = group[q] as usize;
@@ -521,7 +529,7 @@ where
                     }
                 }
                 out.sort_unstable();
-                out
+                out.clone()
             },
         )
         .collect();
