@@ -299,7 +299,7 @@ pub fn factorized_tangent<'s, const D: usize>(
                 let lower = pattern.csc::<D>(&sys.dofs, Storage::Lower);
                 let order = Ordering::Given(pattern.ordering::<D>(sys.direct_ordering));
                 // An error here comes back from the factorization below.
-                let _ = solver.analyse(lower.as_ref(), order);
+                let _ = solver.analyse(lower, order);
             }
         },
     );

@@ -18,10 +18,12 @@ use faer::sparse::linalg::lu::{
 };
 use faer::sparse::linalg::LuError;
 use faer::sparse::{
-    CreationError, SparseColMat, SparseColMatRef, SymbolicSparseColMatRef, Triplet,
+    CreationError, SparseColMat, SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef,
+    Triplet,
 };
 use faer::{Conj, MatMut, Par, Side};
 use serde::{Deserialize, Serialize};
+use std::sync::Arc;
 
 /// The number of tasks faer splits a factorization or solve into. faer divides
 /// the supernodal elimination tree and its dense kernels by this count, not by
@@ -134,9 +136,44 @@ pub enum Ordering<'a> {
 struct Pattern {
     n: usize,
     structure: Structure,
-    col_ptr: Vec<usize>,
-    row_idx: Vec<usize>,
+    columns: Columns,
     perm: Option<Vec<usize>>,
+}
+
+/// The compressed columns of a [`Pattern`]: a copy, or the caller's own
+/// pattern shared through [`DirectSolver::analyse`] (no copy, and a matrix
+/// whose index arrays are that pattern's is known to have it without a
+/// comparison: the shared arrays are immutable and kept alive by the handle).
+enum Columns {
+    Copied {
+        col_ptr: Vec<usize>,
+        row_idx: Vec<usize>,
+    },
+    Shared(Arc<SymbolicSparseColMat<usize>>),
+}
+
+impl Columns {
+    fn col_ptr(&self) -> &[usize] {
+        match self {
+            Columns::Copied { col_ptr, .. } => col_ptr,
+            Columns::Shared(a) => a.col_ptr(),
+        }
+    }
+
+    fn row_idx(&self) -> &[usize] {
+        match self {
+            Columns::Copied { row_idx, .. } => row_idx,
+            Columns::Shared(a) => a.row_idx(),
+        }
+    }
+
+    /// Whether `a` has these columns: the same arrays (shared), or equal ones.
+    fn equal(&self, a: SymbolicSparseColMatRef<usize>) -> bool {
+        let same = |x: &[usize], y: &[usize]| {
+            (x.as_ptr() == y.as_ptr() && x.len() == y.len()) || x == y
+        };
+        same(self.col_ptr(), a.col_ptr()) && same(self.row_idx(), a.row_idx())
+    }
 }
 
 /// Numeric factors of the last successful factorization.
@@ -254,7 +291,7 @@ impl DirectSolver {
                 return Err(SolveError::InvalidInput(msg));
             }
         }
-        self.update_pattern(a.nrows(), structure, a.symbolic(), ordering);
+        self.update_pattern(a.nrows(), structure, a.symbolic(), ordering, None);
         let (method, x) = match structure {
             Structure::General => self.factor_lu(a, b),
             Structure::Symmetric => self.factor_symmetric(a, b),
@@ -278,25 +315,25 @@ impl DirectSolver {
     /// `lower` with `ordering`, unless the solver already holds it: what the
     /// next [`Self::factorize`] of a symmetric K with this pattern and ordering
     /// would compute first, done ahead (e.g. while K's values are assembled).
+    /// The solver keeps the handle `lower` (not a copy) as its pattern.
     pub fn analyse(
         &mut self,
-        lower: SymbolicSparseColMatRef<usize>,
+        lower: &Arc<SymbolicSparseColMat<usize>>,
         ordering: Ordering,
     ) -> Result<(), SolveError> {
+        let n = lower.nrows();
         if let Ordering::Given(perm) = ordering {
-            if perm.len() != lower.nrows() {
-                let msg = format!(
-                    "ordering of length {}, expected {}",
-                    perm.len(),
-                    lower.nrows()
-                );
+            if perm.len() != n {
+                let msg = format!("ordering of length {}, expected {n}", perm.len());
                 return Err(SolveError::InvalidInput(msg));
             }
         }
-        if !self.update_pattern(lower.nrows(), Structure::Symmetric, lower, ordering) {
+        let view = (**lower).as_ref();
+        let shared = Columns::Shared(Arc::clone(lower));
+        if !self.update_pattern(n, Structure::Symmetric, view, ordering, Some(shared)) {
             self.retire_numeric();
         }
-        self.ensure_chol(lower)
+        self.ensure_chol(view)
     }
 
     /// The current factors become the kept buffers of the next factorization
@@ -371,34 +408,36 @@ impl DirectSolver {
     }
 
     /// Keep the cached symbolic factorizations iff the new pattern and ordering
-    /// equal the stored ones; returns whether they do.
+    /// equal the stored ones; returns whether they do. A new pattern is kept
+    /// as `shared` when given, else copied.
     fn update_pattern(
         &mut self,
         n: usize,
         structure: Structure,
         a: SymbolicSparseColMatRef<usize>,
         ordering: Ordering,
+        shared: Option<Columns>,
     ) -> bool {
-        let (col_ptr, row_idx) = (a.col_ptr(), a.row_idx());
         let perm = match ordering {
             Ordering::Amd => None,
             Ordering::Given(p) => Some(p),
         };
         let same = self.pattern.as_ref().is_some_and(|p| {
-            p.n == n
-                && p.structure == structure
-                && p.col_ptr == col_ptr
-                && p.row_idx == row_idx
-                && p.perm.as_deref() == perm
+            p.n == n && p.structure == structure && p.perm.as_deref() == perm && p.columns.equal(a)
         });
         if !same {
             self.chol = None;
             self.lu = None;
+            // The old pattern goes first (it may be as large as the new one).
+            self.pattern = None;
+            let columns = shared.unwrap_or_else(|| Columns::Copied {
+                col_ptr: a.col_ptr().to_vec(),
+                row_idx: a.row_idx().to_vec(),
+            });
             self.pattern = Some(Pattern {
                 n,
                 structure,
-                col_ptr: col_ptr.to_vec(),
-                row_idx: row_idx.to_vec(),
+                columns,
                 perm: perm.map(|p| p.to_vec()),
             });
         }
@@ -1320,7 +1359,8 @@ mod tests {
         ahead
             .factorize_triplets(900, &laplace_2d(30, 1.0, 0.0), Structure::Symmetric)
             .unwrap();
-        ahead.analyse(a.symbolic(), Ordering::Amd).unwrap();
+        let shared = Arc::new(a.symbolic().to_owned().unwrap());
+        ahead.analyse(&shared, Ordering::Amd).unwrap();
         assert_eq!(ahead.symbolic_count(), 2);
         assert!(
             ahead.solve(&b).is_err(),

@@ -25,7 +25,7 @@ use crate::solver::linear::direct::spmv;
 use crate::solver::linear::ordering::{node_amd, node_metis, NodeGraph};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use rayon::prelude::*;
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 
 /// Which part of the tangent is stored.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -52,20 +52,46 @@ pub struct Pattern {
     /// Unknowns of nodes 0..b: the columns of node b are `first[b]..first[b + 1]`
     /// (unknowns are numbered node by node).
     first: Vec<usize>,
-    /// Per node: the stencil entries it takes terms from (its own; for a master,
-    /// also those of the nodes tied to it) with the coefficient of the tie
-    /// (1 for its own), in increasing entry order.
-    source_start: Vec<usize>,
-    sources: Vec<(u32, f64)>,
+    /// Per node, when some node is tied: the stencil entries it takes terms
+    /// from (its own; for a master, also those of the nodes tied to it) with
+    /// the coefficient of the tie (1 for its own), in increasing entry order.
+    /// Without ties a node's sources are its own entries of the node map, with
+    /// coefficient 1, and nothing is stored ([`Pattern::sources`]).
+    tied_sources: Option<TiedSources>,
     /// Per node: the nodes it couples to (masters for tied nodes), ascending.
     neighbour_start: Vec<usize>,
     neighbours: Vec<u32>,
-    lower: OnceLock<SymbolicSparseColMat<usize>>,
-    full: OnceLock<SymbolicSparseColMat<usize>>,
+    lower: OnceLock<Arc<SymbolicSparseColMat<usize>>>,
+    full: OnceLock<Arc<SymbolicSparseColMat<usize>>>,
     amd: OnceLock<Vec<usize>>,
     metis: OnceLock<Vec<usize>>,
     /// What the pattern was built from, to tell whether a later step's fits.
     built_for: BuiltFor,
+}
+
+/// The sources of every node when some node is tied: those of node b are
+/// `list[start[b]..start[b + 1]]`.
+#[derive(Clone, Debug, Default)]
+struct TiedSources {
+    start: Vec<usize>,
+    list: Vec<(u32, f64)>,
+}
+
+/// The stencil entries a node takes terms from, with their coefficients.
+enum Sources<'a> {
+    Own(std::slice::Iter<'a, u32>),
+    Tied(std::slice::Iter<'a, (u32, f64)>),
+}
+
+impl Iterator for Sources<'_> {
+    type Item = (u32, f64);
+
+    fn next(&mut self) -> Option<(u32, f64)> {
+        match self {
+            Sources::Own(entries) => entries.next().map(|&e| (e, 1.0)),
+            Sources::Tied(list) => list.next().copied(),
+        }
+    }
 }
 
 /// The inputs of a pattern: the stencils' nodes (which also fix the node map),
@@ -114,13 +140,13 @@ impl Pattern {
             first.push(first[a] + count);
         }
         debug_assert_eq!(first[n], dofs.free);
-        let (source_start, sources) = sources(map, dofs);
+        let tied_sources = (!dofs.ties.is_empty()).then(|| tied_sources(map, dofs));
+        let sources_of = |b: usize| sources(tied_sources.as_ref(), map, b);
         let (neighbour_start, neighbours) = if let Some(cells) = cells {
             node_graph(
                 n,
                 st.stride,
-                &source_start,
-                &sources,
+                &sources_of,
                 |q, out| {
                     for &p in cells.members(cells.of[q] as usize) {
                         out.extend(st.range(p as usize).map(|e| map.local_of(st, e)));
@@ -133,8 +159,7 @@ impl Pattern {
             node_graph(
                 n,
                 st.stride,
-                &source_start,
-                &sources,
+                &sources_of,
                 |q, out| {
                     out.extend(st.range(q).map(|e| map.local_of(st, e)));
                 },
@@ -144,8 +169,7 @@ impl Pattern {
         };
         Pattern {
             first,
-            source_start,
-            sources,
+            tied_sources,
             neighbour_start,
             neighbours,
             lower: OnceLock::new(),
@@ -201,17 +225,19 @@ impl Pattern {
         self.first[b]..self.first[b + 1]
     }
 
-    /// The compressed-column pattern of the unknowns (built at the first call).
+    /// The compressed-column pattern of the unknowns (built at the first call),
+    /// shared: the direct solver keeps a handle to the pattern it analysed
+    /// instead of a copy.
     pub fn csc<const D: usize>(
         &self,
         dofs: &Dofs,
         storage: Storage,
-    ) -> &SymbolicSparseColMat<usize> {
+    ) -> &Arc<SymbolicSparseColMat<usize>> {
         let cell = match storage {
             Storage::Lower => &self.lower,
             Storage::Full => &self.full,
         };
-        cell.get_or_init(|| self.build_csc::<D>(dofs, storage))
+        cell.get_or_init(|| Arc::new(self.build_csc::<D>(dofs, storage)))
     }
 
     /// Rows of column c of node b: the unknowns of b's neighbours (all
@@ -364,8 +390,7 @@ impl Pattern {
             }
             debug_assert_eq!(at, col_ptr[c + 1] - base);
         }
-        let sources = &self.sources[self.source_start[b]..self.source_start[b + 1]];
-        for &(e2, cc) in sources {
+        for (e2, cc) in sources(self.tied_sources.as_ref(), map, b) {
             let e2 = e2 as usize;
             let q = e2 / st.stride;
             if !column(q, e2, block) {
@@ -428,7 +453,7 @@ pub fn slot(csc: &SymbolicSparseColMat<usize>, r: usize, c: usize) -> Option<usi
 /// Per node, the stencil entries it takes terms from: its own (coefficient 1)
 /// and, for a master, those of the nodes tied to it (the tie's coefficient),
 /// each list in increasing entry order.
-fn sources(map: &NodeMap, dofs: &Dofs) -> (Vec<usize>, Vec<(u32, f64)>) {
+fn tied_sources(map: &NodeMap, dofs: &Dofs) -> TiedSources {
     let n = map.len();
     // Entries of node a in increasing order: its own list from the node map,
     // merged with those of the nodes tied to it.
@@ -456,7 +481,16 @@ fn sources(map: &NodeMap, dofs: &Dofs) -> (Vec<usize>, Vec<(u32, f64)>) {
         }
         start.push(list.len());
     }
-    (start, list)
+    TiedSources { start, list }
+}
+
+/// The sources of node b: the stored ones when some node is tied, else its
+/// own entries of the node map with coefficient 1.
+fn sources<'a>(tied: Option<&'a TiedSources>, map: &'a NodeMap, b: usize) -> Sources<'a> {
+    match tied {
+        Some(t) => Sources::Tied(t.list[t.start[b]..t.start[b + 1]].iter()),
+        None => Sources::Own(map.node_entries(b).iter()),
+    }
 }
 
 /// Particles with the same stencil nodes, numbered: `group[q]` for particle q.
@@ -481,17 +515,17 @@ fn stencil_groups<const D: usize>(st: &Stencils<D>) -> Vec<u32> {
 /// node that `nodes_of(q, …)` lists for a particle q of b's sources, ascending.
 /// Particles of one group (`group[q]`: the same stencil nodes, or the same
 /// cell with F-bar) list the same nodes, so each group is visited once per node.
-fn node_graph<F>(
+fn node_graph<'s, F, S>(
     n: usize,
     stride: usize,
-    source_start: &[usize],
-    sources: &[(u32, f64)],
+    sources_of: &S,
     nodes_of: F,
     group: &[u32],
     dofs: &Dofs,
 ) -> (Vec<usize>, Vec<u32>)
 where
     F: Fn(usize, &mut Vec<usize>) + Sync,
+    S: Fn(usize) -> Sources<'s> + Sync,
 {
     let count = group.iter().max().map_or(0, |&g| g as usize + 1);
     let lists: Vec<Vec<u32>> = (0..n)
@@ -510,7 +544,7 @@ where
             },
             |(seen, visited, scratch, out), b| {
                 out.clear();
-                for &(e, _) in &sources[source_start[b]..source_start[b + 1]] {
+                for (e, _) in sources_of(b) {
                     let q = e as usize / stride;
                     let g = group[q] as usize;
                     if visited[g] == b as u32 {
