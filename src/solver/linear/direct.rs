@@ -169,9 +169,8 @@ impl Columns {
 
     /// Whether `a` has these columns: the same arrays (shared), or equal ones.
     fn equal(&self, a: SymbolicSparseColMatRef<usize>) -> bool {
-        let same = |x: &[usize], y: &[usize]| {
-            (x.as_ptr() == y.as_ptr() && x.len() == y.len()) || x == y
-        };
+        let same =
+            |x: &[usize], y: &[usize]| (x.as_ptr() == y.as_ptr() && x.len() == y.len()) || x == y;
         same(self.col_ptr(), a.col_ptr()) && same(self.row_idx(), a.row_idx())
     }
 }

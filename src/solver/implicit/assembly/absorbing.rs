@@ -36,7 +36,7 @@ pub fn add_absorbing<const D: usize>(
         st,
         dofs,
         Components::Diagonal,
-        |q, e2, block| {
+        |q, e2, _needed, block| {
             let Some(c) = coefficient[q] else {
                 return false;
             };

@@ -44,7 +44,7 @@ pub fn add_consistent_mass<const D: usize>(
         st,
         dofs,
         Components::Diagonal,
-        |q, e2, block| {
+        |q, e2, _needed, block| {
             for (local, e1) in st.range(q).enumerate() {
                 let v = particle_mass[q] * st.weight[e1] * st.weight[e2] * inertia;
                 for i in 0..D {

@@ -302,11 +302,13 @@ impl Pattern {
         SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows)
     }
 
-    /// Adds the term of every particle q with `column(q, e2, block)` true to the
-    /// values of `csc` (`Pattern::csc` with `storage`): for each stencil entry e2
-    /// of q, `column` fills `block[(e1 − first entry of q)·D² + i·D + k]` with the
-    /// term at (node of e1, component i) × (node of e2, component k) for every
-    /// entry e1 of q; `components` says which (i, k) it sets. Spread onto the
+    /// Adds the term of every particle q with `column(q, e2, needed, block)` true
+    /// to the values of `csc` (`Pattern::csc` with `storage`): for each stencil
+    /// entry e2 of q, `column` fills `block[(e1 − first entry of q)·D² + i·D + k]`
+    /// with the term at (node of e1, component i) × (node of e2, component k) for
+    /// every entry e1 of q with `needed[e1 − first entry of q]` (the others are
+    /// not read: with `Lower`, the nodes whose unknowns all lie above the
+    /// diagonal); `components` says which (i, k) it sets. Spread onto the
     /// unknowns through the ties; rows below the diagonal only with `Lower`.
     #[allow(clippy::too_many_arguments)]
     pub fn add_stencil_terms<const D: usize>(
@@ -318,7 +320,7 @@ impl Pattern {
         st: &Stencils<D>,
         dofs: &Dofs,
         components: Components,
-        column: impl Fn(usize, usize, &mut [f64]) -> bool + Sync,
+        column: impl Fn(usize, usize, &[bool], &mut [f64]) -> bool + Sync,
     ) {
         let col_ptr = csc.col_ptr();
         // Split the values into the columns of each node (disjoint, in order).
@@ -336,11 +338,17 @@ impl Pattern {
             .enumerate()
             .with_min_len(16)
             .for_each_init(
-                || (Vec::new(), vec![0.0; st.stride * D * D]),
-                |(offsets, block), (b, vals)| {
+                || {
+                    (
+                        Vec::new(),
+                        vec![false; st.stride],
+                        vec![0.0; st.stride * D * D],
+                    )
+                },
+                |(offsets, needed, block), (b, vals)| {
                     self.add_column_terms(
                         b, vals, col_ptr, storage, map, st, dofs, components, &column, offsets,
-                        block,
+                        needed, block,
                     )
                 },
             );
@@ -361,8 +369,9 @@ impl Pattern {
         st: &Stencils<D>,
         dofs: &Dofs,
         components: Components,
-        column: &impl Fn(usize, usize, &mut [f64]) -> bool,
+        column: &impl Fn(usize, usize, &[bool], &mut [f64]) -> bool,
         offsets: &mut Vec<usize>,
+        needed: &mut [bool],
         block: &mut [f64],
     ) {
         let cols = self.columns(b);
@@ -393,13 +402,23 @@ impl Pattern {
         for (e2, cc) in sources(self.tied_sources.as_ref(), map, b) {
             let e2 = e2 as usize;
             let q = e2 / st.stride;
-            if !column(q, e2, block) {
+            // With `Lower`, a node before b (all its unknowns above b's
+            // columns) takes no term in b's columns.
+            let needed = &mut needed[..st.range(q).len()];
+            for (flag, e1) in needed.iter_mut().zip(st.range(q)) {
+                let n1 = map.local_of(st, e1);
+                *flag = storage == Storage::Full || dofs.owners(n1).any(|(a, _)| a >= b);
+            }
+            if !column(q, e2, needed, block) {
                 continue;
             }
             // The stencil's nodes ascend, so each is found by a short scan on
             // from the previous one (ties may point back: then a search).
             let mut hint = 0;
             for (local, e1) in st.range(q).enumerate() {
+                if !needed[local] {
+                    continue;
+                }
                 let n1 = map.local_of(st, e1);
                 for (a, cr) in dofs.owners(n1) {
                     let Some(j) = position(neighbours, a as u32, hint) else {
