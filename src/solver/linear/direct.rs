@@ -1,11 +1,13 @@
 //! Sparse direct solver for the implicit MPM tangent system `K x = b`, backed by faer 0.24.
 //!
-//! `K` arrives as triplets (duplicates summed). The symbolic factorization (fill-reducing
-//! ordering + elimination structure) is cached and reused while the sparsity pattern is
-//! unchanged. Symmetric matrices go LLᵀ → intranodal LBLᵀ → LU; general ones go to LU.
+//! `K` arrives in compressed columns (or as triplets, duplicates summed). The symbolic
+//! factorization (fill-reducing ordering + elimination structure) is cached and reused while
+//! the sparsity pattern is unchanged. Symmetric matrices go LLᵀ → intranodal LBLᵀ → LU;
+//! general ones go to LU.
 //! Every numeric factorization is checked with one probe solve (see [`CHECK_BACKWARD_TOL`]
 //! and [`CHECK_FORWARD_TOL`]) so that singular or unstably factored matrices give an error
-//! instead of a garbage solution.
+//! instead of a garbage solution; [`DirectSolver::factorize_and_solve`] solves a right-hand
+//! side together with the probe (one pass over the factor for both).
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::perm::PermRef;
