@@ -15,9 +15,10 @@
 //! - `iteration_first`: the whole path of the first iteration of a step whose
 //!   stencils changed, as Newton takes it (`newton::factorized_tangent`:
 //!   pattern, then ordering + symbolic factorization beside the tangent's
-//!   assembly, numeric factorization into the solver's kept buffers; + solve);
+//!   assembly, numeric factorization into the solver's kept buffers, and the
+//!   solve, which rides with the factorization's check);
 //! - `iteration_later`: a later one, or the first of a step that keeps the
-//!   pattern (tangent + refactorize + solve);
+//!   pattern (tangent, refactorization and solve);
 //! - `iteration_first_of_run`: the first, with a fresh solver.
 //!
 //! Problems: the block of problems/bench/block.toml (uGIMP, 2×2 particles per
@@ -253,6 +254,7 @@ fn bench_problem<const D: usize>(c: &mut Criterion, p: &mut Problem<D>) {
     if let Some(rounds) = std::env::var("MPM_BENCH_ALTERNATE")
         .ok()
         .and_then(|r| r.parse::<usize>().ok())
+        .filter(|&r| r > 0)
     {
         alternate(p, &k, &b, rounds);
     }

@@ -111,6 +111,9 @@ fn tangent_error_of<const D: usize>(
             }
         }
     }
+    if kt.symmetric() {
+        lower_equals_full_stiffness(&m, sys);
+    }
     let kmax = k.iter().fold(0.0f64, |a, b| a.max(b.abs()));
     let h = 1e-7;
     let mut worst: f64 = 0.0;
@@ -127,6 +130,46 @@ fn tangent_error_of<const D: usize>(
         }
     }
     (worst / kmax, n, tied, plastic)
+}
+
+/// The stiffness assembled into the lower triangle (where a particle's blocks
+/// for nodes before the column's node are not computed) has, bit for bit, the
+/// values of the full assembly's lower triangle, ties included.
+fn lower_equals_full_stiffness<const D: usize>(m: &Model<D>, sys: &StepSystem<D>) {
+    use super::assembly::stiffness::{add_stiffness, particle_tangents};
+    use super::assembly::{Storage, Tangent};
+    let a = particle_tangents(m, &sys.trial, false).unwrap();
+    let pattern = super::residual::step_pattern(sys);
+    let assemble = |storage| {
+        let csc = pattern.csc::<D>(&sys.dofs, storage);
+        let values = vec![0.0; csc.row_idx().len()];
+        let mut t = Tangent {
+            pattern: csc,
+            values,
+            storage,
+        };
+        let (map, st, dofs) = (&sys.map, &sys.stencils, &sys.dofs);
+        add_stiffness(&mut t, pattern, map, st, dofs, &m.particles.volume, &a);
+        t
+    };
+    let (lower, full) = (assemble(Storage::Lower), assemble(Storage::Full));
+    let (l, f) = (lower.matrix(), full.matrix());
+    for c in 0..l.ncols() {
+        let full_col: Vec<(usize, f64)> = f
+            .row_idx_of_col_raw(c)
+            .iter()
+            .copied()
+            .zip(f.val_of_col(c).iter().copied())
+            .filter(|&(r, _)| r >= c)
+            .collect();
+        let lower_col: Vec<(usize, f64)> = l
+            .row_idx_of_col_raw(c)
+            .iter()
+            .copied()
+            .zip(l.val_of_col(c).iter().copied())
+            .collect();
+        assert_eq!(lower_col, full_col, "column {c}");
+    }
 }
 
 /// The assembled tangent (material + geometric + inertia, 2-40…2-42, and the

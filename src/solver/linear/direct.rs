@@ -133,8 +133,8 @@ pub enum Ordering<'a> {
     Given(&'a [usize]),
 }
 
-/// Sorted, deduplicated pattern of the last factorized matrix and the ordering
-/// given with it (key of the symbolic cache).
+/// Sorted, deduplicated pattern of the last factorized or analysed matrix and
+/// the ordering given with it (key of the symbolic cache).
 struct Pattern {
     n: usize,
     structure: Structure,
@@ -265,6 +265,7 @@ impl DirectSolver {
         b: &[f64],
     ) -> Result<(Method, Vec<f64>), SolveError> {
         if b.len() != a.nrows() {
+            self.retire_numeric();
             let msg = format!(
                 "right-hand side has length {}, expected {}",
                 b.len(),
@@ -681,7 +682,7 @@ impl DirectSolver {
         self.solve_columns(&mut columns, n, 1 + usize::from(b.is_some()))?;
         let x = b.map(|_| columns.split_off(n));
         let y = columns;
-        if y.iter().chain(x.iter().flatten()).any(|t| !t.is_finite()) {
+        if y.iter().any(|t| !t.is_finite()) {
             return Err(SolveError::Singular("non-finite probe solution".into()));
         }
         let (ky, abs_ky) = spmv_and_abs(a, sym, &y);
@@ -1372,6 +1373,14 @@ mod tests {
             .unwrap();
         assert_eq!(ahead.symbolic_count(), 2, "the analysis was not repeated");
         assert_eq!(ahead.solve(&b).unwrap(), x);
+        // A matrix on the shared arrays themselves (the Newton path) is known
+        // to have the analysed pattern: no new analysis, the same solution.
+        let on_shared = SparseColMatRef::new((*shared).as_ref(), a.val());
+        let (_, x_shared) = ahead
+            .factorize_and_solve(on_shared, Structure::Symmetric, Ordering::Amd, &b)
+            .unwrap();
+        assert_eq!(ahead.symbolic_count(), 2);
+        assert_eq!(x_shared, x);
     }
 
     /// A given ordering is used (the solution agrees with AMD's to round-off)
@@ -1440,7 +1449,12 @@ mod tests {
                 pool.install(|| {
                     let mut s = DirectSolver::new();
                     s.factorize_triplets(n, &t, Structure::Symmetric).unwrap();
-                    s.solve(&b).unwrap()
+                    let a = csc_from_triplets(n, &t, Structure::Symmetric).unwrap();
+                    let mut fused = DirectSolver::new();
+                    let (_, x) = fused
+                        .factorize_and_solve(a.as_ref(), Structure::Symmetric, Ordering::Amd, &b)
+                        .unwrap();
+                    (s.solve(&b).unwrap(), x)
                 })
             };
             let one = solve(1);

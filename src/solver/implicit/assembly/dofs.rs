@@ -19,7 +19,7 @@ pub struct Dofs {
     /// index[a·D + d]: equation number, or `NONE`.
     pub index: Vec<u32>,
     pub free: usize,
-    /// Per active node: its tie, if any (empty when no node is tied).
+    /// Per active node: its tie, if any (may be empty when no node is tied).
     pub ties: Vec<Option<Tie>>,
 }
 

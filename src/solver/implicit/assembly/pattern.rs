@@ -56,7 +56,7 @@ pub struct Pattern {
     /// from (its own; for a master, also those of the nodes tied to it) with
     /// the coefficient of the tie (1 for its own), in increasing entry order.
     /// Without ties a node's sources are its own entries of the node map, with
-    /// coefficient 1, and nothing is stored ([`Pattern::sources`]).
+    /// coefficient 1, and nothing is stored (see `sources`).
     tied_sources: Option<TiedSources>,
     /// Per node: the nodes it couples to (masters for tied nodes), ascending.
     neighbour_start: Vec<usize>,
@@ -140,7 +140,8 @@ impl Pattern {
             first.push(first[a] + count);
         }
         debug_assert_eq!(first[n], dofs.free);
-        let tied_sources = (!dofs.ties.is_empty()).then(|| tied_sources(map, dofs));
+        let tied = dofs.ties.iter().any(Option::is_some);
+        let tied_sources = tied.then(|| tied_sources(map, dofs));
         let sources_of = |b: usize| sources(tied_sources.as_ref(), map, b);
         let (neighbour_start, neighbours) = if let Some(cells) = cells {
             node_graph(
@@ -307,8 +308,9 @@ impl Pattern {
     /// entry e2 of q, `column` fills `block[(e1 − first entry of q)·D² + i·D + k]`
     /// with the term at (node of e1, component i) × (node of e2, component k) for
     /// every entry e1 of q with `needed[e1 − first entry of q]` (the others are
-    /// not read: with `Lower`, the nodes whose unknowns all lie above the
-    /// diagonal); `components` says which (i, k) it sets. Spread onto the
+    /// not read: with `Lower`, the entries all of whose owners, the node or the
+    /// masters of its tie, come before the column's node, so that their rows
+    /// lie above the diagonal); `components` says which (i, k) it sets. Spread onto the
     /// unknowns through the ties; rows below the diagonal only with `Lower`.
     #[allow(clippy::too_many_arguments)]
     pub fn add_stencil_terms<const D: usize>(
@@ -402,12 +404,16 @@ impl Pattern {
         for (e2, cc) in sources(self.tied_sources.as_ref(), map, b) {
             let e2 = e2 as usize;
             let q = e2 / st.stride;
-            // With `Lower`, a node before b (all its unknowns above b's
-            // columns) takes no term in b's columns.
+            // With `Lower`, an entry whose owners all come before b (their
+            // unknowns all above b's columns) takes no term in b's columns.
             let needed = &mut needed[..st.range(q).len()];
-            for (flag, e1) in needed.iter_mut().zip(st.range(q)) {
-                let n1 = map.local_of(st, e1);
-                *flag = storage == Storage::Full || dofs.owners(n1).any(|(a, _)| a >= b);
+            if storage == Storage::Full {
+                needed.fill(true);
+            } else {
+                for (flag, e1) in needed.iter_mut().zip(st.range(q)) {
+                    let n1 = map.local_of(st, e1);
+                    *flag = dofs.owners(n1).any(|(a, _)| a >= b);
+                }
             }
             if !column(q, e2, needed, block) {
                 continue;
