@@ -139,7 +139,7 @@ impl<const D: usize> Problem<D> {
         let s = &self.sys;
         let cells = s.trial.fbar.as_ref().map(|f| &f.cells);
         let p = Pattern::new(&s.map, &s.stencils, &s.dofs, cells);
-        p.csc::<D>(&s.dofs, Storage::Lower);
+        p.csc(Storage::Lower);
         p
     }
 }
@@ -256,7 +256,7 @@ fn bench_problem<const D: usize>(c: &mut Criterion, p: &mut Problem<D>) {
         .and_then(|r| r.parse::<usize>().ok())
         .filter(|&r| r > 0)
     {
-        alternate(p, &k, &b, rounds);
+        alternate(p, &k, &sym, &b, rounds);
     }
     let mut group = c.benchmark_group(format!("implicit/{}", p.name));
     group.sample_size(10);
@@ -363,28 +363,14 @@ fn bench_problem<const D: usize>(c: &mut Criterion, p: &mut Problem<D>) {
 /// criterion groups): `rounds` times in turn faer's numeric LLᵀ into fresh
 /// buffers (the yardstick), the first iteration of a step whose stencils
 /// changed and a later iteration; prints the medians and the ratios.
-fn alternate<const D: usize>(p: &Problem<D>, k: &Tangent, b: &[f64], rounds: usize) {
+fn alternate<const D: usize>(
+    p: &Problem<D>,
+    k: &Tangent,
+    sym: &SymbolicCholesky<usize>,
+    b: &[f64],
+    rounds: usize,
+) {
     let (m, sys) = (&p.model, &p.sys);
-    let order = ordering(sys, k);
-    let perm = match order {
-        Ordering::Given(perm) => perm.to_vec(),
-        Ordering::Amd => panic!("the bench's tangent has a node ordering"),
-    };
-    let inv = {
-        let mut inv = vec![0; perm.len()];
-        perm.iter()
-            .enumerate()
-            .for_each(|(new, &old)| inv[old] = new);
-        inv
-    };
-    let n = perm.len();
-    let sym = factorize_symbolic_cholesky(
-        k.matrix().symbolic(),
-        Side::Lower,
-        SymmetricOrdering::Custom(PermRef::new_checked(&perm, &inv, n)),
-        CholeskySymbolicParams::default(),
-    )
-    .expect("symbolic");
     let mut fresh = sys.clone();
     let mut solver = DirectSolver::new();
     factorized_tangent(m, sys, &mut solver, b).expect("factorize");
@@ -396,17 +382,17 @@ fn alternate<const D: usize>(p: &Problem<D>, k: &Tangent, b: &[f64], rounds: usi
         clock.elapsed().as_secs_f64()
     };
     // The yardstick also into kept buffers (faer at its fastest, no page faults).
-    let par = cholesky_parallelism(&sym);
+    let par = cholesky_parallelism(sym);
     let mut values = vec![0.0; sym.len_val()];
     let mut mem = MemBuffer::new(sym.factorize_numeric_llt_scratch::<f64>(par, Default::default()));
     let (mut yard, mut yard_kept) = (Vec::new(), Vec::new());
     let (mut first, mut later) = (Vec::new(), Vec::new());
     for _ in 0..rounds {
         yard.push(time(&mut || {
-            black_box(numeric_llt(&sym, k.matrix(), par));
+            black_box(numeric_llt(sym, k.matrix(), par));
         }));
         yard_kept.push(time(&mut || {
-            numeric_llt_into(&sym, k.matrix(), par, &mut values, &mut mem);
+            numeric_llt_into(sym, k.matrix(), par, &mut values, &mut mem);
             black_box(&values);
         }));
         first.push(time(&mut || {

@@ -296,7 +296,7 @@ pub fn factorized_tangent<'s, const D: usize>(
         || tangent(m, sys, false),
         || {
             if symmetric {
-                let lower = pattern.csc::<D>(&sys.dofs, Storage::Lower);
+                let lower = pattern.csc(Storage::Lower);
                 let order = Ordering::Given(pattern.ordering::<D>(sys.direct_ordering));
                 // An error here comes back from the factorization below.
                 let _ = solver.analyse(lower, order);

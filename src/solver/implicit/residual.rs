@@ -118,7 +118,7 @@ pub fn tangent<'s, const D: usize>(
     } else {
         Storage::Full
     };
-    let csc = pattern.csc::<D>(dofs, storage);
+    let csc = pattern.csc(storage);
     let mut k = Tangent {
         pattern: csc,
         values: vec![0.0; csc.row_idx().len()],

@@ -141,7 +141,7 @@ fn lower_equals_full_stiffness<const D: usize>(m: &Model<D>, sys: &StepSystem<D>
     let a = particle_tangents(m, &sys.trial, false).unwrap();
     let pattern = super::residual::step_pattern(sys);
     let assemble = |storage| {
-        let csc = pattern.csc::<D>(&sys.dofs, storage);
+        let csc = pattern.csc(storage);
         let values = vec![0.0; csc.row_idx().len()];
         let mut t = Tangent {
             pattern: csc,

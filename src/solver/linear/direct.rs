@@ -138,43 +138,19 @@ pub enum Ordering<'a> {
 struct Pattern {
     n: usize,
     structure: Structure,
-    columns: Columns,
+    /// The caller's own pattern when it came through [`DirectSolver::analyse`]
+    /// (no copy), else a copy.
+    columns: Arc<SymbolicSparseColMat<usize>>,
     perm: Option<Vec<usize>>,
 }
 
-/// The compressed columns of a [`Pattern`]: a copy, or the caller's own
-/// pattern shared through [`DirectSolver::analyse`] (no copy, and a matrix
-/// whose index arrays are that pattern's is known to have it without a
-/// comparison: the shared arrays are immutable and kept alive by the handle).
-enum Columns {
-    Copied {
-        col_ptr: Vec<usize>,
-        row_idx: Vec<usize>,
-    },
-    Shared(Arc<SymbolicSparseColMat<usize>>),
-}
-
-impl Columns {
-    fn col_ptr(&self) -> &[usize] {
-        match self {
-            Columns::Copied { col_ptr, .. } => col_ptr,
-            Columns::Shared(a) => a.col_ptr(),
-        }
-    }
-
-    fn row_idx(&self) -> &[usize] {
-        match self {
-            Columns::Copied { row_idx, .. } => row_idx,
-            Columns::Shared(a) => a.row_idx(),
-        }
-    }
-
-    /// Whether `a` has these columns: the same arrays (shared), or equal ones.
-    fn equal(&self, a: SymbolicSparseColMatRef<usize>) -> bool {
-        let same =
-            |x: &[usize], y: &[usize]| (x.as_ptr() == y.as_ptr() && x.len() == y.len()) || x == y;
-        same(self.col_ptr(), a.col_ptr()) && same(self.row_idx(), a.row_idx())
-    }
+/// Whether `a` has the columns `stored`: the same arrays (a matrix on the
+/// shared pattern: they are immutable and kept alive by the handle), or equal
+/// ones.
+fn same_columns(stored: &SymbolicSparseColMat<usize>, a: SymbolicSparseColMatRef<usize>) -> bool {
+    let same =
+        |x: &[usize], y: &[usize]| (x.as_ptr() == y.as_ptr() && x.len() == y.len()) || x == y;
+    same(stored.col_ptr(), a.col_ptr()) && same(stored.row_idx(), a.row_idx())
 }
 
 /// Numeric factors of the last successful factorization.
@@ -293,7 +269,7 @@ impl DirectSolver {
                 return Err(SolveError::InvalidInput(msg));
             }
         }
-        self.update_pattern(a.nrows(), structure, a.symbolic(), ordering, None);
+        self.update_pattern(a.nrows(), structure, a.symbolic(), ordering, None)?;
         let (method, x) = match structure {
             Structure::General => self.factor_lu(a, b),
             Structure::Symmetric => self.factor_symmetric(a, b),
@@ -331,8 +307,8 @@ impl DirectSolver {
             }
         }
         let view = (**lower).as_ref();
-        let shared = Columns::Shared(Arc::clone(lower));
-        if !self.update_pattern(n, Structure::Symmetric, view, ordering, Some(shared)) {
+        let shared = Arc::clone(lower);
+        if !self.update_pattern(n, Structure::Symmetric, view, ordering, Some(shared))? {
             self.retire_numeric();
         }
         self.ensure_chol(view)
@@ -411,31 +387,34 @@ impl DirectSolver {
 
     /// Keep the cached symbolic factorizations iff the new pattern and ordering
     /// equal the stored ones; returns whether they do. A new pattern is kept
-    /// as `shared` when given, else copied.
+    /// as `shared` when given, else copied (an error only if that allocation fails).
     fn update_pattern(
         &mut self,
         n: usize,
         structure: Structure,
         a: SymbolicSparseColMatRef<usize>,
         ordering: Ordering,
-        shared: Option<Columns>,
-    ) -> bool {
+        shared: Option<Arc<SymbolicSparseColMat<usize>>>,
+    ) -> Result<bool, SolveError> {
         let perm = match ordering {
             Ordering::Amd => None,
             Ordering::Given(p) => Some(p),
         };
         let same = self.pattern.as_ref().is_some_and(|p| {
-            p.n == n && p.structure == structure && p.perm.as_deref() == perm && p.columns.equal(a)
+            p.n == n
+                && p.structure == structure
+                && p.perm.as_deref() == perm
+                && same_columns(&p.columns, a)
         });
         if !same {
             self.chol = None;
             self.lu = None;
             // The old pattern goes first (it may be as large as the new one).
             self.pattern = None;
-            let columns = shared.unwrap_or_else(|| Columns::Copied {
-                col_ptr: a.col_ptr().to_vec(),
-                row_idx: a.row_idx().to_vec(),
-            });
+            let columns = match shared {
+                Some(shared) => shared,
+                None => Arc::new(a.to_owned().map_err(backend)?),
+            };
             self.pattern = Some(Pattern {
                 n,
                 structure,
@@ -443,7 +422,7 @@ impl DirectSolver {
                 perm: perm.map(|p| p.to_vec()),
             });
         }
-        same
+        Ok(same)
     }
 
     /// LLᵀ, then LBLᵀ, then LU on the mirrored full matrix; `lower` holds the lower triangle.
@@ -685,7 +664,8 @@ impl DirectSolver {
         if y.iter().any(|t| !t.is_finite()) {
             return Err(SolveError::Singular("non-finite probe solution".into()));
         }
-        let (ky, abs_ky) = spmv_and_abs(a, sym, &y);
+        let ky = spmv(a, sym, &y, false);
+        let abs_ky = spmv(a, sym, &y.iter().map(|t| t.abs()).collect::<Vec<_>>(), true);
         let res = max_abs_diff(&ky, &kv);
         let backward = res / (max_abs(&abs_ky) + max_abs(&kv)).max(f64::MIN_POSITIVE);
         if backward > CHECK_BACKWARD_TOL {
@@ -730,23 +710,6 @@ pub fn spmv(a: SparseColMatRef<usize, f64>, sym: bool, x: &[f64], abs: bool) -> 
         }
     }
     y
-}
-
-/// `(A y, |A| |y|)` in one pass over `a` (the lower triangle of a symmetric
-/// matrix with `sym`).
-fn spmv_and_abs(a: SparseColMatRef<usize, f64>, sym: bool, y: &[f64]) -> (Vec<f64>, Vec<f64>) {
-    let (mut ay, mut abs) = (vec![0.0; a.nrows()], vec![0.0; a.nrows()]);
-    for j in 0..a.ncols() {
-        for (&i, &v) in a.row_idx_of_col_raw(j).iter().zip(a.val_of_col(j)) {
-            ay[i] += v * y[j];
-            abs[i] += v.abs() * y[j].abs();
-            if sym && i != j {
-                ay[j] += v * y[i];
-                abs[j] += v.abs() * y[i].abs();
-            }
-        }
-    }
-    (ay, abs)
 }
 
 /// `max_i |a_i|`.

@@ -229,16 +229,12 @@ impl Pattern {
     /// The compressed-column pattern of the unknowns (built at the first call),
     /// shared: the direct solver keeps a handle to the pattern it analysed
     /// instead of a copy.
-    pub fn csc<const D: usize>(
-        &self,
-        dofs: &Dofs,
-        storage: Storage,
-    ) -> &Arc<SymbolicSparseColMat<usize>> {
+    pub fn csc(&self, storage: Storage) -> &Arc<SymbolicSparseColMat<usize>> {
         let cell = match storage {
             Storage::Lower => &self.lower,
             Storage::Full => &self.full,
         };
-        cell.get_or_init(|| Arc::new(self.build_csc::<D>(dofs, storage)))
+        cell.get_or_init(|| Arc::new(self.build_csc(storage)))
     }
 
     /// Rows of column c of node b: the unknowns of b's neighbours (all
@@ -247,17 +243,13 @@ impl Pattern {
     /// a are `first[a]..first[a + 1]`. Counted, then filled, in parallel over
     /// the nodes (each node writes its own columns: the same result on any
     /// number of threads).
-    fn build_csc<const D: usize>(
-        &self,
-        dofs: &Dofs,
-        storage: Storage,
-    ) -> SymbolicSparseColMat<usize> {
-        let n = dofs.free;
-        debug_assert_eq!(self.first[self.nodes()], n);
+    fn build_csc(&self, storage: Storage) -> SymbolicSparseColMat<usize> {
+        let n = self.first[self.nodes()];
         let lowest = |c: usize| if storage == Storage::Lower { c } else { 0 };
         let rows_of = |a: u32, c: usize| {
             let (lo, hi) = (self.first[a as usize], self.first[a as usize + 1]);
-            lo.max(lowest(c))..hi.max(lo.max(lowest(c)))
+            let from = lo.max(lowest(c));
+            from..hi.max(from)
         };
         let lengths: Vec<usize> = (0..self.nodes())
             .into_par_iter()
@@ -275,15 +267,7 @@ impl Pattern {
             col_ptr.push(col_ptr.last().unwrap() + len);
         }
         let mut rows = vec![0usize; col_ptr[n]];
-        let mut per_node: Vec<&mut [usize]> = Vec::with_capacity(self.nodes());
-        let mut rest = rows.as_mut_slice();
-        for b in 0..self.nodes() {
-            let cols = self.columns(b);
-            let (head, tail) = rest.split_at_mut(col_ptr[cols.end] - col_ptr[cols.start]);
-            per_node.push(head);
-            rest = tail;
-        }
-        per_node
+        self.per_node(&col_ptr, &mut rows)
             .into_par_iter()
             .enumerate()
             .with_min_len(256)
@@ -301,6 +285,19 @@ impl Pattern {
         // Rows ascending within each column: neighbours ascending and unknowns
         // numbered node by node.
         SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows)
+    }
+
+    /// `entries` (a compressed-column array with `col_ptr`) split into the
+    /// columns of each node: disjoint slices, in node order.
+    fn per_node<'v, T>(&self, col_ptr: &[usize], mut entries: &'v mut [T]) -> Vec<&'v mut [T]> {
+        let mut out = Vec::with_capacity(self.nodes());
+        for b in 0..self.nodes() {
+            let cols = self.columns(b);
+            let (head, tail) = entries.split_at_mut(col_ptr[cols.end] - col_ptr[cols.start]);
+            out.push(head);
+            entries = tail;
+        }
+        out
     }
 
     /// Adds the term of every particle q with `column(q, e2, needed, block)` true
@@ -325,17 +322,7 @@ impl Pattern {
         column: impl Fn(usize, usize, &[bool], &mut [f64]) -> bool + Sync,
     ) {
         let col_ptr = csc.col_ptr();
-        // Split the values into the columns of each node (disjoint, in order).
-        let mut per_node: Vec<&mut [f64]> = Vec::with_capacity(self.nodes());
-        let mut rest = values;
-        for b in 0..self.nodes() {
-            let cols = self.columns(b);
-            let len = col_ptr[cols.end] - col_ptr[cols.start];
-            let (head, tail) = rest.split_at_mut(len);
-            per_node.push(head);
-            rest = tail;
-        }
-        per_node
+        self.per_node(col_ptr, values)
             .into_par_iter()
             .enumerate()
             .with_min_len(16)
@@ -555,8 +542,7 @@ where
     let count = group.iter().max().map_or(0, |&g| g as usize + 1);
     let lists: Vec<Vec<u32>> = (0..n)
         .into_par_iter()
-        // Few tasks: each one fills two marker arrays of n and `count` entries.
-        .with_min_len((n / 32).max(64))
+        .with_min_len(64)
         .map_init(
             // Per task: which nodes and groups node b has met (marked with b).
             || {
