@@ -124,6 +124,16 @@ impl Geometry {
         x: &[f64],
         on_boundary: &dyn Fn(usize, f64) -> bool,
     ) -> Option<(Vec<f64>, Vec<f64>)> {
+        (self.nearest_surface_point(x, on_boundary)).map(|s| (s.point, s.normal))
+    }
+
+    /// [`Self::nearest_surface`] with how the normal turns as x moves
+    /// ([`Bend`]), for derivatives of the distance to the surface.
+    pub fn nearest_surface_point(
+        &self,
+        x: &[f64],
+        on_boundary: &dyn Fn(usize, f64) -> bool,
+    ) -> Option<SurfacePoint> {
         let unit = |d: usize, sign: f64| -> Vec<f64> {
             (0..x.len())
                 .map(|i| if i == d { sign } else { 0.0 })
@@ -132,10 +142,10 @@ impl Geometry {
         let on_plane = |d: usize, c: f64, sign: f64| {
             let mut y = x.to_vec();
             y[d] = c;
-            ((x[d] - c).abs(), y, unit(d, sign))
+            ((x[d] - c).abs(), y, unit(d, sign), Bend::Flat)
         };
-        // Candidates (distance, point, normal); the nearest wins.
-        let mut faces: Vec<(f64, Vec<f64>, Vec<f64>)> = Vec::new();
+        // Candidates (distance, point, normal, bend); the nearest wins.
+        let mut faces: Vec<(f64, Vec<f64>, Vec<f64>, Bend)> = Vec::new();
         match self {
             Geometry::Box { min, max } => {
                 for d in 0..x.len() {
@@ -151,9 +161,17 @@ impl Geometry {
                 let r: Vec<f64> = (0..x.len()).map(|d| x[d] - centre[d]).collect();
                 let n = radial(&r);
                 let y = (0..x.len()).map(|d| centre[d] + radius * n[d]).collect();
-                faces.push((radius - norm(&r), y, n));
+                let bend = Bend::About {
+                    distance: norm(&r),
+                    axis: None,
+                };
+                faces.push((radius - norm(&r), y, n, bend));
             }
-            Geometry::Polygon(v) => faces.extend(polygon_faces(v, x, on_boundary)),
+            Geometry::Polygon(v) => faces.extend(
+                polygon_faces(v, x, on_boundary)
+                    .into_iter()
+                    .map(|(l, y, n)| (l, y, n, Bend::Flat)),
+            ),
             Geometry::Cylinder {
                 base,
                 radius,
@@ -162,7 +180,11 @@ impl Geometry {
                 let r = [x[0] - base[0], x[1] - base[1], 0.0];
                 let n = radial(&r);
                 let y = vec![base[0] + radius * n[0], base[1] + radius * n[1], x[2]];
-                faces.push((radius - norm(&r), y, n));
+                let bend = Bend::About {
+                    distance: norm(&r),
+                    axis: Some(2),
+                };
+                faces.push((radius - norm(&r), y, n, bend));
                 for (c, sign) in [(base[2], -1.0), (base[2] + height, 1.0)] {
                     if !on_boundary(2, c) {
                         faces.push(on_plane(2, c, sign));
@@ -173,8 +195,32 @@ impl Geometry {
         faces
             .into_iter()
             .min_by(|a, b| a.0.total_cmp(&b.0))
-            .map(|(_, y, n)| (y, n))
+            .map(|(_, point, normal, bend)| SurfacePoint {
+                point,
+                normal,
+                bend,
+            })
     }
+}
+
+/// A point of a body's surface nearest to a point x inside it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SurfacePoint {
+    pub point: Vec<f64>,
+    /// Outward unit normal.
+    pub normal: Vec<f64>,
+    pub bend: Bend,
+}
+
+/// How the outward normal n at the nearest surface point turns as x moves.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Bend {
+    /// A plane face (a polygon's edge): n is constant.
+    Flat,
+    /// A ball's surface (about its centre) or a cylinder's side (about its
+    /// `axis`) at `distance` from x: ∂n/∂x = (I − a aᵀ − n nᵀ)/distance, a the
+    /// axis (none for a ball).
+    About { distance: f64, axis: Option<usize> },
 }
 
 fn norm(r: &[f64]) -> f64 {

@@ -12,6 +12,7 @@ pub mod fbar;
 pub mod geostatic;
 pub mod mirror;
 pub mod rigid_body;
+pub mod rigid_penalty;
 pub mod rigid_surface;
 pub mod shape;
 pub mod transfer;

@@ -23,8 +23,8 @@
 //! X = c⁰ + Qᵀ(x − c) in the body's `[[body]]` geometry. Faces on a plane of the
 //! grid's boundary (the axis, a symmetry plane) are not surface.
 
-use crate::dim::{Mat3, Vector};
-use crate::model::geometry::Geometry;
+use crate::dim::{restrict, Mat3, Tensor, Vector};
+use crate::model::geometry::{Bend, Geometry};
 use crate::model::particles::Particles;
 use crate::physics::rigid_body::{from3, to3};
 use nalgebra::Vector3;
@@ -147,6 +147,63 @@ impl Surface {
         let n = Vector3::from_fn(|i, _| if i < D { n[i] } else { 0.0 });
         let y = at.centre + at.rotation * (y - at.centre0);
         Some((from3(&y), from3(&(at.rotation * n))))
+    }
+}
+
+/// A deformable particle inside a rigid body: the nearest surface point, the
+/// outward normal there and its derivative ∂n/∂x, in the current frame.
+#[derive(Clone, Copy, Debug)]
+pub struct Inside<const D: usize> {
+    pub point: Vector<D>,
+    pub normal: Vector<D>,
+    pub normal_derivative: Tensor<D>,
+}
+
+impl Placement {
+    /// The placement moved by `by` (a prescribed motion over a step).
+    pub fn shifted(&self, by: &Vector3<f64>) -> Placement {
+        Placement {
+            centre: self.centre + by,
+            ..*self
+        }
+    }
+}
+
+impl Surface {
+    /// [`Self::push_out`] with the derivative of the normal (`Bend`): where a
+    /// penalty pushes a particle at x out of the field's bodies.
+    pub fn inside<const D: usize>(
+        &self,
+        at: &Placement,
+        x: &Vector<D>,
+        on_boundary: &dyn Fn(usize, f64) -> bool,
+    ) -> Option<Inside<D>> {
+        let xr = at.centre0 + at.rotation.transpose() * (to3(x) - at.centre);
+        if (0..D).any(|d| xr[d] <= self.lower[d] || xr[d] >= self.upper[d]) {
+            return None;
+        }
+        let xs = &xr.as_slice()[..D];
+        let s = (self.shapes.iter())
+            .find(|s| s.contains(xs))?
+            .nearest_surface_point(xs, on_boundary)?;
+        let y = Vector3::from_fn(|i, _| if i < D { s.point[i] } else { 0.0 });
+        let n = Vector3::from_fn(|i, _| if i < D { s.normal[i] } else { 0.0 });
+        let dn = match s.bend {
+            Bend::Flat => Mat3::zeros(),
+            Bend::About { distance, axis } => {
+                let mut a = Mat3::identity() - n * n.transpose();
+                if let Some(k) = axis {
+                    a[(k, k)] -= 1.0;
+                }
+                a / distance
+            }
+        };
+        let q = &at.rotation;
+        Some(Inside {
+            point: from3(&(at.centre + q * (y - at.centre0))),
+            normal: from3(&(q * n)),
+            normal_derivative: restrict(&(q * dn * q.transpose())),
+        })
     }
 }
 
