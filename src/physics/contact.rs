@@ -38,7 +38,7 @@ use crate::dim::Vector;
 use crate::model::Model;
 use crate::parallel::MIN_PARALLEL_LEN;
 use crate::physics::rigid_body::FreeBodies;
-use crate::physics::rigid_surface::{Push, Surface};
+use crate::physics::rigid_surface::{on_grid_boundary, rigid_surfaces, Push, Surface};
 use crate::physics::shape::{ShapeFunction, Stencils};
 use crate::physics::transfer::NodeMap;
 use crate::scene::contact::{ContactLaw, ContactPlan};
@@ -472,11 +472,7 @@ impl<const D: usize> Contact<D> {
         let placements: Vec<_> = (self.surfaces.iter())
             .map(|s| s.placement(&m.particles))
             .collect();
-        let grid = &m.grid;
-        let tolerance = 1e-9 * grid.h_min();
-        let on_boundary = |d: usize, c: f64| {
-            (c - grid.min[d]).abs() <= tolerance || (c - grid.max[d]).abs() <= tolerance
-        };
+        let on_boundary = on_grid_boundary(&m.grid);
         let (plan, field, removes) = (&self.plan, &self.field, m.removes_particles());
         let free = self.free.as_ref();
         (0..m.particles.len())
@@ -531,20 +527,7 @@ fn surfaces<const D: usize>(plan: &ContactPlan, m: &Model<D>, field: &[u32]) -> 
                     .is_some_and(|l| l.rigid_projection)
         })
     };
-    (0..plan.fields)
-        .filter(|&k| plan.rigid[k] && keeps_out(k))
-        .map(|k| {
-            let members = (0..field.len())
-                .filter(|&q| field[q] as usize == k)
-                .collect();
-            let shapes = (plan.field_of_body.iter().enumerate())
-                .filter(|&(_, &f)| f as usize == k)
-                .map(|(b, _)| m.bodies[b].clone())
-                .collect();
-            let rotates = plan.free[k] && !m.axisymmetric;
-            Surface::new(k as u32, members, shapes, &m.particles, rotates)
-        })
-        .collect()
+    rigid_surfaces(plan, m, field, &keeps_out)
 }
 
 /// The part of v tangential to the unit normal n.

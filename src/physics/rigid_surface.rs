@@ -25,7 +25,10 @@
 
 use crate::dim::{restrict, Mat3, Tensor, Vector};
 use crate::model::geometry::{Bend, Geometry};
+use crate::model::grid::Grid;
 use crate::model::particles::Particles;
+use crate::model::Model;
+use crate::scene::contact::ContactPlan;
 use crate::physics::rigid_body::{from3, to3};
 use nalgebra::Vector3;
 
@@ -204,6 +207,40 @@ impl Surface {
             normal: from3(&(q * n)),
             normal_derivative: restrict(&(q * dn * q.transpose())),
         })
+    }
+}
+
+/// The rigid fields k of `plan` with `wanted(k)`, with their particles (by
+/// `field`, the field of each particle) and their bodies' geometries; a free
+/// body outside axisymmetry rotates.
+pub fn rigid_surfaces<const D: usize>(
+    plan: &ContactPlan,
+    m: &Model<D>,
+    field: &[u32],
+    wanted: &dyn Fn(usize) -> bool,
+) -> Vec<Surface> {
+    (0..plan.fields)
+        .filter(|&k| plan.rigid[k] && wanted(k))
+        .map(|k| {
+            let members = (0..field.len())
+                .filter(|&q| field[q] as usize == k)
+                .collect();
+            let shapes = (plan.field_of_body.iter().enumerate())
+                .filter(|&(_, &f)| f as usize == k)
+                .map(|(b, _)| m.bodies[b].clone())
+                .collect();
+            let rotates = plan.free[k] && !m.axisymmetric;
+            Surface::new(k as u32, members, shapes, &m.particles, rotates)
+        })
+        .collect()
+}
+
+/// Whether x_d = c is a plane of the grid's boundary (faces there, on the axis
+/// or a symmetry plane, are not surface).
+pub fn on_grid_boundary<const D: usize>(grid: &Grid<D>) -> impl Fn(usize, f64) -> bool + '_ {
+    let tolerance = 1e-9 * grid.h_min();
+    move |d: usize, c: f64| {
+        (c - grid.min[d]).abs() <= tolerance || (c - grid.max[d]).abs() <= tolerance
     }
 }
 

@@ -358,6 +358,15 @@ pub struct ContactConfig {
     /// (`crate::physics::rigid_surface`; default true).
     #[serde(default = "yes")]
     pub rigid_projection: bool,
+    /// Implicit solver: the penalty ε_n = α M A_p / h of a particle against a
+    /// rigid body is this α times the particle's P-wave modulus M, face area A_p
+    /// and 1/h (`crate::solver::implicit::contact`; default 100).
+    #[serde(default = "default_penalty_factor")]
+    pub penalty_factor: f64,
+}
+
+fn default_penalty_factor() -> f64 {
+    100.0
 }
 
 fn yes() -> bool {

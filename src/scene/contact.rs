@@ -26,6 +26,8 @@ pub struct ContactLaw {
     pub normal: ContactNormal,
     /// Deformable particles that enter a rigid body are put back on its surface.
     pub rigid_projection: bool,
+    /// α of the implicit solver's penalty against rigid bodies.
+    pub penalty_factor: f64,
 }
 
 impl ContactLaw {
@@ -36,6 +38,7 @@ impl ContactLaw {
             gap_factor: c.gap_factor,
             normal: c.normal,
             rigid_projection: c.rigid_projection,
+            penalty_factor: c.penalty_factor,
         }
     }
 }
@@ -112,8 +115,13 @@ fn check_law(c: &ContactConfig, i: usize) -> Result<(), KeyError> {
             return Err((key(k), "must be a finite number ≥ 0".into()));
         }
     }
-    if !(c.gap_factor > 0.0 && c.gap_factor.is_finite()) {
-        return Err((key("gap_factor"), "must be a finite number > 0".into()));
+    for (k, v) in [
+        ("gap_factor", c.gap_factor),
+        ("penalty_factor", c.penalty_factor),
+    ] {
+        if !(v > 0.0 && v.is_finite()) {
+            return Err((key(k), "must be a finite number > 0".into()));
+        }
     }
     Ok(())
 }

@@ -25,6 +25,10 @@ pub struct SolverState {
     /// The direct solver's counts (zero in checkpoints written before they were kept).
     #[serde(default)]
     pub direct: Statistics,
+    /// The implicit contact's tangential force of every particle at the end of
+    /// the last step, D values per particle (empty without friction).
+    #[serde(default)]
+    pub contact_tangential: Vec<f64>,
 }
 
 pub trait Stepper<const D: usize> {

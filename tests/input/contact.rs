@@ -105,19 +105,27 @@ fn a_pair_declared_twice_is_rejected() {
 }
 
 #[test]
-fn contact_needs_the_explicit_solver_and_no_b_splines() {
+fn implicit_contact_needs_a_rigid_body_and_explicit_contact_no_b_splines() {
     rejected(
         &scene("[[contact]]\n").replace("kind = \"explicit\"", "kind = \"implicit\"\ndt = 0.1"),
         "contact",
-        &["contact acts in the explicit solver only"],
+        &[
+            "stage 0 is implicit",
+            "between a deformable and a rigid body only, not between bodies 0 and 1",
+        ],
     );
     rejected(
         &scene("[[contact]]\n").replace("\"cpgimp\"", "\"bspline2\""),
         "grid.shape_function",
         &[
             "scene.toml:16:",
-            "contact works with linear, ugimp, cpgimp and cpdi",
+            "contact in the explicit solver works with linear, ugimp, cpgimp and cpdi",
         ],
+    );
+    rejected(
+        &scene("[[contact]]\npenalty_factor = 0.0\n"),
+        "contact.0.penalty_factor",
+        &["must be a finite number > 0"],
     );
 }
 

@@ -16,6 +16,7 @@ mod solver;
 pub use analyses::bench;
 pub use check::{Check, KeyError};
 
+use crate::scene::contact::ContactPlan;
 use crate::scene::{LinearSolver, LinearSystems, SceneConfig, SolverConfig, SolverKind};
 use analyses::{geostatic, strength_reduction};
 use axisymmetry::axisymmetry;
@@ -62,25 +63,8 @@ pub fn validate(s: &SceneConfig) -> Check {
     if s.dimension.is_axisymmetric() {
         axisymmetry(s)?;
     }
-    if crate::scene::contact::plan(s)?.is_some() {
-        use crate::scene::ShapeFunction::{Bspline2, Bspline3, Cpbspline2};
-        ensure(
-            !matches!(s.grid.shape_function, Bspline2 | Bspline3 | Cpbspline2),
-            "grid.shape_function",
-            "contact works with linear, ugimp, cpgimp and cpdi: B-spline supports span \
-             3-4 cells, so bodies share nodes along faces that do not touch and catch \
-             there (a block that should slide 0.43 m slides 0.01 m; docs/contact.md)",
-        )?;
-        for (k, st) in s.stages().into_iter().enumerate() {
-            ensure(
-                st.kind == SolverKind::Explicit,
-                "contact",
-                format!(
-                    "contact acts in the explicit solver only, and stage {k} is implicit \
-                     (implicit contact is not implemented yet)"
-                ),
-            )?;
-        }
+    if let Some(plan) = crate::scene::contact::plan(s)? {
+        implicit_contact(s, &plan)?;
     }
     needs_krylov(s, &materials)?;
     match (&s.solver, s.stages.is_empty()) {
@@ -141,6 +125,65 @@ pub fn validate(s: &SceneConfig) -> Check {
     }
     if let Some(b) = &s.bench {
         bench(b, "bench")?;
+    }
+    Ok(())
+}
+
+/// Contact in explicit stages: node-based, not with B-splines. In implicit
+/// stages: a penalty against rigid bodies with a prescribed motion only
+/// (`solver::implicit::contact`), not in axisymmetric mode.
+fn implicit_contact(s: &SceneConfig, plan: &ContactPlan) -> Check {
+    use crate::scene::ShapeFunction::{Bspline2, Bspline3, Cpbspline2};
+    let stages = s.stages();
+    if stages.iter().any(|st| st.kind == SolverKind::Explicit) {
+        ensure(
+            !matches!(s.grid.shape_function, Bspline2 | Bspline3 | Cpbspline2),
+            "grid.shape_function",
+            "contact in the explicit solver works with linear, ugimp, cpgimp and cpdi: \
+             B-spline supports span 3-4 cells, so bodies share nodes along faces that do \
+             not touch and catch there (a block that should slide 0.43 m slides 0.01 m; \
+             docs/contact.md)",
+        )?;
+    }
+    let Some(k) = stages.iter().position(|st| st.kind != SolverKind::Explicit) else {
+        return Ok(());
+    };
+    let what = format!("stage {k} is implicit, and implicit contact");
+    ensure(
+        !s.dimension.is_axisymmetric(),
+        "dimension",
+        format!("{what} is not implemented in axisymmetric mode"),
+    )?;
+    for i in 0..plan.fields {
+        for j in i + 1..plan.fields {
+            let Some(law) = plan.law(i as u32, j as u32) else {
+                continue;
+            };
+            let body = |f: usize| plan.field_of_body.iter().position(|&b| b as usize == f);
+            let (a, b) = (body(i).unwrap_or(0), body(j).unwrap_or(0));
+            let names = format!("bodies {a} and {b}");
+            ensure(
+                plan.rigid[i] != plan.rigid[j],
+                "contact",
+                format!(
+                    "{what} acts between a deformable and a rigid body only, not between \
+                     {names} (implicit contact of two deformable bodies is not implemented)"
+                ),
+            )?;
+            ensure(
+                !plan.free[i] && !plan.free[j],
+                "contact",
+                format!(
+                    "{what} needs rigid bodies with a prescribed motion, and one of {names} \
+                     is free (`motion = \"free\"`)"
+                ),
+            )?;
+            ensure(
+                law.adhesion == 0.0,
+                "contact",
+                format!("{what} has no adhesion (between {names})"),
+            )?;
+        }
     }
     Ok(())
 }

@@ -18,6 +18,7 @@
 
 pub mod assembly;
 pub mod coarsening;
+pub mod contact;
 pub mod export;
 pub mod failure;
 pub mod krylov;
@@ -38,6 +39,7 @@ use crate::scene::{
 };
 use crate::solver::divergence::{check_state, Divergence};
 use crate::solver::linear::direct::DirectSolver;
+use crate::physics::contact::PairTotal;
 use crate::solver::report::{DirectReport, NewtonRow, SolverReport};
 use crate::solver::stepper::{SolverState, Stepper};
 use failure::Failure;
@@ -59,6 +61,9 @@ pub struct Implicit<const D: usize> {
     /// components exert on the body), nodes with a non-zero reaction only.
     pub reaction: Vec<(u32, Vector<D>)>,
     pub cutbacks: usize,
+    /// Contact tangential forces from a checkpoint, for the contact set up at
+    /// the first step.
+    restored_contact: Vec<f64>,
 }
 
 impl<const D: usize> Implicit<D> {
@@ -73,6 +78,7 @@ impl<const D: usize> Implicit<D> {
             accel: Vec::new(),
             reaction: Vec::new(),
             cutbacks: 0,
+            restored_contact: Vec::new(),
         }
     }
 
@@ -154,6 +160,9 @@ impl<const D: usize> Implicit<D> {
     fn prepare(&mut self, m: &Model<D>, t: f64, dt: f64) {
         self.settings
             .prepare(m, &mut self.system, &mut self.accel, t, dt);
+        if let Some(contact) = self.system.contact.as_mut() {
+            contact.restore_tangential(&std::mem::take(&mut self.restored_contact));
+        }
     }
 }
 
@@ -182,6 +191,10 @@ impl<const D: usize> Stepper<D> for Implicit<D> {
 
     fn reaction(&self) -> Option<&[(u32, Vector<D>)]> {
         Some(&self.reaction)
+    }
+
+    fn take_contact(&mut self) -> Vec<PairTotal<D>> {
+        (self.system.contact.as_mut()).map_or_else(Vec::new, |c| c.take_totals())
     }
 
     fn take_newton_rows(&mut self) -> Vec<NewtonRow> {
@@ -231,6 +244,8 @@ impl<const D: usize> Stepper<D> for Implicit<D> {
             direct: self
                 .direct_solver()
                 .map_or_else(Default::default, |d| d.statistics()),
+            contact_tangential: (self.system.contact.as_ref())
+                .map_or_else(Vec::new, |c| c.tangential_state()),
         }
     }
 
@@ -240,6 +255,7 @@ impl<const D: usize> Stepper<D> for Implicit<D> {
             .collect();
         self.newton.iterations = s.newton_iterations;
         self.cutbacks = s.cutbacks;
+        self.restored_contact = s.contact_tangential.clone();
         match &mut self.newton.linear {
             newton::Linear::Krylov(k) => {
                 k.iterations = s.krylov_iterations;

@@ -55,6 +55,11 @@ pub fn residual<const D: usize>(
         .collect();
     // Absorbing faces: − f_boundary(u), dashpots through v_{n+1}(u) (2-63).
     sys.absorbing.add_residual(map, st, p, u, &mut r);
+    // Contact with rigid bodies: r_I −= S_Ip f_p (`super::contact`).
+    if let Some(contact) = sys.contact.as_mut() {
+        contact.evaluate(m, st, map, u);
+        contact.add_residual(map, st, &mut r);
+    }
     Ok(r)
 }
 
@@ -105,7 +110,9 @@ pub fn tangent<'s, const D: usize>(
     let fbar = sys.trial.fbar.as_ref();
     let pattern = step_pattern(sys);
     // Symmetric unless F-bar or a non-associated material breaks it.
+    let contact = sys.contact.as_ref();
     let symmetric = fbar.is_none()
+        && contact.is_none_or(|c| c.symmetric())
         && (a.values)
             .par_chunks(ParticleTangents::<D>::LEN)
             .enumerate()
@@ -130,6 +137,9 @@ pub fn tangent<'s, const D: usize>(
     }
     // Absorbing faces: Σ S_I S_J (γ/(βΔt) C + K), symmetric.
     add_absorbing(&mut k, &sys.absorbing, pattern, map, st, dofs);
+    if let Some(contact) = contact {
+        contact.add_tangent(&mut k, pattern, map, st, dofs);
+    }
     if sys.inertia > 0.0 {
         match sys.mass_matrix {
             MassMatrix::Lumped => add_lumped_mass::<D>(&mut k, dofs, &sys.mass, sys.inertia),

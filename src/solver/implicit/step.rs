@@ -12,6 +12,7 @@
 //! [`StepSettings::commit`] makes the converged increment the particles' state.
 
 use super::assembly::{Dofs, Pattern};
+use super::contact::RigidContact;
 use super::newmark::Newmark;
 use super::ties::{merge, natural_end_ties, nodal_support, ties};
 use crate::dim::Vector;
@@ -24,7 +25,7 @@ use crate::physics::deformation::Trial;
 use crate::physics::shape::{ShapeFunction, Stencils};
 use crate::physics::transfer::{
     applied_force, external_force, interpolate, mass_average, mass_momentum, mass_weighted,
-    nodal_force, stencils_and_nodes, NodeMap,
+    nodal_force, stencils, NodeMap,
 };
 use crate::scene::{DirectOrdering, Integrator, MassMatrix, SolverConfig};
 use rayon::prelude::*;
@@ -88,6 +89,8 @@ pub struct StepSystem<const D: usize> {
     /// The tangent's sparsity pattern (built at the step's first assembly, kept
     /// for the next step if it fits).
     pub pattern: OnceLock<Pattern>,
+    /// Contact with rigid bodies (None in a scene without).
+    pub contact: Option<RigidContact<D>>,
 }
 
 impl<const D: usize> StepSystem<D> {
@@ -112,6 +115,7 @@ impl<const D: usize> StepSystem<D> {
             trial: Trial::default(),
             direct_ordering: DirectOrdering::Auto,
             pattern: OnceLock::new(),
+            contact: None,
         }
     }
 }
@@ -163,7 +167,15 @@ impl StepSettings {
         dt: f64,
     ) {
         let p = &m.particles;
-        stencils_and_nodes(m, self.shape, &mut sys.stencils, &mut sys.map);
+        if sys.contact.is_none() && m.contact.is_some() {
+            sys.contact = RigidContact::new(m);
+        }
+        stencils(m, self.shape, &mut sys.stencils);
+        if let Some(contact) = sys.contact.as_mut() {
+            contact.leave_out_rigid(&mut sys.stencils);
+            contact.start_step(p, dt);
+        }
+        sys.map.build(&sys.stencils, m.grid.node_count());
         if self.fbar {
             sys.trial.use_fbar(&m.grid, &p.x);
         }
@@ -310,6 +322,9 @@ impl StepSettings {
             .sum();
         for (x, d) in p.x.iter_mut().zip(&dx) {
             *x += d;
+        }
+        if let Some(contact) = sys.contact.as_mut() {
+            contact.commit(p, dt);
         }
         if self.dynamic() {
             let n = map.len();
