@@ -10,7 +10,7 @@
 //! contact.csv.
 
 use super::parameters::{FromParameters, KeyError, Parameters};
-use super::{Increment, Material};
+use super::{Increment, Material, StressDerivative};
 use crate::dim::Mat3;
 use serde::Deserialize;
 
@@ -65,6 +65,12 @@ impl Material for Rigid {
 
     fn update(&self, _inc: &Increment, _history_new: &mut [f64]) -> Mat3 {
         Mat3::zeros()
+    }
+
+    /// No stress, so none changes (the implicit solver keeps a rigid body's
+    /// particles off the grid anyway, `solver::implicit::contact`).
+    fn stress_derivative(&self, _inc: &Increment) -> Option<StressDerivative> {
+        Some(StressDerivative::zeros())
     }
 
     /// No waves cross a rigid body: it does not limit the time step.

@@ -203,6 +203,103 @@ impl Geometry {
     }
 }
 
+impl Geometry {
+    /// The signed distance of x to the surface (negative inside) with the
+    /// nearest surface point, for x inside (`nearest_surface_point`) or outside
+    /// a box, a ball or a polygon; `None` outside a cylinder or where no face is
+    /// surface. Outside a box's edge or corner, or a polygon's vertex, the
+    /// nearest point is that edge or corner and the normal turns about it.
+    pub fn signed_surface_point(
+        &self,
+        x: &[f64],
+        on_boundary: &dyn Fn(usize, f64) -> bool,
+    ) -> Option<(f64, SurfacePoint)> {
+        if self.contains(x) {
+            let s = self.nearest_surface_point(x, on_boundary)?;
+            let depth: f64 = (0..x.len()).map(|d| (s.point[d] - x[d]) * s.normal[d]).sum();
+            return Some((-depth, s));
+        }
+        let about = |y: Vec<f64>, axis: Option<usize>| {
+            let r: Vec<f64> = (0..x.len()).map(|d| x[d] - y[d]).collect();
+            let distance = norm(&r);
+            let bend = Bend::About { distance, axis };
+            (distance, SurfacePoint {
+                point: y,
+                normal: radial(&r),
+                bend,
+            })
+        };
+        match self {
+            Geometry::Box { min, max } => {
+                let y: Vec<f64> = (0..x.len()).map(|d| x[d].clamp(min[d], max[d])).collect();
+                let outside: Vec<usize> = (0..x.len()).filter(|&d| y[d] != x[d]).collect();
+                match outside[..] {
+                    [d] => {
+                        let sign = if x[d] > max[d] { 1.0 } else { -1.0 };
+                        let normal = (0..x.len()).map(|i| if i == d { sign } else { 0.0 });
+                        Some(((x[d] - y[d]).abs(), SurfacePoint {
+                            point: y,
+                            normal: normal.collect(),
+                            bend: Bend::Flat,
+                        }))
+                    }
+                    // An edge of a 3D box: the normal turns about its axis.
+                    [a, b] if x.len() == 3 => Some(about(y, Some(3 - a - b))),
+                    _ => Some(about(y, None)),
+                }
+            }
+            Geometry::Ball { centre, radius } => {
+                let r: Vec<f64> = (0..x.len()).map(|d| x[d] - centre[d]).collect();
+                let n = radial(&r);
+                let point = (0..x.len()).map(|d| centre[d] + radius * n[d]).collect();
+                let bend = Bend::About {
+                    distance: norm(&r),
+                    axis: None,
+                };
+                Some((norm(&r) - radius, SurfacePoint {
+                    point,
+                    normal: n,
+                    bend,
+                }))
+            }
+            Geometry::Polygon(v) => {
+                let k = (0..v.len())
+                    .min_by(|&i, &j| {
+                        let di = segment_distance(x, &v[i], &v[(i + 1) % v.len()]).0;
+                        let dj = segment_distance(x, &v[j], &v[(j + 1) % v.len()]).0;
+                        di.total_cmp(&dj)
+                    })?;
+                let (a, b) = (&v[k], &v[(k + 1) % v.len()]);
+                let (distance, t) = segment_distance(x, a, b);
+                let y: Vec<f64> = (0..2).map(|d| a[d] + t * (b[d] - a[d])).collect();
+                if t <= 0.0 || t >= 1.0 {
+                    return Some(about(y, None));
+                }
+                let r: Vec<f64> = (0..2).map(|d| x[d] - y[d]).collect();
+                Some((distance, SurfacePoint {
+                    point: y,
+                    normal: radial(&r),
+                    bend: Bend::Flat,
+                }))
+            }
+            Geometry::Cylinder { .. } => None,
+        }
+    }
+}
+
+/// The distance of x to the segment ab and the parameter t ∈ [0, 1] of the
+/// nearest point a + t (b − a).
+fn segment_distance(x: &[f64], a: &[f64], b: &[f64]) -> (f64, f64) {
+    let e = [b[0] - a[0], b[1] - a[1]];
+    let l2 = e[0] * e[0] + e[1] * e[1];
+    let t = match l2 > 0.0 {
+        true => (((x[0] - a[0]) * e[0] + (x[1] - a[1]) * e[1]) / l2).clamp(0.0, 1.0),
+        false => 0.0,
+    };
+    let y = [a[0] + t * e[0], a[1] + t * e[1]];
+    (norm(&[x[0] - y[0], x[1] - y[1]]), t)
+}
+
 /// A point of a body's surface nearest to a point x inside it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SurfacePoint {

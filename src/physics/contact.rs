@@ -585,6 +585,7 @@ mod tests {
                 gap_factor: 0.5,
                 normal: ContactNormal::MaxGradient,
                 rigid_projection: true,
+                penalty_factor: 100.0,
             },
         }
     }

@@ -4,8 +4,10 @@
 //! The node-based contact of `physics::contact` corrects grid velocities, which
 //! has no residual to put into a Newton iteration. Here the particle is the
 //! slave point and the rigid body's exact `[[body]]` geometry the master
-//! surface. A particle at x inside the body is `g = n·(s − x) ≥ 0` deep below
-//! its nearest surface point s (outward normal n) and feels
+//! surface. A particle at x that reaches r along the normal (its domain's
+//! half-width, `Surface::reached`) and is at the signed distance d < r from the
+//! body (negative inside; nearest surface point s, outward normal n) is
+//! g = r − d deep in it and feels
 //!
 //!   f = ε_n g n + f_t                                  (normal penalty)
 //!
@@ -19,11 +21,12 @@
 //!   f_t = μ ε_n g h/|h|     otherwise          (slip).
 //!
 //! The derivative ∂f/∂x (f_t⁰ and the body's motion are fixed within a step),
-//! with ∂g/∂x = −nᵀ and N = ∂n/∂x (zero on a plane face; `Bend`):
+//! with N = ∂n/∂x (zero on a plane face; `Bend`) and ∂g/∂x (−nᵀ plus the turn
+//! of the reach with n):
 //!
-//!   ∂(ε_n g n)/∂x = ε_n (g N − n nᵀ)
+//!   ∂(ε_n g n)/∂x = ε_n (g N + n ∂g/∂x)
 //!   ∂h/∂x = −ε_t P − N (nᵀ b) − n (bᵀ N),  b = f_t⁰ − ε_t Δ
-//!   slip: ∂f_t/∂x = −μ ε_n ĥ nᵀ + (μ ε_n g/|h|) (I − ĥ ĥᵀ) ∂h/∂x,  ĥ = h/|h|.
+//!   slip: ∂f_t/∂x = μ ε_n ĥ ∂g/∂x + (μ ε_n g/|h|) (I − ĥ ĥᵀ) ∂h/∂x,  ĥ = h/|h|.
 //!
 //! The stick derivative is symmetric on plane faces; a curved face or slip makes
 //! it unsymmetric.
@@ -58,22 +61,21 @@ pub struct ParticleContact<const D: usize> {
     pub slips: bool,
 }
 
-/// The penalty force on a particle at x inside a body (`inside`: nearest
-/// surface point, normal and its derivative), that moved by `relative` with
+/// The penalty force on a particle that reaches into a body (`inside`: nearest
+/// surface point, normal and its derivative, depth), that moved by `relative` with
 /// respect to the body over the step and carried the tangential force `f_t0` at
 /// the step start.
 pub fn penalty_force<const D: usize>(
     law: &Penalty,
-    x: &Vector<D>,
     inside: &Inside<D>,
     relative: &Vector<D>,
     f_t0: &Vector<D>,
 ) -> ParticleContact<D> {
     let (n, dn) = (&inside.normal, &inside.normal_derivative);
     let id = Tensor::<D>::identity();
-    let g = n.dot(&(inside.point - x)).max(0.0);
+    let (g, dg) = (inside.depth, &inside.depth_gradient);
     let f_n = law.normal * g;
-    let normal_part = (dn * g - n * n.transpose()) * law.normal;
+    let normal_part = (dn * g + n * dg.transpose()) * law.normal;
     if law.friction == 0.0 {
         return ParticleContact {
             force: n * f_n,
@@ -95,7 +97,7 @@ pub fn penalty_force<const D: usize>(
         (h, dh, false)
     } else {
         let t = h / h_norm;
-        let d_t = -(t * n.transpose()) * (law.friction * law.normal)
+        let d_t = (t * dg.transpose()) * (law.friction * law.normal)
             + (id - t * t.transpose()) * dh * (cap / h_norm);
         (t * cap, d_t, true)
     };
@@ -136,8 +138,9 @@ mod tests {
         let f_t0 = Vector2::new(30.0, 5.0);
         let u_body = Vector2::new(0.01, -0.02);
         let force = |y: &Vector2<f64>| {
-            let inside = s.inside(&at, y, &none).expect("inside");
-            penalty_force(&law, y, &inside, &(y - x0 - u_body), &f_t0)
+            let axes = [Vector2::new(0.006, 0.001), Vector2::new(-0.002, 0.005)];
+            let inside = s.reached(&at, y, &axes, &none).expect("inside");
+            penalty_force(&law, &inside, &(y - x0 - u_body), &f_t0)
         };
         let c = force(&x);
         let h = 1e-7;
@@ -171,9 +174,18 @@ mod tests {
             tangential: 1e6,
             friction,
         };
+        // Inside under a face, outside within reach of a corner (the normal
+        // turns about it), inside a disk, outside a disk within reach.
         let x_face = Vector2::new(1.2, 1.975);
+        let x_corner = Vector2::new(2.015, 1.983);
         let x_ball = Vector2::new(1.5, 1.8);
-        for (shape, x) in [(square(), x_face), (disk(), x_ball)] {
+        let x_near_ball = Vector2::new(1.01, 1.985);
+        for (shape, x) in [
+            (square(), x_face),
+            (square(), x_corner),
+            (disk(), x_ball),
+            (disk(), x_near_ball),
+        ] {
             // Frictionless, stick (μ large), slip (μ small).
             for mu in [0.0, 100.0, 0.1] {
                 assert!(check_derivative(shape.clone(), [1.0, 1.0], x, stiff(mu)));
@@ -193,7 +205,8 @@ mod tests {
         let at = s.placement(&p);
         let none = |_: usize, _: f64| false;
         let x = Vector2::new(1.0, 1.99);
-        let inside = s.inside(&at, &x, &none).unwrap();
+        let point = [Vector2::zeros(); 2];
+        let inside = s.reached(&at, &x, &point, &none).unwrap();
         let law = Penalty {
             normal: 1e4,
             tangential: 1e4,
@@ -201,15 +214,18 @@ mod tests {
         };
         // Depth 0.01: normal force 100 up; a slide of 1 along x would take 1e4,
         // capped at μ f_n = 50 against the motion.
-        let c = penalty_force(&law, &x, &inside, &Vector2::new(1.0, 0.0), &Vector2::zeros());
+        let c = penalty_force(&law, &inside, &Vector2::new(1.0, 0.0), &Vector2::zeros());
         assert!((c.depth - 0.01).abs() < 1e-12);
         assert!((c.force - Vector2::new(-50.0, 100.0)).norm() < 1e-9, "{}", c.force);
         assert!(c.slips);
         // A small slide sticks: −ε_t Δ.
-        let c = penalty_force(&law, &x, &inside, &Vector2::new(1e-3, 0.0), &Vector2::zeros());
+        let c = penalty_force(&law, &inside, &Vector2::new(1e-3, 0.0), &Vector2::zeros());
         assert!((c.force - Vector2::new(-10.0, 100.0)).norm() < 1e-9, "{}", c.force);
         assert!(!c.slips);
-        // Outside: no contact.
-        assert!(s.inside(&at, &Vector2::new(1.0, 2.01), &none).is_none());
+        // Outside: no contact, unless the particle reaches the surface.
+        assert!(s.reached(&at, &Vector2::new(1.0, 2.01), &point, &none).is_none());
+        let square = [Vector2::new(0.015, 0.0), Vector2::new(0.0, 0.015)];
+        let reach = s.reached(&at, &Vector2::new(1.0, 2.01), &square, &none).unwrap();
+        assert!((reach.depth - 0.005).abs() < 1e-12 && reach.normal == Vector2::new(0.0, 1.0));
     }
 }

@@ -153,13 +153,18 @@ impl Surface {
     }
 }
 
-/// A deformable particle inside a rigid body: the nearest surface point, the
-/// outward normal there and its derivative ∂n/∂x, in the current frame.
+/// A deformable particle that reaches into a rigid body: its nearest surface
+/// point, the outward normal there and its derivative ∂n/∂x, in the current
+/// frame, and how deep it reaches.
 #[derive(Clone, Copy, Debug)]
 pub struct Inside<const D: usize> {
     pub point: Vector<D>,
     pub normal: Vector<D>,
     pub normal_derivative: Tensor<D>,
+    /// The particle's reach minus its signed distance to the surface (> 0).
+    pub depth: f64,
+    /// ∂depth/∂x.
+    pub depth_gradient: Vector<D>,
 }
 
 impl Placement {
@@ -173,22 +178,32 @@ impl Placement {
 }
 
 impl Surface {
-    /// [`Self::push_out`] with the derivative of the normal (`Bend`): where a
-    /// penalty pushes a particle at x out of the field's bodies.
-    pub fn inside<const D: usize>(
+    /// A particle at x whose domain is the parallelogram (parallelepiped) of
+    /// half-axes `half_axes` a_j about x, and that comes closer than its reach
+    /// r = Σ_j |n·a_j| along the normal to the field's bodies (or is inside
+    /// them): the nearest surface point, the normal n with its derivative N
+    /// (`Bend`), the depth g = r − d (d the signed distance) and
+    /// ∂g/∂x = −n + Σ_j sign(n·a_j) N a_j; `None` when it does not reach.
+    pub fn reached<const D: usize>(
         &self,
         at: &Placement,
         x: &Vector<D>,
+        half_axes: &[Vector<D>; D],
         on_boundary: &dyn Fn(usize, f64) -> bool,
     ) -> Option<Inside<D>> {
+        let widest: f64 = half_axes.iter().map(|a| a.norm()).sum();
         let xr = at.centre0 + at.rotation.transpose() * (to3(x) - at.centre);
-        if (0..D).any(|d| xr[d] <= self.lower[d] || xr[d] >= self.upper[d]) {
+        let outside = |d: usize| xr[d] <= self.lower[d] - widest || xr[d] >= self.upper[d] + widest;
+        if (0..D).any(outside) {
             return None;
         }
         let xs = &xr.as_slice()[..D];
-        let s = (self.shapes.iter())
-            .find(|s| s.contains(xs))?
-            .nearest_surface_point(xs, on_boundary)?;
+        let (distance, s) = (self.shapes.iter())
+            .filter_map(|g| g.signed_surface_point(xs, on_boundary))
+            .min_by(|a, b| a.0.total_cmp(&b.0))?;
+        if distance >= widest {
+            return None;
+        }
         let y = Vector3::from_fn(|i, _| if i < D { s.point[i] } else { 0.0 });
         let n = Vector3::from_fn(|i, _| if i < D { s.normal[i] } else { 0.0 });
         let dn = match s.bend {
@@ -202,10 +217,20 @@ impl Surface {
             }
         };
         let q = &at.rotation;
+        let normal: Vector<D> = from3(&(q * n));
+        let normal_derivative: Tensor<D> = restrict(&(q * dn * q.transpose()));
+        let reach: f64 = half_axes.iter().map(|a| normal.dot(a).abs()).sum();
+        if distance >= reach {
+            return None;
+        }
+        let depth_gradient = (half_axes.iter())
+            .fold(-normal, |g, a| g + normal_derivative * a * normal.dot(a).signum());
         Some(Inside {
             point: from3(&(at.centre + q * (y - at.centre0))),
-            normal: from3(&(q * n)),
-            normal_derivative: restrict(&(q * dn * q.transpose())),
+            normal,
+            normal_derivative,
+            depth: reach - distance,
+            depth_gradient,
         })
     }
 }

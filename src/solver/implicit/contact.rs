@@ -19,7 +19,7 @@
 //! for the next step (stick carries over steps).
 
 use super::assembly::{Components, Dofs, Pattern, Tangent};
-use crate::dim::Vector;
+use crate::dim::{Mat3, Vector};
 use crate::model::particles::Particles;
 use crate::model::Model;
 use crate::parallel::MIN_PARALLEL_LEN;
@@ -147,9 +147,10 @@ impl<const D: usize> RigidContact<D> {
                 let dx = interpolate(map, st, q, u);
                 let x = p.x[q] + dx;
                 let f = this.field[q];
+                let axes = half_axes(&p.f[q], &p.half_length0[q]);
                 (this.surfaces.iter().enumerate()).find_map(|(k, s)| {
                     let law = this.plan.law(f, s.field)?;
-                    let inside = s.inside(&this.end[k], &x, &on_boundary)?;
+                    let inside = s.reached(&this.end[k], &x, &axes, &on_boundary)?;
                     let penalty = Penalty {
                         normal: this.penalty[q],
                         tangential: this.penalty[q],
@@ -160,7 +161,7 @@ impl<const D: usize> RigidContact<D> {
                     Some(Touch {
                         particle: q,
                         surface: k,
-                        contact: penalty_force(&penalty, &x, &inside, &relative, &f_t0),
+                        contact: penalty_force(&penalty, &inside, &relative, &f_t0),
                     })
                 })
             })
@@ -310,4 +311,10 @@ fn pair_totals<const D: usize>(plan: &ContactPlan) -> Vec<PairTotal<D>> {
             nodes: 0,
         })
         .collect()
+}
+
+/// The half-axes F e_j ℓ_j of a particle's domain at the step start (F its
+/// deformation gradient, ℓ its initial half-lengths).
+fn half_axes<const D: usize>(f: &Mat3, half_length0: &Vector<D>) -> [Vector<D>; D] {
+    std::array::from_fn(|j| Vector::<D>::from_fn(|i, _| f[(i, j)] * half_length0[j]))
 }
