@@ -156,14 +156,18 @@ fn implicit_contact(s: &SceneConfig, plan: &ContactPlan) -> Check {
     )?;
     for i in 0..plan.fields {
         for j in i + 1..plan.fields {
+            // Two rigid bodies pass through each other (neither is on the grid).
             let Some(law) = plan.law(i as u32, j as u32) else {
                 continue;
             };
+            if plan.rigid[i] && plan.rigid[j] {
+                continue;
+            }
             let body = |f: usize| plan.field_of_body.iter().position(|&b| b as usize == f);
             let (a, b) = (body(i).unwrap_or(0), body(j).unwrap_or(0));
             let names = format!("bodies {a} and {b}");
             ensure(
-                plan.rigid[i] != plan.rigid[j],
+                plan.rigid[i] || plan.rigid[j],
                 "contact",
                 format!(
                     "{what} acts between a deformable and a rigid body only, not between \

@@ -102,6 +102,10 @@ fn tangent_error_of<const D: usize>(
     let n = dofs.free;
     let mut k = vec![0.0; n * n];
     let kt = tangent(&m, sys, false).unwrap();
+    if let Some(c) = &sys.contact {
+        let slip = c.touches.iter().filter(|t| t.contact.slips).count();
+        CONTACTS.with(|x| x.set((c.touches.len() - slip, slip)));
+    }
     let km = kt.matrix();
     for c in 0..n {
         for (&r, &v) in km.row_idx_of_col_raw(c).iter().zip(km.val_of_col(c)) {
@@ -208,6 +212,60 @@ fn global_tangent_matches_finite_differences_of_the_residual() {
             "{model} {shape} {mass}: tangent off by {error:.2e} of its largest entry"
         );
     }
+}
+
+/// Two rigid bodies pressed into the block: a disk on its top and a box at its
+/// right side, moving with prescribed velocities (`super::contact`).
+const RIGID_BODIES: &str = r#"[[material]]
+name = "steel"
+model = "rigid"
+density = 1000.0
+[[body]]
+name = "disk"
+material = "steel"
+shape = "disk"
+centre = [1.75, 3.2]
+radius = 0.75
+velocity = [0.5, -1.0]
+[[body]]
+name = "wall"
+material = "steel"
+shape = "rectangle"
+min = [2.9, 0.5]
+max = [3.5, 1.5]
+velocity = [-1.0, 0.2]
+"#;
+
+/// The tangent with penalty contact against rigid bodies (a curved and a flat
+/// face, frictionless and with friction: particles sticking and slipping at
+/// the iterate) against central differences of the residual.
+#[test]
+fn tangent_with_rigid_contact_matches_finite_differences_of_the_residual() {
+    let body = BLOCK
+        .replace("[[body]]\nmaterial = \"m\"", "[[body]]\nname = \"block\"\nmaterial = \"m\"")
+        .replace("[[boundary]]", &format!("{RIGID_BODIES}[[boundary]]"));
+    for (shape, mu) in [("linear", 0.0), ("linear", 0.3), ("cpgimp", 0.3), ("bspline2", 0.3)] {
+        let text = body.replace(
+            "[solver]",
+            &format!("[[contact]]\nfriction_coefficient = {mu}\n[solver]"),
+        );
+        let overrides = vec![format!("grid.shape_function={shape}")];
+        let (error, n, _, _) = tangent_error_of::<2>(&text, &overrides, false);
+        // What the contact did at the iterate (the last residual is at u − h e).
+        let (stick, slip) = CONTACTS.with(|c| c.get());
+        println!(
+            "{shape} μ = {mu}: {n} unknowns, {stick} particles sticking, {slip} slipping, \
+             max |K − K_fd| / max|K| = {error:.2e}"
+        );
+        assert!(stick > 0 && (mu == 0.0 || slip > 0), "{stick} stick, {slip} slip");
+        assert!(error < 1e-6, "{shape} μ = {mu}: tangent off by {error:.2e}");
+    }
+}
+
+thread_local! {
+    /// Particles in contact, sticking and slipping, at the tangent of the last
+    /// `tangent_error_of` on this thread.
+    static CONTACTS: std::cell::Cell<(usize, usize)> = const { std::cell::Cell::new((0, 0)) };
 }
 
 /// The axisymmetric tangent (the hoop couplings of `assembly::stiffness`, the
