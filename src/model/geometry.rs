@@ -216,18 +216,23 @@ impl Geometry {
     ) -> Option<(f64, SurfacePoint)> {
         if self.contains(x) {
             let s = self.nearest_surface_point(x, on_boundary)?;
-            let depth: f64 = (0..x.len()).map(|d| (s.point[d] - x[d]) * s.normal[d]).sum();
+            let depth: f64 = (0..x.len())
+                .map(|d| (s.point[d] - x[d]) * s.normal[d])
+                .sum();
             return Some((-depth, s));
         }
         let about = |y: Vec<f64>, axis: Option<usize>| {
             let r: Vec<f64> = (0..x.len()).map(|d| x[d] - y[d]).collect();
             let distance = norm(&r);
             let bend = Bend::About { distance, axis };
-            (distance, SurfacePoint {
-                point: y,
-                normal: radial(&r),
-                bend,
-            })
+            (
+                distance,
+                SurfacePoint {
+                    point: y,
+                    normal: radial(&r),
+                    bend,
+                },
+            )
         };
         match self {
             Geometry::Box { min, max } => {
@@ -237,11 +242,14 @@ impl Geometry {
                     [d] => {
                         let sign = if x[d] > max[d] { 1.0 } else { -1.0 };
                         let normal = (0..x.len()).map(|i| if i == d { sign } else { 0.0 });
-                        Some(((x[d] - y[d]).abs(), SurfacePoint {
-                            point: y,
-                            normal: normal.collect(),
-                            bend: Bend::Flat,
-                        }))
+                        Some((
+                            (x[d] - y[d]).abs(),
+                            SurfacePoint {
+                                point: y,
+                                normal: normal.collect(),
+                                bend: Bend::Flat,
+                            },
+                        ))
                     }
                     // An edge of a 3D box: the normal turns about its axis.
                     [a, b] if x.len() == 3 => Some(about(y, Some(3 - a - b))),
@@ -256,19 +264,21 @@ impl Geometry {
                     distance: norm(&r),
                     axis: None,
                 };
-                Some((norm(&r) - radius, SurfacePoint {
-                    point,
-                    normal: n,
-                    bend,
-                }))
+                Some((
+                    norm(&r) - radius,
+                    SurfacePoint {
+                        point,
+                        normal: n,
+                        bend,
+                    },
+                ))
             }
             Geometry::Polygon(v) => {
-                let k = (0..v.len())
-                    .min_by(|&i, &j| {
-                        let di = segment_distance(x, &v[i], &v[(i + 1) % v.len()]).0;
-                        let dj = segment_distance(x, &v[j], &v[(j + 1) % v.len()]).0;
-                        di.total_cmp(&dj)
-                    })?;
+                let k = (0..v.len()).min_by(|&i, &j| {
+                    let di = segment_distance(x, &v[i], &v[(i + 1) % v.len()]).0;
+                    let dj = segment_distance(x, &v[j], &v[(j + 1) % v.len()]).0;
+                    di.total_cmp(&dj)
+                })?;
                 let (a, b) = (&v[k], &v[(k + 1) % v.len()]);
                 let (distance, t) = segment_distance(x, a, b);
                 let y: Vec<f64> = (0..2).map(|d| a[d] + t * (b[d] - a[d])).collect();
@@ -276,11 +286,14 @@ impl Geometry {
                     return Some(about(y, None));
                 }
                 let r: Vec<f64> = (0..2).map(|d| x[d] - y[d]).collect();
-                Some((distance, SurfacePoint {
-                    point: y,
-                    normal: radial(&r),
-                    bend: Bend::Flat,
-                }))
+                Some((
+                    distance,
+                    SurfacePoint {
+                        point: y,
+                        normal: radial(&r),
+                        bend: Bend::Flat,
+                    },
+                ))
             }
             Geometry::Cylinder { .. } => None,
         }

@@ -28,8 +28,8 @@ use crate::model::geometry::{Bend, Geometry};
 use crate::model::grid::Grid;
 use crate::model::particles::Particles;
 use crate::model::Model;
-use crate::scene::contact::ContactPlan;
 use crate::physics::rigid_body::{from3, to3};
+use crate::scene::contact::ContactPlan;
 use nalgebra::Vector3;
 
 /// One rigid velocity field: its particles and the geometries of its bodies.
@@ -198,13 +198,53 @@ impl Surface {
             return None;
         }
         let xs = &xr.as_slice()[..D];
-        let (distance, s) = (self.shapes.iter())
-            .filter_map(|g| g.signed_surface_point(xs, on_boundary))
+        let (distance, s, shape) = (self.shapes.iter())
+            .filter_map(|g| {
+                g.signed_surface_point(xs, on_boundary)
+                    .map(|(d, s)| (d, s, g))
+            })
             .min_by(|a, b| a.0.total_cmp(&b.0))?;
         if distance >= widest {
             return None;
         }
-        let y = Vector3::from_fn(|i, _| if i < D { s.point[i] } else { 0.0 });
+        let q = &at.rotation;
+        let to_world = |y: &[f64]| {
+            let y = Vector3::from_fn(|i, _| if i < D { y[i] } else { 0.0 });
+            from3::<D>(&(at.centre + q * (y - at.centre0)))
+        };
+        if let Geometry::Box { min, max } = shape {
+            // Beyond an edge or a corner of a box, the domain overlaps the box
+            // only if it crosses every face plane it is beyond (separating axes).
+            let beyond: Vec<usize> = (0..D)
+                .filter(|&d| xs[d] < min[d] || xs[d] > max[d])
+                .collect();
+            if beyond.len() > 1 {
+                let axes = half_axes.map(|a| restrict::<D>(&q.transpose()) * a);
+                let overlap = |d: usize| {
+                    let reach: f64 = axes.iter().map(|a| a[d].abs()).sum();
+                    reach - (xs[d] - xs[d].clamp(min[d], max[d])).abs()
+                };
+                let d = beyond
+                    .iter()
+                    .copied()
+                    .min_by(|&a, &b| overlap(a).total_cmp(&overlap(b)))?;
+                if overlap(d) <= 0.0 {
+                    return None;
+                }
+                let sign = if xs[d] > max[d] { 1.0 } else { -1.0 };
+                let mut y: Vec<f64> = (0..D).map(|i| xs[i].clamp(min[i], max[i])).collect();
+                y[d] = if sign > 0.0 { max[d] } else { min[d] };
+                let n3 = q * Vector3::from_fn(|i, _| if i == d { sign } else { 0.0 });
+                let normal: Vector<D> = from3(&n3);
+                return Some(Inside {
+                    point: to_world(&y),
+                    normal,
+                    normal_derivative: Tensor::<D>::zeros(),
+                    depth: overlap(d),
+                    depth_gradient: -normal,
+                });
+            }
+        }
         let n = Vector3::from_fn(|i, _| if i < D { s.normal[i] } else { 0.0 });
         let dn = match s.bend {
             Bend::Flat => Mat3::zeros(),
@@ -216,17 +256,17 @@ impl Surface {
                 a / distance
             }
         };
-        let q = &at.rotation;
         let normal: Vector<D> = from3(&(q * n));
         let normal_derivative: Tensor<D> = restrict(&(q * dn * q.transpose()));
         let reach: f64 = half_axes.iter().map(|a| normal.dot(a).abs()).sum();
         if distance >= reach {
             return None;
         }
-        let depth_gradient = (half_axes.iter())
-            .fold(-normal, |g, a| g + normal_derivative * a * normal.dot(a).signum());
+        let depth_gradient = (half_axes.iter()).fold(-normal, |g, a| {
+            g + normal_derivative * a * normal.dot(a).signum()
+        });
         Some(Inside {
-            point: from3(&(at.centre + q * (y - at.centre0))),
+            point: to_world(&s.point),
             normal,
             normal_derivative,
             depth: reach - distance,

@@ -64,6 +64,10 @@ pub struct SolverReport {
     pub beta: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gamma: Option<f64>,
+    /// Implicit contact with rigid bodies: the deepest penalty penetration of a
+    /// converged step (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contact_penetration: Option<f64>,
 }
 
 impl SolverReport {
@@ -82,6 +86,7 @@ impl SolverReport {
             direct: None,
             beta: None,
             gamma: None,
+            contact_penetration: None,
         }
     }
 }

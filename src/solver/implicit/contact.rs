@@ -14,7 +14,8 @@
 //! The penalty of particle p is ε_n = ε_t = α M_p A_p / h (α the contact's
 //! `penalty_factor`, M_p its material's P-wave modulus, A_p = V_p^{(D−1)/D} its
 //! face, h the smallest cell size): a particle pressed by a traction t sinks
-//! g ≈ t h / (α M) into the body, which the run reports (`max_penetration`).
+//! g ≈ t h / (α M) into the body, which the run reports (summary.json's
+//! `contact_penetration`, the deepest of the converged steps).
 //! The tangential force at the step start of each particle in contact is kept
 //! for the next step (stick carries over steps).
 
@@ -61,6 +62,8 @@ pub struct RigidContact<const D: usize> {
     /// Contacts at the last residual, in particle order.
     pub touches: Vec<Touch<D>>,
     totals: Vec<PairTotal<D>>,
+    /// The deepest penalty depth of a converged step so far.
+    pub deepest: f64,
 }
 
 impl<const D: usize> RigidContact<D> {
@@ -107,6 +110,7 @@ impl<const D: usize> RigidContact<D> {
             motion: Vec::new(),
             touches: Vec::new(),
             totals,
+            deepest: 0.0,
         })
     }
 
@@ -156,7 +160,11 @@ impl<const D: usize> RigidContact<D> {
                         tangential: this.penalty[q],
                         friction: law.friction,
                     };
-                    let f_t0 = this.tangential.get(q).copied().unwrap_or(Vector::<D>::zeros());
+                    let f_t0 = this
+                        .tangential
+                        .get(q)
+                        .copied()
+                        .unwrap_or(Vector::<D>::zeros());
                     let relative = dx - this.motion[k];
                     Some(Touch {
                         particle: q,
@@ -233,8 +241,11 @@ impl<const D: usize> RigidContact<D> {
     /// contact forces into the pair totals (force × dt), and the rigid bodies'
     /// particles moved by their motion.
     pub fn commit(&mut self, p: &mut Particles<D>, dt: f64) {
+        self.deepest = self.deepest.max(self.max_penetration());
         if !self.tangential.is_empty() {
-            self.tangential.iter_mut().for_each(|f| *f = Vector::<D>::zeros());
+            self.tangential
+                .iter_mut()
+                .for_each(|f| *f = Vector::<D>::zeros());
             for t in &self.touches {
                 self.tangential[t.particle] = t.contact.tangential;
             }
@@ -262,7 +273,9 @@ impl<const D: usize> RigidContact<D> {
     /// The tangential forces carried to the next step, D values per particle
     /// (empty without friction), for a checkpoint.
     pub fn tangential_state(&self) -> Vec<f64> {
-        (self.tangential.iter()).flat_map(|f| f.iter().copied()).collect()
+        (self.tangential.iter())
+            .flat_map(|f| f.iter().copied())
+            .collect()
     }
 
     /// Continue with the tangential forces of a checkpoint (`tangential_state`;
@@ -299,7 +312,9 @@ impl<const D: usize> RigidContact<D> {
 /// A zero total for every pair of fields i < j, in order (contact.csv's rows).
 fn pair_totals<const D: usize>(plan: &ContactPlan) -> Vec<PairTotal<D>> {
     let first_body = |field: usize| {
-        (plan.field_of_body.iter()).position(|&x| x as usize == field).unwrap() as u32
+        (plan.field_of_body.iter())
+            .position(|&x| x as usize == field)
+            .unwrap() as u32
     };
     let f = plan.fields;
     (0..f)

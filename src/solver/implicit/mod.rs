@@ -32,6 +32,7 @@ pub mod ties;
 
 use crate::dim::Vector;
 use crate::model::Model;
+use crate::physics::contact::PairTotal;
 use crate::physics::shape::{ShapeFunction, Stencils};
 use crate::physics::transfer::{stencils_and_nodes, NodeMap};
 use crate::scene::{
@@ -39,7 +40,6 @@ use crate::scene::{
 };
 use crate::solver::divergence::{check_state, Divergence};
 use crate::solver::linear::direct::DirectSolver;
-use crate::physics::contact::PairTotal;
 use crate::solver::report::{DirectReport, NewtonRow, SolverReport};
 use crate::solver::stepper::{SolverState, Stepper};
 use failure::Failure;
@@ -227,6 +227,7 @@ impl<const D: usize> Stepper<D> for Implicit<D> {
             }),
             beta: newmark.then_some(self.settings.newmark.beta),
             gamma: newmark.then_some(self.settings.newmark.gamma),
+            contact_penetration: self.system.contact.as_ref().map(|c| c.deepest),
         }
     }
 

@@ -242,9 +242,17 @@ velocity = [-1.0, 0.2]
 #[test]
 fn tangent_with_rigid_contact_matches_finite_differences_of_the_residual() {
     let body = BLOCK
-        .replace("[[body]]\nmaterial = \"m\"", "[[body]]\nname = \"block\"\nmaterial = \"m\"")
+        .replace(
+            "[[body]]\nmaterial = \"m\"",
+            "[[body]]\nname = \"block\"\nmaterial = \"m\"",
+        )
         .replace("[[boundary]]", &format!("{RIGID_BODIES}[[boundary]]"));
-    for (shape, mu) in [("linear", 0.0), ("linear", 0.3), ("cpgimp", 0.3), ("bspline2", 0.3)] {
+    for (shape, mu) in [
+        ("linear", 0.0),
+        ("linear", 0.3),
+        ("cpgimp", 0.3),
+        ("bspline2", 0.3),
+    ] {
         let text = body.replace(
             "[solver]",
             &format!("[[contact]]\nfriction_coefficient = {mu}\n[solver]"),
@@ -257,7 +265,10 @@ fn tangent_with_rigid_contact_matches_finite_differences_of_the_residual() {
             "{shape} μ = {mu}: {n} unknowns, {stick} particles sticking, {slip} slipping, \
              max |K − K_fd| / max|K| = {error:.2e}"
         );
-        assert!(stick > 0 && (mu == 0.0 || slip > 0), "{stick} stick, {slip} slip");
+        assert!(
+            stick > 0 && (mu == 0.0 || slip > 0),
+            "{stick} stick, {slip} slip"
+        );
         assert!(error < 1e-6, "{shape} μ = {mu}: tangent off by {error:.2e}");
     }
 }
