@@ -179,11 +179,13 @@ impl Placement {
 
 impl Surface {
     /// A particle at x whose domain is the parallelogram (parallelepiped) of
-    /// half-axes `half_axes` a_j about x, and that comes closer than its reach
+    /// half-axes `half_axes` a_j about x, and that comes as close as its reach
     /// r = Σ_j |n·a_j| along the normal to the field's bodies (or is inside
     /// them): the nearest surface point, the normal n with its derivative N
-    /// (`Bend`), the depth g = r − d (d the signed distance) and
-    /// ∂g/∂x = −n + Σ_j sign(n·a_j) N a_j; `None` when it does not reach.
+    /// (`Bend`), the depth g = r − d ≥ 0 (d the signed distance) and
+    /// ∂g/∂x = −n + Σ_j sign(n·a_j) N a_j; `None` when it does not reach. A
+    /// domain that just touches (g = 0) is in contact: no force, but the
+    /// stiffness that holds a body resting on the surface.
     pub fn reached<const D: usize>(
         &self,
         at: &Placement,
@@ -204,7 +206,7 @@ impl Surface {
                     .map(|(d, s)| (d, s, g))
             })
             .min_by(|a, b| a.0.total_cmp(&b.0))?;
-        if distance >= widest {
+        if distance > widest {
             return None;
         }
         let q = &at.rotation;
@@ -228,7 +230,7 @@ impl Surface {
                     .iter()
                     .copied()
                     .min_by(|&a, &b| overlap(a).total_cmp(&overlap(b)))?;
-                if overlap(d) <= 0.0 {
+                if overlap(d) < 0.0 {
                     return None;
                 }
                 let sign = if xs[d] > max[d] { 1.0 } else { -1.0 };
@@ -259,7 +261,7 @@ impl Surface {
         let normal: Vector<D> = from3(&(q * n));
         let normal_derivative: Tensor<D> = restrict(&(q * dn * q.transpose()));
         let reach: f64 = half_axes.iter().map(|a| normal.dot(a).abs()).sum();
-        if distance >= reach {
+        if distance > reach {
             return None;
         }
         let depth_gradient = (half_axes.iter()).fold(-normal, |g, a| {

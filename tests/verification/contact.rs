@@ -913,11 +913,12 @@ fn implicit_rigid_plate_compresses_a_block_to_the_hencky_stress() {
     // problems/contact_plate_implicit.toml: the plate of
     // `rigid_plate_compresses_a_block_to_the_hencky_stress` as a quasi-static
     // implicit run with penalty contact (25 load steps to λ = 0.75). Measured: the
-    // plate's force within 2.2 % of σ_yy(t) × 1 m at every step and 0.41 % at the
-    // end (the contact acts at the top layer's centres, half a particle below the
-    // surface: an O(h) offset); the volume mean of σ_yy −1.4 %; every step in at
-    // most 5 Newton iterations, converging quadratically (order 1.86); the
-    // deepest penalty penetration 4.3e-4 m = h/116 (α = 100).
+    // plate's force within 2.2 % of σ_yy(t) × 1 m at every step and 1.3 % at the
+    // end (the top layer is loaded at its centres, half a particle below the
+    // surface, and its reach is the undeformed half-width: O(h) offsets); the
+    // volume mean of σ_yy −0.50 %; every step in at most 5 Newton iterations,
+    // converging quadratically (order 1.86); the deepest penalty penetration
+    // 1.94e-4 m, the estimate σ h / (α M).
     let (result, dir) = run_problem("contact_plate_implicit.toml", &["output.frames=0"]);
     let summary = result.unwrap();
     assert_eq!(summary.status, Status::Completed);
@@ -941,12 +942,11 @@ fn implicit_rigid_plate_compresses_a_block_to_the_hencky_stress() {
         "force within {worst:.4} of σ(t) A ({last:.4} at the end); mean σ_yy {mean:+.4}; \
          penetration {penetration:.2e} m; at most {most} Newton iterations a step, order {order:.2}"
     );
-    assert!(worst < 0.025 && last < 0.01, "force {worst}, {last}");
-    assert!(mean.abs() < 0.02, "mean σ_yy off by {mean}");
-    // σ h / (α M) = 3.9e5 × 0.05 / (100 × 1e6) = 1.9e-4 m on average at the
-    // end; the deepest particle 4.3e-4 m (< h/100).
+    assert!(worst < 0.025 && last < 0.02, "force {worst}, {last}");
+    assert!(mean.abs() < 0.01, "mean σ_yy off by {mean}");
+    // σ h / (α M) = 3.9e5 × 0.05 / (100 × 1e6) = 1.9e-4 m at the end.
     assert!(
-        penetration > 1.5e-4 && penetration < 5e-4,
+        penetration > 1.7e-4 && penetration < 2.2e-4,
         "penetration {penetration}"
     );
     assert!(most <= 5 && order > 1.8, "{most} iterations, order {order}");
@@ -990,4 +990,117 @@ fn implicit_contact_takes_the_same_path_through_krylov_and_any_thread_count() {
     let worst = (a.iter().zip(&b)).fold(0.0f64, |w, (x, y)| w.max((x / y - 1.0).abs()));
     println!("GMRES against direct: forces within {worst:.2e}");
     assert!(a.len() >= 10 && worst < 1e-7, "{} rows, {worst}", a.len());
+}
+
+/// q/c_u of `problems/contact_footing_implicit.toml` (contact force over B/2 =
+/// 1 m, c_u = 10 kPa) at the end, its relative error against Prandtl's 2 + π,
+/// and the relative change over the last fifth of the run (the plateau).
+fn implicit_footing(cells: &str) -> (f64, f64, f64) {
+    let (result, dir) = run_problem("contact_footing_implicit.toml", &[cells]);
+    assert_eq!(result.unwrap().status, Status::Completed);
+    let c = Table::read(&dir.path().join("contact.csv")).unwrap();
+    let q: Vec<f64> = c.col("fy").iter().map(|f| -f / 1.0e4).collect();
+    let (last, earlier) = (q[q.len() - 1], q[q.len() * 4 / 5]);
+    let prandtl = 2.0 + std::f64::consts::PI;
+    (last, last / prandtl - 1.0, last / earlier - 1.0)
+}
+
+#[test]
+fn implicit_contact_footing_converges_to_prandtl_at_first_order() {
+    // A rigid smooth footing pushed into weightless Tresca soil through implicit
+    // penalty contact (F-bar, cpGIMP). Measured: q/c_u = 5.857 (+13.9 %) at
+    // h = 0.25 m and 5.515 (+7.3 %) at h = 0.125 m, error ratio 1.92 (first
+    // order); 5.338 (+3.8 %) at h = 0.0625 m (the ignored test below); the
+    // explicit contact footing: +17, +12, +8.4 % on the same grids.
+    let (q1, e1, p1) = implicit_footing("grid.cells=[20,14]");
+    let (q2, e2, p2) = implicit_footing("grid.cells=[40,28]");
+    println!(
+        "q/c_u {q1:.4} ({:+.2} %), {q2:.4} ({:+.2} %); error ratio {:.2}; plateau changes \
+         {p1:.1e}, {p2:.1e}",
+        100.0 * e1,
+        100.0 * e2,
+        e1 / e2
+    );
+    assert!(e1 > 0.0 && e1 < 0.15 && e2 > 0.0 && e2 < 0.08, "{e1} {e2}");
+    assert!(e1 / e2 > 1.7, "first order: ratio {}", e1 / e2);
+    assert!(p1.abs() < 5e-3 && p2.abs() < 5e-3, "plateau {p1} {p2}");
+}
+
+#[test]
+#[ignore = "about 15 minutes: the h = B/32 footing"]
+fn implicit_contact_footing_is_within_5_percent_of_prandtl_at_h_b_over_32() {
+    let (q, e, p) = implicit_footing("grid.cells=[80,56]");
+    println!("q/c_u {q:.4} ({:+.2} %), plateau change {p:.1e}", 100.0 * e);
+    assert!(e.abs() < 0.05, "{e}");
+}
+
+/// An elastic block (1 m × 0.5 m, 1000 kg/m³) resting on a rigid base under
+/// gravity, lateral rollers, frictional contact its only vertical support.
+const RESTING_BLOCK: &str = r#"dimension = 2
+gravity = [0.0, -10.0]
+[grid]
+min = [0.0, -0.2]
+max = [1.0, 1.0]
+cells = [10, 12]
+shape_function = "cpgimp"
+[[material]]
+name = "soil"
+model = "hencky"
+density = 1000.0
+youngs_modulus = 1.0e6
+poisson_ratio = 0.3
+[[material]]
+name = "steel"
+model = "rigid"
+density = 1000.0
+[[body]]
+name = "block"
+material = "soil"
+shape = "rectangle"
+min = [0.0, 0.0]
+max = [1.0, 0.5]
+[[body]]
+name = "base"
+material = "steel"
+shape = "rectangle"
+min = [0.0, -0.1]
+max = [1.0, 0.0]
+[[contact]]
+friction_coefficient = 0.5
+[[boundary]]
+face = "xmin"
+condition = "roller"
+[[boundary]]
+face = "xmax"
+condition = "roller"
+[solver]
+kind = "implicit"
+integrator = "quasi_static"
+end_time = 1.0
+load_steps = 5
+[output]
+frames = 0
+history_interval = 0.0
+"#;
+
+#[test]
+fn implicit_contact_carries_a_block_resting_on_a_rigid_base() {
+    // Gravity ramped in 5 quasi-static steps onto a block whose only vertical
+    // support is the contact: the contact force equals the weight applied so far
+    // (λ × 5000 N/m) at every step. The bottom layer starts exactly touching the
+    // base (depth 0), so the contact's stiffness, not its force, holds the block
+    // at the first iteration.
+    let (result, dir) = run_text(RESTING_BLOCK, &[]);
+    assert_eq!(result.unwrap().status, Status::Completed);
+    let c = Table::read(&dir.path().join("contact.csv")).unwrap();
+    let (t, fx, fy) = (c.col("t"), c.col("fx"), c.col("fy"));
+    let worst = (0..t.len()).fold(0.0f64, |w, k| {
+        w.max((fy[k] / (5000.0 * t[k]) - 1.0).abs())
+            .max(fx[k].abs() / 5000.0)
+    });
+    println!(
+        "{} rows: contact force within {worst:.1e} of the weight applied",
+        t.len()
+    );
+    assert!(t.len() == 5 && worst < 1e-8, "{worst}");
 }

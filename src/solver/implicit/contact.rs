@@ -20,7 +20,7 @@
 //! for the next step (stick carries over steps).
 
 use super::assembly::{Components, Dofs, Pattern, Tangent};
-use crate::dim::{Mat3, Vector};
+use crate::dim::Vector;
 use crate::model::particles::Particles;
 use crate::model::Model;
 use crate::parallel::MIN_PARALLEL_LEN;
@@ -151,7 +151,7 @@ impl<const D: usize> RigidContact<D> {
                 let dx = interpolate(map, st, q, u);
                 let x = p.x[q] + dx;
                 let f = this.field[q];
-                let axes = half_axes(&p.f[q], &p.half_length0[q]);
+                let axes = half_axes(&p.half_length0[q]);
                 (this.surfaces.iter().enumerate()).find_map(|(k, s)| {
                     let law = this.plan.law(f, s.field)?;
                     let inside = s.reached(&this.end[k], &x, &axes, &on_boundary)?;
@@ -328,8 +328,11 @@ fn pair_totals<const D: usize>(plan: &ContactPlan) -> Vec<PairTotal<D>> {
         .collect()
 }
 
-/// The half-axes F e_j ℓ_j of a particle's domain at the step start (F its
-/// deformation gradient, ℓ its initial half-lengths).
-fn half_axes<const D: usize>(f: &Mat3, half_length0: &Vector<D>) -> [Vector<D>; D] {
-    std::array::from_fn(|j| Vector::<D>::from_fn(|i, _| f[(i, j)] * half_length0[j]))
+/// The half-axes ℓ_j e_j of a particle's initial domain (ℓ its initial
+/// half-lengths). The reach is not deformed with the particle: with the
+/// step-start F the reach of a particle resting on a body would jump at every
+/// step by its strain times ℓ, much more than the penalty depth, and the body
+/// would lose its support.
+fn half_axes<const D: usize>(half_length0: &Vector<D>) -> [Vector<D>; D] {
+    std::array::from_fn(|j| Vector::<D>::from_fn(|i, _| if i == j { half_length0[j] } else { 0.0 }))
 }
