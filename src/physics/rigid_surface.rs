@@ -178,35 +178,35 @@ impl Placement {
 }
 
 impl Surface {
-    /// A particle at x whose domain is the parallelogram (parallelepiped) of
-    /// half-axes `half_axes` a_j about x, and that comes as close as its reach
-    /// r = Σ_j |n·a_j| along the normal to the field's bodies (or is inside
-    /// them): the nearest surface point, the normal n with its derivative N
-    /// (`Bend`), the depth g = r − d ≥ 0 (d the signed distance) and
-    /// ∂g/∂x = −n + Σ_j sign(n·a_j) N a_j; `None` when it does not reach. A
-    /// domain that just touches (g = 0) is in contact: no force, but the
-    /// stiffness that holds a body resting on the surface.
+    /// A particle at x whose domain an ellipse (ellipsoid) of semi-axes ℓ
+    /// (`half_lengths`, along the coordinate axes) stands for, and that comes as
+    /// close to the field's bodies as its reach r = |L n| along the outward
+    /// normal n (L = diag ℓ), or is inside them: the nearest surface point, n
+    /// with its derivative N (`Bend`), the depth g = r − d ≥ 0 (d the signed
+    /// distance) and ∂g/∂x = −n + N L² n / r; `None` when it does not reach. A
+    /// particle that just touches (g = 0) is in contact: no force, but the
+    /// stiffness that holds a body resting on the surface. The round reach keeps
+    /// the normal continuous about a body's corners (the contact region is the
+    /// body's offset, rounded there), and a particle beside a footing's corner
+    /// is not caught by it.
     pub fn reached<const D: usize>(
         &self,
         at: &Placement,
         x: &Vector<D>,
-        half_axes: &[Vector<D>; D],
+        half_lengths: &Vector<D>,
         on_boundary: &dyn Fn(usize, f64) -> bool,
     ) -> Option<Inside<D>> {
-        let widest: f64 = half_axes.iter().map(|a| a.norm()).sum();
+        let reach = half_lengths.max();
         let xr = at.centre0 + at.rotation.transpose() * (to3(x) - at.centre);
-        let outside = |d: usize| xr[d] <= self.lower[d] - widest || xr[d] >= self.upper[d] + widest;
+        let outside = |d: usize| xr[d] < self.lower[d] - reach || xr[d] > self.upper[d] + reach;
         if (0..D).any(outside) {
             return None;
         }
         let xs = &xr.as_slice()[..D];
-        let (distance, s, shape) = (self.shapes.iter())
-            .filter_map(|g| {
-                g.signed_surface_point(xs, on_boundary)
-                    .map(|(d, s)| (d, s, g))
-            })
+        let (distance, s) = (self.shapes.iter())
+            .filter_map(|g| g.signed_surface_point(xs, on_boundary))
             .min_by(|a, b| a.0.total_cmp(&b.0))?;
-        if distance > widest {
+        if distance > reach {
             return None;
         }
         let q = &at.rotation;
@@ -214,39 +214,6 @@ impl Surface {
             let y = Vector3::from_fn(|i, _| if i < D { y[i] } else { 0.0 });
             from3::<D>(&(at.centre + q * (y - at.centre0)))
         };
-        if let Geometry::Box { min, max } = shape {
-            // Beyond an edge or a corner of a box, the domain overlaps the box
-            // only if it crosses every face plane it is beyond (separating axes).
-            let beyond: Vec<usize> = (0..D)
-                .filter(|&d| xs[d] < min[d] || xs[d] > max[d])
-                .collect();
-            if beyond.len() > 1 {
-                let axes = half_axes.map(|a| restrict::<D>(&q.transpose()) * a);
-                let overlap = |d: usize| {
-                    let reach: f64 = axes.iter().map(|a| a[d].abs()).sum();
-                    reach - (xs[d] - xs[d].clamp(min[d], max[d])).abs()
-                };
-                let d = beyond
-                    .iter()
-                    .copied()
-                    .min_by(|&a, &b| overlap(a).total_cmp(&overlap(b)))?;
-                if overlap(d) < 0.0 {
-                    return None;
-                }
-                let sign = if xs[d] > max[d] { 1.0 } else { -1.0 };
-                let mut y: Vec<f64> = (0..D).map(|i| xs[i].clamp(min[i], max[i])).collect();
-                y[d] = if sign > 0.0 { max[d] } else { min[d] };
-                let n3 = q * Vector3::from_fn(|i, _| if i == d { sign } else { 0.0 });
-                let normal: Vector<D> = from3(&n3);
-                return Some(Inside {
-                    point: to_world(&y),
-                    normal,
-                    normal_derivative: Tensor::<D>::zeros(),
-                    depth: overlap(d),
-                    depth_gradient: -normal,
-                });
-            }
-        }
         let n = Vector3::from_fn(|i, _| if i < D { s.normal[i] } else { 0.0 });
         let dn = match s.bend {
             Bend::Flat => Mat3::zeros(),
@@ -260,19 +227,19 @@ impl Surface {
         };
         let normal: Vector<D> = from3(&(q * n));
         let normal_derivative: Tensor<D> = restrict(&(q * dn * q.transpose()));
-        let reach: f64 = half_axes.iter().map(|a| normal.dot(a).abs()).sum();
-        if distance > reach {
+        let l2n = half_lengths
+            .component_mul(half_lengths)
+            .component_mul(&normal);
+        let reach_n = l2n.dot(&normal).sqrt();
+        if distance > reach_n {
             return None;
         }
-        let depth_gradient = (half_axes.iter()).fold(-normal, |g, a| {
-            g + normal_derivative * a * normal.dot(a).signum()
-        });
         Some(Inside {
             point: to_world(&s.point),
             normal,
             normal_derivative,
-            depth: reach - distance,
-            depth_gradient,
+            depth: reach_n - distance,
+            depth_gradient: normal_derivative * l2n / reach_n - normal,
         })
     }
 }

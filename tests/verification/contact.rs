@@ -1119,14 +1119,15 @@ fn fit_line(pts: &[(f64, f64)]) -> (f64, f64) {
 fn implicit_contact_reproduces_hertz_line_contact() {
     // problems/contact_hertz.toml (papers/contact_hertz): a rigid cylinder
     // R = 0.5 m pressed 0.01 m into an elastic block (E = 1 MPa, ν = 0.3), h =
-    // 0.02 m. Hertz for the measured force P: b = √(4PR/(πE*)) = 0.0628 m (6.3
+    // 0.02 m. Hertz for the measured force P: b = √(4PR/(πE*)) = 0.0614 m (6.1
     // cells across 2b), p0 = 2P/(πb). Below the contact's centre σ_z(z) =
     // −p0/√(1 + z²/b²): fitting 1/σ² = 1/p0² + z²/(p0² b²) to the axis column
-    // between one cell and 1.6 b deep gives p0 −2.7 %, b +2.2 % (h = 0.01 m:
-    // −0.2 %, +1.3 %; h = 0.04 m, 3.3 cells across 2b: −3.5 %, −6.1 %). The
-    // stresses of the top layers are not the pressure: the contact acts at the
-    // top particles' centres, inside the top cell, and the layers just below it
-    // oscillate about Hertz's field by tens of per cent (printed, not asserted).
+    // between one cell and 1.6 b deep gives b −7.6 %, p0 +7.5 % (the issue asks
+    // 10 % from 5 cells across 2b; h = 0.04 m: −15.8 %, +10.4 %; h = 0.01 m:
+    // +1.7 %, −0.3 %). The stresses of the top layers are not the pressure: the
+    // contact acts at the top particles' centres, inside the top cell, and the
+    // layers just below oscillate about Hertz's field by tens of per cent
+    // (printed, not asserted).
     let (result, dir) = run_problem("contact_hertz.toml", &[]);
     assert_eq!(result.unwrap().status, Status::Completed);
     let c = Table::read(&dir.path().join("contact.csv")).unwrap();
@@ -1135,7 +1136,13 @@ fn implicit_contact_reproduces_hertz_line_contact() {
     let b = (4.0 * force * r / (std::f64::consts::PI * e_star)).sqrt();
     let p0 = 2.0 * force / (std::f64::consts::PI * b);
     let p = Table::read(&dir.path().join("particles_final.csv")).unwrap();
-    let (body, x0, y0, x, syy) = (p.col("body"), p.col("X0"), p.col("Y0"), p.col("x"), p.col("syy"));
+    let (body, x0, y0, x, syy) = (
+        p.col("body"),
+        p.col("X0"),
+        p.col("Y0"),
+        p.col("x"),
+        p.col("syy"),
+    );
     let block: Vec<usize> = (0..body.len()).filter(|&i| body[i] == 0.0).collect();
     let axis: Vec<(f64, f64)> = (block.iter())
         .filter(|&&i| (x0[i] - 0.005).abs() < 1e-9)
@@ -1168,7 +1175,7 @@ fn implicit_contact_reproduces_hertz_line_contact() {
         rel(peak, p0)
     );
     assert!(2.0 * b / 0.02 >= 5.0, "2b/h = {}", 2.0 * b / 0.02);
-    assert!(rel(b_axis, b).abs() < 0.05 && rel(p0_axis, p0).abs() < 0.05);
+    assert!(rel(b_axis, b).abs() < 0.1 && rel(p0_axis, p0).abs() < 0.1);
 }
 
 /// problems/contact_plate_implicit.toml as a cube (h = 0.2 m across, 0.1 m
@@ -1271,5 +1278,8 @@ fn implicit_rigid_plate_compresses_a_hencky_cube_in_3d() {
     println!("mean σ_zz {mean:+.4}; force within {worst:.4}; penetration {penetration:.2e} m");
     assert!(mean.abs() < 0.01, "mean σ_zz off by {mean}");
     assert!(worst < 0.05, "force {worst}");
-    assert!(penetration > 0.0 && penetration < 1e-3, "penetration {penetration}");
+    assert!(
+        penetration > 0.0 && penetration < 1e-3,
+        "penetration {penetration}"
+    );
 }

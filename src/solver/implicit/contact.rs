@@ -151,10 +151,10 @@ impl<const D: usize> RigidContact<D> {
                 let dx = interpolate(map, st, q, u);
                 let x = p.x[q] + dx;
                 let f = this.field[q];
-                let axes = half_axes(&p.half_length0[q]);
                 (this.surfaces.iter().enumerate()).find_map(|(k, s)| {
                     let law = this.plan.law(f, s.field)?;
-                    let inside = s.reached(&this.end[k], &x, &axes, &on_boundary)?;
+                    let ell = &p.half_length0[q];
+                    let inside = s.reached(&this.end[k], &x, ell, &on_boundary)?;
                     let penalty = Penalty {
                         normal: this.penalty[q],
                         tangential: this.penalty[q],
@@ -326,13 +326,4 @@ fn pair_totals<const D: usize>(plan: &ContactPlan) -> Vec<PairTotal<D>> {
             nodes: 0,
         })
         .collect()
-}
-
-/// The half-axes ℓ_j e_j of a particle's initial domain (ℓ its initial
-/// half-lengths). The reach is not deformed with the particle: with the
-/// step-start F the reach of a particle resting on a body would jump at every
-/// step by its strain times ℓ, much more than the penalty depth, and the body
-/// would lose its support.
-fn half_axes<const D: usize>(half_length0: &Vector<D>) -> [Vector<D>; D] {
-    std::array::from_fn(|j| Vector::<D>::from_fn(|i, _| if i == j { half_length0[j] } else { 0.0 }))
 }
