@@ -996,7 +996,12 @@ fn implicit_contact_takes_the_same_path_through_krylov_and_any_thread_count() {
 /// 1 m, c_u = 10 kPa) at the end, its relative error against Prandtl's 2 + π,
 /// and the relative change over the last fifth of the run (the plateau).
 fn implicit_footing(cells: &str) -> (f64, f64, f64) {
-    let (result, dir) = run_problem("contact_footing_implicit.toml", &[cells]);
+    implicit_footing_with(&[cells])
+}
+
+/// [`implicit_footing`] with any overrides.
+fn implicit_footing_with(overrides: &[&str]) -> (f64, f64, f64) {
+    let (result, dir) = run_problem("contact_footing_implicit.toml", overrides);
     assert_eq!(result.unwrap().status, Status::Completed);
     let c = Table::read(&dir.path().join("contact.csv")).unwrap();
     let q: Vec<f64> = c.col("fy").iter().map(|f| -f / 1.0e4).collect();
@@ -1024,6 +1029,19 @@ fn implicit_contact_footing_converges_to_prandtl_at_first_order() {
     assert!(e1 > 0.0 && e1 < 0.15 && e2 > 0.0 && e2 < 0.08, "{e1} {e2}");
     assert!(e1 / e2 > 1.7, "first order: ratio {}", e1 / e2);
     assert!(p1.abs() < 5e-3 && p2.abs() < 5e-3, "plateau {p1} {p2}");
+    // Rough (μ = 10: the soil sticks under the footing): Newton converges through
+    // the stick–slip changes at the footing's edge; 5.921 (+15.2 %) at h = 0.25 m
+    // (5.552, +8.0 %, at h = 0.125 m).
+    let (q, e, p) =
+        implicit_footing_with(&["grid.cells=[20,14]", "contact.0.friction_coefficient=10"]);
+    println!(
+        "rough: q/c_u {q:.4} ({:+.2} %), plateau change {p:.1e}",
+        100.0 * e
+    );
+    assert!(
+        e > e1 && e < 0.17 && p.abs() < 5e-3,
+        "rough {e}, plateau {p}"
+    );
 }
 
 #[test]
