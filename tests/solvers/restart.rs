@@ -411,3 +411,22 @@ fn impact_restart_is_byte_identical() {
         1,
     );
 }
+
+#[test]
+fn implicit_contact_restart_keeps_the_friction_history() {
+    // A rough rigid footing (implicit penalty contact, μ = 10): the particles'
+    // tangential contact forces are carried across steps, and a checkpoint keeps
+    // them (the state's `contact_tangential`); contact.csv goes on. The penalty
+    // comes from the particles' initial volumes, so a contact set up at the
+    // restart has the same.
+    restarts_are_exact(
+        "contact_footing_implicit.toml",
+        &[
+            "grid.cells=[20,14]",
+            "solver.load_steps=10",
+            "contact.0.friction_coefficient=10",
+        ],
+        0.3,
+        2,
+    );
+}

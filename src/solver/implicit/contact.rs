@@ -12,7 +12,7 @@
 //!   r_I −= S_Ip f_p,   K_IJ −= S_Ip S_Jp ∂f_p/∂x_p.
 //!
 //! The penalty of particle p is ε_n = ε_t = α M_p A_p / h (α the contact's
-//! `penalty_factor`, M_p its material's P-wave modulus, A_p = V_p^{(D−1)/D} its
+//! `penalty_factor`, M_p its material's P-wave modulus, A_p = V⁰_p^{(D−1)/D} its
 //! face, h the smallest cell size): a particle pressed by a traction t sinks
 //! g ≈ t h / (α M) into the body, which the run reports (summary.json's
 //! `contact_penetration`, the deepest of the converged steps).
@@ -87,7 +87,7 @@ impl<const D: usize> RigidContact<D> {
                 match (plan.rigid[f as usize], law) {
                     (false, Some(law)) => {
                         let modulus = m.materials[p.material[q] as usize].p_wave_modulus();
-                        let face = p.volume[q].powf((D as f64 - 1.0) / D as f64);
+                        let face = p.volume0[q].powf((D as f64 - 1.0) / D as f64);
                         law.penalty_factor * modulus * face / h
                     }
                     _ => 0.0,
