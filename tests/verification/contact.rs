@@ -1015,7 +1015,7 @@ fn implicit_contact_footing_converges_to_prandtl_at_first_order() {
     // A rigid smooth footing pushed into weightless Tresca soil through implicit
     // penalty contact (F-bar, cpGIMP). Measured: q/c_u = 5.857 (+13.9 %) at
     // h = 0.25 m and 5.515 (+7.3 %) at h = 0.125 m, error ratio 1.92 (first
-    // order); 5.338 (+3.8 %) at h = 0.0625 m (the ignored test below); the
+    // order); 5.339 (+3.8 %) at h = 0.0625 m (the ignored test below); the
     // explicit contact footing: +17, +12, +8.4 % on the same grids.
     let (q1, e1, p1) = implicit_footing("grid.cells=[20,14]");
     let (q2, e2, p2) = implicit_footing("grid.cells=[40,28]");
@@ -1045,9 +1045,9 @@ fn implicit_contact_footing_converges_to_prandtl_at_first_order() {
 }
 
 #[test]
-#[ignore = "about 15 minutes: the h = B/32 footings, smooth and rough"]
+#[ignore = "about 8 to 12 minutes: the h = B/32 footings, smooth and rough"]
 fn implicit_contact_footing_is_within_5_percent_of_prandtl_at_h_b_over_32() {
-    // Measured: smooth 5.338 (+3.8 %), rough (μ = 10) 5.361 (+4.3 %).
+    // Measured: smooth 5.339 (+3.8 %), rough (μ = 10) 5.361 (+4.3 %).
     for mu in ["0", "10"] {
         let friction = format!("contact.0.friction_coefficient={mu}");
         let (q, e, p) = implicit_footing_with(&["grid.cells=[80,56]", &friction]);
