@@ -158,14 +158,8 @@ impl Geometry {
                 }
             }
             Geometry::Ball { centre, radius } => {
-                let r: Vec<f64> = (0..x.len()).map(|d| x[d] - centre[d]).collect();
-                let n = radial(&r);
-                let y = (0..x.len()).map(|d| centre[d] + radius * n[d]).collect();
-                let bend = Bend::About {
-                    distance: norm(&r),
-                    axis: None,
-                };
-                faces.push((radius - norm(&r), y, n, bend));
+                let (d, s) = ball_point(x, centre, *radius);
+                faces.push((-d, s.point, s.normal, s.bend));
             }
             Geometry::Polygon(v) => faces.extend(
                 polygon_faces(v, x, on_boundary)
@@ -256,23 +250,7 @@ impl Geometry {
                     _ => Some(about(y, None)),
                 }
             }
-            Geometry::Ball { centre, radius } => {
-                let r: Vec<f64> = (0..x.len()).map(|d| x[d] - centre[d]).collect();
-                let n = radial(&r);
-                let point = (0..x.len()).map(|d| centre[d] + radius * n[d]).collect();
-                let bend = Bend::About {
-                    distance: norm(&r),
-                    axis: None,
-                };
-                Some((
-                    norm(&r) - radius,
-                    SurfacePoint {
-                        point,
-                        normal: n,
-                        bend,
-                    },
-                ))
-            }
+            Geometry::Ball { centre, radius } => Some(ball_point(x, centre, *radius)),
             Geometry::Polygon(v) => {
                 let k = (0..v.len()).min_by(|&i, &j| {
                     let di = segment_distance(x, &v[i], &v[(i + 1) % v.len()]).0;
@@ -298,6 +276,28 @@ impl Geometry {
             Geometry::Cylinder { .. } => None,
         }
     }
+}
+
+/// The signed distance of x to a ball's surface (negative inside) and the
+/// nearest surface point, whose normal turns about the centre.
+fn ball_point(x: &[f64], centre: &[f64], radius: f64) -> (f64, SurfacePoint) {
+    let r: Vec<f64> = (0..x.len()).map(|d| x[d] - centre[d]).collect();
+    let normal = radial(&r);
+    let point = (0..x.len())
+        .map(|d| centre[d] + radius * normal[d])
+        .collect();
+    let bend = Bend::About {
+        distance: norm(&r),
+        axis: None,
+    };
+    (
+        norm(&r) - radius,
+        SurfacePoint {
+            point,
+            normal,
+            bend,
+        },
+    )
 }
 
 /// The distance of x to the segment ab and the parameter t ∈ [0, 1] of the

@@ -1051,7 +1051,10 @@ fn implicit_contact_footing_is_within_5_percent_of_prandtl_at_h_b_over_32() {
     for mu in ["0", "10"] {
         let friction = format!("contact.0.friction_coefficient={mu}");
         let (q, e, p) = implicit_footing_with(&["grid.cells=[80,56]", &friction]);
-        println!("μ = {mu}: q/c_u {q:.4} ({:+.2} %), plateau change {p:.1e}", 100.0 * e);
+        println!(
+            "μ = {mu}: q/c_u {q:.4} ({:+.2} %), plateau change {p:.1e}",
+            100.0 * e
+        );
         assert!(e.abs() < 0.05, "μ = {mu}: {e}");
     }
 }
