@@ -84,6 +84,33 @@ pub struct PairTotal<const D: usize> {
     pub nodes: usize,
 }
 
+/// A zero total for every pair of fields i < j, in the order of
+/// [`pair_position`] (contact.csv's rows).
+pub fn pair_totals<const D: usize>(plan: &ContactPlan) -> Vec<PairTotal<D>> {
+    let first_body = |field: usize| {
+        (plan.field_of_body.iter())
+            .position(|&x| x as usize == field)
+            .unwrap() as u32
+    };
+    let f = plan.fields;
+    (0..f)
+        .flat_map(|i| (i + 1..f).map(move |j| (i, j)))
+        .map(|(i, j)| PairTotal {
+            bodies: [first_body(i), first_body(j)],
+            impulse: Vector::<D>::zeros(),
+            dissipation: 0.0,
+            nodes: 0,
+        })
+        .collect()
+}
+
+/// The position of the pair of fields i < j among `fields` fields in
+/// [`pair_totals`]: the pairs (0, 1), (0, 2), …, (1, 2), … in order.
+pub fn pair_position(fields: usize, i: usize, j: usize) -> usize {
+    debug_assert!(i < j && j < fields);
+    i * fields - i * (i + 1) / 2 + (j - i - 1)
+}
+
 /// The contact state of an explicit run.
 #[derive(Debug)]
 pub struct Contact<const D: usize> {
@@ -101,8 +128,6 @@ pub struct Contact<const D: usize> {
     /// The rigid fields that keep deformable particles out
     /// (`physics::rigid_surface`).
     surfaces: Vec<Surface>,
-    /// Index into `totals` of field pair (i, j), i < j, at i · fields + j.
-    pair_index: Vec<usize>,
     /// Scratch of `split_shared_nodes`, one entry per grid node: the fields that
     /// touch it (bit f for field f) and, at a shared node, its first split id.
     fields_at: Vec<AtomicU64>,
@@ -118,26 +143,7 @@ impl<const D: usize> Contact<D> {
             .iter()
             .map(|&b| plan.field_of_body[b as usize])
             .collect();
-        let f = plan.fields;
-        let mut pair_index = vec![usize::MAX; f * f];
-        let mut totals = Vec::new();
-        let first_body = |field: usize| {
-            plan.field_of_body
-                .iter()
-                .position(|&x| x as usize == field)
-                .unwrap() as u32
-        };
-        for i in 0..f {
-            for j in i + 1..f {
-                pair_index[i * f + j] = totals.len();
-                totals.push(PairTotal {
-                    bodies: [first_body(i), first_body(j)],
-                    impulse: Vector::<D>::zeros(),
-                    dissipation: 0.0,
-                    nodes: 0,
-                });
-            }
-        }
+        let totals = pair_totals(&plan);
         Contact {
             free: FreeBodies::new(&plan.free, &field),
             surfaces: surfaces(&plan, m, &field),
@@ -147,7 +153,6 @@ impl<const D: usize> Contact<D> {
             meetings: Vec::new(),
             rigid_nodes: Vec::new(),
             totals,
-            pair_index,
             fields_at: Vec::new(),
             offset: Vec::new(),
         }
@@ -296,7 +301,7 @@ impl<const D: usize> Contact<D> {
                     self.meetings.push(Meeting {
                         r,
                         s,
-                        pair: self.pair_index[fr * f + fs],
+                        pair: pair_position(f, fr, fs),
                         fields: [fr, fs],
                         position: x_node,
                         normal,
@@ -454,7 +459,7 @@ impl<const D: usize> Contact<D> {
             p.v[q] += dv;
             let dp = dv * p.mass[q];
             let fq = self.field[q] as usize;
-            let total = &mut self.totals[self.pair_index[fq.min(k) * self.plan.fields + fq.max(k)]];
+            let total = &mut self.totals[pair_position(self.plan.fields, fq.min(k), fq.max(k))];
             total.impulse += if fq < k { dp } else { -dp };
             if self.plan.free[k] {
                 kicks.push((k, push.x, -dp));

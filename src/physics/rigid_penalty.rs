@@ -54,8 +54,6 @@ pub struct ParticleContact<const D: usize> {
     pub derivative: Tensor<D>,
     /// Penetration depth g.
     pub depth: f64,
-    /// The outward normal.
-    pub normal: Vector<D>,
     /// Tangential force (part of `force`).
     pub tangential: Vector<D>,
     pub slips: bool,
@@ -81,7 +79,6 @@ pub fn penalty_force<const D: usize>(
             force: n * f_n,
             derivative: normal_part,
             depth: g,
-            normal: *n,
             tangential: Vector::<D>::zeros(),
             slips: false,
         };
@@ -105,7 +102,6 @@ pub fn penalty_force<const D: usize>(
         force: n * f_n + tangential,
         derivative: normal_part + d_t,
         depth: g,
-        normal: *n,
         tangential,
         slips,
     }

@@ -24,7 +24,7 @@ use crate::dim::Vector;
 use crate::model::particles::Particles;
 use crate::model::Model;
 use crate::parallel::MIN_PARALLEL_LEN;
-use crate::physics::contact::PairTotal;
+use crate::physics::contact::{pair_position, pair_totals, PairTotal};
 use crate::physics::rigid_body::to3;
 use crate::physics::rigid_penalty::{penalty_force, ParticleContact, Penalty};
 use crate::physics::rigid_surface::{on_grid_boundary, rigid_surfaces, Placement, Surface};
@@ -50,8 +50,8 @@ pub struct RigidContact<const D: usize> {
     field: Vec<u32>,
     /// The rigid bodies some deformable body is in contact with.
     surfaces: Vec<Surface>,
-    /// ε_n (= ε_t) of each particle; 0 for particles in no contact.
-    penalty: Vec<f64>,
+    /// Whether each field is deformable and in contact with a rigid body.
+    slave: Vec<bool>,
     /// Tangential force of each particle at the step start (empty when every
     /// contact is frictionless).
     tangential: Vec<Vector<D>>,
@@ -79,20 +79,10 @@ impl<const D: usize> RigidContact<D> {
         if surfaces.is_empty() {
             return None;
         }
-        let h = m.grid.h_min();
-        let penalty: Vec<f64> = (0..p.len())
-            .map(|q| {
-                let f = field[q];
-                let law = (surfaces.iter()).find_map(|s| plan.law(f, s.field));
-                match (plan.rigid[f as usize], law) {
-                    (false, Some(law)) => {
-                        let modulus = m.materials[p.material[q] as usize].p_wave_modulus();
-                        let face = p.volume0[q].powf((D as f64 - 1.0) / D as f64);
-                        law.penalty_factor * modulus * face / h
-                    }
-                    _ => 0.0,
-                }
-            })
+        let touches_some =
+            |f: usize| (surfaces.iter()).any(|s| plan.law(f as u32, s.field).is_some());
+        let slave: Vec<bool> = (0..plan.fields)
+            .map(|f| !plan.rigid[f] && touches_some(f))
             .collect();
         let friction = (plan.laws.iter()).any(|l| l.is_some_and(|l| l.friction > 0.0));
         let tangential = match friction {
@@ -104,7 +94,7 @@ impl<const D: usize> RigidContact<D> {
             plan,
             field,
             surfaces,
-            penalty,
+            slave,
             tangential,
             end: Vec::new(),
             motion: Vec::new(),
@@ -142,22 +132,26 @@ impl<const D: usize> RigidContact<D> {
     pub fn evaluate(&mut self, m: &Model<D>, st: &Stencils<D>, map: &NodeMap, u: &[Vector<D>]) {
         let p = &m.particles;
         let on_boundary = on_grid_boundary(&m.grid);
+        let h = m.grid.h_min();
         let this = &*self;
         let touches = (0..p.len())
             .into_par_iter()
             .with_min_len(MIN_PARALLEL_LEN)
-            .filter(|&q| this.penalty[q] > 0.0 && st.count[q] > 0)
+            .filter(|&q| this.slave[this.field[q] as usize] && st.count[q] > 0)
             .filter_map(|q| {
                 let dx = interpolate(map, st, q, u);
                 let x = p.x[q] + dx;
-                let f = this.field[q];
+                let (f, ell) = (this.field[q], &p.half_length0[q]);
                 (this.surfaces.iter().enumerate()).find_map(|(k, s)| {
                     let law = this.plan.law(f, s.field)?;
-                    let ell = &p.half_length0[q];
                     let inside = s.reached(&this.end[k], &x, ell, &on_boundary)?;
+                    // ε = α M A / h.
+                    let modulus = m.materials[p.material[q] as usize].p_wave_modulus();
+                    let face = p.volume0[q].powf((D as f64 - 1.0) / D as f64);
+                    let epsilon = law.penalty_factor * modulus * face / h;
                     let penalty = Penalty {
-                        normal: this.penalty[q],
-                        tangential: this.penalty[q],
+                        normal: epsilon,
+                        tangential: epsilon,
                         friction: law.friction,
                     };
                     let f_t0 = this
@@ -255,10 +249,9 @@ impl<const D: usize> RigidContact<D> {
         }
         for t in &self.touches {
             let (r, s) = (self.field[t.particle], self.surfaces[t.surface].field);
-            let (i, sign) = match r < s {
-                true => (self.pair(r, s), 1.0),
-                false => (self.pair(s, r), -1.0),
-            };
+            let (lo, hi) = (r.min(s) as usize, r.max(s) as usize);
+            let i = pair_position(self.plan.fields, lo, hi);
+            let sign = if r < s { 1.0 } else { -1.0 };
             let total = &mut self.totals[i];
             total.impulse += t.contact.force * (sign * dt);
             total.nodes += 1;
@@ -293,12 +286,6 @@ impl<const D: usize> RigidContact<D> {
         (self.touches.iter()).fold(0.0, |g, t| g.max(t.contact.depth))
     }
 
-    /// Index into the totals of fields i < j.
-    fn pair(&self, i: u32, j: u32) -> usize {
-        let f = self.plan.fields as u32;
-        (i * f - i * (i + 1) / 2 + (j - i - 1)) as usize
-    }
-
     /// The totals since the last call, reset.
     pub fn take_totals(&mut self) -> Vec<PairTotal<D>> {
         let out = self.totals.clone();
@@ -307,23 +294,4 @@ impl<const D: usize> RigidContact<D> {
         }
         out
     }
-}
-
-/// A zero total for every pair of fields i < j, in order (contact.csv's rows).
-fn pair_totals<const D: usize>(plan: &ContactPlan) -> Vec<PairTotal<D>> {
-    let first_body = |field: usize| {
-        (plan.field_of_body.iter())
-            .position(|&x| x as usize == field)
-            .unwrap() as u32
-    };
-    let f = plan.fields;
-    (0..f)
-        .flat_map(|i| (i + 1..f).map(move |j| (i, j)))
-        .map(|(i, j)| PairTotal {
-            bodies: [first_body(i), first_body(j)],
-            impulse: Vector::<D>::zeros(),
-            dissipation: 0.0,
-            nodes: 0,
-        })
-        .collect()
 }

@@ -34,7 +34,7 @@ use crate::dim::Vector;
 use crate::model::Model;
 use crate::physics::contact::PairTotal;
 use crate::physics::shape::{ShapeFunction, Stencils};
-use crate::physics::transfer::{stencils_and_nodes, NodeMap};
+use crate::physics::transfer::NodeMap;
 use crate::scene::{
     Integrator, LinearSolver, LinearSystems, PreconditionerKind, SolverConfig, SolverKind,
 };
@@ -171,7 +171,8 @@ impl<const D: usize> Implicit<D> {
 /// weakly supported nodes tied to their neighbours. `mpm bench` reports it.
 pub fn unknowns<const D: usize>(m: &Model<D>, shape: ShapeFunction, s: &SolverConfig) -> usize {
     let (mut st, mut map) = (Stencils::<D>::default(), NodeMap::default());
-    stencils_and_nodes(m, shape, &mut st, &mut map);
+    let contact = contact::RigidContact::new(m);
+    step::step_stencils(m, shape, contact.as_ref(), &mut st, &mut map);
     number_unknowns(m, &st, &map, s.min_node_support()).1.free
 }
 

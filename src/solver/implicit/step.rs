@@ -170,12 +170,11 @@ impl StepSettings {
         if sys.contact.is_none() && m.contact.is_some() {
             sys.contact = RigidContact::new(m);
         }
-        stencils(m, self.shape, &mut sys.stencils);
+        let contact = sys.contact.as_ref();
+        step_stencils(m, self.shape, contact, &mut sys.stencils, &mut sys.map);
         if let Some(contact) = sys.contact.as_mut() {
-            contact.leave_out_rigid(&mut sys.stencils);
             contact.start_step(p, dt);
         }
-        sys.map.build(&sys.stencils, m.grid.node_count());
         if self.fbar {
             sys.trial.use_fbar(&m.grid, &p.x);
         }
@@ -345,6 +344,22 @@ impl StepSettings {
         }
         work
     }
+}
+
+/// The particles' stencils at the step start and the active nodes they touch;
+/// with contact against rigid bodies, those bodies' particles stay off the grid.
+pub fn step_stencils<const D: usize>(
+    m: &Model<D>,
+    shape: ShapeFunction,
+    contact: Option<&RigidContact<D>>,
+    st: &mut Stencils<D>,
+    map: &mut NodeMap,
+) {
+    stencils(m, shape, st);
+    if let Some(contact) = contact {
+        contact.leave_out_rigid(st);
+    }
+    map.build(st, m.grid.node_count());
 }
 
 /// The conditions at the active nodes and the numbering of the unknowns: the
