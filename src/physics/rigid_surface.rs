@@ -138,7 +138,7 @@ impl Surface {
         x: &Vector<D>,
         on_boundary: &dyn Fn(usize, f64) -> bool,
     ) -> Option<(Vector<D>, Vector<D>)> {
-        let xr = at.centre0 + at.rotation.transpose() * (to3(x) - at.centre);
+        let xr = at.to_body(x);
         if (0..D).any(|d| xr[d] <= self.lower[d] || xr[d] >= self.upper[d]) {
             return None;
         }
@@ -146,10 +146,7 @@ impl Surface {
         let (y, n) = (self.shapes.iter())
             .find(|s| s.contains(xs))?
             .nearest_surface(xs, on_boundary)?;
-        let y = Vector3::from_fn(|i, _| if i < D { y[i] } else { 0.0 });
-        let n = Vector3::from_fn(|i, _| if i < D { n[i] } else { 0.0 });
-        let y = at.centre + at.rotation * (y - at.centre0);
-        Some((from3(&y), from3(&(at.rotation * n))))
+        Some((at.point_to_world(&y), at.direction_to_world(&n)))
     }
 }
 
@@ -168,6 +165,23 @@ pub struct Inside<const D: usize> {
 }
 
 impl Placement {
+    /// A point x in the body's `[[body]]` geometry: X = c⁰ + Qᵀ(x − c).
+    fn to_body<const D: usize>(&self, x: &Vector<D>) -> Vector3<f64> {
+        self.centre0 + self.rotation.transpose() * (to3(x) - self.centre)
+    }
+
+    /// A point of the body's geometry where it is now: x = c + Q (X − c⁰).
+    fn point_to_world<const D: usize>(&self, y: &[f64]) -> Vector<D> {
+        let y = Vector3::from_fn(|i, _| if i < D { y[i] } else { 0.0 });
+        from3(&(self.centre + self.rotation * (y - self.centre0)))
+    }
+
+    /// A direction of the body's geometry where it is now: Q n.
+    fn direction_to_world<const D: usize>(&self, n: &[f64]) -> Vector<D> {
+        let n = Vector3::from_fn(|i, _| if i < D { n[i] } else { 0.0 });
+        from3(&(self.rotation * n))
+    }
+
     /// The placement moved by `by` (a prescribed motion over a step).
     pub fn shifted(&self, by: &Vector3<f64>) -> Placement {
         Placement {
@@ -197,7 +211,7 @@ impl Surface {
         on_boundary: &dyn Fn(usize, f64) -> bool,
     ) -> Option<Inside<D>> {
         let reach = half_lengths.max();
-        let xr = at.centre0 + at.rotation.transpose() * (to3(x) - at.centre);
+        let xr = at.to_body(x);
         let outside = |d: usize| xr[d] < self.lower[d] - reach || xr[d] > self.upper[d] + reach;
         if (0..D).any(outside) {
             return None;
@@ -210,10 +224,6 @@ impl Surface {
             return None;
         }
         let q = &at.rotation;
-        let to_world = |y: &[f64]| {
-            let y = Vector3::from_fn(|i, _| if i < D { y[i] } else { 0.0 });
-            from3::<D>(&(at.centre + q * (y - at.centre0)))
-        };
         let n = Vector3::from_fn(|i, _| if i < D { s.normal[i] } else { 0.0 });
         let dn = match s.bend {
             Bend::Flat => Mat3::zeros(),
@@ -225,7 +235,7 @@ impl Surface {
                 a / distance
             }
         };
-        let normal: Vector<D> = from3(&(q * n));
+        let normal: Vector<D> = at.direction_to_world(&s.normal);
         let normal_derivative: Tensor<D> = restrict(&(q * dn * q.transpose()));
         let l2n = half_lengths
             .component_mul(half_lengths)
@@ -235,7 +245,7 @@ impl Surface {
             return None;
         }
         Some(Inside {
-            point: to_world(&s.point),
+            point: at.point_to_world(&s.point),
             normal,
             normal_derivative,
             depth: reach_n - distance,

@@ -425,10 +425,7 @@ fn rigid_plate_compresses_a_block_to_the_hencky_stress() {
         &["output.frames=0", "solver.damping=0"],
     );
     assert_eq!(result.unwrap().status, Status::Completed);
-    let hencky = |t: f64| {
-        let lambda = 1.0 - 0.1 * t;
-        1.0e6 * lambda.ln() / lambda
-    };
+    let hencky = hencky_plate_stress;
     let p = Table::read(&dir.path().join("particles_final.csv")).unwrap();
     let (body, y, y0) = (p.col("body"), p.col("y"), p.col("Y0"));
     let (syy, volume) = (p.col("syy"), p.col("volume"));
@@ -889,14 +886,18 @@ fn a_rigid_body_impact_does_not_depend_on_the_number_of_threads() {
     }
 }
 
+/// The Cauchy stress E ln λ / λ of the Hencky block (E = 1 MPa, ν = 0) that
+/// the rigid plate has compressed to λ = 1 − 0.1 t at time t.
+fn hencky_plate_stress(t: f64) -> f64 {
+    let lambda = 1.0 - 0.1 * t;
+    1.0e6 * lambda.ln() / lambda
+}
+
 /// The plate's force (contact.csv) row by row against σ_yy(t) × 1 m of the
 /// Hencky block compressed at 0.1 m/s: the largest relative difference, and the
 /// one of the last row.
 fn plate_force_error(dir: &tempfile::TempDir) -> (f64, f64) {
-    let hencky = |t: f64| {
-        let lambda = 1.0 - 0.1 * t;
-        1.0e6 * lambda.ln() / lambda
-    };
+    let hencky = hencky_plate_stress;
     let c = Table::read(&dir.path().join("contact.csv")).unwrap();
     let (t, fy) = (c.col("t"), c.col("fy"));
     let errors: Vec<f64> = (0..t.len())
@@ -1291,10 +1292,7 @@ fn implicit_rigid_plate_compresses_a_hencky_cube_in_3d() {
         moment += szz[i] * volume[i];
         v += volume[i];
     }
-    let hencky = |t: f64| {
-        let lambda = 1.0 - 0.1 * t;
-        1.0e6 * lambda.ln() / lambda
-    };
+    let hencky = hencky_plate_stress;
     let mean = moment / v / hencky(2.5) - 1.0;
     let c = Table::read(&dir.path().join("contact.csv")).unwrap();
     let (t, fz) = (c.col("t"), c.col("fz"));
