@@ -138,7 +138,7 @@ impl Surface {
         x: &Vector<D>,
         on_boundary: &dyn Fn(usize, f64) -> bool,
     ) -> Option<(Vector<D>, Vector<D>)> {
-        let xr = at.to_body(x);
+        let xr = at.body_point(x);
         if (0..D).any(|d| xr[d] <= self.lower[d] || xr[d] >= self.upper[d]) {
             return None;
         }
@@ -166,7 +166,7 @@ pub struct Inside<const D: usize> {
 
 impl Placement {
     /// A point x in the body's `[[body]]` geometry: X = c⁰ + Qᵀ(x − c).
-    fn to_body<const D: usize>(&self, x: &Vector<D>) -> Vector3<f64> {
+    fn body_point<const D: usize>(&self, x: &Vector<D>) -> Vector3<f64> {
         self.centre0 + self.rotation.transpose() * (to3(x) - self.centre)
     }
 
@@ -211,7 +211,7 @@ impl Surface {
         on_boundary: &dyn Fn(usize, f64) -> bool,
     ) -> Option<Inside<D>> {
         let reach = half_lengths.max();
-        let xr = at.to_body(x);
+        let xr = at.body_point(x);
         let outside = |d: usize| xr[d] < self.lower[d] - reach || xr[d] > self.upper[d] + reach;
         if (0..D).any(outside) {
             return None;
