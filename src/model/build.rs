@@ -14,7 +14,7 @@ use crate::model::loads::Loads;
 use crate::model::particles::Particles;
 use crate::model::{axisymmetry, Model};
 use crate::scene::{
-    axis, expr, BodyConfig, BoundaryConfig, Condition, Face, Fill, ParticlesOutside, Scene,
+    axis, expr, BodyConfig, BoundaryConfig, Condition, DomainStress, Face, Fill, ParticlesOutside, Scene,
     SceneError,
 };
 
@@ -98,6 +98,7 @@ impl<const D: usize> Model<D> {
         Ok(Model {
             erosion,
             remove_outside: c.grid.particles_outside == ParticlesOutside::Remove,
+            linear_domain_stress: c.grid.domain_stress == DomainStress::Linear,
             grid,
             particles,
             materials: base_materials.clone(),

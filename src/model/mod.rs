@@ -57,6 +57,9 @@ pub struct Model<const D: usize> {
     /// Whether particles that leave the grid are removed from the transfers
     /// (`[grid] particles_outside = "remove"`) instead of stopping the run.
     pub remove_outside: bool,
+    /// `[grid] domain_stress = "linear"`: a stress linear within each particle
+    /// domain in the implicit internal force (`physics::stress_gradient`).
+    pub linear_domain_stress: bool,
 }
 
 impl<const D: usize> Model<D> {

@@ -15,4 +15,5 @@ pub mod rigid_body;
 pub mod rigid_penalty;
 pub mod rigid_surface;
 pub mod shape;
+pub mod stress_gradient;
 pub mod transfer;

@@ -16,6 +16,23 @@ pub struct GridConfig {
     /// What a particle that leaves the grid box does to the run.
     #[serde(default)]
     pub particles_outside: ParticlesOutside,
+    /// The stress within a particle domain in the internal force.
+    #[serde(default)]
+    pub domain_stress: DomainStress,
+}
+
+/// `domain_stress`: the stress within each particle domain is the particle's
+/// (`"constant"`, the default, as in every MPM code) or linear about it with
+/// a least-squares gradient from the neighbouring particles of the same body
+/// (`"linear"`, `physics::stress_gradient`): for `cpgimp` and `cpbspline2` in
+/// implicit stages; it removes the O(h) stress error of the particles at a
+/// body's faces (docs/accuracy.md).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DomainStress {
+    #[default]
+    Constant,
+    Linear,
 }
 
 /// `particles_outside`: a particle that leaves the grid stops the run

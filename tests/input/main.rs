@@ -8,6 +8,7 @@ mod common;
 mod axisymmetric;
 mod bench;
 mod contact;
+mod domain_stress;
 mod fuzz;
 mod impact;
 mod key_paths;

@@ -6,8 +6,10 @@
 //! faces, the basis is a partition of unity, and Σ N_I X_I = x with X_I the Greville
 //! abscissae (`grid.node_position`), up to the faces included.
 
-use super::linear::{cell_coordinate, cell_index, tensor_product, AxisFactors, MAX_PER_AXIS};
-use crate::dim::Vector;
+use super::linear::{
+    cell_coordinate, cell_index, moment_product, tensor_product, AxisFactors, MAX_PER_AXIS,
+};
+use crate::dim::{Tensor, Vector};
 use crate::model::grid::Grid;
 
 /// Knot `k` (cell units) of the clamped uniform knot vector of degree `p` on `cells` cells.
@@ -169,6 +171,59 @@ fn domain_basis(xi: f64, half: f64, p: usize, cells: usize) -> AxisFactors {
         f.slope[at_a.first - first + r] -= at_a.weight[r] / length;
     }
     f
+}
+
+/// The domain averages of (y − x) N_I' (dimensionless) and of (y − x) N_I (per
+/// cell) over the clipped domain of `domain_basis`, x the particle at `xi`, in
+/// the order of its functions (two-point Gauss per span: exact for p ≤ 2).
+fn domain_moments(xi: f64, half: f64, p: usize, cells: usize) -> ([f64; MAX_PER_AXIS], [f64; MAX_PER_AXIS]) {
+    let n = cells as f64;
+    let (a, b) = ((xi - half).max(0.0), (xi + half).min(n));
+    let (mut slope_moment, mut weight_moment) = ([0.0; MAX_PER_AXIS], [0.0; MAX_PER_AXIS]);
+    let length = b - a;
+    if length <= 1e-12 {
+        return (slope_moment, weight_moment);
+    }
+    let first = cell_index(a, cells);
+    let last = ((b.ceil() as usize).max(1) - 1).clamp(first, cells - 1);
+    let gauss = 0.5 / 3f64.sqrt();
+    for span in first..=last {
+        let (lo, hi) = (a.max(span as f64), b.min(span as f64 + 1.0));
+        if hi <= lo {
+            continue;
+        }
+        let (mid, w) = (0.5 * (lo + hi), 0.5 * (hi - lo) / length);
+        for t in [mid - gauss * (hi - lo), mid + gauss * (hi - lo)] {
+            let g = basis(t, p, cells);
+            for r in 0..=p {
+                slope_moment[g.first - first + r] += w * (t - xi) * g.slope[r];
+                weight_moment[g.first - first + r] += w * (t - xi) * g.weight[r];
+            }
+        }
+    }
+    (slope_moment, weight_moment)
+}
+
+/// The first moments of the domain-averaged B-spline gradients about the
+/// particle, M_kj = (1/|Ω|) ∫_Ω (y − x)_k ∂_j N_I, in the order of
+/// `evaluate_domain` (`super::gimp::moments` for the hats; quadratic only).
+pub fn domain_gradient_moments<const D: usize>(
+    grid: &Grid<D>,
+    x: &Vector<D>,
+    half: &Vector<D>,
+    degree: usize,
+    out: &mut [Tensor<D>],
+) -> usize {
+    assert_eq!(degree, 2, "first moments of the domain-averaged B-splines: quadratic only");
+    let axes: [_; D] = std::array::from_fn(|d| {
+        let xi = cell_coordinate(grid, x, d);
+        let mut f = domain_basis(xi, half[d] / grid.h[d], degree, grid.cells[d]);
+        f.slope.iter_mut().for_each(|s| *s /= grid.h[d]);
+        let (t, mut u) = domain_moments(xi, half[d] / grid.h[d], degree, grid.cells[d]);
+        u.iter_mut().for_each(|u| *u *= grid.h[d]);
+        (f, t, u)
+    });
+    moment_product(&axes, out)
 }
 
 /// Quadratic or cubic B-splines averaged over the axis-aligned particle domain
@@ -441,6 +496,70 @@ mod tests {
             }
         }
         assert!(inside > 50, "only {inside} domains inside the grid");
+    }
+
+    /// The first moments of the domain-averaged gradients about the particle
+    /// (`domain_gradient_moments`) against Gauss quadrature of (y − x) ⊗ ∇N_I
+    /// with the point-sampled basis over the clipped domain (split at the knots),
+    /// in the order of `evaluate_domain`.
+    fn domain_gradient_moments_match_quadrature<const D: usize>() {
+        let g = test_grid::<D>(2);
+        let mut rng = Rng::new(6);
+        let gauss = [(-0.5 * 0.6f64.sqrt(), 5.0 / 18.0), (0.0, 8.0 / 18.0), (0.5 * 0.6f64.sqrt(), 5.0 / 18.0)];
+        for x in sample_points(&g, 120) {
+            let half = Vector::<D>::from_fn(|d, _| g.h[d] * rng.range(0.01, 0.5));
+            let (a, b) = ((x - half).sup(&g.min), (x + half).inf(&g.max));
+            let rules: [Vec<(f64, f64)>; D] = std::array::from_fn(|d| {
+                let mut cuts = vec![a[d]];
+                cuts.extend(
+                    (0..=g.cells[d])
+                        .map(|i| g.min[d] + i as f64 * g.h[d])
+                        .filter(|&y| y > a[d] && y < b[d]),
+                );
+                cuts.push(b[d]);
+                let mut points = Vec::new();
+                for piece in cuts.windows(2) {
+                    let (mid, len) = ((piece[0] + piece[1]) / 2.0, piece[1] - piece[0]);
+                    for (s, w) in gauss {
+                        points.push((mid + s * len, w * len / (b[d] - a[d])));
+                    }
+                }
+                points
+            });
+            let mut moment = vec![Tensor::<D>::zeros(); g.node_count()];
+            let total: usize = rules.iter().map(|r| r.len()).product();
+            for flat in 0..total {
+                let mut rest = flat;
+                let (mut y, mut q) = (Vector::<D>::zeros(), 1.0);
+                for d in 0..D {
+                    let (yd, qd) = rules[d][rest % rules[d].len()];
+                    rest /= rules[d].len();
+                    y[d] = yd;
+                    q *= qd;
+                }
+                let point = eval(&g, &y, 2);
+                for k in 0..point.len() {
+                    moment[point.node[k] as usize] += (y - x) * point.grad[k].transpose() * q;
+                }
+            }
+            let s = eval_domain(&g, &x, &half);
+            let mut m = vec![Tensor::<D>::repeat(f64::NAN); 4usize.pow(D as u32)];
+            assert_eq!(domain_gradient_moments(&g, &x, &half, 2, &mut m), s.len());
+            for (k, n) in s.nodes().iter().enumerate() {
+                let error = (m[k] - moment[*n as usize]).norm();
+                assert!(error < 1e-12, "first moment of {n} at {x}: {error:e}");
+            }
+        }
+    }
+
+    #[test]
+    fn domain_gradient_moments_match_quadrature_2d() {
+        domain_gradient_moments_match_quadrature::<2>();
+    }
+
+    #[test]
+    fn domain_gradient_moments_match_quadrature_3d() {
+        domain_gradient_moments_match_quadrature::<3>();
     }
 
     #[test]

@@ -11,8 +11,11 @@
 //! Σ S_I X_I is then the centre (a + b)/2 of the clipped domain, not x, and the
 //! gradient is the clipped-domain average of ∇N_I, not ∂S_I/∂x_p.
 
-use super::linear::{cell_coordinate, cell_index, tensor_product, AxisFactors, MAX_PER_AXIS};
-use crate::dim::Vector;
+use super::linear::{
+    cell_coordinate, cell_index, moment_product, tensor_product, AxisFactors, MomentFactors,
+    MAX_PER_AXIS,
+};
+use crate::dim::{Tensor, Vector};
 use crate::model::grid::Grid;
 
 /// Unit hat φ(t) = max(0, 1 − |t|).
@@ -78,6 +81,59 @@ pub fn evaluate<const D: usize>(
     debug_assert_eq!(grid.degree, 1, "GIMP lives on a degree-1 grid");
     let axes: [AxisFactors; D] = std::array::from_fn(|d| domain_factors(grid, x, half, d));
     tensor_product(grid, &axes, node, w, grad)
+}
+
+/// Ψ(t) = ∫_{−∞}^t s φ(s) ds, the first moment of the unit hat (piecewise cubic).
+fn hat_first_moment(t: f64) -> f64 {
+    if t <= -1.0 {
+        0.0
+    } else if t <= 0.0 {
+        t * t / 2.0 + t * t * t / 3.0 - 1.0 / 6.0
+    } else if t < 1.0 {
+        -1.0 / 6.0 + t * t / 2.0 - t * t * t / 3.0
+    } else {
+        0.0
+    }
+}
+
+/// Per axis, the domain averages of (y − x) N_I' (dimensionless) and of
+/// (y − x) N_I (a length) over the clipped domain [a, b], x the particle.
+fn moment_factors<const D: usize>(
+    grid: &Grid<D>,
+    x: &Vector<D>,
+    half: &Vector<D>,
+    d: usize,
+) -> MomentFactors {
+    let f = domain_factors(grid, x, half, d);
+    let cells = grid.cells[d];
+    let reach = half[d] / grid.h[d];
+    let xi = cell_coordinate(grid, x, d);
+    let (a, b) = ((xi - reach).max(0.0), (xi + reach).min(cells as f64));
+    let (mut slope_moment, mut weight_moment) = ([0.0; MAX_PER_AXIS], [0.0; MAX_PER_AXIS]);
+    for k in 0..f.count {
+        let node = (f.first + k) as f64;
+        let (a, b, c) = (a - node, b - node, xi - node);
+        // ∫ (y − x) N' dy = [(y − x) N]_a^b − ∫ N dy (by parts).
+        slope_moment[k] = ((b - c) * hat(b) - (a - c) * hat(a)) / (b - a) - f.weight[k];
+        weight_moment[k] = grid.h[d]
+            * (hat_first_moment(b) - hat_first_moment(a) - c * (hat_integral(b) - hat_integral(a)))
+            / (b - a);
+    }
+    (f, slope_moment, weight_moment)
+}
+
+/// The first moments of the GIMP gradients over the particle domain Ω about the
+/// particle x, M_kj = (1/|Ω|) ∫_Ω (y − x)_k ∂_j N_I(y) dy, entry by entry in the
+/// order of `evaluate`: with a stress linear within the domain,
+/// (1/|Ω|) ∫_Ω σ ∇N_I = σ(x) ∇S_I + Σ_k ∂_kσ M_k·.
+pub fn moments<const D: usize>(
+    grid: &Grid<D>,
+    x: &Vector<D>,
+    half: &Vector<D>,
+    out: &mut [Tensor<D>],
+) -> usize {
+    let axes: [_; D] = std::array::from_fn(|d| moment_factors(grid, x, half, d));
+    moment_product(&axes, out)
 }
 
 #[cfg(test)]
@@ -164,8 +220,9 @@ mod tests {
         points
     }
 
-    /// Weights and gradients equal the domain averages of the hat functions and their
-    /// gradients, integrated independently by Gauss quadrature of `linear::evaluate`;
+    /// Weights, gradients and the gradients' first moments about the particle equal
+    /// the domain averages of the hat functions, their gradients and (y − x) ⊗ ∇N,
+    /// integrated independently by Gauss quadrature of `linear::evaluate`;
     /// this covers the clipping at the faces.
     fn domain_average_of_hats<const D: usize>() {
         let g = test_grid::<D>(1);
@@ -177,6 +234,7 @@ mod tests {
                 std::array::from_fn(|d| axis_quadrature(&g, a[d], b[d], d));
             let mut w = vec![0.0; g.node_count()];
             let mut grad = vec![Vector::<D>::zeros(); g.node_count()];
+            let mut moment = vec![Tensor::<D>::zeros(); g.node_count()];
             let total: usize = rules.iter().map(|r| r.len()).product();
             for flat in 0..total {
                 let mut rest = flat;
@@ -191,9 +249,16 @@ mod tests {
                 for k in 0..hats.len() {
                     w[hats.node[k] as usize] += q * hats.w[k];
                     grad[hats.node[k] as usize] += hats.grad[k] * q;
+                    moment[hats.node[k] as usize] += (y - x) * hats.grad[k].transpose() * q;
                 }
             }
             let s = eval(&g, &x, &half);
+            let mut m = vec![Tensor::<D>::repeat(f64::NAN); 3usize.pow(D as u32)];
+            assert_eq!(moments(&g, &x, &half, &mut m), s.len());
+            for (k, n) in s.nodes().iter().enumerate() {
+                let error = (m[k] - moment[*n as usize]).norm();
+                assert!(error < 1e-12, "first moment of {n} at {x}: {error:e}");
+            }
             for n in 0..g.node_count() {
                 assert!(
                     (s.weight_of(n) - w[n]).abs() < 1e-12,

@@ -4,7 +4,7 @@
 //! Also home of the tensor-product assembly shared by the separable families
 //! (linear, GIMP, B-splines).
 
-use crate::dim::Vector;
+use crate::dim::{Tensor, Vector};
 use crate::model::grid::Grid;
 
 /// Most nodes a separable family touches per direction (cubic B-spline).
@@ -93,6 +93,64 @@ pub(super) fn tensor_product<const D: usize>(
         loop {
             local[d] += 1;
             if local[d] < axes[d].count {
+                break;
+            }
+            local[d] = 0;
+            d += 1;
+            if d == D {
+                return n;
+            }
+        }
+    }
+}
+
+/// Per-axis factors with the domain averages of (y − x) N' (dimensionless) and
+/// (y − x) N (a length) of each function.
+pub(super) type MomentFactors = (AxisFactors, [f64; MAX_PER_AXIS], [f64; MAX_PER_AXIS]);
+
+/// The first moments M_kj = (1/|Ω|) ∫_Ω (y − x)_k ∂_j N_I of a separable
+/// domain-averaged family: the factor of axis e is (y − x)N' for e = k = j,
+/// (y − x)N for e = k ≠ j, N' for e = j ≠ k and N otherwise. Entries in the
+/// order and with the skips of `tensor_product`; returns the count.
+pub(super) fn moment_product<const D: usize>(axes: &[MomentFactors; D], out: &mut [Tensor<D>]) -> usize {
+    if axes.iter().any(|a| a.0.count == 0) {
+        return 0;
+    }
+    let mut local = [0usize; D];
+    let mut n = 0;
+    loop {
+        let (f, slope_moment, weight_moment) = (
+            |e: usize| &axes[e].0,
+            |e: usize| axes[e].1[local[e]],
+            |e: usize| axes[e].2[local[e]],
+        );
+        let weight: f64 = (0..D).map(|e| f(e).weight[local[e]]).product();
+        let gradient_is_zero = (0..D).all(|d| {
+            (0..D)
+                .map(|e| match e == d {
+                    true => f(e).slope[local[e]],
+                    false => f(e).weight[local[e]],
+                })
+                .product::<f64>()
+                == 0.0
+        });
+        if weight != 0.0 || !gradient_is_zero {
+            out[n] = Tensor::<D>::from_fn(|k, j| {
+                (0..D)
+                    .map(|e| match (e == k, e == j) {
+                        (true, true) => slope_moment(e),
+                        (true, false) => weight_moment(e),
+                        (false, true) => f(e).slope[local[e]],
+                        (false, false) => f(e).weight[local[e]],
+                    })
+                    .product()
+            });
+            n += 1;
+        }
+        let mut d = 0;
+        loop {
+            local[d] += 1;
+            if local[d] < axes[d].0.count {
                 break;
             }
             local[d] = 0;

@@ -50,10 +50,65 @@ pub fn evaluate<const D: usize>(
     }
 }
 
+/// The first moments M_kj = (1/|Ω|) ∫_Ω (y − x)_k ∂_j N_I of the gradients over
+/// the particle domain about the particle, entry by entry in the order of
+/// `evaluate` (`physics::stress_gradient`): for the families that integrate over
+/// a box domain stretched with the material, `cpgimp` and `cpbspline2`; `None`
+/// for the others.
+pub fn gradient_moments<const D: usize>(
+    shape: ShapeFunction,
+    grid: &Grid<D>,
+    x: &Vector<D>,
+    half_length0: &Vector<D>,
+    f: &Mat3,
+    out: &mut [Tensor<D>],
+) -> Option<usize> {
+    let half = contiguous_half_length(grid, half_length0, f);
+    match shape {
+        ShapeFunction::Cpgimp => Some(gimp::moments(grid, x, &half, out)),
+        ShapeFunction::Cpbspline2 => Some(bspline::domain_gradient_moments(grid, x, &half, 2, out)),
+        _ => None,
+    }
+}
+
+/// The mean of a nodal field (`value` of a grid node) at the 2^D corners of the
+/// particle's box domain, by the point values of the grid basis the family
+/// averages (hats for `cpgimp`, quadratic B-splines for `cpbspline2`); corners
+/// outside the grid are taken on its faces. `None` for the other families.
+pub fn domain_corner_mean<const D: usize>(
+    shape: ShapeFunction,
+    grid: &Grid<D>,
+    x: &Vector<D>,
+    half_length0: &Vector<D>,
+    f: &Mat3,
+    value: impl Fn(u32) -> Vector<D>,
+) -> Option<Vector<D>> {
+    let point = match shape {
+        ShapeFunction::Cpgimp => ShapeFunction::Linear,
+        ShapeFunction::Cpbspline2 => ShapeFunction::Bspline2,
+        _ => return None,
+    };
+    let half = contiguous_half_length(grid, half_length0, f);
+    let (mut node, mut w, mut grad) = ([0u32; 27], [0.0; 27], [Vector::<D>::zeros(); 27]);
+    let mut sum = Vector::<D>::zeros();
+    for corner in 0..1usize << D {
+        let y = Vector::<D>::from_fn(|d, _| match corner >> d & 1 {
+            1 => x[d] + half[d],
+            _ => x[d] - half[d],
+        });
+        let y = y.sup(&grid.min).inf(&grid.max);
+        let n = evaluate(point, grid, &y, half_length0, f, &mut node, &mut w, &mut grad);
+        for k in 0..n {
+            sum += value(node[k]) * w[k];
+        }
+    }
+    Some(sum / (1usize << D) as f64)
+}
+
 /// The contiguous particle domain's half-lengths (cpGIMP): the reference ones
 /// stretched by F_dd, kept within (0, h/2] so the support stays within two cells per
 /// axis (a domain stretched beyond a cell is capped at one cell).
-fn contiguous_half_length<const D: usize>(
+pub(crate) fn contiguous_half_length<const D: usize>(
     grid: &Grid<D>,
     half_length0: &Vector<D>,
     f: &Mat3,

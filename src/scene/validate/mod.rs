@@ -17,7 +17,10 @@ pub use analyses::bench;
 pub use check::{Check, KeyError};
 
 use crate::scene::contact::ContactPlan;
-use crate::scene::{LinearSolver, LinearSystems, SceneConfig, SolverConfig, SolverKind};
+use crate::scene::{
+    DomainStress, LinearSolver, LinearSystems, SceneConfig, ShapeFunction, SolverConfig,
+    SolverKind,
+};
 use analyses::{geostatic, strength_reduction};
 use axisymmetry::axisymmetry;
 use check::{ensure, vector};
@@ -65,6 +68,9 @@ pub fn validate(s: &SceneConfig) -> Check {
     }
     if let Some(plan) = crate::scene::contact::plan(s)? {
         implicit_contact(s, &plan)?;
+    }
+    if s.grid.domain_stress == DomainStress::Linear {
+        linear_domain_stress(s)?;
     }
     needs_krylov(s, &materials)?;
     match (&s.solver, s.stages.is_empty()) {
@@ -125,6 +131,55 @@ pub fn validate(s: &SceneConfig) -> Check {
     }
     if let Some(b) = &s.bench {
         bench(b, "bench")?;
+    }
+    Ok(())
+}
+
+/// `domain_stress = "linear"` (`physics::stress_gradient`): box domains
+/// (cpGIMP, cpB-spline), implicit stages only, without F-bar (whose tangent
+/// it does not combine with), not in axisymmetric mode, and not with CG (the
+/// tangent is unsymmetric).
+fn linear_domain_stress(s: &SceneConfig) -> Check {
+    let key = "grid.domain_stress";
+    ensure(
+        matches!(s.grid.shape_function, ShapeFunction::Cpgimp | ShapeFunction::Cpbspline2),
+        key,
+        format!(
+            "\"linear\" integrates over box particle domains: it needs shape_function = \
+             \"cpgimp\" or \"cpbspline2\", not \"{}\"",
+            s.grid.shape_function.name()
+        ),
+    )?;
+    ensure(
+        !s.dimension.is_axisymmetric(),
+        key,
+        "\"linear\" is not implemented in axisymmetric mode",
+    )?;
+    for (k, st) in s.stages().iter().enumerate() {
+        let what = match s.stages.is_empty() {
+            true => "the solver".to_string(),
+            false => format!("stage {k}"),
+        };
+        ensure(
+            st.kind == SolverKind::Implicit,
+            key,
+            format!(
+                "\"linear\" is implemented in the implicit solver only, and {what} is explicit"
+            ),
+        )?;
+        ensure(
+            !st.fbar(),
+            key,
+            format!("\"linear\" does not combine with F-bar, and {what} has fbar = true"),
+        )?;
+        ensure(
+            st.linear_solver() != LinearSolver::Cg,
+            key,
+            format!(
+                "\"linear\" makes the tangent unsymmetric, and {what} has linear_solver = \
+                 \"cg\": use \"direct\" or \"gmres\""
+            ),
+        )?;
     }
     Ok(())
 }

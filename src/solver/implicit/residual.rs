@@ -13,6 +13,7 @@
 
 use super::assembly::absorbing::add_absorbing;
 use super::assembly::fbar::add_fbar_stiffness;
+use super::assembly::linear_stress::add_linear_stress_stiffness;
 use super::assembly::mass::{add_consistent_mass, add_lumped_mass};
 use super::assembly::stiffness::{
     add_stiffness, hoop_symmetric, major_symmetric, particle_tangents, relative_pk1,
@@ -47,7 +48,12 @@ pub fn residual<const D: usize>(
     let pk1: Vec<_> = (0..p.len())
         .map(|q| relative_pk1(&sys.trial.df[q], &sys.trial.stress[q]))
         .collect();
-    let f_int = internal_force(map, st, &p.volume, &pk1);
+    let mut f_int = internal_force(map, st, &p.volume, &pk1);
+    // A stress linear within each particle domain (`physics::stress_gradient`).
+    if let Some(linear) = &sys.linear_stress {
+        let f_linear = linear.force(map, st, &p.volume, &pk1);
+        f_int.iter_mut().zip(f_linear).for_each(|(f, g)| *f += g);
+    }
     let w: Vec<Vector<D>> = u.iter().zip(&sys.u_tilde).map(|(a, b)| a - b).collect();
     let f_inertia = inertial_force(p, sys, &w);
     let mut r: Vec<Vector<D>> = (0..u.len())
@@ -112,6 +118,7 @@ pub fn tangent<'s, const D: usize>(
     // Symmetric unless F-bar or a non-associated material breaks it.
     let contact = sys.contact.as_ref();
     let symmetric = fbar.is_none()
+        && sys.linear_stress.is_none()
         && contact.is_none_or(|c| c.symmetric())
         && (a.values)
             .par_chunks(ParticleTangents::<D>::LEN)
@@ -136,6 +143,9 @@ pub fn tangent<'s, const D: usize>(
         Some(state) => add_fbar_stiffness(&mut k, pattern, map, st, dofs, &p.volume, state, &a),
     }
     // Absorbing faces: Σ S_I S_J (γ/(βΔt) C + K), symmetric.
+    if let Some(linear) = &sys.linear_stress {
+        add_linear_stress_stiffness(&mut k, pattern, map, st, dofs, &p.volume, &a, linear);
+    }
     add_absorbing(&mut k, &sys.absorbing, pattern, map, st, dofs);
     if let Some(contact) = contact {
         contact.add_tangent(&mut k, pattern, map, st, dofs);
@@ -155,7 +165,8 @@ pub fn tangent<'s, const D: usize>(
 /// step, or kept from the previous step).
 pub fn step_pattern<const D: usize>(sys: &StepSystem<D>) -> &Pattern {
     let cells = sys.trial.fbar.as_ref().map(|f| &f.cells);
-    (sys.pattern).get_or_init(|| Pattern::new(&sys.map, &sys.stencils, &sys.dofs, cells))
+    let fit = sys.linear_stress.as_ref().map(|l| &l.fit);
+    (sys.pattern).get_or_init(|| Pattern::new(&sys.map, &sys.stencils, &sys.dofs, cells, fit))
 }
 
 /// The fill-reducing ordering for the factorization of the tangent `k` of

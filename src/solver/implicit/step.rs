@@ -22,7 +22,8 @@ use crate::parallel::MIN_PARALLEL_LEN;
 use crate::physics::absorbing::{self, AbsorbingStep};
 use crate::physics::boundary::implicit_node_constraint;
 use crate::physics::deformation::Trial;
-use crate::physics::shape::{ShapeFunction, Stencils};
+use crate::physics::shape::{domain_corner_mean, ShapeFunction, Stencils};
+use crate::physics::stress_gradient::LinearStress;
 use crate::physics::transfer::{
     applied_force, external_force, interpolate, mass_average, mass_momentum, mass_weighted,
     nodal_force, stencils, NodeMap,
@@ -91,6 +92,9 @@ pub struct StepSystem<const D: usize> {
     pub pattern: OnceLock<Pattern>,
     /// Contact with rigid bodies (None in a scene without).
     pub contact: Option<RigidContact<D>>,
+    /// The linear domain stress of the step-start configuration (None unless
+    /// `[grid] domain_stress = "linear"`).
+    pub linear_stress: Option<LinearStress<D>>,
 }
 
 impl<const D: usize> StepSystem<D> {
@@ -116,6 +120,7 @@ impl<const D: usize> StepSystem<D> {
             direct_ordering: DirectOrdering::Auto,
             pattern: OnceLock::new(),
             contact: None,
+            linear_stress: None,
         }
     }
 }
@@ -181,6 +186,9 @@ impl StepSettings {
         if self.dynamic() && accel.len() != p.len() {
             *accel = self.initial_acceleration(m, &sys.stencils, &sys.map);
         }
+        sys.linear_stress = m
+            .linear_domain_stress
+            .then(|| LinearStress::new(self.shape, &m.grid, p, &sys.stencils));
         let (st, map) = (&sys.stencils, &sys.map);
         let (constraint, dofs) = number_unknowns(m, st, map, self.min_node_support);
         let n = map.len();
@@ -222,9 +230,10 @@ impl StepSettings {
         // The previous step's pattern, ordering and (in the direct solver) symbolic
         // factorization serve again when no stencil, constraint or tie changed.
         let cells = sys.trial.fbar.as_ref().map(|f| &f.cells);
+        let fit = sys.linear_stress.as_ref().map(|l| &l.fit);
         let kept = std::mem::take(&mut sys.pattern)
             .into_inner()
-            .filter(|pattern| pattern.fits(st, &dofs, cells));
+            .filter(|pattern| pattern.fits(st, &dofs, cells, fit));
         sys.pattern = OnceLock::new();
         if let Some(pattern) = kept {
             let _ = sys.pattern.set(pattern);
@@ -237,6 +246,34 @@ impl StepSettings {
         sys.u_tilde = u_tilde;
         sys.g_new = g_new;
         sys.scales_new = scales_new;
+    }
+
+    /// The particles' displacements over the step: Σ_I S_Ip u_I; with a linear
+    /// domain stress, the mean of u at the corners of the step-start domain,
+    /// as CPDI moves its particles, so that the domains keep tiling the body
+    /// (the domain average moves a domain's centre by δ²u''/24 off its
+    /// corners' mean, which opens gaps and overlaps of O(h²) at the faces;
+    /// docs/accuracy.md).
+    fn particle_displacements<const D: usize>(
+        &self,
+        m: &Model<D>,
+        sys: &StepSystem<D>,
+        u: &[Vector<D>],
+    ) -> Vec<Vector<D>> {
+        let (p, map, st) = (&m.particles, &sys.map, &sys.stencils);
+        (0..p.len())
+            .into_par_iter()
+            .with_min_len(crate::parallel::MIN_PARALLEL_LEN)
+            .map(|q| match sys.linear_stress.is_some() && st.count[q] > 0 {
+                false => interpolate(map, st, q, u),
+                true => {
+                    let value = |n: u32| u[map.local[n as usize] as usize];
+                    let shape = self.shape;
+                    domain_corner_mean(shape, &m.grid, &p.x[q], &p.half_length0[q], &p.f[q], value)
+                        .expect("a linear domain stress on a box domain")
+                }
+            })
+            .collect()
     }
 
     /// Particle accelerations at t = 0 from M a = f_ext − f_int (lumped).
@@ -308,10 +345,10 @@ impl StepSettings {
         let (g_old, scales_old) = self.load_factors(m, sys.t);
         let load_old = |q: usize| load_factor(&m.load_ramp_of, q, &scales_old);
         let load_new = |q: usize| load_factor(&m.load_ramp_of, q, &sys.scales_new);
+        let dx = self.particle_displacements(m, sys, u);
         let p = &mut m.particles;
         sys.trial.commit(p);
         let (map, st) = (&sys.map, &sys.stencils);
-        let dx: Vec<Vector<D>> = (0..p.len()).map(|q| interpolate(map, st, q, u)).collect();
         let work: f64 = (0..p.len())
             .map(|q| {
                 let f_old = applied_force(p, q, &(m.gravity * g_old), &load_old);

@@ -355,6 +355,17 @@ fn axisymmetric_fbar_tangent_matches_finite_differences_of_the_residual() {
     }
 }
 
+/// A Mohr-Coulomb material with c small against the stresses of the tangent
+/// checks' iterate (plastic there), dilation angle ψ.
+fn mohr_coulomb_keys(psi: f64) -> Vec<String> {
+    vec![
+        "material.0.model=mohr_coulomb".to_string(),
+        "material.0.cohesion=200.0".to_string(),
+        "material.0.friction_angle=20.0".to_string(),
+        format!("material.0.dilation_angle={psi}"),
+    ]
+}
+
 /// The F-bar tangent (`assembly::fbar::fbar_triplets`: each particle couples to the
 /// nodes of every particle in its cell) against central differences of the
 /// F-bar residual, with linear and smooth shape functions, through ties, and
@@ -362,14 +373,7 @@ fn axisymmetric_fbar_tangent_matches_finite_differences_of_the_residual() {
 /// iterate, ψ = 0 and ψ > 0). 2 × 2 particles per cell (as in the slope).
 #[test]
 fn global_tangent_with_fbar_matches_finite_differences_of_the_residual() {
-    let mohr_coulomb = |psi: f64| {
-        vec![
-            "material.0.model=mohr_coulomb".to_string(),
-            "material.0.cohesion=200.0".to_string(),
-            "material.0.friction_angle=20.0".to_string(),
-            format!("material.0.dilation_angle={psi}"),
-        ]
-    };
+    let mohr_coulomb = mohr_coulomb_keys;
     let hencky = vec!["material.0.model=hencky".to_string()];
     for (name, material, shape, support) in [
         ("hencky", hencky.clone(), "linear", 0.0),
@@ -417,6 +421,53 @@ fn global_tangent_with_fbar_matches_finite_differences_of_the_residual() {
         assert!(error < 1e-6, "F-bar 3D {name} {shape}: {error:.2e}");
         if name.starts_with("mohr") {
             assert!(plastic > 0, "F-bar 3D {name} {shape}: no plastic particle");
+        }
+    }
+}
+
+/// The tangent with a stress linear within the particle domains (`[grid]
+/// domain_stress = "linear"`: each particle couples to the nodes of its
+/// least-squares neighbours, `assembly::linear_stress`) against central
+/// differences of the residual: 2D and 3D, both families, with ties, both
+/// mass matrices, elastic and plastic.
+#[test]
+fn linear_domain_stress_tangent_matches_finite_differences_of_the_residual() {
+    let cases_2d = [
+        ("hencky", "cpgimp", "lumped", 0.0),
+        ("neo_hookean", "cpbspline2", "consistent", 0.01),
+        ("hencky", "cpbspline2", "lumped", 0.3),
+        ("linear_elastic", "cpgimp", "consistent", 0.3),
+    ];
+    for (model, shape, mass, support) in cases_2d {
+        let overrides = vec![
+            format!("material.0.model={model}"),
+            format!("grid.shape_function={shape}"),
+            format!("solver.mass={mass}"),
+            format!("solver.min_node_support={support}"),
+            "grid.domain_stress=linear".to_string(),
+        ];
+        let (error, n, tied, _) = tangent_error(&overrides, false);
+        println!(
+            "linear domain stress {model} {shape} {mass}: {n} unknowns, {tied} tied nodes, \
+             max |K − K_fd| / max|K| = {error:.2e}"
+        );
+        assert!(error < 1e-6, "{model} {shape} {mass}: tangent off by {error:.2e}");
+    }
+    let mut plastic_case = mohr_coulomb_keys(0.0);
+    plastic_case.push("grid.shape_function=cpbspline2".into());
+    for (name, mut overrides) in [
+        ("hencky cpgimp", vec!["grid.shape_function=cpgimp".to_string()]),
+        ("mohr_coulomb cpbspline2", plastic_case),
+    ] {
+        overrides.push("grid.domain_stress=linear".to_string());
+        let (error, n, tied, plastic) = tangent_error_of::<3>(BLOCK_3D, &overrides, false);
+        println!(
+            "linear domain stress 3D {name}: {n} unknowns, {tied} tied nodes, {plastic} plastic \
+             particles, max |K − K_fd| / max|K| = {error:.2e}"
+        );
+        assert!(error < 1e-6, "3D {name}: tangent off by {error:.2e}");
+        if name.starts_with("mohr") {
+            assert!(plastic > 0, "3D {name}: no plastic particle");
         }
     }
 }
@@ -634,16 +685,16 @@ fn a_pattern_is_kept_only_while_it_fits() {
     solver.prepare(&m, 0.0, 0.01);
     let sys = &solver.system;
     let cells = sys.trial.fbar.as_ref().map(|f| &f.cells);
-    let pattern = Pattern::new(&sys.map, &sys.stencils, &sys.dofs, cells);
-    assert!(pattern.fits(&sys.stencils, &sys.dofs, cells));
+    let pattern = Pattern::new(&sys.map, &sys.stencils, &sys.dofs, cells, None);
+    assert!(pattern.fits(&sys.stencils, &sys.dofs, cells, None));
     // Another node in one stencil, another unknown, other cells: a new pattern.
     let mut moved = sys.stencils.clone();
     moved.node[0] += 1;
-    assert!(!pattern.fits(&moved, &sys.dofs, cells));
+    assert!(!pattern.fits(&moved, &sys.dofs, cells, None));
     let mut dofs = sys.dofs.clone();
     dofs.free -= 1;
-    assert!(!pattern.fits(&sys.stencils, &dofs, cells));
-    assert!(!pattern.fits(&sys.stencils, &sys.dofs, None));
+    assert!(!pattern.fits(&sys.stencils, &dofs, cells, None));
+    assert!(!pattern.fits(&sys.stencils, &sys.dofs, None, None));
     // Through the solver: the next step keeps the pattern while the particles
     // stay put, and builds a new one after one crosses into another cell.
     let _ = solver.system.pattern.set(pattern);

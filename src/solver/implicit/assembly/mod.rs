@@ -11,11 +11,14 @@
 //! - [`stiffness`]: Σ_p V_p ∇S_Ip A_p ∇S_Jp with A_p = ∂P/∂ΔF, material (2-41)
 //!   and geometric (2-42) parts;
 //! - [`fbar`]: the same with F-bar, which also couples the particles of a cell;
+//! - [`linear_stress`]: the stress gradient within the particle domains, which
+//!   couples each particle to the nodes of its least-squares neighbours;
 //! - [`mass`]: the inertia M/(βΔt²) of 2-40, lumped or consistent;
 //! - [`absorbing`]: the dashpots and springs of absorbing faces (2-63).
 
 pub mod absorbing;
 pub mod fbar;
+pub mod linear_stress;
 pub mod mass;
 pub mod pattern;
 pub mod stiffness;

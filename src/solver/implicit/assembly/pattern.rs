@@ -19,6 +19,7 @@
 use super::Dofs;
 use crate::physics::fbar::Cells;
 use crate::physics::shape::Stencils;
+use crate::physics::stress_gradient::LeastSquares;
 use crate::physics::transfer::NodeMap;
 use crate::scene::DirectOrdering;
 use crate::solver::linear::direct::spmv;
@@ -101,23 +102,39 @@ struct BuiltFor {
     count: Vec<u32>,
     node: Vec<u32>,
     cell_of: Option<Vec<u32>>,
+    /// The least-squares neighbour lists (offsets, neighbours).
+    neighbours: Option<(Vec<usize>, Vec<u32>)>,
     dofs: Dofs,
 }
 
 impl BuiltFor {
-    fn new<const D: usize>(st: &Stencils<D>, dofs: &Dofs, cells: Option<&Cells>) -> BuiltFor {
+    fn new<const D: usize>(
+        st: &Stencils<D>,
+        dofs: &Dofs,
+        cells: Option<&Cells>,
+        fit: Option<&LeastSquares<D>>,
+    ) -> BuiltFor {
         BuiltFor {
             count: st.count.clone(),
             node: st.node.clone(),
             cell_of: cells.map(|c| c.of.clone()),
+            neighbours: fit.map(|f| (f.lists().0.to_vec(), f.lists().1.to_vec())),
             dofs: dofs.clone(),
         }
     }
 
-    fn fits<const D: usize>(&self, st: &Stencils<D>, dofs: &Dofs, cells: Option<&Cells>) -> bool {
+    fn fits<const D: usize>(
+        &self,
+        st: &Stencils<D>,
+        dofs: &Dofs,
+        cells: Option<&Cells>,
+        fit: Option<&LeastSquares<D>>,
+    ) -> bool {
         self.count == st.count
             && self.node == st.node
             && self.cell_of.as_deref() == cells.map(|c| c.of.as_slice())
+            && self.neighbours.as_ref().map(|(o, n)| (o.as_slice(), n.as_slice()))
+                == fit.map(|f| f.lists())
             && self.dofs == *dofs
     }
 }
@@ -125,12 +142,14 @@ impl BuiltFor {
 impl Pattern {
     /// The node graph of the stencils `st` over the active nodes of `map` with
     /// the unknowns `dofs`; with `cells` (F-bar), every particle also couples to
-    /// the nodes of the other particles of its cell.
+    /// the nodes of the other particles of its cell; with `fit` (a linear
+    /// domain stress), to the nodes of its least-squares neighbours.
     pub fn new<const D: usize>(
         map: &NodeMap,
         st: &Stencils<D>,
         dofs: &Dofs,
         cells: Option<&Cells>,
+        fit: Option<&LeastSquares<D>>,
     ) -> Pattern {
         let n = map.len();
         let mut first = Vec::with_capacity(n + 1);
@@ -143,7 +162,22 @@ impl Pattern {
         let tied = dofs.ties.iter().any(Option::is_some);
         let tied_sources = tied.then(|| tied_sources(map, dofs));
         let sources_of = |b: usize| sources(tied_sources.as_ref(), map, b);
-        let (neighbour_start, neighbours) = if let Some(cells) = cells {
+        let (neighbour_start, neighbours) = if let Some(fit) = fit {
+            assert!(cells.is_none(), "F-bar with a linear domain stress");
+            let each: Vec<u32> = (0..st.count.len() as u32).collect();
+            node_graph(
+                n,
+                st.stride,
+                &sources_of,
+                |q, out| {
+                    for &p in std::iter::once(&(q as u32)).chain(fit.neighbours(q)) {
+                        out.extend(st.range(p as usize).map(|e| map.local_of(st, e)));
+                    }
+                },
+                &each,
+                dofs,
+            )
+        } else if let Some(cells) = cells {
             node_graph(
                 n,
                 st.stride,
@@ -177,7 +211,7 @@ impl Pattern {
             full: OnceLock::new(),
             amd: OnceLock::new(),
             metis: OnceLock::new(),
-            built_for: BuiltFor::new(st, dofs, cells),
+            built_for: BuiltFor::new(st, dofs, cells, fit),
         }
     }
 
@@ -189,8 +223,9 @@ impl Pattern {
         st: &Stencils<D>,
         dofs: &Dofs,
         cells: Option<&Cells>,
+        fit: Option<&LeastSquares<D>>,
     ) -> bool {
-        self.built_for.fits(st, dofs, cells)
+        self.built_for.fits(st, dofs, cells, fit)
     }
 
     /// The node graph with the unknowns of each node.
@@ -341,6 +376,57 @@ impl Pattern {
                     )
                 },
             );
+    }
+
+    /// Adds terms that couple a particle's stencil to nodes beyond it: for each
+    /// stencil entry e2 of particle q (node J), `rows(q, e2, out)` lists
+    /// (node I, block) with block[i·D + k] the term at (I, component i) ×
+    /// (J, component k), for any active nodes I that the pattern couples to J.
+    /// Spread onto the unknowns through the ties; the whole matrix only
+    /// (`Storage::Full`). In parallel over the columns' nodes, each visiting its
+    /// sources in order: the same sums for any number of threads.
+    #[allow(clippy::too_many_arguments)]
+    pub fn add_listed_terms<const D: usize>(
+        &self,
+        values: &mut [f64],
+        csc: &SymbolicSparseColMat<usize>,
+        storage: Storage,
+        map: &NodeMap,
+        st: &Stencils<D>,
+        dofs: &Dofs,
+        rows: impl Fn(usize, usize, &mut Vec<(usize, [f64; 9])>) + Sync,
+    ) {
+        assert_eq!(storage, Storage::Full, "listed terms need the whole matrix");
+        let (col_ptr, row_idx) = (csc.col_ptr(), csc.row_idx());
+        self.per_node(col_ptr, values)
+            .into_par_iter()
+            .enumerate()
+            .with_min_len(16)
+            .for_each_init(Vec::new, |out, (b, vals)| {
+                let cols = self.columns(b);
+                if cols.is_empty() {
+                    return;
+                }
+                let base = col_ptr[cols.start];
+                for (e2, cc) in sources(self.tied_sources.as_ref(), map, b) {
+                    let q = e2 as usize / st.stride;
+                    out.clear();
+                    rows(q, e2 as usize, out);
+                    for (n1, block) in out.iter() {
+                        for (a, cr) in dofs.owners(*n1) {
+                            for i in 0..D {
+                                let Some(r) = dofs.of(a, i, D) else { continue };
+                                for k in 0..D {
+                                    let Some(c) = dofs.of(b, k, D) else { continue };
+                                    let column = &row_idx[col_ptr[c]..col_ptr[c + 1]];
+                                    let at = column.binary_search(&r).expect("listed entry in the pattern");
+                                    vals[col_ptr[c] - base + at] += block[i * D + k] * cr * cc;
+                                }
+                            }
+                        }
+                    }
+                }
+            });
     }
 
     /// The terms of node b's columns (`vals`, from `col_ptr[first column]` on).
