@@ -14,8 +14,8 @@ use crate::model::loads::Loads;
 use crate::model::particles::Particles;
 use crate::model::{axisymmetry, Model};
 use crate::scene::{
-    axis, expr, BodyConfig, BoundaryConfig, Condition, DomainStress, Face, Fill, ParticlesOutside, Scene,
-    SceneError,
+    axis, expr, BodyConfig, BoundaryConfig, Condition, DomainStress, Face, Fill, ParticlesOutside,
+    Scene, SceneError,
 };
 
 impl<const D: usize> Model<D> {

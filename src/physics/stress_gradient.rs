@@ -17,8 +17,8 @@
 //! not span every direction gets no gradient.
 
 use crate::dim::{embed_deformation, restrict, Mat3, Tensor, Vector};
-use crate::model::particles::Particles;
 use crate::model::grid::Grid;
+use crate::model::particles::Particles;
 use crate::physics::shape::{contiguous_half_length, gradient_moments, ShapeFunction, Stencils};
 use crate::physics::transfer::NodeMap;
 use rayon::prelude::*;
@@ -59,7 +59,13 @@ impl<const D: usize> LinearStress<D> {
 
     /// The internal force's linear part Σ_p V_p Σ_k ∂_kτ_p M_Ip,k· at every
     /// active node, τ the stress measure of `internal_force` and V its volumes.
-    pub fn force(&self, map: &NodeMap, st: &Stencils<D>, volume: &[f64], stress: &[Mat3]) -> Vec<Vector<D>> {
+    pub fn force(
+        &self,
+        map: &NodeMap,
+        st: &Stencils<D>,
+        volume: &[f64],
+        stress: &[Mat3],
+    ) -> Vec<Vector<D>> {
         let g = self.fit.gradients(stress);
         map.gather(st.stride, Vector::<D>::zeros(), |q, e| {
             (0..D).fold(Vector::<D>::zeros(), |acc, k| {
@@ -171,11 +177,14 @@ fn fit<const D: usize>(p: usize, near: &[u32], x: &[Vector<D>]) -> Vec<(u32, Vec
     // Scaled to unit diagonal, so that the singularity test does not depend on units.
     let scale = Vector::<D>::from_fn(|d, _| a[(d, d)].sqrt());
     let unit = Tensor::<D>::from_fn(|i, j| a[(i, j)] / (scale[i] * scale[j]));
-    let inverse = match scale.iter().all(|s| *s > 0.0) && embed_deformation(&unit).determinant() > 1e-8 {
-        true => unit.try_inverse().map(|u| Tensor::<D>::from_fn(|i, j| u[(i, j)] / (scale[i] * scale[j]))),
-        false => None,
-    }
-    .unwrap_or_else(Tensor::<D>::zeros);
+    let inverse =
+        match scale.iter().all(|s| *s > 0.0) && embed_deformation(&unit).determinant() > 1e-8 {
+            true => unit
+                .try_inverse()
+                .map(|u| Tensor::<D>::from_fn(|i, j| u[(i, j)] / (scale[i] * scale[j]))),
+            false => None,
+        }
+        .unwrap_or_else(Tensor::<D>::zeros);
     near.iter()
         .map(|&q| (q, inverse * (x[q as usize] - x[p])))
         .collect()
@@ -233,7 +242,8 @@ impl<const D: usize> Bins<D> {
 
     fn ijk(&self, x: &Vector<D>) -> [usize; D] {
         std::array::from_fn(|d| {
-            (((x[d] - self.min[d]) / self.width[d]).floor().max(0.0) as usize).min(self.count[d] - 1)
+            (((x[d] - self.min[d]) / self.width[d]).floor().max(0.0) as usize)
+                .min(self.count[d] - 1)
         })
     }
 
@@ -314,7 +324,8 @@ mod tests {
         let (x, half, body) = lattice::<D>(6, 0.25);
         let active = vec![true; x.len()];
         let ls = LeastSquares::new(&x, &half, &body, &active);
-        let slope: [Mat3; D] = std::array::from_fn(|k| Mat3::from_fn(|i, j| (1 + i + 2 * j + 5 * k) as f64));
+        let slope: [Mat3; D] =
+            std::array::from_fn(|k| Mat3::from_fn(|i, j| (1 + i + 2 * j + 5 * k) as f64));
         let value: Vec<Mat3> = (0..x.len())
             .map(|p| {
                 let jump = Mat3::repeat(100.0 * body[p] as f64);
@@ -323,7 +334,11 @@ mod tests {
             .collect();
         for (p, g) in ls.gradients(&value).iter().enumerate() {
             for k in 0..D {
-                assert!((g[k] - slope[k]).norm() < 1e-9 * slope[k].norm(), "particle {p} direction {k}: {}", g[k]);
+                assert!(
+                    (g[k] - slope[k]).norm() < 1e-9 * slope[k].norm(),
+                    "particle {p} direction {k}: {}",
+                    g[k]
+                );
             }
         }
     }
@@ -342,11 +357,16 @@ mod tests {
     /// particles are neither fitted nor used.
     #[test]
     fn degenerate_neighbourhoods_get_no_gradient() {
-        let x: Vec<Vector<2>> = (0..5).map(|i| Vector::<2>::new(0.5 * i as f64, 1.0)).collect();
+        let x: Vec<Vector<2>> = (0..5)
+            .map(|i| Vector::<2>::new(0.5 * i as f64, 1.0))
+            .collect();
         let half = vec![Vector::<2>::repeat(0.25); 5];
         let body = vec![0; 5];
         let value: Vec<Mat3> = (0..5).map(|i| Mat3::repeat(i as f64)).collect();
         let ls = LeastSquares::new(&x, &half, &body, &[true; 5]);
-        assert!(ls.gradients(&value).iter().all(|g| g.iter().all(|m| m.norm() == 0.0)));
+        assert!(ls
+            .gradients(&value)
+            .iter()
+            .all(|g| g.iter().all(|m| m.norm() == 0.0)));
     }
 }

@@ -28,7 +28,10 @@ fn rejected(text: &str, part: &str) {
 #[test]
 fn linear_domain_stress_is_accepted_with_box_domains_in_implicit_stages() {
     for shape in ["cpgimp", "cpbspline2"] {
-        let text = column(shape, "linear_solver = \"gmres\"\npreconditioner = \"lagged_direct\"\n");
+        let text = column(
+            shape,
+            "linear_solver = \"gmres\"\npreconditioner = \"lagged_direct\"\n",
+        );
         Scene::parse("column.toml", &text, &[]).unwrap();
     }
 }
@@ -59,5 +62,8 @@ fn an_unknown_domain_stress_is_named() {
     let text = column("cpgimp", "").replace("\"linear\"", "\"quadratic\"");
     let e = Scene::parse("column.toml", &text, &[]).expect_err("must be rejected");
     assert_eq!(e.key.as_deref(), Some("grid.domain_stress"), "{e}");
-    assert!(e.to_string().contains("expected `constant` or `linear`"), "{e}");
+    assert!(
+        e.to_string().contains("expected `constant` or `linear`"),
+        "{e}"
+    );
 }

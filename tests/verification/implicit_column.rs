@@ -272,10 +272,19 @@ fn linear_domain_stress_converges_at_second_order() {
         .collect();
     let e: Vec<f64> = runs.iter().map(|r| r.error).collect();
     for i in 0..e.len() {
-        let rate = if i > 0 { (e[i - 1] / e[i]).log2() } else { f64::NAN };
+        let rate = if i > 0 {
+            (e[i - 1] / e[i]).log2()
+        } else {
+            f64::NAN
+        };
         println!("cells {:>4}: error {:.4e}  rate {rate:.2}", cells[i], e[i]);
         if i > 0 {
-            assert!(rate >= 1.8, "rate {rate:.2} from {} to {} cells", cells[i - 1], cells[i]);
+            assert!(
+                rate >= 1.8,
+                "rate {rate:.2} from {} to {} cells",
+                cells[i - 1],
+                cells[i]
+            );
         }
     }
     let rate = mean_rate(&e);
@@ -283,8 +292,16 @@ fn linear_domain_stress_converges_at_second_order() {
     assert!(rate >= 1.8, "mean rate {rate:.2} over 16 → 256 cells");
     assert!(e[4] < 1e-8, "error at 256 cells {:.3e}", e[4]);
     for (run, n) in runs.iter().zip(cells) {
-        let iterations = run.newton.col("iteration").iter().filter(|&&k| k > 0.0).count();
-        assert!(iterations <= 5 * 20, "{n} cells: {iterations} Newton iterations in 20 load steps");
+        let iterations = run
+            .newton
+            .col("iteration")
+            .iter()
+            .filter(|&&k| k > 0.0)
+            .count();
+        assert!(
+            iterations <= 5 * 20,
+            "{n} cells: {iterations} Newton iterations in 20 load steps"
+        );
     }
 }
 
@@ -309,5 +326,9 @@ fn linear_domain_stress_converges_at_large_strain() {
     let rate = (e[0] / e[2]).log2() / 4.0;
     println!("rate 16 → 256: {rate:.2}; one stress per domain at 256 cells: {constant:.3e}");
     assert!(rate >= 1.8, "rate {rate:.2} over 16 → 256 cells");
-    assert!(e[2] < constant / 100.0, "linear {:.3e} vs constant {constant:.3e}", e[2]);
+    assert!(
+        e[2] < constant / 100.0,
+        "linear {:.3e} vs constant {constant:.3e}",
+        e[2]
+    );
 }

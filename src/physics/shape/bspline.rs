@@ -176,7 +176,12 @@ fn domain_basis(xi: f64, half: f64, p: usize, cells: usize) -> AxisFactors {
 /// The domain averages of (y − x) N_I' (dimensionless) and of (y − x) N_I (per
 /// cell) over the clipped domain of `domain_basis`, x the particle at `xi`, in
 /// the order of its functions (two-point Gauss per span: exact for p ≤ 2).
-fn domain_moments(xi: f64, half: f64, p: usize, cells: usize) -> ([f64; MAX_PER_AXIS], [f64; MAX_PER_AXIS]) {
+fn domain_moments(
+    xi: f64,
+    half: f64,
+    p: usize,
+    cells: usize,
+) -> ([f64; MAX_PER_AXIS], [f64; MAX_PER_AXIS]) {
     let n = cells as f64;
     let (a, b) = ((xi - half).max(0.0), (xi + half).min(n));
     let (mut slope_moment, mut weight_moment) = ([0.0; MAX_PER_AXIS], [0.0; MAX_PER_AXIS]);
@@ -214,7 +219,10 @@ pub fn domain_gradient_moments<const D: usize>(
     degree: usize,
     out: &mut [Tensor<D>],
 ) -> usize {
-    assert_eq!(degree, 2, "first moments of the domain-averaged B-splines: quadratic only");
+    assert_eq!(
+        degree, 2,
+        "first moments of the domain-averaged B-splines: quadratic only"
+    );
     let axes: [_; D] = std::array::from_fn(|d| {
         let xi = cell_coordinate(grid, x, d);
         let mut f = domain_basis(xi, half[d] / grid.h[d], degree, grid.cells[d]);
@@ -505,7 +513,11 @@ mod tests {
     fn domain_gradient_moments_match_quadrature<const D: usize>() {
         let g = test_grid::<D>(2);
         let mut rng = Rng::new(6);
-        let gauss = [(-0.5 * 0.6f64.sqrt(), 5.0 / 18.0), (0.0, 8.0 / 18.0), (0.5 * 0.6f64.sqrt(), 5.0 / 18.0)];
+        let gauss = [
+            (-0.5 * 0.6f64.sqrt(), 5.0 / 18.0),
+            (0.0, 8.0 / 18.0),
+            (0.5 * 0.6f64.sqrt(), 5.0 / 18.0),
+        ];
         for x in sample_points(&g, 120) {
             let half = Vector::<D>::from_fn(|d, _| g.h[d] * rng.range(0.01, 0.5));
             let (a, b) = ((x - half).sup(&g.min), (x + half).inf(&g.max));

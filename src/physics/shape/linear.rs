@@ -112,7 +112,10 @@ pub(super) type MomentFactors = (AxisFactors, [f64; MAX_PER_AXIS], [f64; MAX_PER
 /// domain-averaged family: the factor of axis e is (y − x)N' for e = k = j,
 /// (y − x)N for e = k ≠ j, N' for e = j ≠ k and N otherwise. Entries in the
 /// order and with the skips of `tensor_product`; returns the count.
-pub(super) fn moment_product<const D: usize>(axes: &[MomentFactors; D], out: &mut [Tensor<D>]) -> usize {
+pub(super) fn moment_product<const D: usize>(
+    axes: &[MomentFactors; D],
+    out: &mut [Tensor<D>],
+) -> usize {
     if axes.iter().any(|a| a.0.count == 0) {
         return 0;
     }

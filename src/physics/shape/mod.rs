@@ -97,7 +97,16 @@ pub fn domain_corner_mean<const D: usize>(
             _ => x[d] - half[d],
         });
         let y = y.sup(&grid.min).inf(&grid.max);
-        let n = evaluate(point, grid, &y, half_length0, f, &mut node, &mut w, &mut grad);
+        let n = evaluate(
+            point,
+            grid,
+            &y,
+            half_length0,
+            f,
+            &mut node,
+            &mut w,
+            &mut grad,
+        );
         for k in 0..n {
             sum += value(node[k]) * w[k];
         }

@@ -18,8 +18,7 @@ pub use check::{Check, KeyError};
 
 use crate::scene::contact::ContactPlan;
 use crate::scene::{
-    DomainStress, LinearSolver, LinearSystems, SceneConfig, ShapeFunction, SolverConfig,
-    SolverKind,
+    DomainStress, LinearSolver, LinearSystems, SceneConfig, ShapeFunction, SolverConfig, SolverKind,
 };
 use analyses::{geostatic, strength_reduction};
 use axisymmetry::axisymmetry;
@@ -142,7 +141,10 @@ pub fn validate(s: &SceneConfig) -> Check {
 fn linear_domain_stress(s: &SceneConfig) -> Check {
     let key = "grid.domain_stress";
     ensure(
-        matches!(s.grid.shape_function, ShapeFunction::Cpgimp | ShapeFunction::Cpbspline2),
+        matches!(
+            s.grid.shape_function,
+            ShapeFunction::Cpgimp | ShapeFunction::Cpbspline2
+        ),
         key,
         format!(
             "\"linear\" integrates over box particle domains: it needs shape_function = \

@@ -451,12 +451,18 @@ fn linear_domain_stress_tangent_matches_finite_differences_of_the_residual() {
             "linear domain stress {model} {shape} {mass}: {n} unknowns, {tied} tied nodes, \
              max |K − K_fd| / max|K| = {error:.2e}"
         );
-        assert!(error < 1e-6, "{model} {shape} {mass}: tangent off by {error:.2e}");
+        assert!(
+            error < 1e-6,
+            "{model} {shape} {mass}: tangent off by {error:.2e}"
+        );
     }
     let mut plastic_case = mohr_coulomb_keys(0.0);
     plastic_case.push("grid.shape_function=cpbspline2".into());
     for (name, mut overrides) in [
-        ("hencky cpgimp", vec!["grid.shape_function=cpgimp".to_string()]),
+        (
+            "hencky cpgimp",
+            vec!["grid.shape_function=cpgimp".to_string()],
+        ),
         ("mohr_coulomb cpbspline2", plastic_case),
     ] {
         overrides.push("grid.domain_stress=linear".to_string());

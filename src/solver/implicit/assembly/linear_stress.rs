@@ -69,10 +69,11 @@ fn left_rows<const D: usize>(
         .with_min_len(MIN_PARALLEL_LEN / 16)
         .map(|q| {
             let mut rows: Vec<(usize, Vector<D>)> = Vec::new();
-            let mut add = |node: usize, v: Vector<D>| match rows.iter_mut().find(|(n, _)| *n == node) {
-                Some((_, x)) => *x += v,
-                None => rows.push((node, v)),
-            };
+            let mut add =
+                |node: usize, v: Vector<D>| match rows.iter_mut().find(|(n, _)| *n == node) {
+                    Some((_, x)) => *x += v,
+                    None => rows.push((node, v)),
+                };
             for &p in fit.neighbours(q) {
                 let p = p as usize;
                 let c = fit.coefficient(p, q as u32);
@@ -82,7 +83,10 @@ fn left_rows<const D: usize>(
             }
             let own: Vector<D> = fit.coefficients(q).iter().sum();
             for e in st.range(q) {
-                add(map.local_of(st, e), -(moments[e].transpose() * own) * volume[q]);
+                add(
+                    map.local_of(st, e),
+                    -(moments[e].transpose() * own) * volume[q],
+                );
             }
             rows
         })

@@ -133,7 +133,10 @@ impl BuiltFor {
         self.count == st.count
             && self.node == st.node
             && self.cell_of.as_deref() == cells.map(|c| c.of.as_slice())
-            && self.neighbours.as_ref().map(|(o, n)| (o.as_slice(), n.as_slice()))
+            && self
+                .neighbours
+                .as_ref()
+                .map(|(o, n)| (o.as_slice(), n.as_slice()))
                 == fit.map(|f| f.lists())
             && self.dofs == *dofs
     }
@@ -419,7 +422,9 @@ impl Pattern {
                                 for k in 0..D {
                                     let Some(c) = dofs.of(b, k, D) else { continue };
                                     let column = &row_idx[col_ptr[c]..col_ptr[c + 1]];
-                                    let at = column.binary_search(&r).expect("listed entry in the pattern");
+                                    let at = column
+                                        .binary_search(&r)
+                                        .expect("listed entry in the pattern");
                                     vals[col_ptr[c] - base + at] += block[i * D + k] * cr * cc;
                                 }
                             }
