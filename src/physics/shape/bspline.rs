@@ -129,15 +129,10 @@ fn basis_in_span(xi: f64, first: usize, p: usize, cells: usize) -> AxisFactors {
 /// average applied to B-splines; the integral by two-point Gauss–Legendre per knot
 /// span, exact up to degree 3). At most p + 2 functions for b − a ≤ 1 cell.
 fn domain_basis(xi: f64, half: f64, p: usize, cells: usize) -> AxisFactors {
-    let n = cells as f64;
-    let (a, b) = ((xi - half).max(0.0), (xi + half).min(n));
-    let length = b - a;
-    if length <= 1e-12 {
+    let Some(rule) = DomainRule::new(xi, half, cells) else {
         return basis(xi, p, cells);
-    }
-    let first = cell_index(a, cells);
-    // The last span that [a, b] enters with positive length.
-    let last = ((b.ceil() as usize).max(1) - 1).clamp(first, cells - 1);
+    };
+    let (a, b, first, last) = (rule.a, rule.b, rule.first, rule.last);
     let mut f = AxisFactors {
         first,
         count: last - first + p + 1,
@@ -148,29 +143,74 @@ fn domain_basis(xi: f64, half: f64, p: usize, cells: usize) -> AxisFactors {
         f.count <= MAX_PER_AXIS,
         "particle domain wider than one cell"
     );
-    let gauss = 0.5 / 3f64.sqrt();
-    for span in first..=last {
-        let (lo, hi) = (a.max(span as f64), b.min(span as f64 + 1.0));
-        if hi <= lo {
-            continue;
-        }
-        let (mid, w) = (0.5 * (lo + hi), 0.5 * (hi - lo) / length);
-        for t in [mid - gauss * (hi - lo), mid + gauss * (hi - lo)] {
-            let g = basis(t, p, cells);
-            for r in 0..=p {
-                f.weight[g.first - first + r] += w * g.weight[r];
-            }
+    for &(t, w) in rule.points() {
+        let g = basis(t, p, cells);
+        for r in 0..=p {
+            f.weight[g.first - first + r] += w * g.weight[r];
         }
     }
     let (at_a, at_b) = (
         basis_in_span(a, first, p, cells),
         basis_in_span(b, last, p, cells),
     );
+    let length = b - a;
     for r in 0..=p {
         f.slope[at_b.first - first + r] += at_b.weight[r] / length;
         f.slope[at_a.first - first + r] -= at_a.weight[r] / length;
     }
     f
+}
+
+/// The clipped particle domain [a, b] along one axis (cell units), the knot
+/// spans it enters and their two-point Gauss–Legendre points with weights that
+/// sum to 1 (exact for polynomials of degree 3 per span).
+struct DomainRule {
+    a: f64,
+    b: f64,
+    first: usize,
+    last: usize,
+    point: [(f64, f64); 6],
+    count: usize,
+}
+
+impl DomainRule {
+    /// For a particle at `xi` with half-width `half`; `None` when the clipped
+    /// domain has no length.
+    fn new(xi: f64, half: f64, cells: usize) -> Option<Self> {
+        let (a, b) = ((xi - half).max(0.0), (xi + half).min(cells as f64));
+        let length = b - a;
+        if length <= 1e-12 {
+            return None;
+        }
+        let first = cell_index(a, cells);
+        // The last span that [a, b] enters with positive length.
+        let last = ((b.ceil() as usize).max(1) - 1).clamp(first, cells - 1);
+        let mut rule = DomainRule {
+            a,
+            b,
+            first,
+            last,
+            point: [(0.0, 0.0); 6],
+            count: 0,
+        };
+        let gauss = 0.5 / 3f64.sqrt();
+        for span in first..=last {
+            let (lo, hi) = (a.max(span as f64), b.min(span as f64 + 1.0));
+            if hi <= lo {
+                continue;
+            }
+            let (mid, w) = (0.5 * (lo + hi), 0.5 * (hi - lo) / length);
+            for t in [mid - gauss * (hi - lo), mid + gauss * (hi - lo)] {
+                rule.point[rule.count] = (t, w);
+                rule.count += 1;
+            }
+        }
+        Some(rule)
+    }
+
+    fn points(&self) -> &[(f64, f64)] {
+        &self.point[..self.count]
+    }
 }
 
 /// The domain averages of (y − x) N_I' (dimensionless) and of (y − x) N_I (per
@@ -182,28 +222,15 @@ fn domain_moments(
     p: usize,
     cells: usize,
 ) -> ([f64; MAX_PER_AXIS], [f64; MAX_PER_AXIS]) {
-    let n = cells as f64;
-    let (a, b) = ((xi - half).max(0.0), (xi + half).min(n));
     let (mut slope_moment, mut weight_moment) = ([0.0; MAX_PER_AXIS], [0.0; MAX_PER_AXIS]);
-    let length = b - a;
-    if length <= 1e-12 {
+    let Some(rule) = DomainRule::new(xi, half, cells) else {
         return (slope_moment, weight_moment);
-    }
-    let first = cell_index(a, cells);
-    let last = ((b.ceil() as usize).max(1) - 1).clamp(first, cells - 1);
-    let gauss = 0.5 / 3f64.sqrt();
-    for span in first..=last {
-        let (lo, hi) = (a.max(span as f64), b.min(span as f64 + 1.0));
-        if hi <= lo {
-            continue;
-        }
-        let (mid, w) = (0.5 * (lo + hi), 0.5 * (hi - lo) / length);
-        for t in [mid - gauss * (hi - lo), mid + gauss * (hi - lo)] {
-            let g = basis(t, p, cells);
-            for r in 0..=p {
-                slope_moment[g.first - first + r] += w * (t - xi) * g.slope[r];
-                weight_moment[g.first - first + r] += w * (t - xi) * g.weight[r];
-            }
+    };
+    for &(t, w) in rule.points() {
+        let g = basis(t, p, cells);
+        for r in 0..=p {
+            slope_moment[g.first - rule.first + r] += w * (t - xi) * g.slope[r];
+            weight_moment[g.first - rule.first + r] += w * (t - xi) * g.weight[r];
         }
     }
     (slope_moment, weight_moment)
@@ -508,36 +535,16 @@ mod tests {
 
     /// The first moments of the domain-averaged gradients about the particle
     /// (`domain_gradient_moments`) against Gauss quadrature of (y − x) ⊗ ∇N_I
-    /// with the point-sampled basis over the clipped domain (split at the knots),
+    /// with the point-sampled basis over the clipped domain (`axis_quadrature`),
     /// in the order of `evaluate_domain`.
     fn domain_gradient_moments_match_quadrature<const D: usize>() {
         let g = test_grid::<D>(2);
         let mut rng = Rng::new(6);
-        let gauss = [
-            (-0.5 * 0.6f64.sqrt(), 5.0 / 18.0),
-            (0.0, 8.0 / 18.0),
-            (0.5 * 0.6f64.sqrt(), 5.0 / 18.0),
-        ];
         for x in sample_points(&g, 120) {
             let half = Vector::<D>::from_fn(|d, _| g.h[d] * rng.range(0.01, 0.5));
             let (a, b) = ((x - half).sup(&g.min), (x + half).inf(&g.max));
-            let rules: [Vec<(f64, f64)>; D] = std::array::from_fn(|d| {
-                let mut cuts = vec![a[d]];
-                cuts.extend(
-                    (0..=g.cells[d])
-                        .map(|i| g.min[d] + i as f64 * g.h[d])
-                        .filter(|&y| y > a[d] && y < b[d]),
-                );
-                cuts.push(b[d]);
-                let mut points = Vec::new();
-                for piece in cuts.windows(2) {
-                    let (mid, len) = ((piece[0] + piece[1]) / 2.0, piece[1] - piece[0]);
-                    for (s, w) in gauss {
-                        points.push((mid + s * len, w * len / (b[d] - a[d])));
-                    }
-                }
-                points
-            });
+            let rules: [Vec<(f64, f64)>; D] =
+                std::array::from_fn(|d| axis_quadrature(&g, a[d], b[d], d));
             let mut moment = vec![Tensor::<D>::zeros(); g.node_count()];
             let total: usize = rules.iter().map(|r| r.len()).product();
             for flat in 0..total {

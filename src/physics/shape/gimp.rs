@@ -199,27 +199,6 @@ mod tests {
         sum_rules::<3>();
     }
 
-    /// Gauss points and weights (summing to 1) of the clipped domain along axis d,
-    /// split at the node lines so that the hats are linear on every piece.
-    fn axis_quadrature<const D: usize>(g: &Grid<D>, a: f64, b: f64, d: usize) -> Vec<(f64, f64)> {
-        let mut cuts = vec![a];
-        cuts.extend(
-            (0..=g.cells[d])
-                .map(|i| g.min[d] + i as f64 * g.h[d])
-                .filter(|&y| y > a && y < b),
-        );
-        cuts.push(b);
-        let gauss = 0.5 / 3f64.sqrt();
-        let mut points = Vec::new();
-        for piece in cuts.windows(2) {
-            let (mid, len) = ((piece[0] + piece[1]) / 2.0, piece[1] - piece[0]);
-            for s in [-gauss, gauss] {
-                points.push((mid + s * len, 0.5 * len / (b - a)));
-            }
-        }
-        points
-    }
-
     /// Weights, gradients and the gradients' first moments about the particle equal
     /// the domain averages of the hat functions, their gradients and (y − x) ⊗ ∇N,
     /// integrated independently by Gauss quadrature of `linear::evaluate`;
