@@ -55,6 +55,30 @@ run mc_7x3.5_h0.125 footing_mc $nc_m "${big[@]}" --set "grid.cells=[56,28]"
 run tresca_linear_h0.25  footing_tresca $nc_t --set grid.shape_function=linear
 run tresca_linear_h0.125 footing_tresca $nc_t --set grid.shape_function=linear --set "grid.cells=[40,24]"
 
+# MC=1: Mohr-Coulomb at phi = 10, 20, 30 deg, associated and psi = 0, at
+# h = B/8, B/16, B/32 (the tables "Mohr-Coulomb at 10, 20, 30 deg" of README.md;
+# about 15 minutes on 2 cores, most of it phi = 30 deg at B/32).
+if [ "${MC:-0}" = 1 ]; then
+  nc_10=8.344926  # (N_q - 1) cot 10 deg
+  nc_30=30.139628 # (N_q - 1) cot 30 deg
+  phi10=(--set material.0.friction_angle=10 --set material.0.dilation_angle=10)
+  run mc10_h0.25    footing_mc $nc_10 "${phi10[@]}" --set "grid.cells=[16,10]"
+  run mc10_h0.125   footing_mc $nc_10 "${phi10[@]}"
+  run mc10_h0.0625  footing_mc $nc_10 "${phi10[@]}" --set "grid.cells=[64,40]"
+  run mc20_h0.0625  footing_mc $nc_m --set "grid.cells=[64,40]" --set "boundary.3.velocity=[0.0,-0.006]"
+  run mc30_h0.25    footing_mc_30 $nc_30 --set "grid.cells=[40,18]"
+  run mc30_h0.125   footing_mc_30 $nc_30
+  run mc30_h0.0625  footing_mc_30 $nc_30 --set "grid.cells=[160,72]"
+  for phi in 10 20 30; do
+    case $phi in 10) scene=footing_mc; exact=$nc_10; coarse="[16,10]";;
+                 20) scene=footing_mc; exact=$nc_m;  coarse="[16,10]";;
+                 30) scene=footing_mc_30; exact=$nc_30; coarse="[40,18]";; esac
+    psi0=(--set material.0.friction_angle=$phi --set material.0.dilation_angle=0)
+    run mc${phi}_psi0_h0.25  $scene $exact "${psi0[@]}" --set "grid.cells=$coarse"
+    run mc${phi}_psi0_h0.125 $scene $exact "${psi0[@]}" || true
+  done
+fi
+
 # Limit-analysis bounds on the same geometry (docs/limit_analysis.md).
 for scene in limit_footing_tresca limit_footing_mc; do
   "$mpm" limit "problems/$scene.toml" --out "$out/$scene" | tail -1

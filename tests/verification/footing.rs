@@ -136,7 +136,71 @@ fn tresca_footing_with_linear_shapes_locks_and_fbar_cures_it() {
 /// before it drops quadratically (without line search: about 20, and a cut-back).
 #[test]
 fn mohr_coulomb_footing_reaches_prandtl() {
-    footing("footing_mc.toml", &[], 20.0, 0.05, 20);
+    footing("footing_mc.toml", &[], 20.0, 0.03, 20);
+}
+
+/// Associated Mohr–Coulomb at φ = 10°, 20° (`footing_mc.toml`) and 30°
+/// (`footing_mc_30.toml`: a 10 m × 4.5 m block, E/c = 1e5) at h = B/8 and B/16
+/// (issue 16 item 4). The error is the footing's edge: the prescribed control
+/// points end at the Greville abscissa B/2 − h/2, the surface is rigid up to
+/// B/2 − h only, and the load over the nominal B/2 is low by O(h/B), more so
+/// the larger φ. Measured N_c: 8.151, 8.267 (−2.3 %, −0.93 %); 13.989, 14.412
+/// (−5.7 %, −2.85 %); 27.522, 28.862 (−8.7 %, −4.2 %); error ratios 2.4, 2.0,
+/// 2.05 (first order); the first-order Richardson extrapolation
+/// 2 N_c(B/16) − N_c(B/8) = 8.384, 14.835, 30.201 (+0.46 %, +0.00 %, +0.20 %).
+/// At B/32 (papers/footing_prandtl): −0.33 %, −1.6 %.
+#[test]
+fn mohr_coulomb_footings_converge_to_prandtl_at_first_order() {
+    let cases: [(f64, &str, Vec<&str>); 3] = [
+        (
+            10.0,
+            "footing_mc.toml",
+            vec![
+                "material.0.friction_angle=10",
+                "material.0.dilation_angle=10",
+            ],
+        ),
+        (20.0, "footing_mc.toml", vec![]),
+        (30.0, "footing_mc_30.toml", vec![]),
+    ];
+    for (phi, scene, keys) in cases {
+        let exact = prandtl_nc(phi);
+        let nc = |fine: bool| {
+            let mut overrides = keys.clone();
+            if !fine {
+                overrides.push(match phi {
+                    30.0 => "grid.cells=[40,18]",
+                    _ => "grid.cells=[16,10]",
+                });
+            }
+            exact * (1.0 + footing(scene, &overrides, phi, 0.1, 60))
+        };
+        let (coarse, fine) = (nc(false), nc(true));
+        let (e_coarse, e_fine) = ((coarse - exact) / exact, (fine - exact) / exact);
+        let extrapolated = 2.0 * fine - coarse;
+        let e_extrapolated = (extrapolated - exact) / exact;
+        eprintln!(
+            "φ = {phi}°: N_c {coarse:.4} ({:+.2} %), {fine:.4} ({:+.2} %), ratio {:.2}; \
+             Richardson {extrapolated:.4} ({:+.2} %); Prandtl {exact:.4}",
+            100.0 * e_coarse,
+            100.0 * e_fine,
+            e_coarse / e_fine,
+            100.0 * e_extrapolated
+        );
+        let tolerance = if phi < 25.0 { 0.03 } else { 0.05 };
+        assert!(
+            e_fine.abs() < tolerance,
+            "φ = {phi}°: N_c at B/16 off by {e_fine:+.3e}"
+        );
+        assert!(
+            e_coarse < 0.0 && (1.7..2.6).contains(&(e_coarse / e_fine)),
+            "φ = {phi}°: first order from below, errors {e_coarse:+.3e}, {e_fine:+.3e}"
+        );
+        assert!(
+            e_extrapolated.abs() < 0.01,
+            "φ = {phi}°: extrapolated N_c off by {e_extrapolated:+.3e}"
+        );
+    }
 }
 
 /// A footing scene whose `[[boundary]]` table of the footing is replaced by `footing`.
