@@ -15,12 +15,17 @@ fn column(shape: &str, solver: &str) -> String {
     .replace("load_steps = 20\n", &format!("load_steps = 20\n{solver}"))
 }
 
-/// The error names `grid.domain_stress` at its line, and holds `part`.
+/// The error names `grid.domain_stress` at its line (column 17, the value),
+/// and holds `part`.
 fn rejected(text: &str, part: &str) {
     let e = Scene::parse("column.toml", text, &[]).expect_err("must be rejected");
     assert_eq!(e.key.as_deref(), Some("grid.domain_stress"), "{e}");
     let s = e.to_string();
-    for part in ["column.toml:20:17:", part] {
+    let line = 1 + text
+        .lines()
+        .position(|l| l.starts_with("domain_stress"))
+        .unwrap();
+    for part in [format!("column.toml:{line}:17:").as_str(), part] {
         assert!(s.contains(part), "`{part}` not in: {s}");
     }
 }

@@ -213,7 +213,7 @@ fn value_at(doc: &DocumentMut, path: &[Seg]) -> Option<Value> {
 fn scaled(v: Option<&Value>, rng: &mut Rng) -> String {
     let factor = *rng.pick(&[1e-3, 0.1, 0.5, 2.0, 10.0, 1e3]);
     let scale = |v: &Value| match v {
-        Value::Float(x) => Some(format!("{:e}", x.value() * factor)),
+        Value::Float(x) => Some(toml_float(x.value() * factor)),
         Value::Integer(n) => Some(((*n.value() as f64 * factor).round() as i64).to_string()),
         _ => None,
     };
@@ -226,6 +226,16 @@ fn scaled(v: Option<&Value>, rng: &mut Rng) -> String {
         None => None,
     }
     .unwrap_or_else(|| rng.pick(VALUES).to_string())
+}
+
+/// A float as TOML writes it (`nan`, `inf`, `-inf` for the non-finite ones: an
+/// earlier mutation may have left one to be scaled).
+fn toml_float(x: f64) -> String {
+    match x {
+        x if x.is_nan() => "nan".into(),
+        x if x.is_infinite() => if x > 0.0 { "inf" } else { "-inf" }.into(),
+        x => format!("{x:e}"),
+    }
 }
 
 /// An extreme value of the same type as `v` (numbers, arrays of numbers).
