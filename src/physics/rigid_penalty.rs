@@ -29,7 +29,10 @@
 //!   slip: ∂f_t/∂x = μ ε_n ĥ ∂g/∂x + (μ ε_n g/|h|) (I − ĥ ĥᵀ) ∂h/∂x,  ĥ = h/|h|.
 //!
 //! The stick derivative is symmetric on plane faces; a curved face or slip makes
-//! it unsymmetric.
+//! it unsymmetric. A slipping particle dissipates the tangential force times the
+//! plastic part of its trial displacement, (|h| − μ ε_n g)/ε_t (the elastic part
+//! is stored in the tangential penalty and given back), the force taken as the
+//! mean of the step's start and end (trapezoidal: second order in the step).
 
 use crate::dim::{Tensor, Vector};
 use crate::physics::rigid_surface::Inside;
@@ -57,6 +60,9 @@ pub struct ParticleContact<const D: usize> {
     /// Tangential force (part of `force`).
     pub tangential: Vector<D>,
     pub slips: bool,
+    /// The work friction dissipated over the step: the slip (|h| − μ ε_n g)/ε_t
+    /// times the mean of |f_t⁰| and |f_t| (trapezoidal; zero when it sticks).
+    pub dissipation: f64,
 }
 
 /// The penalty force on a particle that reaches into a body (`inside`: nearest
@@ -81,6 +87,7 @@ pub fn penalty_force<const D: usize>(
             depth: g,
             tangential: Vector::<D>::zeros(),
             slips: false,
+            dissipation: 0.0,
         };
     }
     let p = id - n * n.transpose();
@@ -93,6 +100,7 @@ pub fn penalty_force<const D: usize>(
     let (tangential, d_t, slips) = if h_norm <= cap {
         (h, dh, false)
     } else {
+        // The plastic part of the trial: the slip of the step.
         let t = h / h_norm;
         let d_t = (t * dg.transpose()) * (law.friction * law.normal)
             + (id - t * t.transpose()) * dh * (cap / h_norm);
@@ -104,6 +112,10 @@ pub fn penalty_force<const D: usize>(
         depth: g,
         tangential,
         slips,
+        dissipation: match slips {
+            true => 0.5 * (f_t0.norm() + cap) * (h_norm - cap) / law.tangential,
+            false => 0.0,
+        },
     }
 }
 

@@ -209,7 +209,13 @@ fn mohr_coulomb_footings_converge_to_prandtl_at_first_order() {
 #[test]
 #[ignore]
 fn mohr_coulomb_30_footing_reaches_prandtl_within_3_percent_at_b_over_32() {
-    footing("footing_mc_30.toml", &["grid.cells=[160,72]"], 30.0, 0.03, 60);
+    footing(
+        "footing_mc_30.toml",
+        &["grid.cells=[160,72]"],
+        30.0,
+        0.03,
+        60,
+    );
 }
 
 /// A footing scene whose `[[boundary]]` table of the footing is replaced by `footing`.

@@ -255,6 +255,7 @@ impl<const D: usize> RigidContact<D> {
             let total = &mut self.totals[i];
             total.impulse += t.contact.force * (sign * dt);
             total.nodes += 1;
+            total.dissipation += t.contact.dissipation;
         }
         for q in 0..p.len() {
             if self.is_rigid(q) {
@@ -291,6 +292,7 @@ impl<const D: usize> RigidContact<D> {
         let out = self.totals.clone();
         for t in &mut self.totals {
             t.impulse = Vector::<D>::zeros();
+            t.dissipation = 0.0;
         }
         out
     }
