@@ -3,7 +3,8 @@
 //! The column names are a contract with users' post-processing scripts:
 //! `id,body,X0,Y0[,Z0],x,y[,z],vx,vy[,vz],sxx,syy,szz,sxy[,syz,sxz],volume0,volume,mass`,
 //! followed by extra columns only where the run has them (`eps_p`, the equivalent
-//! plastic strain, when a material has one).
+//! plastic strain, when a material has one; `contact_fx,contact_fy[,contact_fz]`,
+//! each particle's contact force, after an implicit stage with rigid contact).
 
 use std::io;
 use std::path::Path;

@@ -14,6 +14,7 @@ pub mod interrupt;
 pub mod recorders;
 pub mod summary;
 
+use crate::dim::Vector;
 pub use energy::{kinetic_energy, strain_energy};
 
 use crate::model::memory::{self, Estimate};
@@ -415,6 +416,8 @@ fn run_dim<const D: usize>(
     let first_stage = ck.map_or(0, |c| c.stage);
     let mut stages = ck.map_or_else(Vec::new, |c| c.stages_done.clone());
     let mut last: Option<(SolverReport, f64, usize)> = None;
+    // The last stage's per-particle contact forces (implicit contact only).
+    let mut contact_forces: Option<Vec<Vector<D>>> = None;
     // An output that cannot be written ends the run as failed.
     let mut failure: Option<std::io::Error> = None;
     for (k, sc) in cfg.stages().into_iter().enumerate().skip(first_stage) {
@@ -475,6 +478,7 @@ fn run_dim<const D: usize>(
             strength_reduction_factor: sc.strength_reduction_factor.map(|_| strength_factor),
         });
         last = Some((report, dt, stepper.active_nodes()));
+        contact_forces = stepper.contact_forces(model.particles.len());
         if line.interrupted.is_some() {
             break;
         }
@@ -546,8 +550,19 @@ fn run_dim<const D: usize>(
         .state(&line.moment(&model), true)
         .and_then(|()| {
             let eps_p = model.plastic_strain();
-            let extra: Vec<(&str, &[f64])> =
+            let mut extra: Vec<(&str, &[f64])> =
                 eps_p.iter().map(|e| ("eps_p", e.as_slice())).collect();
+            // Implicit contact with rigid bodies: each particle's contact force.
+            let components: Vec<Vec<f64>> = (contact_forces.iter())
+                .flat_map(|f| (0..D).map(move |d| f.iter().map(|v| v[d]).collect()))
+                .collect();
+            let names = ["contact_fx", "contact_fy", "contact_fz"];
+            extra.extend(
+                names
+                    .iter()
+                    .zip(&components)
+                    .map(|(n, c)| (*n, c.as_slice())),
+            );
             write_particles_csv_with(&out.join("particles_final.csv"), &model.particles, &extra)
         });
     if let Err(e) = finish {

@@ -66,6 +66,14 @@ pub trait Stepper<const D: usize> {
         Vec::new()
     }
 
+    /// The contact force on every particle at the last converged step
+    /// (implicit contact with rigid bodies, `particles_final.csv`'s
+    /// `contact_f*` columns); `None` for a solver without per-particle contact
+    /// forces.
+    fn contact_forces(&self, _particles: usize) -> Option<Vec<Vector<D>>> {
+        None
+    }
+
     /// The state carried across steps, for a checkpoint.
     fn state(&self) -> SolverState {
         SolverState::default()

@@ -1357,5 +1357,26 @@ fn implicit_friction_dissipation_closes_the_energy_balance() {
             dissipation.windows(2).all(|d| d[1] >= d[0]),
             "dissipation never decreases"
         );
+        // Each particle's contact force (particles_final.csv) sums to the pair's.
+        let p = Table::read(&dir.path().join("particles_final.csv")).unwrap();
+        let (cx, cy, body) = (p.col("contact_fx"), p.col("contact_fy"), p.col("body"));
+        let (sx, sy): (f64, f64) = (cx.iter().sum(), cy.iter().sum());
+        let touching = cy.iter().filter(|f| **f != 0.0).count();
+        let on_plate = (0..body.len())
+            .filter(|&i| body[i] == 1.0 && cy[i] != 0.0)
+            .count();
+        println!("   particle forces sum to ({sx:.3}, {sy:.3}) N over {touching} particles");
+        assert!(
+            (sx / fx.last().unwrap() - 1.0).abs() < 1e-9,
+            "Σ contact_fx {sx}"
+        );
+        assert!(
+            (sy / fy.last().unwrap() - 1.0).abs() < 1e-9,
+            "Σ contact_fy {sy}"
+        );
+        assert!(
+            touching > 0 && on_plate == 0,
+            "{touching} particles, {on_plate} on the plate"
+        );
     }
 }

@@ -282,6 +282,16 @@ impl<const D: usize> RigidContact<D> {
         }
     }
 
+    /// The contact force on each of `n` particles at the last residual (zero
+    /// for particles out of contact and for the rigid bodies' own).
+    pub fn particle_forces(&self, n: usize) -> Vec<Vector<D>> {
+        let mut f = vec![Vector::<D>::zeros(); n];
+        for t in &self.touches {
+            f[t.particle] += t.contact.force;
+        }
+        f
+    }
+
     /// The deepest penetration at the last residual.
     pub fn max_penetration(&self) -> f64 {
         (self.touches.iter()).fold(0.0, |g, t| g.max(t.contact.depth))

@@ -198,6 +198,10 @@ impl<const D: usize> Stepper<D> for Implicit<D> {
         (self.system.contact.as_mut()).map_or_else(Vec::new, |c| c.take_totals())
     }
 
+    fn contact_forces(&self, particles: usize) -> Option<Vec<Vector<D>>> {
+        (self.system.contact.as_ref()).map(|c| c.particle_forces(particles))
+    }
+
     fn take_newton_rows(&mut self) -> Vec<NewtonRow> {
         std::mem::take(&mut self.newton.log)
     }
