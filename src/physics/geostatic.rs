@@ -16,6 +16,8 @@
 //! given, before any strength reduction).
 
 use crate::dim::Mat3;
+use crate::material::parameters::FromParameters;
+use crate::material::rigid::Rigid;
 use crate::model::Model;
 use crate::scene::GeostaticConfig;
 
@@ -31,6 +33,10 @@ pub fn initialise<const D: usize>(model: &mut Model<D>, g: &GeostaticConfig) {
     let p = &mut model.particles;
     for q in 0..p.len() {
         let m = p.material[q] as usize;
+        // A rigid body carries no stress.
+        if model.base_materials[m].model() == Rigid::NAME {
+            continue;
+        }
         let k0 = g.k0.unwrap_or_else(|| {
             let phi = model.base_materials[m]
                 .frictional_strength()

@@ -261,3 +261,28 @@ fn bad_strength_reduction_and_geostatic_keys_are_named() {
         "{e}"
     );
 }
+
+/// Strength reduction with implicit contact (issue 14 item 5): the slope held
+/// at its back by a smooth rigid wall (`slope_griffiths_lane_wall.toml`,
+/// frictionless penalty contact with a rigid body at rest) instead of the
+/// roller on the grid face. A smooth wall is a roller: the same bracket of the
+/// factor of safety (measured 1.4062 stable, 1.4125 failed on the coarse grid;
+/// 1.3625, 1.3687 on the shipped one). The wall takes no K0 state.
+#[test]
+fn a_slope_against_a_smooth_rigid_wall_has_the_factor_of_safety_of_the_roller() {
+    let (roller, _) = search_problem("slope_griffiths_lane.toml", &["grid.cells=[40,12]"]);
+    let (wall, dir) = search_problem("slope_griffiths_lane_wall.toml", &["grid.cells=[41,12]"]);
+    let (roller, wall) = (roller.unwrap(), wall.unwrap());
+    let (b_roller, b_wall) = (
+        roller.factor_of_safety_bracket.unwrap(),
+        wall.factor_of_safety_bracket.unwrap(),
+    );
+    eprintln!("factor of safety: roller {b_roller:?}, smooth rigid wall {b_wall:?}");
+    assert_eq!(b_roller, b_wall, "the same bracket");
+    // The wall pushed back: its contact force on the slope is along +x.
+    let stable = dir.path().join(wall.mechanism_stable.as_ref().unwrap());
+    let c = Table::read(&stable.join("contact.csv")).unwrap();
+    let fx = *c.col("fx").last().unwrap();
+    eprintln!("the wall's force on the slope in the last stable trial: fx = {fx:.1} kN/m");
+    assert!(fx > 0.0, "the wall holds the slope: fx = {fx}");
+}
