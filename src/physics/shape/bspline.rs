@@ -543,19 +543,8 @@ mod tests {
         for x in sample_points(&g, 120) {
             let half = Vector::<D>::from_fn(|d, _| g.h[d] * rng.range(0.01, 0.5));
             let (a, b) = ((x - half).sup(&g.min), (x + half).inf(&g.max));
-            let rules: [Vec<(f64, f64)>; D] =
-                std::array::from_fn(|d| axis_quadrature(&g, a[d], b[d], d));
             let mut moment = vec![Tensor::<D>::zeros(); g.node_count()];
-            let total: usize = rules.iter().map(|r| r.len()).product();
-            for flat in 0..total {
-                let mut rest = flat;
-                let (mut y, mut q) = (Vector::<D>::zeros(), 1.0);
-                for d in 0..D {
-                    let (yd, qd) = rules[d][rest % rules[d].len()];
-                    rest /= rules[d].len();
-                    y[d] = yd;
-                    q *= qd;
-                }
+            for (y, q) in box_quadrature(&g, &a, &b) {
                 let point = eval(&g, &y, 2);
                 for k in 0..point.len() {
                     moment[point.node[k] as usize] += (y - x) * point.grad[k].transpose() * q;

@@ -209,21 +209,10 @@ mod tests {
         for x in sample_points(&g, 150) {
             let half = random_half(&g, &mut rng);
             let (a, b) = clipped(&g, &x, &half);
-            let rules: [Vec<(f64, f64)>; D] =
-                std::array::from_fn(|d| axis_quadrature(&g, a[d], b[d], d));
             let mut w = vec![0.0; g.node_count()];
             let mut grad = vec![Vector::<D>::zeros(); g.node_count()];
             let mut moment = vec![Tensor::<D>::zeros(); g.node_count()];
-            let total: usize = rules.iter().map(|r| r.len()).product();
-            for flat in 0..total {
-                let mut rest = flat;
-                let (mut y, mut q) = (Vector::<D>::zeros(), 1.0);
-                for d in 0..D {
-                    let (yd, qd) = rules[d][rest % rules[d].len()];
-                    rest /= rules[d].len();
-                    y[d] = yd;
-                    q *= qd;
-                }
+            for (y, q) in box_quadrature(&g, &a, &b) {
                 let hats = Stencil::collect(1 << D, |n, w, gr| linear::evaluate(&g, &y, n, w, gr));
                 for k in 0..hats.len() {
                     w[hats.node[k] as usize] += q * hats.w[k];

@@ -311,6 +311,31 @@ pub(crate) mod tests {
         points
     }
 
+    /// Gauss points and weights (summing to 1) of the box [a, b]: the tensor
+    /// product of `axis_quadrature` along every axis.
+    pub(crate) fn box_quadrature<const D: usize>(
+        g: &Grid<D>,
+        a: &Vector<D>,
+        b: &Vector<D>,
+    ) -> Vec<(Vector<D>, f64)> {
+        let rules: [Vec<(f64, f64)>; D] =
+            std::array::from_fn(|d| axis_quadrature(g, a[d], b[d], d));
+        let total: usize = rules.iter().map(|r| r.len()).product();
+        (0..total)
+            .map(|flat| {
+                let mut rest = flat;
+                let (mut y, mut q) = (Vector::<D>::zeros(), 1.0);
+                for d in 0..D {
+                    let (yd, qd) = rules[d][rest % rules[d].len()];
+                    rest /= rules[d].len();
+                    y[d] = yd;
+                    q *= qd;
+                }
+                (y, q)
+            })
+            .collect()
+    }
+
     /// Is `t` within `tol` of an integer?
     pub(crate) fn near_integer(t: f64, tol: f64) -> bool {
         (t - t.round()).abs() < tol
