@@ -36,14 +36,14 @@ fn hat_integral(t: f64) -> f64 {
     }
 }
 
-/// Averages of the hats along axis `d` over the clipped domain (in cell units).
-fn domain_factors<const D: usize>(
+/// The particle's cell coordinate xi along axis `d` and its domain [a, b]
+/// clipped to the grid (cell units).
+fn clipped_domain<const D: usize>(
     grid: &Grid<D>,
     x: &Vector<D>,
     half: &Vector<D>,
     d: usize,
-) -> AxisFactors {
-    let cells = grid.cells[d];
+) -> (f64, f64, f64) {
     let reach = half[d] / grid.h[d];
     assert!(
         reach > 0.0 && 2.0 * reach <= 1.0 + 1e-12,
@@ -52,7 +52,22 @@ fn domain_factors<const D: usize>(
         grid.h[d]
     );
     let xi = cell_coordinate(grid, x, d);
-    let (a, b) = ((xi - reach).max(0.0), (xi + reach).min(cells as f64));
+    (
+        xi,
+        (xi - reach).max(0.0),
+        (xi + reach).min(grid.cells[d] as f64),
+    )
+}
+
+/// Averages of the hats along axis `d` over the clipped domain (in cell units).
+fn domain_factors<const D: usize>(
+    grid: &Grid<D>,
+    x: &Vector<D>,
+    half: &Vector<D>,
+    d: usize,
+) -> AxisFactors {
+    let cells = grid.cells[d];
+    let (_, a, b) = clipped_domain(grid, x, half, d);
     let first = cell_index(a, cells);
     let mut f = AxisFactors {
         first,
@@ -105,10 +120,7 @@ fn moment_factors<const D: usize>(
     d: usize,
 ) -> MomentFactors {
     let f = domain_factors(grid, x, half, d);
-    let cells = grid.cells[d];
-    let reach = half[d] / grid.h[d];
-    let xi = cell_coordinate(grid, x, d);
-    let (a, b) = ((xi - reach).max(0.0), (xi + reach).min(cells as f64));
+    let (xi, a, b) = clipped_domain(grid, x, half, d);
     let (mut slope_moment, mut weight_moment) = ([0.0; MAX_PER_AXIS], [0.0; MAX_PER_AXIS]);
     for k in 0..f.count {
         let node = (f.first + k) as f64;

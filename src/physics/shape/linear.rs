@@ -63,24 +63,14 @@ pub(super) fn tensor_product<const D: usize>(
     for d in 1..D {
         stride[d] = stride[d - 1] * grid.nodes[d - 1];
     }
-    if axes.iter().any(|a| a.count == 0) {
+    let count: [usize; D] = std::array::from_fn(|d| axes[d].count);
+    if count.contains(&0) {
         return 0;
     }
     let mut local = [0usize; D];
     let mut n = 0;
     loop {
-        let weight: f64 = (0..D).map(|d| axes[d].weight[local[d]]).product();
-        let gradient = Vector::<D>::from_fn(|d, _| {
-            (0..D)
-                .map(|e| {
-                    if e == d {
-                        axes[e].slope[local[e]]
-                    } else {
-                        axes[e].weight[local[e]]
-                    }
-                })
-                .product()
-        });
+        let (weight, gradient) = weight_and_gradient(axes, &local);
         if weight != 0.0 || gradient.iter().any(|g| *g != 0.0) {
             let index: usize = (0..D).map(|d| (axes[d].first + local[d]) * stride[d]).sum();
             node[n] = index as u32;
@@ -88,20 +78,43 @@ pub(super) fn tensor_product<const D: usize>(
             grad[n] = gradient;
             n += 1;
         }
-        // Next local multi-index, x fastest.
-        let mut d = 0;
-        loop {
-            local[d] += 1;
-            if local[d] < axes[d].count {
-                break;
-            }
-            local[d] = 0;
-            d += 1;
-            if d == D {
-                return n;
-            }
+        if !next_local(&mut local, &count) {
+            return n;
         }
     }
+}
+
+/// S_I = Π_d S_d and ∂S_I/∂x_d = S'_d Π_{e≠d} S_e at the local multi-index `local`.
+fn weight_and_gradient<const D: usize>(
+    axes: &[AxisFactors; D],
+    local: &[usize; D],
+) -> (f64, Vector<D>) {
+    let weight: f64 = (0..D).map(|d| axes[d].weight[local[d]]).product();
+    let gradient = Vector::<D>::from_fn(|d, _| {
+        (0..D)
+            .map(|e| {
+                if e == d {
+                    axes[e].slope[local[e]]
+                } else {
+                    axes[e].weight[local[e]]
+                }
+            })
+            .product()
+    });
+    (weight, gradient)
+}
+
+/// Advances `local` to the next multi-index below `count`, x fastest; false
+/// after the last.
+fn next_local<const D: usize>(local: &mut [usize; D], count: &[usize; D]) -> bool {
+    for d in 0..D {
+        local[d] += 1;
+        if local[d] < count[d] {
+            return true;
+        }
+        local[d] = 0;
+    }
+    false
 }
 
 /// Per-axis factors with the domain averages of (y − x) N' (dimensionless) and
@@ -116,33 +129,22 @@ pub(super) fn moment_product<const D: usize>(
     axes: &[MomentFactors; D],
     out: &mut [Tensor<D>],
 ) -> usize {
-    if axes.iter().any(|a| a.0.count == 0) {
+    let factors: [AxisFactors; D] = std::array::from_fn(|d| axes[d].0);
+    let count: [usize; D] = std::array::from_fn(|d| factors[d].count);
+    if count.contains(&0) {
         return 0;
     }
     let mut local = [0usize; D];
     let mut n = 0;
     loop {
-        let (f, slope_moment, weight_moment) = (
-            |e: usize| &axes[e].0,
-            |e: usize| axes[e].1[local[e]],
-            |e: usize| axes[e].2[local[e]],
-        );
-        let weight: f64 = (0..D).map(|e| f(e).weight[local[e]]).product();
-        let gradient_is_zero = (0..D).all(|d| {
-            (0..D)
-                .map(|e| match e == d {
-                    true => f(e).slope[local[e]],
-                    false => f(e).weight[local[e]],
-                })
-                .product::<f64>()
-                == 0.0
-        });
-        if weight != 0.0 || !gradient_is_zero {
+        let (weight, gradient) = weight_and_gradient(&factors, &local);
+        if weight != 0.0 || gradient.iter().any(|g| *g != 0.0) {
+            let f = |e: usize| &factors[e];
             out[n] = Tensor::<D>::from_fn(|k, j| {
                 (0..D)
                     .map(|e| match (e == k, e == j) {
-                        (true, true) => slope_moment(e),
-                        (true, false) => weight_moment(e),
+                        (true, true) => axes[e].1[local[e]],
+                        (true, false) => axes[e].2[local[e]],
                         (false, true) => f(e).slope[local[e]],
                         (false, false) => f(e).weight[local[e]],
                     })
@@ -150,17 +152,8 @@ pub(super) fn moment_product<const D: usize>(
             });
             n += 1;
         }
-        let mut d = 0;
-        loop {
-            local[d] += 1;
-            if local[d] < axes[d].0.count {
-                break;
-            }
-            local[d] = 0;
-            d += 1;
-            if d == D {
-                return n;
-            }
+        if !next_local(&mut local, &count) {
+            return n;
         }
     }
 }

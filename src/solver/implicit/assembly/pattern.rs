@@ -400,7 +400,7 @@ impl Pattern {
         rows: impl Fn(usize, usize, &mut Vec<(usize, [f64; 9])>) + Sync,
     ) {
         assert_eq!(storage, Storage::Full, "listed terms need the whole matrix");
-        let (col_ptr, row_idx) = (csc.col_ptr(), csc.row_idx());
+        let col_ptr = csc.col_ptr();
         self.per_node(col_ptr, values)
             .into_par_iter()
             .enumerate()
@@ -411,21 +411,18 @@ impl Pattern {
                     return;
                 }
                 let base = col_ptr[cols.start];
+                let col_of: [Option<usize>; D] = std::array::from_fn(|k| dofs.of(b, k, D));
                 for (e2, cc) in sources(self.tied_sources.as_ref(), map, b) {
-                    let q = e2 as usize / st.stride;
                     out.clear();
-                    rows(q, e2 as usize, out);
+                    rows(e2 as usize / st.stride, e2 as usize, out);
                     for (n1, block) in out.iter() {
                         for (a, cr) in dofs.owners(*n1) {
                             for i in 0..D {
                                 let Some(r) = dofs.of(a, i, D) else { continue };
-                                for k in 0..D {
-                                    let Some(c) = dofs.of(b, k, D) else { continue };
-                                    let column = &row_idx[col_ptr[c]..col_ptr[c + 1]];
-                                    let at = column
-                                        .binary_search(&r)
-                                        .expect("listed entry in the pattern");
-                                    vals[col_ptr[c] - base + at] += block[i * D + k] * cr * cc;
+                                for (k, c) in col_of.iter().enumerate() {
+                                    let Some(c) = *c else { continue };
+                                    let at = slot(csc, r, c).expect("listed entry in the pattern");
+                                    vals[at - base] += block[i * D + k] * cr * cc;
                                 }
                             }
                         }
