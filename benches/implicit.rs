@@ -138,7 +138,7 @@ impl<const D: usize> Problem<D> {
     fn pattern(&self) -> Pattern {
         let s = &self.sys;
         let cells = s.trial.fbar.as_ref().map(|f| &f.cells);
-        let p = Pattern::new(&s.map, &s.stencils, &s.dofs, cells, None);
+        let p = Pattern::new(&s.map, &s.stencils, &s.dofs, cells, None, &[]);
         p.csc(Storage::Lower);
         p
     }

@@ -37,38 +37,13 @@
 use crate::dim::Vector;
 use crate::model::Model;
 use crate::parallel::MIN_PARALLEL_LEN;
+use crate::physics::field_split::{FieldSplit, Meeting};
 use crate::physics::rigid_body::FreeBodies;
 use crate::physics::rigid_surface::{on_grid_boundary, rigid_surfaces, Push, Surface};
 use crate::physics::shape::{ShapeFunction, Stencils};
 use crate::physics::transfer::NodeMap;
-use crate::scene::contact::{ContactLaw, ContactPlan};
-use crate::scene::ContactNormal;
+use crate::scene::contact::ContactPlan;
 use rayon::prelude::*;
-use std::sync::atomic::AtomicU64;
-use std::sync::atomic::Ordering::Relaxed;
-
-/// Two fields meeting at a node in this step.
-#[derive(Clone, Copy, Debug)]
-struct Meeting<const D: usize> {
-    /// Active indices of the two split nodes (field r < field s).
-    r: usize,
-    s: usize,
-    /// Index of the field pair in `Contact::totals`.
-    pair: usize,
-    /// The fields r < s.
-    fields: [usize; 2],
-    /// The grid node's position.
-    position: Vector<D>,
-    /// Common normal, from r to s.
-    normal: Vector<D>,
-    /// Whether r and s are rigid bodies.
-    rigid: [bool; 2],
-    /// Nodal contact area (length per unit thickness in 2D).
-    area: f64,
-    /// The gap criterion holds.
-    close: bool,
-    law: ContactLaw,
-}
 
 /// What the contact of one field pair did since the totals were last taken.
 #[derive(Clone, Debug, PartialEq)]
@@ -117,8 +92,8 @@ pub struct Contact<const D: usize> {
     plan: ContactPlan,
     /// Field of each particle.
     field: Vec<u32>,
-    /// Grid node and field of each split node of this step, ascending.
-    split: Vec<(u32, u32)>,
+    /// The split of the shared nodes (`physics::field_split`).
+    fields: FieldSplit,
     meetings: Vec<Meeting<D>>,
     /// Active nodes of rigid fields this step, with the rigid body's velocity.
     rigid_nodes: Vec<(usize, Vector<D>)>,
@@ -128,10 +103,6 @@ pub struct Contact<const D: usize> {
     /// The rigid fields that keep deformable particles out
     /// (`physics::rigid_surface`).
     surfaces: Vec<Surface>,
-    /// Scratch of `split_shared_nodes`, one entry per grid node: the fields that
-    /// touch it (bit f for field f) and, at a shared node, its first split id.
-    fields_at: Vec<AtomicU64>,
-    offset: Vec<u32>,
 }
 
 impl<const D: usize> Contact<D> {
@@ -148,171 +119,11 @@ impl<const D: usize> Contact<D> {
             free: FreeBodies::new(&plan.free, &field),
             surfaces: surfaces(&plan, m, &field),
             plan,
+            fields: FieldSplit::new(field.clone()),
             field,
-            split: Vec::new(),
             meetings: Vec::new(),
             rigid_nodes: Vec::new(),
             totals,
-            fields_at: Vec::new(),
-            offset: Vec::new(),
-        }
-    }
-
-    /// Give every field its own node at each grid node that several fields touch:
-    /// renumber those stencil entries to split ids (n_grid + k) and return the grid
-    /// node of each split id. A bit mask of the fields at each grid node finds the
-    /// shared nodes; the split ids follow grid node and field order, so they are
-    /// the same for any order of the particles and any number of threads.
-    fn split_shared_nodes(&mut self, st: &mut Stencils<D>, n_grid: usize) -> Vec<u32> {
-        if self.fields_at.len() != n_grid {
-            self.fields_at = (0..n_grid).map(|_| AtomicU64::new(0)).collect();
-            self.offset = vec![0; n_grid];
-        }
-        let (mask, field) = (&self.fields_at, &self.field);
-        let n_particles = st.count.len();
-        (0..n_particles)
-            .into_par_iter()
-            .with_min_len(MIN_PARALLEL_LEN)
-            .for_each(|p| {
-                let bit = 1u64 << field[p];
-                for e in st.range(p) {
-                    let m = &mask[st.node[e] as usize];
-                    if m.load(Relaxed) & bit == 0 {
-                        m.fetch_or(bit, Relaxed);
-                    }
-                }
-            });
-        let several = |m: u64| m & m.wrapping_sub(1) != 0;
-        let shared: Vec<u32> = (0..n_grid as u32)
-            .into_par_iter()
-            .with_min_len(MIN_PARALLEL_LEN)
-            .filter(|&g| several(mask[g as usize].load(Relaxed)))
-            .collect();
-        self.split.clear();
-        for &g in &shared {
-            self.offset[g as usize] = self.split.len() as u32;
-            let mut m = mask[g as usize].load(Relaxed);
-            while m != 0 {
-                self.split.push((g, m.trailing_zeros()));
-                m &= m - 1;
-            }
-        }
-        let (stride, count, offset) = (st.stride, &st.count, &self.offset);
-        st.node
-            .par_chunks_mut(stride)
-            .zip(count.par_iter())
-            .enumerate()
-            .with_min_len(MIN_PARALLEL_LEN)
-            .for_each(|(p, (nodes, &n))| {
-                let below = (1u64 << field[p]) - 1;
-                for g in &mut nodes[..n as usize] {
-                    let m = mask[*g as usize].load(Relaxed);
-                    if several(m) {
-                        let k = offset[*g as usize] + (m & below).count_ones();
-                        *g = (n_grid as u32) + k;
-                    }
-                }
-            });
-        // Clear the masks for the next step.
-        mask.par_iter()
-            .with_min_len(MIN_PARALLEL_LEN)
-            .for_each(|m| m.store(0, Relaxed));
-        self.split.iter().map(|&(g, _)| g).collect()
-    }
-
-    /// The meetings of this step: at every split grid node, each pair of fields
-    /// with its normal, area and gap criterion, from the step-start particles.
-    fn prepare(&mut self, m: &Model<D>, st: &Stencils<D>, map: &NodeMap) {
-        self.meetings.clear();
-        let first_split = map.len() - self.split.len();
-        let p = &m.particles;
-        let owner = st.owner();
-        // Volume gradient of each split node, Σ_p V_p ∇S_Ip. In axisymmetric mode
-        // the r–z area A_p = V_p/r_p weighs it: Σ_p r_p A_p ∇S_Ip would be the
-        // gradient of r × the body's indicator, tilted towards the axis by about
-        // h/r at a flat face.
-        let axisymmetric = m.axisymmetric;
-        let weight = |q: usize| match axisymmetric {
-            true => p.volume[q] / p.x[q][0],
-            false => p.volume[q],
-        };
-        let gradient: Vec<Vector<D>> = (first_split..map.len())
-            .into_par_iter()
-            .map(|a| {
-                map.node_entries(a)
-                    .iter()
-                    .fold(Vector::<D>::zeros(), |acc, &e| {
-                        acc + st.grad[e as usize] * weight(owner.of(e))
-                    })
-            })
-            .collect();
-        // Farthest extent of a field's particles along a direction, from node a.
-        let extent = |a: usize, x_node: &Vector<D>, n: &Vector<D>| -> f64 {
-            map.node_entries(a)
-                .iter()
-                .map(|&e| {
-                    let q = owner.of(e);
-                    let f = &p.f[q];
-                    let reach: f64 = (0..D)
-                        .map(|d| {
-                            let column = Vector::<D>::from_fn(|i, _| f[(i, d)]);
-                            p.half_length0[q][d] * n.dot(&column).abs()
-                        })
-                        .sum();
-                    (p.x[q] - x_node).dot(n) + reach
-                })
-                .fold(f64::NEG_INFINITY, f64::max)
-        };
-        let unit = |v: Vector<D>| {
-            let n = v.norm();
-            if n > 0.0 {
-                v / n
-            } else {
-                v
-            }
-        };
-        let h = m.grid.h_min();
-        let f = self.plan.fields;
-        let mut k = 0;
-        while k < self.split.len() {
-            let g = self.split[k].0;
-            let end = k + self.split[k..].iter().take_while(|s| s.0 == g).count();
-            let x_node = m.grid.node_position(m.grid.node_ijk(g as usize));
-            for i in k..end {
-                for j in i + 1..end {
-                    let (fr, fs) = (self.split[i].1 as usize, self.split[j].1 as usize);
-                    let law = self
-                        .plan
-                        .law(fr as u32, fs as u32)
-                        .expect("fields in contact");
-                    let (gr, gs) = (gradient[i], gradient[j]);
-                    let normal = match law.normal {
-                        ContactNormal::MaxGradient if gr.norm() >= gs.norm() => unit(gr),
-                        ContactNormal::MaxGradient => -unit(gs),
-                        ContactNormal::Average => unit(unit(gr) - unit(gs)),
-                    };
-                    if normal == Vector::<D>::zeros() {
-                        continue;
-                    }
-                    let (r, s) = (first_split + i, first_split + j);
-                    let gap = -extent(r, &x_node, &normal) - extent(s, &x_node, &-normal);
-                    // The contact area (adhesion), per radian in axisymmetric mode.
-                    let ring = if axisymmetric { x_node[0] } else { 1.0 };
-                    self.meetings.push(Meeting {
-                        r,
-                        s,
-                        pair: pair_position(f, fr, fs),
-                        fields: [fr, fs],
-                        position: x_node,
-                        normal,
-                        rigid: [self.plan.rigid[fr], self.plan.rigid[fs]],
-                        area: 0.5 * (gr.norm() + gs.norm()) * ring,
-                        close: gap <= law.gap_factor * h,
-                        law,
-                    });
-                }
-            }
-            k = end;
         }
     }
 
@@ -328,9 +139,8 @@ impl<const D: usize> Contact<D> {
         crate::physics::transfer::stencils(m, shape, st);
         let p = &m.particles;
         let n_grid = m.grid.node_count();
-        map.split = self.split_shared_nodes(st, n_grid);
-        map.build(st, n_grid + map.split.len());
-        self.prepare(m, st, map);
+        self.fields.split(st, map, n_grid);
+        self.meetings = self.fields.meetings(&self.plan, m, st, map, false);
         self.rigid_nodes.clear();
         if let Some(free) = &mut self.free {
             free.start(p, m.axisymmetric);
@@ -572,6 +382,8 @@ fn exchange<const D: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::contact::ContactLaw;
+    use crate::scene::ContactNormal;
 
     fn meeting(normal: Vector<2>, mu: f64) -> Meeting<2> {
         Meeting {
@@ -583,6 +395,7 @@ mod tests {
             normal,
             rigid: [false, false],
             area: 1.0,
+            gap: 0.0,
             close: true,
             law: ContactLaw {
                 friction: mu,

@@ -9,6 +9,7 @@ pub mod bulk_viscosity;
 pub mod contact;
 pub mod deformation;
 pub mod fbar;
+pub mod field_split;
 pub mod geostatic;
 pub mod mirror;
 pub mod rigid_body;

@@ -187,8 +187,42 @@ fn linear_domain_stress(s: &SceneConfig) -> Check {
 }
 
 /// Contact in explicit stages: node-based, not with B-splines. In implicit
-/// stages: a penalty against rigid bodies with a prescribed motion only
-/// (`solver::implicit::contact`), not in axisymmetric mode.
+/// stages: a penalty against rigid bodies with a prescribed motion or between
+/// the split nodes of deformable bodies (`solver::implicit::contact`), not in
+/// axisymmetric mode.
+/// Implicit contact between two deformable bodies (`names`) splits their
+/// shared nodes: refused with what does not know split nodes.
+fn deformable_pair(s: &SceneConfig, what: &str, names: &str) -> Check {
+    use crate::scene::solver::PreconditionerKind::{LaggedMultigrid, Multigrid};
+    for (k, st) in s.stages().iter().enumerate() {
+        if st.kind == SolverKind::Explicit {
+            continue;
+        }
+        ensure(
+            !matches!(st.preconditioner(), Multigrid | LaggedMultigrid),
+            "contact",
+            format!(
+                "{what} between {names} gives each body its own nodes where they meet, \
+                 and stage {k}'s multigrid coarsens the grid's nodes only: use another \
+                 preconditioner or the direct solver"
+            ),
+        )?;
+        ensure(
+            !st.fbar(),
+            "contact",
+            format!(
+                "{what} between {names} keeps the bodies apart, and stage {k}'s F-bar \
+                 averages the dilation over cells that both bodies share"
+            ),
+        )?;
+    }
+    ensure(
+        s.grid.domain_stress == DomainStress::Constant,
+        "grid.domain_stress",
+        format!("{what} between {names} is not implemented with a linear domain stress"),
+    )
+}
+
 fn implicit_contact(s: &SceneConfig, plan: &ContactPlan) -> Check {
     use crate::scene::ShapeFunction::{Bspline2, Bspline3, Cpbspline2};
     let stages = s.stages();
@@ -223,14 +257,9 @@ fn implicit_contact(s: &SceneConfig, plan: &ContactPlan) -> Check {
             let body = |f: usize| plan.field_of_body.iter().position(|&b| b as usize == f);
             let (a, b) = (body(i).unwrap_or(0), body(j).unwrap_or(0));
             let names = format!("bodies {a} and {b}");
-            ensure(
-                plan.rigid[i] || plan.rigid[j],
-                "contact",
-                format!(
-                    "{what} acts between a deformable and a rigid body only, not between \
-                     {names} (implicit contact of two deformable bodies is not implemented)"
-                ),
-            )?;
+            if !plan.rigid[i] && !plan.rigid[j] {
+                deformable_pair(s, &what, &names)?;
+            }
             ensure(
                 !plan.free[i] && !plan.free[j],
                 "contact",

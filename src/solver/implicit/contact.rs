@@ -1,4 +1,5 @@
-//! Contact with rigid bodies in the implicit solver (quasi-static and Newmark).
+//! Penalty contact in the implicit solver (quasi-static and Newmark): with
+//! rigid bodies, and between deformable bodies.
 //!
 //! A rigid body with a prescribed motion is not part of the grid problem: its
 //! particles touch no node (their stencils are emptied) and move at their
@@ -18,18 +19,45 @@
 //! `contact_penetration`, the deepest of the converged steps).
 //! The tangential force at the step start of each particle in contact is kept
 //! for the next step (stick carries over steps).
+//!
+//! **Two deformable bodies** are kept apart on the grid: every grid node that
+//! both touch is split into one node per body (`physics::field_split`), so each
+//! body has its own displacement there and neither drags the other along. At
+//! such a node I the two fields r < s meet with the common normal n (from r to
+//! s) and the distance D between their surfaces at the step start (both from the
+//! step-start particles, `Meeting`). The step's nodal displacements u_r, u_s
+//! close the gap to D − (u_r − u_s)·n, so r is
+//!
+//!   g = (u_r − u_s)·n − D
+//!
+//! deep in s, and a penalty with the same law as above (`penalty_force` with the
+//! outward normal −n, fixed within the step, and the relative motion u_r − u_s)
+//! pushes r back and s forward: r_r −= f, r_s += f, and with ∂f = ∂f/∂u_r
+//!
+//!   K_rr −= ∂f, K_ss −= ∂f, K_rs += ∂f, K_sr += ∂f.
+//!
+//! Its penalty is ε = α M A_I / h, with A_I the meeting's nodal area and M the
+//! stiffer P-wave modulus of the particles at the two nodes. The tangential
+//! force of a meeting is kept for the next step under its grid node and
+//! fields. Unlike the explicit contact this one does not use the gap factor λ:
+//! the penalty acts from D = 0 on (a node where the bodies touch at the step
+//! start carries stiffness but no force).
 
-use super::assembly::{Components, Dofs, Pattern, Tangent};
+use super::assembly::pattern::slot;
+use super::assembly::{Components, Dofs, Pattern, Storage, Tangent};
+use super::ties::NodeFields;
+use crate::dim::Tensor;
 use crate::dim::Vector;
 use crate::model::particles::Particles;
 use crate::model::Model;
 use crate::parallel::MIN_PARALLEL_LEN;
 use crate::physics::contact::{pair_position, pair_totals, PairTotal};
+use crate::physics::field_split::{FieldSplit, Meeting};
 use crate::physics::rigid_body::to3;
 use crate::physics::rigid_penalty::{penalty_force, ParticleContact, Penalty};
-use crate::physics::rigid_surface::{on_grid_boundary, rigid_surfaces, Placement, Surface};
-use crate::physics::shape::Stencils;
-use crate::physics::transfer::{interpolate, NodeMap};
+use crate::physics::rigid_surface::{on_grid_boundary, rigid_surfaces, Inside, Placement, Surface};
+use crate::physics::shape::{ShapeFunction, Stencils};
+use crate::physics::transfer::{interpolate, stencils, NodeMap};
 use crate::scene::contact::ContactPlan;
 use rayon::prelude::*;
 
@@ -37,14 +65,88 @@ use rayon::prelude::*;
 #[derive(Clone, Copy, Debug)]
 pub struct Touch<const D: usize> {
     pub particle: usize,
-    /// Index of the rigid body in `RigidContact::surfaces`.
+    /// Index of the rigid body in `PenaltyContact::surfaces`.
     pub surface: usize,
     pub contact: ParticleContact<D>,
 }
 
-/// The implicit solver's contact with rigid bodies.
+/// The smallest nodal area of a meeting, as a fraction of a cell face h^{D−1}.
+const MIN_AREA: f64 = 0.05;
+
+/// Two deformable fields in contact at a split node at the last evaluation of
+/// the residual.
+#[derive(Clone, Copy, Debug)]
+pub struct NodeTouch<const D: usize> {
+    /// Index in `PenaltyContact::meetings`.
+    pub meeting: usize,
+    /// The force on field r (s gets the opposite) and its derivative by u_r.
+    pub contact: ParticleContact<D>,
+}
+
+/// The contact between deformable bodies on the split grid.
 #[derive(Clone, Debug)]
-pub struct RigidContact<const D: usize> {
+struct Fields<const D: usize> {
+    split: FieldSplit,
+    /// The meetings of this step, their penalties and tangential forces at the
+    /// step start.
+    meetings: Vec<Meeting<D>>,
+    penalty: Vec<f64>,
+    f_t0: Vec<Vector<D>>,
+    /// (grid node, r, s) of each meeting.
+    keys: Vec<[u32; 3]>,
+    /// Tangential forces carried from the last step, by (grid node, r, s).
+    history: Vec<([u32; 3], Vector<D>)>,
+    /// Meetings in contact at the last residual.
+    touches: Vec<NodeTouch<D>>,
+}
+
+impl<const D: usize> Fields<D> {
+    /// Each meeting's tangential force at the step start: the one its grid node
+    /// and fields carried at the end of the last step, or zero.
+    fn assign_f_t0(&mut self) {
+        let history = &self.history;
+        self.f_t0 = (self.keys.iter())
+            .map(|key| match history.binary_search_by_key(key, |h| h.0) {
+                Ok(i) => history[i].1,
+                Err(_) => Vector::<D>::zeros(),
+            })
+            .collect();
+    }
+
+    /// The meetings in contact at the nodal displacement increments u: the
+    /// penalty of field r against s (module docs).
+    fn evaluate(&mut self, u: &[Vector<D>]) {
+        self.touches = (self.meetings.iter().enumerate())
+            .filter_map(|(k, mt)| {
+                let relative = u[mt.r] - u[mt.s];
+                let depth = relative.dot(&mt.normal) - mt.gap;
+                if depth < 0.0 {
+                    return None;
+                }
+                let inside = Inside {
+                    point: mt.position,
+                    normal: -mt.normal,
+                    normal_derivative: Tensor::<D>::zeros(),
+                    depth,
+                    depth_gradient: mt.normal,
+                };
+                let law = Penalty {
+                    normal: self.penalty[k],
+                    tangential: self.penalty[k],
+                    friction: mt.law.friction,
+                };
+                Some(NodeTouch {
+                    meeting: k,
+                    contact: penalty_force(&law, &inside, &relative, &self.f_t0[k]),
+                })
+            })
+            .collect();
+    }
+}
+
+/// The implicit solver's penalty contact.
+#[derive(Clone, Debug)]
+pub struct PenaltyContact<const D: usize> {
     plan: ContactPlan,
     /// Field of each particle.
     field: Vec<u32>,
@@ -64,9 +166,11 @@ pub struct RigidContact<const D: usize> {
     totals: Vec<PairTotal<D>>,
     /// The deepest penalty depth of a converged step so far.
     pub deepest: f64,
+    /// Contact between deformable bodies (None without such a pair).
+    fields: Option<Fields<D>>,
 }
 
-impl<const D: usize> RigidContact<D> {
+impl<const D: usize> PenaltyContact<D> {
     /// The contact of model m with rigid bodies, or None without any.
     pub fn new(m: &Model<D>) -> Option<Self> {
         let plan = m.contact.clone()?;
@@ -76,7 +180,12 @@ impl<const D: usize> RigidContact<D> {
             .collect();
         let paired = |k: usize| (0..plan.fields).any(|j| plan.law(k as u32, j as u32).is_some());
         let surfaces = rigid_surfaces(&plan, m, &field, &paired);
-        if surfaces.is_empty() {
+        let deformable = |i: usize| !plan.rigid[i];
+        let deformable_pair = (0..plan.fields).any(|i| {
+            (i + 1..plan.fields)
+                .any(|j| deformable(i) && deformable(j) && plan.law(i as u32, j as u32).is_some())
+        });
+        if surfaces.is_empty() && !deformable_pair {
             return None;
         }
         let touches_some =
@@ -85,12 +194,21 @@ impl<const D: usize> RigidContact<D> {
             .map(|f| !plan.rigid[f] && touches_some(f))
             .collect();
         let friction = (plan.laws.iter()).any(|l| l.is_some_and(|l| l.friction > 0.0));
-        let tangential = match friction {
+        let tangential = match friction && !surfaces.is_empty() {
             true => vec![Vector::<D>::zeros(); p.len()],
             false => Vec::new(),
         };
+        let fields = deformable_pair.then(|| Fields {
+            split: FieldSplit::new(field.clone()),
+            meetings: Vec::new(),
+            penalty: Vec::new(),
+            f_t0: Vec::new(),
+            keys: Vec::new(),
+            history: Vec::new(),
+            touches: Vec::new(),
+        });
         let totals = pair_totals(&plan);
-        Some(RigidContact {
+        Some(PenaltyContact {
             plan,
             field,
             surfaces,
@@ -101,7 +219,100 @@ impl<const D: usize> RigidContact<D> {
             touches: Vec::new(),
             totals,
             deepest: 0.0,
+            fields,
         })
+    }
+
+    /// The step's stencils and node map: the rigid bodies' particles left out
+    /// and, with contact between deformable bodies, their shared nodes split
+    /// and the meetings there found (from the step-start particles).
+    pub fn stencils(
+        &mut self,
+        m: &Model<D>,
+        shape: ShapeFunction,
+        st: &mut Stencils<D>,
+        map: &mut NodeMap,
+    ) {
+        stencils(m, shape, st);
+        self.leave_out_rigid(st);
+        let n_grid = m.grid.node_count();
+        let Some(fields) = self.fields.as_mut() else {
+            map.build(st, n_grid);
+            return;
+        };
+        fields.split.split(st, map, n_grid);
+        let h = m.grid.h_min();
+        fields.meetings = fields.split.meetings(&self.plan, m, st, map, true);
+        // Where both fields' volume gradients are small the node is inside both
+        // stencils but at neither surface: its normal would be round-off and
+        // its gap along it meaningless (two bodies' particles side by side
+        // across the node), so it is no meeting.
+        let face = h.powi(D as i32 - 1);
+        fields.meetings.retain(|mt| mt.area >= MIN_AREA * face);
+        // A gap of round-off (faces that coincide at the step start) is none.
+        for mt in &mut fields.meetings {
+            if mt.gap.abs() <= 1e-9 * h {
+                mt.gap = 0.0;
+            }
+        }
+        // ε = α M A / h, M the stiffer material at the two nodes.
+        let (p, owner) = (&m.particles, st.owner());
+        let modulus = |a: usize| {
+            (map.node_entries(a).iter())
+                .map(|&e| m.materials[p.material[owner.of(e)] as usize].p_wave_modulus())
+                .fold(0.0, f64::max)
+        };
+        fields.penalty = (fields.meetings.iter())
+            .map(|mt| mt.law.penalty_factor * modulus(mt.r).max(modulus(mt.s)) * mt.area / h)
+            .collect();
+        fields.keys = (fields.meetings.iter())
+            .map(|mt| {
+                let [r, s] = mt.fields;
+                [map.grid_node(mt.r) as u32, r as u32, s as u32]
+            })
+            .collect();
+        fields.assign_f_t0();
+        fields.touches.clear();
+    }
+
+    /// Drop the meetings at tied (weakly supported) nodes: a tied node's
+    /// displacement is extrapolated from its masters, and a penalty on it would
+    /// act on them through the extrapolation's lever (coefficients 2 and −1).
+    pub fn drop_tied_meetings(&mut self, dofs: &Dofs) {
+        let Some(f) = self.fields.as_mut() else {
+            return;
+        };
+        let tied = |a: usize| dofs.ties.get(a).is_some_and(Option::is_some);
+        let keep: Vec<bool> = (f.meetings.iter())
+            .map(|mt| !tied(mt.r) && !tied(mt.s))
+            .collect();
+        let mut k = 0;
+        f.meetings.retain(|_| (keep[k], k += 1).0);
+        let mut k = 0;
+        f.penalty.retain(|_| (keep[k], k += 1).0);
+        let mut k = 0;
+        f.f_t0.retain(|_| (keep[k], k += 1).0);
+        let mut k = 0;
+        f.keys.retain(|_| (keep[k], k += 1).0);
+    }
+
+    /// The field of every active node, with contact between deformable bodies
+    /// (for the ties of weakly supported nodes, which must not cross bodies).
+    pub fn node_fields(&self, st: &Stencils<D>, map: &NodeMap) -> Option<NodeFields> {
+        let fields = self.fields.as_ref()?;
+        let owner = st.owner();
+        let of = (0..map.len())
+            .map(|a| fields.split.field(owner.of(map.node_entries(a)[0])))
+            .collect();
+        Some(NodeFields::new(map, of))
+    }
+
+    /// Pairs of active nodes that the contact couples beyond the stencils (the
+    /// two nodes of each meeting), for the tangent's pattern.
+    pub fn coupled_nodes(&self) -> Vec<(u32, u32)> {
+        (self.fields.iter())
+            .flat_map(|f| f.meetings.iter().map(|mt| (mt.r as u32, mt.s as u32)))
+            .collect()
     }
 
     /// Whether particle q belongs to a rigid body (it stays off the grid).
@@ -169,26 +380,43 @@ impl<const D: usize> RigidContact<D> {
             })
             .collect();
         self.touches = touches;
+        if let Some(fields) = self.fields.as_mut() {
+            fields.evaluate(u);
+        }
     }
 
-    /// r_I −= S_Ip f_p over the particles in contact.
+    /// r_I −= S_Ip f_p over the particles in contact; r_r −= f, r_s += f over
+    /// the meetings in contact.
     pub fn add_residual(&self, map: &NodeMap, st: &Stencils<D>, r: &mut [Vector<D>]) {
         for t in &self.touches {
             for e in st.range(t.particle) {
                 r[map.local_of(st, e)] -= t.contact.force * st.weight[e];
             }
         }
+        for (f, t) in self.node_touches() {
+            let mt = &f.meetings[t.meeting];
+            r[mt.r] -= t.contact.force;
+            r[mt.s] += t.contact.force;
+        }
+    }
+
+    /// The meetings in contact at the last residual, with their fields.
+    fn node_touches(&self) -> impl Iterator<Item = (&Fields<D>, &NodeTouch<D>)> {
+        (self.fields.iter()).flat_map(|f| f.touches.iter().map(move |t| (f, t)))
     }
 
     /// Whether every contact's derivative is symmetric (plane faces, no slip).
     pub fn symmetric(&self) -> bool {
-        self.touches.iter().all(|t| {
-            let d = &t.contact.derivative;
+        let symmetric = |c: &ParticleContact<D>| {
+            let d = &c.derivative;
             (d - d.transpose()).amax() <= 1e-10 * d.amax()
-        })
+        };
+        self.touches.iter().all(|t| symmetric(&t.contact))
+            && self.node_touches().all(|(_, t)| symmetric(&t.contact))
     }
 
-    /// K_IJ −= S_Ip S_Jp ∂f_p/∂x_p over the particles in contact.
+    /// K_IJ −= S_Ip S_Jp ∂f_p/∂x_p over the particles in contact; K_rr −= ∂f,
+    /// K_ss −= ∂f, K_rs += ∂f, K_sr += ∂f over the meetings in contact.
     pub fn add_tangent(
         &self,
         k: &mut Tangent,
@@ -197,6 +425,18 @@ impl<const D: usize> RigidContact<D> {
         st: &Stencils<D>,
         dofs: &Dofs,
     ) {
+        for (f, t) in self.node_touches() {
+            let mt = &f.meetings[t.meeting];
+            let d = &t.contact.derivative;
+            for (a, b, sign) in [
+                (mt.r, mt.r, -1.0),
+                (mt.s, mt.s, -1.0),
+                (mt.r, mt.s, 1.0),
+                (mt.s, mt.r, 1.0),
+            ] {
+                add_node_block(k, dofs, a, b, &(d * sign));
+            }
+        }
         if self.touches.is_empty() {
             return;
         }
@@ -257,6 +497,20 @@ impl<const D: usize> RigidContact<D> {
             total.nodes += 1;
             total.dissipation += t.contact.dissipation;
         }
+        if let Some(f) = self.fields.as_mut() {
+            f.history = (f.touches.iter())
+                .filter(|t| t.contact.tangential != Vector::<D>::zeros())
+                .map(|t| (f.keys[t.meeting], t.contact.tangential))
+                .collect();
+            f.history.sort_by_key(|h| h.0);
+            for t in &f.touches {
+                let mt = &f.meetings[t.meeting];
+                let total = &mut self.totals[mt.pair];
+                total.impulse += t.contact.force * dt;
+                total.nodes += 1;
+                total.dissipation += t.contact.dissipation;
+            }
+        }
         for q in 0..p.len() {
             if self.is_rigid(q) {
                 p.x[q] += p.v[q] * dt;
@@ -266,19 +520,35 @@ impl<const D: usize> RigidContact<D> {
 
     /// The tangential forces carried to the next step, D values per particle
     /// (empty without friction), for a checkpoint.
+    /// Then, with contact between deformable bodies, 3 + D values per meeting
+    /// that carries a tangential force: its grid node, fields r and s, force.
     pub fn tangential_state(&self) -> Vec<f64> {
-        (self.tangential.iter())
-            .flat_map(|f| f.iter().copied())
-            .collect()
+        let particles = self.tangential.iter().flat_map(|f| f.iter().copied());
+        let meetings = (self.fields.iter()).flat_map(|f| {
+            (f.history.iter())
+                .flat_map(|(key, v)| key.iter().map(|&k| k as f64).chain(v.iter().copied()))
+        });
+        particles.chain(meetings).collect()
     }
 
     /// Continue with the tangential forces of a checkpoint (`tangential_state`;
     /// nothing happens with an empty one).
     pub fn restore_tangential(&mut self, state: &[f64]) {
-        if state.len() == self.tangential.len() * D {
-            self.tangential = (state.chunks_exact(D))
-                .map(Vector::<D>::from_column_slice)
+        let n = self.tangential.len() * D;
+        if state.is_empty() || state.len() < n || (state.len() - n) % (3 + D) != 0 {
+            return;
+        }
+        self.tangential = (state[..n].chunks_exact(D))
+            .map(Vector::<D>::from_column_slice)
+            .collect();
+        if let Some(f) = self.fields.as_mut() {
+            f.history = (state[n..].chunks_exact(3 + D))
+                .map(|c| {
+                    let key = [c[0] as u32, c[1] as u32, c[2] as u32];
+                    (key, Vector::<D>::from_column_slice(&c[3..]))
+                })
                 .collect();
+            f.assign_f_t0();
         }
     }
 
@@ -294,7 +564,9 @@ impl<const D: usize> RigidContact<D> {
 
     /// The deepest penetration at the last residual.
     pub fn max_penetration(&self) -> f64 {
-        (self.touches.iter()).fold(0.0, |g, t| g.max(t.contact.depth))
+        let particles = self.touches.iter().map(|t| t.contact.depth);
+        let nodes = self.node_touches().map(|(_, t)| t.contact.depth);
+        particles.chain(nodes).fold(0.0, f64::max)
     }
 
     /// The totals since the last call, reset.
@@ -305,5 +577,29 @@ impl<const D: usize> RigidContact<D> {
             t.dissipation = 0.0;
         }
         out
+    }
+}
+
+/// K_ab += block over the unknowns of active nodes a and b (a tied node's
+/// terms going to its masters; the lower triangle only with `Lower`).
+fn add_node_block<const D: usize>(
+    k: &mut Tangent,
+    dofs: &Dofs,
+    a: usize,
+    b: usize,
+    block: &Tensor<D>,
+) {
+    for i in 0..D {
+        let rows = dofs.terms(a, i, D);
+        for j in 0..D {
+            for &(r, cr) in rows.as_slice() {
+                for &(c, cc) in dofs.terms(b, j, D).as_slice() {
+                    if k.storage == Storage::Full || r >= c {
+                        let s = slot(k.pattern, r, c).expect("contact entry in the pattern");
+                        k.values[s] += block[(i, j)] * cr * cc;
+                    }
+                }
+            }
+        }
     }
 }

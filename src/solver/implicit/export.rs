@@ -87,7 +87,8 @@ impl Export {
         header.extend(&axes[..D]);
         let mut csv = CsvWriter::create(&self.dir.join(name), &header)?;
         let mut rows: Vec<(usize, u32, usize)> = Vec::with_capacity(sys.dofs.free);
-        for (a, &node) in sys.map.active.iter().enumerate() {
+        for a in 0..sys.map.len() {
+            let node = sys.map.grid_node(a) as u32;
             for d in 0..D {
                 if let Some(i) = sys.dofs.of(a, d, D) {
                     rows.push((i, node, d));

@@ -142,7 +142,9 @@ impl<const D: usize> Implicit<D> {
         let converged = self
             .newton
             .solve(m, &mut self.system, step, level, started)?;
-        self.reaction = (self.system.map.active.iter().copied())
+        let map = &self.system.map;
+        self.reaction = (0..map.len())
+            .map(|a| map.grid_node(a) as u32)
             .zip(converged.reaction)
             .filter(|(_, f)| *f != Vector::<D>::zeros())
             .collect();
@@ -171,9 +173,11 @@ impl<const D: usize> Implicit<D> {
 /// weakly supported nodes tied to their neighbours. `mpm bench` reports it.
 pub fn unknowns<const D: usize>(m: &Model<D>, shape: ShapeFunction, s: &SolverConfig) -> usize {
     let (mut st, mut map) = (Stencils::<D>::default(), NodeMap::default());
-    let contact = contact::RigidContact::new(m);
-    step::step_stencils(m, shape, contact.as_ref(), &mut st, &mut map);
-    number_unknowns(m, &st, &map, s.min_node_support()).1.free
+    let mut contact = contact::PenaltyContact::new(m);
+    step::step_stencils(m, shape, contact.as_mut(), &mut st, &mut map);
+    number_unknowns(m, &st, &map, contact.as_ref(), s.min_node_support())
+        .1
+        .free
 }
 
 impl<const D: usize> Stepper<D> for Implicit<D> {

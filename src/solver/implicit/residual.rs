@@ -61,7 +61,8 @@ pub fn residual<const D: usize>(
         .collect();
     // Absorbing faces: − f_boundary(u), dashpots through v_{n+1}(u) (2-63).
     sys.absorbing.add_residual(map, st, p, u, &mut r);
-    // Contact with rigid bodies: r_I −= S_Ip f_p (`super::contact`).
+    // Contact: r_I −= S_Ip f_p with rigid bodies, r_r −= f, r_s += f between
+    // the nodes of deformable bodies (`super::contact`).
     if let Some(contact) = sys.contact.as_mut() {
         contact.evaluate(m, st, map, u);
         contact.add_residual(map, st, &mut r);
@@ -166,7 +167,9 @@ pub fn tangent<'s, const D: usize>(
 pub fn step_pattern<const D: usize>(sys: &StepSystem<D>) -> &Pattern {
     let cells = sys.trial.fbar.as_ref().map(|f| &f.cells);
     let fit = sys.linear_stress.as_ref().map(|l| &l.fit);
-    (sys.pattern).get_or_init(|| Pattern::new(&sys.map, &sys.stencils, &sys.dofs, cells, fit))
+    let coupled = (sys.contact.as_ref()).map_or_else(Vec::new, |c| c.coupled_nodes());
+    (sys.pattern)
+        .get_or_init(|| Pattern::new(&sys.map, &sys.stencils, &sys.dofs, cells, fit, &coupled))
 }
 
 /// The fill-reducing ordering for the factorization of the tangent `k` of

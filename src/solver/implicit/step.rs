@@ -12,7 +12,7 @@
 //! [`StepSettings::commit`] makes the converged increment the particles' state.
 
 use super::assembly::{Dofs, Pattern};
-use super::contact::RigidContact;
+use super::contact::PenaltyContact;
 use super::newmark::Newmark;
 use super::ties::{merge, natural_end_ties, nodal_support, ties};
 use crate::dim::Vector;
@@ -91,7 +91,7 @@ pub struct StepSystem<const D: usize> {
     /// for the next step if it fits).
     pub pattern: OnceLock<Pattern>,
     /// Contact with rigid bodies (None in a scene without).
-    pub contact: Option<RigidContact<D>>,
+    pub contact: Option<PenaltyContact<D>>,
     /// The linear domain stress of the step-start configuration (None unless
     /// `[grid] domain_stress = "linear"`).
     pub linear_stress: Option<LinearStress<D>>,
@@ -173,9 +173,9 @@ impl StepSettings {
     ) {
         let p = &m.particles;
         if sys.contact.is_none() && m.contact.is_some() {
-            sys.contact = RigidContact::new(m);
+            sys.contact = PenaltyContact::new(m);
         }
-        let contact = sys.contact.as_ref();
+        let contact = sys.contact.as_mut();
         step_stencils(m, self.shape, contact, &mut sys.stencils, &mut sys.map);
         if let Some(contact) = sys.contact.as_mut() {
             contact.start_step(p, dt);
@@ -190,7 +190,11 @@ impl StepSettings {
             .linear_domain_stress
             .then(|| LinearStress::new(self.shape, &m.grid, p, &sys.stencils));
         let (st, map) = (&sys.stencils, &sys.map);
-        let (constraint, dofs) = number_unknowns(m, st, map, self.min_node_support);
+        let contact = sys.contact.as_ref();
+        let (constraint, dofs) = number_unknowns(m, st, map, contact, self.min_node_support);
+        if let Some(contact) = sys.contact.as_mut() {
+            contact.drop_tied_meetings(&dofs);
+        }
         let n = map.len();
 
         // External force at the end of the step; inertia terms: the Newmark
@@ -231,9 +235,10 @@ impl StepSettings {
         // factorization serve again when no stencil, constraint or tie changed.
         let cells = sys.trial.fbar.as_ref().map(|f| &f.cells);
         let fit = sys.linear_stress.as_ref().map(|l| &l.fit);
+        let coupled = (sys.contact.as_ref()).map_or_else(Vec::new, |c| c.coupled_nodes());
         let kept = std::mem::take(&mut sys.pattern)
             .into_inner()
-            .filter(|pattern| pattern.fits(st, &dofs, cells, fit));
+            .filter(|pattern| pattern.fits(st, &dofs, cells, fit, &coupled));
         sys.pattern = OnceLock::new();
         if let Some(pattern) = kept {
             let _ = sys.pattern.set(pattern);
@@ -384,19 +389,22 @@ impl StepSettings {
 }
 
 /// The particles' stencils at the step start and the active nodes they touch;
-/// with contact against rigid bodies, those bodies' particles stay off the grid.
+/// with contact, rigid bodies' particles stay off the grid and deformable
+/// bodies in contact get nodes of their own (`PenaltyContact::stencils`).
 pub fn step_stencils<const D: usize>(
     m: &Model<D>,
     shape: ShapeFunction,
-    contact: Option<&RigidContact<D>>,
+    contact: Option<&mut PenaltyContact<D>>,
     st: &mut Stencils<D>,
     map: &mut NodeMap,
 ) {
-    stencils(m, shape, st);
-    if let Some(contact) = contact {
-        contact.leave_out_rigid(st);
+    match contact {
+        Some(contact) => contact.stencils(m, shape, st, map),
+        None => {
+            stencils(m, shape, st);
+            map.build(st, m.grid.node_count());
+        }
     }
-    map.build(st, m.grid.node_count());
 }
 
 /// The conditions at the active nodes and the numbering of the unknowns: the
@@ -405,17 +413,28 @@ pub fn number_unknowns<const D: usize>(
     m: &Model<D>,
     st: &Stencils<D>,
     map: &NodeMap,
+    contact: Option<&PenaltyContact<D>>,
     min_node_support: f64,
 ) -> (Vec<Constraint<D>>, Dofs) {
     let constraint: Vec<Constraint<D>> = map
         .active
         .par_iter()
+        .enumerate()
         .with_min_len(MIN_PARALLEL_LEN)
-        .map(|&g| implicit_node_constraint(&m.grid, &m.faces, &m.friction, g as usize))
+        .map(|(a, _)| implicit_node_constraint(&m.grid, &m.faces, &m.friction, map.grid_node(a)))
         .collect();
     let support = nodal_support(map, st, &m.particles.volume, m.grid.cell_volume());
-    let weak = ties(&m.grid, map, &support, &constraint, min_node_support);
-    let natural = natural_end_ties(&m.grid, &m.faces, map);
+    let fields = contact.and_then(|c| c.node_fields(st, map));
+    let fields = fields.as_ref();
+    let weak = ties(
+        &m.grid,
+        map,
+        fields,
+        &support,
+        &constraint,
+        min_node_support,
+    );
+    let natural = natural_end_ties(&m.grid, &m.faces, map, fields);
     let ties = merge(weak, natural, map.len());
     let dofs = Dofs::with_ties(constraint.iter().map(|c| c.fixed), ties);
     (constraint, dofs)

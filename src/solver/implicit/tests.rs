@@ -691,16 +691,16 @@ fn a_pattern_is_kept_only_while_it_fits() {
     solver.prepare(&m, 0.0, 0.01);
     let sys = &solver.system;
     let cells = sys.trial.fbar.as_ref().map(|f| &f.cells);
-    let pattern = Pattern::new(&sys.map, &sys.stencils, &sys.dofs, cells, None);
-    assert!(pattern.fits(&sys.stencils, &sys.dofs, cells, None));
+    let pattern = Pattern::new(&sys.map, &sys.stencils, &sys.dofs, cells, None, &[]);
+    assert!(pattern.fits(&sys.stencils, &sys.dofs, cells, None, &[]));
     // Another node in one stencil, another unknown, other cells: a new pattern.
     let mut moved = sys.stencils.clone();
     moved.node[0] += 1;
-    assert!(!pattern.fits(&moved, &sys.dofs, cells, None));
+    assert!(!pattern.fits(&moved, &sys.dofs, cells, None, &[]));
     let mut dofs = sys.dofs.clone();
     dofs.free -= 1;
-    assert!(!pattern.fits(&sys.stencils, &dofs, cells, None));
-    assert!(!pattern.fits(&sys.stencils, &sys.dofs, None, None));
+    assert!(!pattern.fits(&sys.stencils, &dofs, cells, None, &[]));
+    assert!(!pattern.fits(&sys.stencils, &sys.dofs, None, None, &[]));
     // Through the solver: the next step keeps the pattern while the particles
     // stay put, and builds a new one after one crosses into another cell.
     let _ = solver.system.pattern.set(pattern);

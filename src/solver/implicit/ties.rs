@@ -31,6 +31,52 @@ use crate::physics::shape::Stencils;
 use crate::physics::transfer::NodeMap;
 use crate::scene::Face;
 
+/// The field (body group, `physics::field_split`) of every active node, with
+/// contact between deformable bodies: a grid node they share holds one node
+/// per field, and a node's neighbours for a tie are those of its own field (a
+/// tie across fields would glue the bodies together).
+#[derive(Clone, Debug)]
+pub struct NodeFields {
+    of: Vec<u32>,
+    /// (grid node, field, active node), ascending.
+    by_grid: Vec<(u32, u32, u32)>,
+}
+
+impl NodeFields {
+    /// From the field of every active node of `map`.
+    pub fn new(map: &NodeMap, of: Vec<u32>) -> Self {
+        let mut by_grid: Vec<(u32, u32, u32)> = (0..map.len())
+            .map(|a| (map.grid_node(a) as u32, of[a], a as u32))
+            .collect();
+        by_grid.sort_unstable();
+        NodeFields { of, by_grid }
+    }
+}
+
+/// The active node at grid node `target` that can stand beside active node
+/// `from`: the grid node's own, or with `fields` the one of `from`'s field.
+fn active_at(
+    map: &NodeMap,
+    fields: Option<&NodeFields>,
+    from: usize,
+    target: usize,
+) -> Option<usize> {
+    match fields {
+        None => match map.local[target] {
+            NodeMap::NONE => None,
+            a => Some(a as usize),
+        },
+        Some(f) => {
+            let key = (target as u32, f.of[from]);
+            let i = f
+                .by_grid
+                .binary_search_by_key(&key, |&(g, k, _)| (g, k))
+                .ok()?;
+            Some(f.by_grid[i].2 as usize)
+        }
+    }
+}
+
 /// Σ_p V_p S_Ip / (cell volume) at every active node.
 pub fn nodal_support<const D: usize>(
     map: &NodeMap,
@@ -51,6 +97,7 @@ pub fn nodal_support<const D: usize>(
 pub fn ties<const D: usize>(
     grid: &Grid<D>,
     map: &NodeMap,
+    fields: Option<&NodeFields>,
     support: &[f64],
     constraint: &[Constraint<D>],
     threshold: f64,
@@ -60,13 +107,13 @@ pub fn ties<const D: usize>(
         return Vec::new();
     }
     let directions = directions::<D>();
-    let position = |b: usize| grid.node_position(grid.node_ijk(map.active[b] as usize));
+    let position = |b: usize| grid.node_position(grid.node_ijk(map.grid_node(b)));
     (0..map.len())
         .map(|a| {
             if !weak(a) || !constraint[a].is_free() {
                 return None;
             }
-            let ijk = grid.node_ijk(map.active[a] as usize);
+            let ijk = grid.node_ijk(map.grid_node(a));
             let mut best: Option<(usize, f64, usize, usize)> = None; // (|s|², score, J, K)
             for s in &directions {
                 let order = s.iter().map(|c| (c * c) as usize).sum::<usize>();
@@ -74,8 +121,8 @@ pub fn ties<const D: usize>(
                     break; // a shorter direction already works
                 }
                 let (Some(j), Some(k)) = (
-                    neighbour(grid, map, ijk, s, 1),
-                    neighbour(grid, map, ijk, s, 2),
+                    neighbour(grid, map, fields, a, ijk, s, 1),
+                    neighbour(grid, map, fields, a, ijk, s, 2),
                 ) else {
                     continue;
                 };
@@ -111,13 +158,14 @@ pub fn natural_end_ties<const D: usize>(
     grid: &Grid<D>,
     faces: &[FaceCondition<D>],
     map: &NodeMap,
+    fields: Option<&NodeFields>,
 ) -> Vec<(usize, Tie)> {
     if grid.degree != 3 {
         return Vec::new();
     }
     let mut out = Vec::new();
     for a in 0..map.len() {
-        let ijk = grid.node_ijk(map.active[a] as usize);
+        let ijk = grid.node_ijk(map.grid_node(a));
         let ends: Vec<Face> = (0..D)
             .filter(|&d| grid.cells[d] >= 3)
             .flat_map(|axis| [false, true].map(|upper| Face { axis, upper }))
@@ -131,12 +179,11 @@ pub fn natural_end_ties<const D: usize>(
             } else {
                 k
             };
-            map.local[grid.node_index(n)]
+            active_at(map, fields, a, grid.node_index(n))
         };
-        let (first, second) = (line(0), line(1));
-        if first != NodeMap::NONE && second != NodeMap::NONE {
+        if let (Some(first), Some(second)) = (line(0), line(1)) {
             let tie = Tie {
-                master: [second as usize, first as usize],
+                master: [second, first],
                 coef: [3.0, -2.0],
             };
             out.push((a, tie));
@@ -243,6 +290,8 @@ fn directions<const D: usize>() -> Vec<[i64; D]> {
 fn neighbour<const D: usize>(
     grid: &Grid<D>,
     map: &NodeMap,
+    fields: Option<&NodeFields>,
+    from: usize,
     ijk: [usize; D],
     s: &[i64; D],
     m: i64,
@@ -255,8 +304,5 @@ fn neighbour<const D: usize>(
         }
         target[d] = i as usize;
     }
-    match map.local[grid.node_index(target)] {
-        NodeMap::NONE => None,
-        a => Some(a as usize),
-    }
+    active_at(map, fields, from, grid.node_index(target))
 }

@@ -104,6 +104,8 @@ struct BuiltFor {
     cell_of: Option<Vec<u32>>,
     /// The least-squares neighbour lists (offsets, neighbours).
     neighbours: Option<(Vec<usize>, Vec<u32>)>,
+    /// Node pairs coupled beyond the stencils (contact).
+    coupled: Vec<(u32, u32)>,
     dofs: Dofs,
 }
 
@@ -113,12 +115,14 @@ impl BuiltFor {
         dofs: &Dofs,
         cells: Option<&Cells>,
         fit: Option<&LeastSquares<D>>,
+        coupled: &[(u32, u32)],
     ) -> BuiltFor {
         BuiltFor {
             count: st.count.clone(),
             node: st.node.clone(),
             cell_of: cells.map(|c| c.of.clone()),
             neighbours: fit.map(|f| (f.lists().0.to_vec(), f.lists().1.to_vec())),
+            coupled: coupled.to_vec(),
             dofs: dofs.clone(),
         }
     }
@@ -129,8 +133,10 @@ impl BuiltFor {
         dofs: &Dofs,
         cells: Option<&Cells>,
         fit: Option<&LeastSquares<D>>,
+        coupled: &[(u32, u32)],
     ) -> bool {
-        self.count == st.count
+        self.coupled == coupled
+            && self.count == st.count
             && self.node == st.node
             && self.cell_of.as_deref() == cells.map(|c| c.of.as_slice())
             && self
@@ -146,13 +152,15 @@ impl Pattern {
     /// The node graph of the stencils `st` over the active nodes of `map` with
     /// the unknowns `dofs`; with `cells` (F-bar), every particle also couples to
     /// the nodes of the other particles of its cell; with `fit` (a linear
-    /// domain stress), to the nodes of its least-squares neighbours.
+    /// domain stress), to the nodes of its least-squares neighbours; and each
+    /// pair of `coupled` nodes (contact between the nodes of two bodies).
     pub fn new<const D: usize>(
         map: &NodeMap,
         st: &Stencils<D>,
         dofs: &Dofs,
         cells: Option<&Cells>,
         fit: Option<&LeastSquares<D>>,
+        coupled: &[(u32, u32)],
     ) -> Pattern {
         let n = map.len();
         let mut first = Vec::with_capacity(n + 1);
@@ -205,6 +213,7 @@ impl Pattern {
                 dofs,
             )
         };
+        let (neighbour_start, neighbours) = with_pairs(neighbour_start, neighbours, coupled, dofs);
         Pattern {
             first,
             tied_sources,
@@ -214,7 +223,7 @@ impl Pattern {
             full: OnceLock::new(),
             amd: OnceLock::new(),
             metis: OnceLock::new(),
-            built_for: BuiltFor::new(st, dofs, cells, fit),
+            built_for: BuiltFor::new(st, dofs, cells, fit, coupled),
         }
     }
 
@@ -227,8 +236,9 @@ impl Pattern {
         dofs: &Dofs,
         cells: Option<&Cells>,
         fit: Option<&LeastSquares<D>>,
+        coupled: &[(u32, u32)],
     ) -> bool {
-        self.built_for.fits(st, dofs, cells, fit)
+        self.built_for.fits(st, dofs, cells, fit, coupled)
     }
 
     /// The node graph with the unknowns of each node.
@@ -672,6 +682,39 @@ where
         start.push(start.last().unwrap() + l.len());
     }
     (start, lists.concat())
+}
+
+/// The node graph (`start`, `adjacency`) with every pair of `coupled` nodes
+/// (their owners) joined both ways.
+fn with_pairs(
+    start: Vec<usize>,
+    adjacency: Vec<u32>,
+    coupled: &[(u32, u32)],
+    dofs: &Dofs,
+) -> (Vec<usize>, Vec<u32>) {
+    if coupled.is_empty() {
+        return (start, adjacency);
+    }
+    let n = start.len() - 1;
+    let mut lists: Vec<Vec<u32>> = (0..n)
+        .map(|b| adjacency[start[b]..start[b + 1]].to_vec())
+        .collect();
+    for &(a, b) in coupled {
+        for (oa, _) in dofs.owners(a as usize) {
+            for (ob, _) in dofs.owners(b as usize) {
+                lists[oa].push(ob as u32);
+                lists[ob].push(oa as u32);
+            }
+        }
+    }
+    let mut out_start = Vec::with_capacity(n + 1);
+    out_start.push(0);
+    for l in &mut lists {
+        l.sort_unstable();
+        l.dedup();
+        out_start.push(out_start.last().unwrap() + l.len());
+    }
+    (out_start, lists.concat())
 }
 
 /// The assembled tangent of one Newton iterate: values in the step's pattern.
