@@ -105,13 +105,29 @@ fn a_pair_declared_twice_is_rejected() {
 }
 
 #[test]
-fn implicit_contact_needs_a_rigid_body_and_explicit_contact_no_b_splines() {
+fn implicit_contact_of_deformable_bodies_refuses_multigrid_and_fbar_and_explicit_contact_no_b_splines(
+) {
+    let implicit = |extra: &str| {
+        scene("[[contact]]\n").replace(
+            "kind = \"explicit\"",
+            &format!("kind = \"implicit\"\ndt = 0.1\n{extra}"),
+        )
+    };
     rejected(
-        &scene("[[contact]]\n").replace("kind = \"explicit\"", "kind = \"implicit\"\ndt = 0.1"),
+        &implicit("linear_solver = \"cg\"\npreconditioner = \"multigrid\""),
         "contact",
         &[
             "stage 0 is implicit",
-            "between a deformable and a rigid body only, not between bodies 0 and 1",
+            "between bodies 0 and 1 gives each body its own nodes",
+            "multigrid coarsens the grid's nodes only",
+        ],
+    );
+    rejected(
+        &implicit("fbar = true"),
+        "contact",
+        &[
+            "between bodies 0 and 1 keeps the bodies apart",
+            "F-bar averages the dilation",
         ],
     );
     rejected(

@@ -1380,3 +1380,166 @@ fn implicit_friction_dissipation_closes_the_energy_balance() {
         );
     }
 }
+
+/// The block's slide along the incline at the end time of
+/// `problems/contact_incline_implicit.toml` (two deformable bodies, Newmark)
+/// with friction μ, and the end time.
+fn implicit_slide(mu: f64, extra: &[&str]) -> (f64, f64, tempfile::TempDir) {
+    let mu = format!("contact.0.friction_coefficient={mu}");
+    let mut overrides = vec![mu.as_str(), "output.frames=0"];
+    overrides.extend(extra);
+    let (result, dir) = run_problem("contact_incline_implicit.toml", &overrides);
+    assert_eq!(result.unwrap().status, Status::Completed);
+    let h = Table::read(&dir.path().join("history.csv")).unwrap();
+    let (t, x) = (h.col("t"), h.col("body1_x"));
+    (*t.last().unwrap(), x.last().unwrap() - x[0], dir)
+}
+
+#[test]
+fn implicit_block_slides_on_a_deformable_incline_as_the_closed_form() {
+    // Measured: −0.0005 %, +0.18 %, +0.99 % at t = 0.5 s (Newmark, Δt = 5 ms,
+    // cpGIMP, 20 cells over the block). One shared velocity field would carry
+    // the block with the base: it would not move.
+    for mu in [0.0, 0.3, 0.5] {
+        let (t, x, _) = implicit_slide(mu, &[]);
+        let exact = closed_form(45.0, mu, t);
+        let err = (x / exact - 1.0).abs();
+        println!("mu {mu}: x = {x:.5} m, closed form {exact:.5} m, error {err:.2e}");
+        assert!(err < 0.01, "mu {mu}: x = {x}, exact {exact}");
+    }
+}
+
+/// A block resting on another, rollers on the sides, quasi-static gravity: in
+/// uniaxial strain a frictionless or rough interface changes nothing, so the
+/// stresses equal those of the glued pair (one body).
+const STACKED: &str = r#"dimension = 2
+gravity = [0.0, -10.0]
+[grid]
+min = [0.0, 0.0]
+max = [1.0, 2.5]
+cells = [10, 25]
+shape_function = "cpgimp"
+[[material]]
+name = "soil"
+model = "hencky"
+density = 2000.0
+youngs_modulus = 1.0e7
+poisson_ratio = 0.3
+[[body]]
+name = "base"
+material = "soil"
+shape = "rectangle"
+min = [0.0, 0.0]
+max = [1.0, 1.0]
+[[body]]
+name = "top"
+material = "soil"
+shape = "rectangle"
+min = [0.0, 1.0]
+max = [1.0, 2.0]
+[[contact]]
+bodies = ["base", "top"]
+friction_coefficient = 0.3
+[[boundary]]
+face = "ymin"
+condition = "fixed"
+[[boundary]]
+face = "xmin"
+condition = "roller"
+[[boundary]]
+face = "xmax"
+condition = "roller"
+[solver]
+kind = "implicit"
+integrator = "quasi_static"
+end_time = 1.0
+load_steps = 4
+[output]
+frames = 0
+"#;
+
+#[test]
+fn implicit_contact_carries_a_deformable_block_resting_on_another_as_if_glued() {
+    // Measured (4 load steps): the contact force is the top block's weight,
+    // 20 kN/m, to 3e-14 at every step; the penetration 1.7e-6 m = σ h / (α M).
+    // σ_yy against the glued pair, relative to the exact ρ g (2 − y): linear
+    // 4.5e-5 everywhere; cpGIMP 2e-4 away from the interface but 1.7 % in the
+    // two cells beside it (each body's cell mean off the exact by ∓1.6 %; after
+    // 1 load step 0, after 8 steps 2.0 %): a known error of the split nodes
+    // with domains that reach across the interface node (docs/contact.md).
+    for (shape, tolerance) in [("linear", 1e-4), ("cpgimp", 2e-2)] {
+        let shape_set = format!("grid.shape_function={shape}");
+        let glued_text = STACKED.replace(
+            "[[contact]]\nbodies = [\"base\", \"top\"]\nfriction_coefficient = 0.3\n",
+            "",
+        );
+        let (glued, gdir) = run_text(&glued_text, &[shape_set.as_str()]);
+        assert_eq!(glued.unwrap().status, Status::Completed);
+        let syy = |dir: &tempfile::TempDir| {
+            let t = Table::read(&dir.path().join("particles_final.csv")).unwrap();
+            (t.col("Y0").to_vec(), t.col("syy").to_vec())
+        };
+        let (y0, reference) = syy(&gdir);
+        for mu in ["0.0", "0.3"] {
+            let set = format!("contact.0.friction_coefficient={mu}");
+            let (summary, dir) = run_text(STACKED, &[set.as_str(), shape_set.as_str()]);
+            let summary = summary.unwrap();
+            assert_eq!(summary.status, Status::Completed);
+            let c = Table::read(&dir.path().join("contact.csv")).unwrap();
+            let (t, fx, fy) = (c.col("t"), c.col("fx"), c.col("fy"));
+            let weight = 2000.0 * 1.0 * 10.0;
+            let force = (0..t.len()).fold(0.0f64, |w, k| {
+                let off = (fy[k] / (-weight * t[k]) - 1.0).abs();
+                w.max(off).max((fx[k] / weight).abs())
+            });
+            let (_, s) = syy(&dir);
+            let stress = (0..s.len()).fold(0.0f64, |w, q| {
+                w.max((s[q] - reference[q]).abs() / (2000.0 * 10.0 * (2.0 - y0[q])))
+            });
+            let depth = summary.solver.contact_penetration.unwrap_or(0.0);
+            println!(
+                "{shape} mu {mu}: contact force within {force:.1e} of the weight, σ_yy within \
+                 {stress:.1e} of the glued pair, penetration {depth:.2e} m"
+            );
+            assert!(
+                t.len() == 4 && force < 1e-9,
+                "{} rows, force off by {force}",
+                t.len()
+            );
+            assert!(
+                stress < tolerance,
+                "{shape}: σ_yy off the glued pair by {stress}"
+            );
+            assert!(depth > 0.0 && depth < 1e-5, "penetration {depth}");
+        }
+    }
+}
+
+#[test]
+fn implicit_contact_of_deformable_bodies_does_not_depend_on_the_number_of_threads() {
+    let set = ["output.frames=0", "solver.end_time=0.05"];
+    let one = run_cli("contact_incline_implicit.toml", 1, &set);
+    let two = run_cli("contact_incline_implicit.toml", 2, &set);
+    for f in ["particles_final.csv", "contact.csv", "newton.csv"] {
+        let strip = |bytes: Vec<u8>| -> String {
+            // newton.csv's wall-clock column differs between any two runs.
+            String::from_utf8(bytes)
+                .unwrap()
+                .lines()
+                .map(|l| {
+                    l.split(',')
+                        .enumerate()
+                        .filter(|(i, _)| *i != 7)
+                        .map(|(_, v)| v)
+                        .collect::<Vec<_>>()
+                        .join(",")
+                })
+                .collect::<Vec<_>>()
+                .join("\n")
+        };
+        assert!(
+            strip(read_output(&one, f)) == strip(read_output(&two, f)),
+            "{f} differs"
+        );
+    }
+}

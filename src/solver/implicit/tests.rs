@@ -77,7 +77,7 @@ fn tangent_error_of<const D: usize>(
     let sys = &mut solver.system;
     assert_eq!(sys.absorbing.is_empty(), !absorbing);
     // A smooth, finite-strain iterate (strains of a few per cent).
-    let nodes: Vec<usize> = sys.map.active.iter().map(|&g| g as usize).collect();
+    let nodes: Vec<usize> = (0..sys.map.len()).map(|a| sys.map.grid_node(a)).collect();
     let mut u: Vec<Vector<D>> = nodes
         .iter()
         .zip(&sys.constraint)
@@ -91,6 +91,19 @@ fn tangent_error_of<const D: usize>(
             })
         })
         .collect();
+    // With contact between deformable bodies, the nodes of the second body are
+    // pushed into the first (`SHIFT`).
+    let contact = sys.contact.as_ref();
+    if let Some(fields) = contact.and_then(|c| c.node_fields(&sys.stencils, &sys.map)) {
+        let shift = SHIFT.with(|s| s.get());
+        for (a, u_a) in u.iter_mut().enumerate() {
+            if fields.field(a) > 0 {
+                let x = m.grid.node_position(m.grid.node_ijk(nodes[a]));
+                u_a[0] += shift[0] * x[0];
+                u_a[1] -= shift[1];
+            }
+        }
+    }
     let dofs = sys.dofs.clone();
     dofs.follow_ties(&mut u);
     let tied = dofs.ties.iter().filter(|t| t.is_some()).count();
@@ -103,8 +116,8 @@ fn tangent_error_of<const D: usize>(
     let mut k = vec![0.0; n * n];
     let kt = tangent(&m, sys, false).unwrap();
     if let Some(c) = &sys.contact {
-        let slip = c.touches.iter().filter(|t| t.contact.slips).count();
-        CONTACTS.with(|x| x.set((c.touches.len() - slip, slip)));
+        let (stick, slip) = c.stick_and_slip();
+        CONTACTS.with(|x| x.set((stick, slip)));
     }
     let km = kt.matrix();
     for c in 0..n {
@@ -274,9 +287,83 @@ fn tangent_with_rigid_contact_matches_finite_differences_of_the_residual() {
 }
 
 thread_local! {
-    /// Particles in contact, sticking and slipping, at the tangent of the last
-    /// `tangent_error_of` on this thread.
+    /// Particles (or meetings of two deformable bodies) in contact, sticking
+    /// and slipping, at the tangent of the last `tangent_error_of` on this
+    /// thread.
     static CONTACTS: std::cell::Cell<(usize, usize)> = const { std::cell::Cell::new((0, 0)) };
+    /// The iterate of `tangent_error_of` moves the nodes of a second deformable
+    /// body by (s₀ x, −s₁) (x the node's abscissa).
+    static SHIFT: std::cell::Cell<[f64; 2]> = const { std::cell::Cell::new([0.0, 0.0]) };
+}
+
+/// Two deformable blocks, one on the other (`[[contact]]` between them).
+const STACK: &str = r#"dimension = 2
+gravity = [0.0, -10.0]
+[grid]
+min = [0.0, 0.0]
+max = [4.0, 4.0]
+cells = [8, 8]
+shape_function = "linear"
+[[material]]
+name = "m"
+model = "hencky"
+density = 1000.0
+youngs_modulus = 1.0e5
+poisson_ratio = 0.3
+[[body]]
+name = "base"
+material = "m"
+shape = "rectangle"
+min = [0.0, 0.0]
+max = [4.0, 1.5]
+particles_per_cell = 2
+[[body]]
+name = "top"
+material = "m"
+shape = "rectangle"
+min = [0.5, 1.5]
+max = [3.0, 2.5]
+particles_per_cell = 2
+[[contact]]
+bodies = ["base", "top"]
+friction_coefficient = 0.3
+[[boundary]]
+face = "ymin"
+condition = "fixed"
+[solver]
+kind = "implicit"
+integrator = "newmark"
+end_time = 1.0
+dt = 0.01
+"#;
+
+/// The tangent with penalty contact between two deformable bodies (their
+/// shared nodes split, a penalty between the nodes of each meeting):
+/// frictionless and with friction (meetings sticking and slipping at the
+/// iterate), against central differences of the residual. The upper body's
+/// nodes are pushed 2 mm into the lower one and slid by 1 mm per metre of x,
+/// so that μ = 0.3 sticks at small x and slips at large x.
+#[test]
+fn tangent_with_deformable_contact_matches_finite_differences_of_the_residual() {
+    SHIFT.with(|s| s.set([1e-3, 2e-3]));
+    for (shape, mu) in [("linear", 0.0), ("linear", 0.3), ("bspline2", 0.3)] {
+        let overrides = vec![
+            format!("grid.shape_function={shape}"),
+            format!("contact.0.friction_coefficient={mu}"),
+        ];
+        let (error, n, tied, _) = tangent_error_of::<2>(STACK, &overrides, false);
+        let (stick, slip) = CONTACTS.with(|c| c.get());
+        println!(
+            "{shape} μ = {mu}: {n} unknowns ({tied} nodes tied), {stick} meetings sticking, \
+             {slip} slipping, max |K − K_fd| / max|K| = {error:.2e}"
+        );
+        assert!(
+            stick > 0 && (mu == 0.0 || slip > 0),
+            "{stick} stick, {slip} slip"
+        );
+        assert!(error < 1e-6, "{shape} μ = {mu}: tangent off by {error:.2e}");
+    }
+    SHIFT.with(|s| s.set([0.0, 0.0]));
 }
 
 /// The axisymmetric tangent (the hoop couplings of `assembly::stiffness`, the

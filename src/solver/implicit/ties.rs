@@ -43,6 +43,11 @@ pub struct NodeFields {
 }
 
 impl NodeFields {
+    /// Field of active node a.
+    pub fn field(&self, a: usize) -> u32 {
+        self.of[a]
+    }
+
     /// From the field of every active node of `map`.
     pub fn new(map: &NodeMap, of: Vec<u32>) -> Self {
         let mut by_grid: Vec<(u32, u32, u32)> = (0..map.len())
@@ -103,16 +108,22 @@ pub fn ties<const D: usize>(
     threshold: f64,
 ) -> Vec<Option<Tie>> {
     let weak = |a: usize| support[a] < threshold;
-    if threshold <= 0.0 || !(0..map.len()).any(|a| weak(a) && constraint[a].is_free()) {
+    // A split node (one body's node where two bodies meet) on a face with a
+    // prescribed component is tied too, to masters on that face with the same
+    // prescribed components: the other body no longer shares its stiffness,
+    // and its free components would be nearly singular.
+    let may_tie = |a: usize| constraint[a].is_free() || map.is_split(a);
+    if threshold <= 0.0 || !(0..map.len()).any(|a| weak(a) && may_tie(a)) {
         return Vec::new();
     }
     let directions = directions::<D>();
     let position = |b: usize| grid.node_position(grid.node_ijk(map.grid_node(b)));
     (0..map.len())
         .map(|a| {
-            if !weak(a) || !constraint[a].is_free() {
+            if !weak(a) || !may_tie(a) {
                 return None;
             }
+            let same_face = |b: usize| constraint[b].fixed == constraint[a].fixed;
             let ijk = grid.node_ijk(map.grid_node(a));
             let mut best: Option<(usize, f64, usize, usize)> = None; // (|s|², score, J, K)
             for s in &directions {
@@ -126,6 +137,10 @@ pub fn ties<const D: usize>(
                 ) else {
                     continue;
                 };
+                let prescribed_alike = same_face(j) && same_face(k);
+                if !(constraint[a].is_free() || prescribed_alike) {
+                    continue;
+                }
                 let score = support[j].min(support[k]);
                 if weak(j) || weak(k) || best.is_some_and(|b| b.1 >= score) {
                     continue;
