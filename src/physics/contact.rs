@@ -5,26 +5,20 @@
 //! P2G and again after the grid update (Bardenhagen et al., CMES 2, 2001; Nairn,
 //! Hammerquist & Smith, CMAME 362, 2020).
 //!
-//! **Split nodes.** A grid node that particles of two or more velocity fields touch
-//! (`scene::contact`: bodies without a contact between them form one field) is
-//! split: each field gets a node of its own, with an id past the grid's node count
-//! (`NodeMap::split`). Every transfer (mass, momentum, forces, the velocity
-//! gradient, G2P) then works per field there without change, and a node that one
-//! field touches stays as it is. A scene whose fields never share a node splits
-//! nothing and runs bit for bit as without contact.
+//! **Split nodes and meetings** (`physics::field_split`): every grid node that
+//! particles of two or more velocity fields touch is split, one node per field,
+//! so every transfer (mass, momentum, forces, the velocity gradient, G2P) works
+//! per field there without change; a scene whose fields never share a node splits
+//! nothing and runs bit for bit as without contact. Each pair of fields r < s at a
+//! split node meets with one normal n from r to s (37; by default the maximum
+//! volume gradient: the average tilts at the corners of a body sliding on another
+//! and catches there, a block that should slide 0.87 m on a frictionless incline
+//! slides 0.77 m with it, 0.864 m with the maximum, docs/contact.md), a nodal area
+//! and the gap D between their surfaces.
 //!
-//! **Contact at a shared node** I, fields r < s:
-//! - normal: one n from r to s (37), from the "volume gradients" g = Σ_p V_p ∇S_Ip
-//!   of the fields (≈ ∮ S_I n dA over a field's boundary, so g points out of its
-//!   field): by default the unit g of the field with the larger |g|, ĝ_r or −ĝ_s
-//!   (Nairn's maximum volume gradient); or the average (ĝ_r − ĝ_s)/|ĝ_r − ĝ_s|
-//!   (MPM3D). The average tilts at the corners of a body sliding on another and
-//!   catches there: a block that should slide 0.87 m on a frictionless incline
-//!   slides 0.77 m with it, 0.864 m with the maximum (docs/contact.md);
+//! **Contact at a meeting**, fields r < s:
 //! - approach: (v_r − v_s)·n > 0 (39);
-//! - gap: D = D_r + D_s ≤ λ h (42), with D_r = −max_p((x_p − x_I)·n + l_p) over r's
-//!   particles at I and D_s the same along −n (001 eq. 5); l_p is the extent of the
-//!   particle's domain along the normal, Σ_d l⁰_d |n·F e_d|; h the smallest cell size;
+//! - gap criterion: D ≤ λ h (42), h the smallest cell size;
 //! - correction (41 and Coulomb): the momentum that sticking takes from r is
 //!   P = m_r m_s/(m_r + m_s) (v_r − v_s); the contact removes its normal part P_n and
 //!   of the tangential part P_t at most μ P_n + c A Δt (c the adhesion, A the
@@ -37,7 +31,7 @@
 use crate::dim::Vector;
 use crate::model::Model;
 use crate::parallel::MIN_PARALLEL_LEN;
-use crate::physics::field_split::{FieldSplit, Meeting};
+use crate::physics::field_split::{pair_position, FieldSplit, Meeting};
 use crate::physics::rigid_body::FreeBodies;
 use crate::physics::rigid_surface::{on_grid_boundary, rigid_surfaces, Push, Surface};
 use crate::physics::shape::{ShapeFunction, Stencils};
@@ -79,12 +73,6 @@ pub fn pair_totals<const D: usize>(plan: &ContactPlan) -> Vec<PairTotal<D>> {
         .collect()
 }
 
-/// The position of the pair of fields i < j among `fields` fields in
-/// [`pair_totals`]: the pairs (0, 1), (0, 2), …, (1, 2), … in order.
-pub fn pair_position(fields: usize, i: usize, j: usize) -> usize {
-    debug_assert!(i < j && j < fields);
-    i * fields - i * (i + 1) / 2 + (j - i - 1)
-}
 
 /// The contact state of an explicit run.
 #[derive(Debug)]

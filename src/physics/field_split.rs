@@ -26,7 +26,6 @@
 use crate::dim::Vector;
 use crate::model::Model;
 use crate::parallel::MIN_PARALLEL_LEN;
-use crate::physics::contact::pair_position;
 use crate::physics::rigid_surface::on_grid_boundary;
 use crate::physics::shape::Stencils;
 use crate::physics::transfer::NodeMap;
@@ -60,6 +59,13 @@ pub struct Meeting<const D: usize> {
     /// The gap criterion D ≤ λ h holds.
     pub close: bool,
     pub law: ContactLaw,
+}
+
+/// The position of the pair of fields i < j among `fields` fields in
+/// [`pair_totals`]: the pairs (0, 1), (0, 2), …, (1, 2), … in order.
+pub fn pair_position(fields: usize, i: usize, j: usize) -> usize {
+    debug_assert!(i < j && j < fields);
+    i * fields - i * (i + 1) / 2 + (j - i - 1)
 }
 
 /// The split of shared grid nodes into one node per field.
