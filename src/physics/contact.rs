@@ -73,7 +73,6 @@ pub fn pair_totals<const D: usize>(plan: &ContactPlan) -> Vec<PairTotal<D>> {
         .collect()
 }
 
-
 /// The contact state of an explicit run.
 #[derive(Debug)]
 pub struct Contact<const D: usize> {
