@@ -383,6 +383,7 @@ mod tests {
             rigid: [false, false],
             area: 1.0,
             gap: 0.0,
+            reach: [0.0; 2],
             close: true,
             law: ContactLaw {
                 friction: mu,

@@ -56,6 +56,10 @@ pub struct Meeting<const D: usize> {
     /// Distance between the fields' surfaces along the normal, D = D_r + D_s
     /// (negative where they overlap).
     pub gap: f64,
+    /// How far each field's surface lies beyond the node along its outward
+    /// normal (n for r, −n for s): r's surface is at x_I + reach[0] n, s's at
+    /// x_I − reach[1] n.
+    pub reach: [f64; 2],
     /// The gap criterion D ≤ λ h holds.
     pub close: bool,
     pub law: ContactLaw,
@@ -278,7 +282,8 @@ impl FieldSplit {
                         continue;
                     }
                     let (r, s) = (first_split + i, first_split + j);
-                    let gap = -extent(r, &x_node, &normal) - extent(s, &x_node, &-normal);
+                    let reach = [extent(r, &x_node, &normal), extent(s, &x_node, &-normal)];
+                    let gap = -reach[0] - reach[1];
                     // The contact area (adhesion), per radian in axisymmetric mode.
                     let ring = if axisymmetric { x_node[0] } else { 1.0 };
                     meetings.push(Meeting {
@@ -291,6 +296,7 @@ impl FieldSplit {
                         rigid: [plan.rigid[fr], plan.rigid[fs]],
                         area: 0.5 * (gr.norm() + gs.norm()) * ring,
                         gap,
+                        reach,
                         close: gap <= law.gap_factor * h,
                         law,
                     });

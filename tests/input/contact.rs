@@ -105,8 +105,7 @@ fn a_pair_declared_twice_is_rejected() {
 }
 
 #[test]
-fn implicit_contact_of_deformable_bodies_refuses_multigrid_and_fbar_and_explicit_contact_no_b_splines(
-) {
+fn implicit_contact_of_deformable_bodies_refusals_and_explicit_contact_no_b_splines() {
     let implicit = |extra: &str| {
         scene("[[contact]]\n").replace(
             "kind = \"explicit\"",
@@ -129,6 +128,11 @@ fn implicit_contact_of_deformable_bodies_refuses_multigrid_and_fbar_and_explicit
             "between bodies 0 and 1 keeps the bodies apart",
             "F-bar averages the dilation",
         ],
+    );
+    rejected(
+        &implicit("").replace("\"cpgimp\"", "\"bspline3\""),
+        "grid.shape_function",
+        &["between bodies 0 and 1 is not implemented with cubic B-splines"],
     );
     rejected(
         &scene("[[contact]]\n").replace("\"cpgimp\"", "\"bspline2\""),

@@ -220,6 +220,14 @@ fn deformable_pair(s: &SceneConfig, what: &str, names: &str) -> Check {
         s.grid.domain_stress == DomainStress::Constant,
         "grid.domain_stress",
         format!("{what} between {names} is not implemented with a linear domain stress"),
+    )?;
+    ensure(
+        s.grid.shape_function != crate::scene::ShapeFunction::Bspline3,
+        "grid.shape_function",
+        format!(
+            "{what} between {names} is not implemented with cubic B-splines (two blocks \
+             resting on each other came out wrong beside the interface)"
+        ),
     )
 }
 

@@ -61,8 +61,8 @@ pub fn residual<const D: usize>(
         .collect();
     // Absorbing faces: − f_boundary(u), dashpots through v_{n+1}(u) (2-63).
     sys.absorbing.add_residual(map, st, p, u, &mut r);
-    // Contact: r_I −= S_Ip f_p with rigid bodies, r_r −= f, r_s += f between
-    // the nodes of deformable bodies (`super::contact`).
+    // Contact: r_I −= S_Ip f_p with rigid bodies, r_a −= c_a f between the
+    // surfaces of deformable bodies (`super::contact`).
     if let Some(contact) = sys.contact.as_mut() {
         contact.evaluate(m, st, map, u);
         contact.add_residual(map, st, &mut r);

@@ -340,13 +340,21 @@ dt = 0.01
 /// The tangent with penalty contact between two deformable bodies (their
 /// shared nodes split, a penalty between the nodes of each meeting):
 /// frictionless and with friction (meetings sticking and slipping at the
-/// iterate), against central differences of the residual. The upper body's
+/// iterate), at the meeting's nodes (point bases) and at the surfaces' points
+/// (domain bases), against central differences of the residual. The upper body's
 /// nodes are pushed 2 mm into the lower one and slid by 1 mm per metre of x,
 /// so that μ = 0.3 sticks at small x and slips at large x.
 #[test]
 fn tangent_with_deformable_contact_matches_finite_differences_of_the_residual() {
     SHIFT.with(|s| s.set([1e-3, 2e-3]));
-    for (shape, mu) in [("linear", 0.0), ("linear", 0.3), ("bspline2", 0.3)] {
+    for (shape, mu) in [
+        ("linear", 0.0),
+        ("linear", 0.3),
+        ("bspline2", 0.3),
+        ("cpgimp", 0.0),
+        ("cpgimp", 0.3),
+        ("cpdi", 0.3),
+    ] {
         let overrides = vec![
             format!("grid.shape_function={shape}"),
             format!("contact.0.friction_coefficient={mu}"),
@@ -359,6 +367,28 @@ fn tangent_with_deformable_contact_matches_finite_differences_of_the_residual() 
         );
         assert!(
             stick > 0 && (mu == 0.0 || slip > 0),
+            "{stick} stick, {slip} slip"
+        );
+        assert!(error < 1e-6, "{shape} μ = {mu}: tangent off by {error:.2e}");
+    }
+    // The interface mid-cell, at y = 1.25 (the meetings' surface points off
+    // the nodes, domain bases).
+    let text = STACK
+        .replace("max = [4.0, 1.5]", "max = [4.0, 1.25]")
+        .replace("min = [0.5, 1.5]", "min = [0.5, 1.25]");
+    for (shape, mu) in [("cpgimp", 0.0), ("cpgimp", 0.3), ("cpdi", 0.3)] {
+        let overrides = vec![
+            format!("grid.shape_function={shape}"),
+            format!("contact.0.friction_coefficient={mu}"),
+        ];
+        let (error, n, tied, _) = tangent_error_of::<2>(&text, &overrides, false);
+        let (stick, slip) = CONTACTS.with(|c| c.get());
+        println!(
+            "{shape} μ = {mu}, interface mid-cell: {n} unknowns ({tied} nodes tied), \
+             {stick} meetings sticking, {slip} slipping, max |K − K_fd| / max|K| = {error:.2e}"
+        );
+        assert!(
+            stick + slip > 0 && (mu == 0.0 || slip > 0),
             "{stick} stick, {slip} slip"
         );
         assert!(error < 1e-6, "{shape} μ = {mu}: tangent off by {error:.2e}");

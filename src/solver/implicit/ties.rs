@@ -48,6 +48,16 @@ impl NodeFields {
         self.of[a]
     }
 
+    /// The active node of `field` at grid node g, if any.
+    pub fn active(&self, g: usize, field: u32) -> Option<usize> {
+        let key = (g as u32, field);
+        let i = self
+            .by_grid
+            .binary_search_by_key(&key, |&(g, k, _)| (g, k))
+            .ok()?;
+        Some(self.by_grid[i].2 as usize)
+    }
+
     /// From the field of every active node of `map`.
     pub fn new(map: &NodeMap, of: Vec<u32>) -> Self {
         let mut by_grid: Vec<(u32, u32, u32)> = (0..map.len())
