@@ -430,3 +430,22 @@ fn implicit_contact_restart_keeps_the_friction_history() {
         2,
     );
 }
+
+#[test]
+fn implicit_deformable_contact_restart_keeps_the_meetings_gaps_and_friction() {
+    // A block sliding on a deformable base (Newmark, split nodes, μ = 0.3): each
+    // meeting's gap and tangential force at a step's end are carried to the next
+    // step under its grid node and fields, and a checkpoint keeps them
+    // (`contact_tangential`); without them the restarted run takes the gaps from
+    // the particles and differs.
+    restarts_are_exact(
+        "contact_incline_implicit.toml",
+        &[
+            "solver.end_time=0.06",
+            "output.frames=0",
+            "output.history_interval=0.01",
+        ],
+        0.025,
+        2,
+    );
+}
