@@ -1582,3 +1582,43 @@ fn implicit_contact_of_deformable_bodies_does_not_depend_on_the_number_of_thread
         );
     }
 }
+
+#[test]
+fn implicit_contact_of_deformable_and_rigid_bodies_together_balances() {
+    // The stacked blocks with a rigid plate pressed onto the top one (1 cm/s):
+    // both kinds of implicit contact in one system. At every step the base
+    // carries the top block's weight plus the plate's force (measured 1e-11 of
+    // the force), in 4 Newton iterations a step.
+    let plate = "[[material]]\nname = \"steel\"\nmodel = \"rigid\"\ndensity = 1000.0\n\
+                 [[body]]\nname = \"plate\"\nmaterial = \"steel\"\nshape = \"rectangle\"\n\
+                 min = [0.0, 2.0]\nmax = [1.0, 2.1]\nvelocity = [0.0, -0.01]\n\
+                 [[contact]]\nfriction_coefficient = 0.3\n";
+    let text = STACKED.replace(
+        "[[contact]]\nbodies = [\"base\", \"top\"]\nfriction_coefficient = 0.3\n",
+        plate,
+    );
+    let (summary, dir) = run_text(&text, &[]);
+    let summary = summary.unwrap();
+    assert_eq!(summary.status, Status::Completed);
+    let c = Table::read(&dir.path().join("contact.csv")).unwrap();
+    let (t, first, second, fy) = (c.col("t"), c.col("first"), c.col("second"), c.col("fy"));
+    let weight = 2000.0 * 1.0 * 10.0;
+    let mut pressed = 0;
+    for k in (0..t.len()).filter(|&k| first[k] == 0.0 && second[k] == 1.0) {
+        // The plate's row (bodies 1 and 2) at the same time.
+        let j = (0..t.len())
+            .find(|&j| t[j] == t[k] && first[j] == 1.0 && second[j] == 2.0)
+            .unwrap();
+        let expected = -weight * t[k] + fy[j];
+        let off = (fy[k] / expected - 1.0).abs();
+        println!(
+            "t = {}: base–top {:.1} N/m, top–plate {:.1} N/m, balance {off:.1e}",
+            t[k], fy[k], fy[j]
+        );
+        assert!(off < 1e-8, "t = {}: {} against {expected}", t[k], fy[k]);
+        pressed += (fy[j] < -1.0) as usize;
+    }
+    assert!(pressed >= 2, "the plate pressed in {pressed} steps");
+    let newton = summary.solver.newton_iterations.unwrap_or(usize::MAX);
+    assert!(newton <= 4 * 4, "{newton} Newton iterations in 4 steps");
+}
