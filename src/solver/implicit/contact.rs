@@ -82,32 +82,40 @@ const MIN_AREA: f64 = 0.05;
 /// the residual.
 #[derive(Clone, Copy, Debug)]
 pub struct NodeTouch<const D: usize> {
-    /// Index in `PenaltyContact::meetings`.
+    /// Index of the meeting in `Fields::joints`.
     pub meeting: usize,
     /// The force on field r (s gets the opposite) and its derivative by u_r.
     pub contact: ParticleContact<D>,
+}
+
+/// A meeting of two deformable fields and what its penalty needs.
+#[derive(Clone, Debug)]
+struct Joint<const D: usize> {
+    meeting: Meeting<D>,
+    /// ε = α M A / h.
+    penalty: f64,
+    /// (grid node, r, s): what its history is kept under.
+    key: [u32; 3],
+    /// Tangential force at the step start.
+    f_t0: Vector<D>,
+    /// The nodes whose displacements make the relative displacement δ of the
+    /// two surfaces, with signed weights (`surface_points`).
+    points: Vec<(usize, f64)>,
+    /// Gap at the last residual, D − δ·n.
+    gap_end: f64,
 }
 
 /// The contact between deformable bodies on the split grid.
 #[derive(Clone, Debug)]
 struct Fields<const D: usize> {
     split: FieldSplit,
-    /// The meetings of this step, their penalties and tangential forces at the
-    /// step start.
-    meetings: Vec<Meeting<D>>,
-    penalty: Vec<f64>,
-    f_t0: Vec<Vector<D>>,
-    /// (grid node, r, s) of each meeting.
-    keys: Vec<[u32; 3]>,
+    /// The field of every active node of this step.
+    nodes: Option<NodeFields>,
+    /// The meetings of this step.
+    joints: Vec<Joint<D>>,
     /// What each meeting carried out of the last step, by (grid node, r, s):
     /// its tangential force and its gap at the step's end.
     history: Vec<([u32; 3], Vector<D>, f64)>,
-    /// Each meeting's gap at the last residual, D − (u_r(c_r) − u_s(c_s))·n.
-    gap_end: Vec<f64>,
-    /// Per meeting, the nodes whose displacements make the relative
-    /// displacement of the two surfaces, with signed weights: field r's at its
-    /// surface point c_r (+S), field s's at c_s (−S).
-    points: Vec<Vec<(usize, f64)>>,
     /// Meetings in contact at the last residual.
     touches: Vec<NodeTouch<D>>,
 }
@@ -119,53 +127,48 @@ impl<const D: usize> Fields<D> {
     /// (The particles' surfaces would not do for a meeting that goes on: a
     /// compressed particle's extent shrinks with F, so the gap they show opens
     /// by the compression of the two half-domains at every step, and the
-    /// penalty, closing it, strains the cells at the interface: 1.7 % off the
-    /// stress there after 4 load steps of a block resting on another.)
+    /// penalty, closing it, strains the cells at the interface.)
     fn assign_history(&mut self) {
         let history = &self.history;
-        self.f_t0 = vec![Vector::<D>::zeros(); self.keys.len()];
-        for (k, key) in self.keys.iter().enumerate() {
-            if let Ok(i) = history.binary_search_by_key(key, |h| h.0) {
-                self.f_t0[k] = history[i].1;
-                self.meetings[k].gap = history[i].2;
+        for j in &mut self.joints {
+            j.f_t0 = Vector::<D>::zeros();
+            if let Ok(i) = history.binary_search_by_key(&j.key, |h| h.0) {
+                j.f_t0 = history[i].1;
+                j.meeting.gap = history[i].2;
             }
         }
     }
 
-    /// The meetings in contact at the nodal displacement increments u: the
-    /// penalty of field r against s (module docs).
+    /// The meetings in contact at the displacement increments u: the penalty
+    /// of field r against s (module docs).
     fn evaluate(&mut self, u: &[Vector<D>]) {
-        let relative = |k: usize| {
-            (self.points[k].iter()).fold(Vector::<D>::zeros(), |acc, &(a, c)| acc + u[a] * c)
-        };
-        self.gap_end = (self.meetings.iter().enumerate())
-            .map(|(k, mt)| mt.gap - relative(k).dot(&mt.normal))
-            .collect();
-        self.touches = (self.meetings.iter().enumerate())
-            .filter_map(|(k, mt)| {
-                let relative = relative(k);
-                let depth = relative.dot(&mt.normal) - mt.gap;
-                if depth < 0.0 {
-                    return None;
-                }
-                let inside = Inside {
-                    point: mt.position,
-                    normal: -mt.normal,
-                    normal_derivative: Tensor::<D>::zeros(),
-                    depth,
-                    depth_gradient: mt.normal,
-                };
-                let law = Penalty {
-                    normal: self.penalty[k],
-                    tangential: self.penalty[k],
-                    friction: mt.law.friction,
-                };
-                Some(NodeTouch {
-                    meeting: k,
-                    contact: penalty_force(&law, &inside, &relative, &self.f_t0[k]),
-                })
-            })
-            .collect();
+        self.touches.clear();
+        for (k, j) in self.joints.iter_mut().enumerate() {
+            let mt = &j.meeting;
+            let relative =
+                (j.points.iter()).fold(Vector::<D>::zeros(), |acc, &(a, c)| acc + u[a] * c);
+            let depth = relative.dot(&mt.normal) - mt.gap;
+            j.gap_end = -depth;
+            if depth < 0.0 {
+                continue;
+            }
+            let inside = Inside {
+                point: mt.position,
+                normal: -mt.normal,
+                normal_derivative: Tensor::<D>::zeros(),
+                depth,
+                depth_gradient: mt.normal,
+            };
+            let law = Penalty {
+                normal: j.penalty,
+                tangential: j.penalty,
+                friction: mt.law.friction,
+            };
+            self.touches.push(NodeTouch {
+                meeting: k,
+                contact: penalty_force(&law, &inside, &relative, &j.f_t0),
+            });
+        }
     }
 }
 
@@ -225,13 +228,9 @@ impl<const D: usize> PenaltyContact<D> {
         };
         let fields = deformable_pair.then(|| Fields {
             split: FieldSplit::new(field.clone()),
-            meetings: Vec::new(),
-            penalty: Vec::new(),
-            f_t0: Vec::new(),
-            keys: Vec::new(),
+            nodes: None,
+            joints: Vec::new(),
             history: Vec::new(),
-            gap_end: Vec::new(),
-            points: Vec::new(),
             touches: Vec::new(),
         });
         let totals = pair_totals(&plan);
@@ -269,43 +268,43 @@ impl<const D: usize> PenaltyContact<D> {
         };
         fields.split.split(st, map, n_grid);
         let h = m.grid.h_min();
-        fields.meetings = fields.split.meetings(&self.plan, m, st, map, true);
+        let mut meetings = fields.split.meetings(&self.plan, m, st, map, true);
         // Where both fields' volume gradients are small the node is inside both
         // stencils but at neither surface: its normal would be round-off and
         // its gap along it meaningless (two bodies' particles side by side
         // across the node), so it is no meeting.
         let face = h.powi(D as i32 - 1);
-        fields.meetings.retain(|mt| mt.area >= MIN_AREA * face);
-        // A gap of round-off (faces that coincide at the step start) is none.
-        for mt in &mut fields.meetings {
-            if mt.gap.abs() <= 1e-9 * h {
-                mt.gap = 0.0;
-            }
-        }
-        // ε = α M A / h, M the stiffer material at the two nodes.
+        meetings.retain(|mt| mt.area >= MIN_AREA * face);
         let (p, owner) = (&m.particles, st.owner());
+        let of = (0..map.len())
+            .map(|a| fields.split.field(owner.of(map.node_entries(a)[0])))
+            .collect();
+        let nodes = NodeFields::new(map, of);
+        // ε = α M A / h, M the stiffer material at the two nodes.
         let modulus = |a: usize| {
             (map.node_entries(a).iter())
                 .map(|&e| m.materials[p.material[owner.of(e)] as usize].p_wave_modulus())
                 .fold(0.0, f64::max)
         };
-        fields.penalty = (fields.meetings.iter())
-            .map(|mt| mt.law.penalty_factor * modulus(mt.r).max(modulus(mt.s)) * mt.area / h)
-            .collect();
-        fields.keys = (fields.meetings.iter())
-            .map(|mt| {
+        fields.joints = (meetings.into_iter())
+            .map(|mut mt| {
+                // A gap of round-off (faces that coincide at the step start) is none.
+                if mt.gap.abs() <= 1e-9 * h {
+                    mt.gap = 0.0;
+                }
                 let [r, s] = mt.fields;
-                [map.grid_node(mt.r) as u32, r as u32, s as u32]
+                Joint {
+                    penalty: mt.law.penalty_factor * modulus(mt.r).max(modulus(mt.s)) * mt.area / h,
+                    key: [map.grid_node(mt.r) as u32, r as u32, s as u32],
+                    f_t0: Vector::<D>::zeros(),
+                    points: surface_points(&mt, shape, &m.grid, &nodes),
+                    gap_end: mt.gap,
+                    meeting: mt,
+                }
             })
             .collect();
+        fields.nodes = Some(nodes);
         fields.assign_history();
-        let of = (0..map.len())
-            .map(|a| fields.split.field(owner.of(map.node_entries(a)[0])))
-            .collect();
-        let nodes = NodeFields::new(map, of);
-        fields.points = (fields.meetings.iter())
-            .map(|mt| surface_points(mt, shape, &m.grid, &nodes))
-            .collect();
         fields.touches.clear();
     }
 
@@ -317,47 +316,29 @@ impl<const D: usize> PenaltyContact<D> {
             return;
         };
         let tied = |a: usize| dofs.ties.get(a).is_some_and(Option::is_some);
-        let keep: Vec<bool> = (f.meetings.iter())
-            .map(|mt| !tied(mt.r) && !tied(mt.s))
-            .collect();
-        let mut k = 0;
-        f.meetings.retain(|_| (keep[k], k += 1).0);
-        let mut k = 0;
-        f.penalty.retain(|_| (keep[k], k += 1).0);
-        let mut k = 0;
-        f.f_t0.retain(|_| (keep[k], k += 1).0);
-        let mut k = 0;
-        f.keys.retain(|_| (keep[k], k += 1).0);
-        let mut k = 0;
-        f.points.retain(|_| (keep[k], k += 1).0);
+        f.joints
+            .retain(|j| !tied(j.meeting.r) && !tied(j.meeting.s));
     }
 
-    /// The field of every active node, with contact between deformable bodies
-    /// (for the ties of weakly supported nodes, which must not cross bodies).
-    pub fn node_fields(&self, st: &Stencils<D>, map: &NodeMap) -> Option<NodeFields> {
-        let fields = self.fields.as_ref()?;
-        let owner = st.owner();
-        let of = (0..map.len())
-            .map(|a| fields.split.field(owner.of(map.node_entries(a)[0])))
-            .collect();
-        Some(NodeFields::new(map, of))
+    /// The field of every active node of this step, with contact between
+    /// deformable bodies (for the ties of weakly supported nodes, which must
+    /// not cross bodies).
+    pub fn node_fields(&self) -> Option<&NodeFields> {
+        self.fields.as_ref()?.nodes.as_ref()
     }
 
     /// Pairs of active nodes that the contact couples beyond the stencils (the
     /// two nodes of each meeting), for the tangent's pattern.
     pub fn coupled_nodes(&self) -> Vec<(u32, u32)> {
-        let pairs = |points: &Vec<(usize, f64)>| {
-            let nodes: Vec<u32> = points.iter().map(|&(a, _)| a as u32).collect();
-            let each = nodes.clone();
-            nodes
-                .into_iter()
-                .flat_map(move |a| each.clone().into_iter().map(move |b| (a, b)))
-                .filter(|(a, b)| a < b)
-                .collect::<Vec<_>>()
-        };
-        (self.fields.iter())
-            .flat_map(|f| f.points.iter().flat_map(pairs))
-            .collect()
+        let mut pairs = Vec::new();
+        for j in self.fields.iter().flat_map(|f| &f.joints) {
+            for &(a, _) in &j.points {
+                for &(b, _) in j.points.iter().filter(|&&(b, _)| a < b) {
+                    pairs.push((a as u32, b as u32));
+                }
+            }
+        }
+        pairs
     }
 
     /// Whether particle q belongs to a rigid body (it stays off the grid).
@@ -439,7 +420,7 @@ impl<const D: usize> PenaltyContact<D> {
             }
         }
         for (f, t) in self.node_touches() {
-            for &(a, c) in &f.points[t.meeting] {
+            for &(a, c) in &f.joints[t.meeting].points {
                 r[a] -= t.contact.force * c;
             }
         }
@@ -472,8 +453,9 @@ impl<const D: usize> PenaltyContact<D> {
     ) {
         for (f, t) in self.node_touches() {
             let d = &t.contact.derivative;
-            for &(a, ca) in &f.points[t.meeting] {
-                for &(b, cb) in &f.points[t.meeting] {
+            let points = &f.joints[t.meeting].points;
+            for &(a, ca) in points {
+                for &(b, cb) in points {
                     add_node_block(k, dofs, a, b, &(d * (-ca * cb)));
                 }
             }
@@ -539,17 +521,16 @@ impl<const D: usize> PenaltyContact<D> {
             total.dissipation += t.contact.dissipation;
         }
         if let Some(f) = self.fields.as_mut() {
-            let mut tangential = vec![Vector::<D>::zeros(); f.meetings.len()];
+            let mut tangential = vec![Vector::<D>::zeros(); f.joints.len()];
             for t in &f.touches {
                 tangential[t.meeting] = t.contact.tangential;
             }
-            f.history = (0..f.meetings.len())
-                .map(|k| (f.keys[k], tangential[k], f.gap_end[k]))
+            f.history = (f.joints.iter().zip(tangential))
+                .map(|(j, f_t)| (j.key, f_t, j.gap_end))
                 .collect();
             f.history.sort_by_key(|h| h.0);
             for t in &f.touches {
-                let mt = &f.meetings[t.meeting];
-                let total = &mut self.totals[mt.pair];
+                let total = &mut self.totals[f.joints[t.meeting].meeting.pair];
                 total.impulse += t.contact.force * dt;
                 total.nodes += 1;
                 total.dissipation += t.contact.dissipation;

@@ -424,8 +424,7 @@ pub fn number_unknowns<const D: usize>(
         .map(|(a, _)| implicit_node_constraint(&m.grid, &m.faces, &m.friction, map.grid_node(a)))
         .collect();
     let support = nodal_support(map, st, &m.particles.volume, m.grid.cell_volume());
-    let fields = contact.and_then(|c| c.node_fields(st, map));
-    let fields = fields.as_ref();
+    let fields = contact.and_then(|c| c.node_fields());
     let weak = ties(
         &m.grid,
         map,

@@ -94,7 +94,7 @@ fn tangent_error_of<const D: usize>(
     // With contact between deformable bodies, the nodes of the second body are
     // pushed into the first (`SHIFT`).
     let contact = sys.contact.as_ref();
-    if let Some(fields) = contact.and_then(|c| c.node_fields(&sys.stencils, &sys.map)) {
+    if let Some(fields) = contact.and_then(|c| c.node_fields()) {
         let shift = SHIFT.with(|s| s.get());
         for (a, u_a) in u.iter_mut().enumerate() {
             if fields.field(a) > 0 {
@@ -271,19 +271,25 @@ fn tangent_with_rigid_contact_matches_finite_differences_of_the_residual() {
             &format!("[[contact]]\nfriction_coefficient = {mu}\n[solver]"),
         );
         let overrides = vec![format!("grid.shape_function={shape}")];
-        let (error, n, _, _) = tangent_error_of::<2>(&text, &overrides, false);
-        // What the contact did at the iterate (the last residual is at u − h e).
-        let (stick, slip) = CONTACTS.with(|c| c.get());
-        println!(
-            "{shape} μ = {mu}: {n} unknowns, {stick} particles sticking, {slip} slipping, \
-             max |K − K_fd| / max|K| = {error:.2e}"
-        );
-        assert!(
-            stick > 0 && (mu == 0.0 || slip > 0),
-            "{stick} stick, {slip} slip"
-        );
-        assert!(error < 1e-6, "{shape} μ = {mu}: tangent off by {error:.2e}");
+        assert_contact_tangent(&text, &overrides, &format!("{shape} μ = {mu}"), mu);
     }
+}
+
+/// `tangent_error_of` a scene with contact: the tangent within 1e-6 of central
+/// differences, and the iterate with contacts sticking (and, with friction μ,
+/// slipping) at it (the last residual is at u − h e).
+fn assert_contact_tangent(text: &str, overrides: &[String], label: &str, mu: f64) {
+    let (error, n, tied, _) = tangent_error_of::<2>(text, overrides, false);
+    let (stick, slip) = CONTACTS.with(|c| c.get());
+    println!(
+        "{label}: {n} unknowns ({tied} nodes tied), {stick} contacts sticking, {slip} \
+         slipping, max |K − K_fd| / max|K| = {error:.2e}"
+    );
+    assert!(
+        stick > 0 && (mu == 0.0 || slip > 0),
+        "{label}: {stick} stick, {slip} slip"
+    );
+    assert!(error < 1e-6, "{label}: tangent off by {error:.2e}");
 }
 
 thread_local! {
@@ -369,22 +375,17 @@ fn tangent_with_deformable_contact_matches_finite_differences_of_the_residual() 
             format!("grid.shape_function={shape}"),
             format!("contact.0.friction_coefficient={mu}"),
         ];
-        let (error, n, tied, _) = tangent_error_of::<2>(text, &overrides, false);
-        let (stick, slip) = CONTACTS.with(|c| c.get());
         let at = if *text == mid_cell {
             "mid-cell"
         } else {
             "on a node row"
         };
-        println!(
-            "{shape} μ = {mu}, interface {at}: {n} unknowns ({tied} nodes tied), {stick} \
-             meetings sticking, {slip} slipping, max |K − K_fd| / max|K| = {error:.2e}"
+        assert_contact_tangent(
+            text,
+            &overrides,
+            &format!("{shape} μ = {mu}, interface {at}"),
+            mu,
         );
-        assert!(
-            stick > 0 && (mu == 0.0 || slip > 0),
-            "{stick} stick, {slip} slip"
-        );
-        assert!(error < 1e-6, "{shape} μ = {mu}: tangent off by {error:.2e}");
     }
     SHIFT.with(|s| s.set([0.0, 0.0]));
 }
