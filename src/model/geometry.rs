@@ -1,10 +1,11 @@
 //! The geometry of a body: an axis-aligned box (rectangle in 2D), a ball (disk,
-//! sphere), a cylinder along z (3D) or a simple polygon (2D), as given by the `[[body]]` keys. The model
+//! sphere), a cylinder along z (3D), a simple polygon (2D) or a polygon extruded
+//! along an axis (a prism, 3D), as given by the `[[body]]` keys. The model
 //! fills it with particles (`contains`, within `BodyConfig::bounds`, which the
 //! validation also uses) and measures the depth of a particle below its body's
 //! top surface for geostatic stresses (`top`).
 
-use crate::scene::{BodyConfig, BodyShape};
+use crate::scene::{prism_plane, BodyConfig, BodyShape};
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Geometry {
@@ -19,6 +20,15 @@ pub enum Geometry {
         base: Vec<f64>,
         radius: f64,
         height: f64,
+    },
+    /// The polygon `section` (coordinates along the axes `plane`) extruded over
+    /// `from..to` along `axis`.
+    Prism {
+        section: Vec<Vec<f64>>,
+        axis: usize,
+        plane: [usize; 2],
+        from: f64,
+        to: f64,
     },
 }
 
@@ -40,6 +50,16 @@ impl Geometry {
                 radius: b.radius.expect("validated"),
                 height: b.height.expect("validated"),
             },
+            BodyShape::Prism => {
+                let extent = b.extent.as_ref().expect("validated");
+                Geometry::Prism {
+                    section: b.vertices.clone().expect("validated"),
+                    axis: b.prism_axis(),
+                    plane: prism_plane(b.prism_axis()),
+                    from: extent[0],
+                    to: extent[1],
+                }
+            }
         }
     }
 
@@ -59,6 +79,17 @@ impl Geometry {
             } => {
                 let r2 = (x[0] - base[0]).powi(2) + (x[1] - base[1]).powi(2);
                 r2 < radius.powi(2) && x[2] > base[2] && x[2] < base[2] + height
+            }
+            Geometry::Prism {
+                section,
+                axis,
+                plane,
+                from,
+                to,
+            } => {
+                x[*axis] > *from
+                    && x[*axis] < *to
+                    && point_in_polygon(x[plane[0]], x[plane[1]], section)
             }
         }
     }
@@ -84,6 +115,12 @@ impl Geometry {
                 let w = 1 - v;
                 let r2 = (x[w] - base[w]).powi(2);
                 up * base[v] + (radius.powi(2) - r2).max(0.0).sqrt()
+            }
+            Geometry::Prism { axis, from, to, .. } if v == *axis => (up * from).max(up * to),
+            Geometry::Prism { section, plane, .. } => {
+                // v is one of the section's axes: its top on the line through x.
+                let k = usize::from(plane[1] == v);
+                polygon_top(section, x[plane[1 - k]], k, up)
             }
         }
     }
@@ -112,6 +149,24 @@ impl Geometry {
                 vec![base[0] - radius, base[1] - radius, base[2]],
                 vec![base[0] + radius, base[1] + radius, base[2] + height],
             ),
+            Geometry::Prism {
+                section,
+                axis,
+                plane,
+                from,
+                to,
+            } => {
+                let (mut lo, mut hi) = (vec![0.0; 3], vec![0.0; 3]);
+                (lo[*axis], hi[*axis]) = (*from, *to);
+                for (k, &d) in plane.iter().enumerate() {
+                    lo[d] = section.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min);
+                    hi[d] = section
+                        .iter()
+                        .map(|p| p[k])
+                        .fold(f64::NEG_INFINITY, f64::max);
+                }
+                (lo, hi)
+            }
         }
     }
 
@@ -182,6 +237,29 @@ impl Geometry {
                 for (c, sign) in [(base[2], -1.0), (base[2] + height, 1.0)] {
                     if !on_boundary(2, c) {
                         faces.push(on_plane(2, c, sign));
+                    }
+                }
+            }
+            Geometry::Prism {
+                section,
+                axis,
+                plane,
+                from,
+                to,
+            } => {
+                // The section's edges, extruded: points and normals in the plane.
+                let xs = [x[plane[0]], x[plane[1]]];
+                let in_plane = |d: usize, c: f64| on_boundary(plane[d], c);
+                for (l, y, n) in polygon_faces(section, &xs, &in_plane) {
+                    let (mut point, mut normal) = (x.to_vec(), vec![0.0; 3]);
+                    for k in 0..2 {
+                        (point[plane[k]], normal[plane[k]]) = (y[k], n[k]);
+                    }
+                    faces.push((l, point, normal, Bend::Flat));
+                }
+                for (c, sign) in [(*from, -1.0), (*to, 1.0)] {
+                    if !on_boundary(*axis, c) {
+                        faces.push(on_plane(*axis, c, sign));
                     }
                 }
             }
@@ -273,7 +351,7 @@ impl Geometry {
                     },
                 ))
             }
-            Geometry::Cylinder { .. } => None,
+            Geometry::Cylinder { .. } | Geometry::Prism { .. } => None,
         }
     }
 }
@@ -484,5 +562,61 @@ mod tests {
         assert_eq!(polygon_top(&v, 5.0, 1, 1.0), 10.0);
         assert!((polygon_top(&v, 25.0, 1, 1.0) - 5.0).abs() < 1e-12);
         assert!((polygon_top(&v, 35.0, 1, 1.0) - 0.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_prism_is_its_section_extruded() {
+        // The 2:1 slope in the x–z plane, extruded over 0 < y < 4 (axis y).
+        let section: Vec<Vec<f64>> = [[0.0, 0.0], [35.0, 0.0], [15.0, 10.0], [0.0, 10.0]]
+            .iter()
+            .map(|p| p.to_vec())
+            .collect();
+        let prism = Geometry::Prism {
+            section: section.clone(),
+            axis: 1,
+            plane: prism_plane(1),
+            from: 0.0,
+            to: 4.0,
+        };
+        let slope = Geometry::Polygon(section);
+        for (x, z) in [
+            (5.0, 5.0),
+            (25.0, 4.9),
+            (25.0, 5.1),
+            (36.0, 0.5),
+            (10.0, 9.99),
+        ] {
+            for y in [-0.1, 0.1, 3.9, 4.1] {
+                let inside = slope.contains(&[x, z]) && (0.0..4.0).contains(&y);
+                assert_eq!(prism.contains(&[x, y, z]), inside, "({x}, {y}, {z})");
+            }
+            // Depth below the top along z (up = +1), and the extent along y.
+            assert_eq!(prism.top(&[x, 2.0, z], 2, 1.0), slope.top(&[x, z], 1, 1.0));
+            assert_eq!(prism.top(&[x, 2.0, z], 1, 1.0), 4.0);
+            assert_eq!(prism.top(&[x, 2.0, z], 1, -1.0), 0.0);
+        }
+        assert_eq!(prism.bounds(), (vec![0.0, 0.0, 0.0], vec![35.0, 4.0, 10.0]));
+        // Inside: the slope face (normal (1, 0, 2)/√5), an end face, or a face
+        // on a boundary plane left out.
+        let none = |_: usize, _: f64| false;
+        let s = prism
+            .nearest_surface_point(&[24.0, 2.0, 5.0], &none)
+            .unwrap();
+        let n = [1.0 / 5f64.sqrt(), 0.0, 2.0 / 5f64.sqrt()];
+        assert!(
+            (0..3).all(|d| (s.normal[d] - n[d]).abs() < 1e-12),
+            "{:?}",
+            s.normal
+        );
+        assert!((s.point[1] - 2.0).abs() < 1e-15);
+        let s = prism
+            .nearest_surface_point(&[5.0, 0.2, 5.0], &none)
+            .unwrap();
+        assert_eq!((s.normal.clone(), s.point[1]), (vec![0.0, -1.0, 0.0], 0.0));
+        let symmetry = |d: usize, c: f64| d == 1 && c == 0.0;
+        let s = prism
+            .nearest_surface_point(&[5.0, 0.2, 9.0], &symmetry)
+            .unwrap();
+        assert_eq!(s.normal, vec![0.0, 0.0, 1.0]);
     }
 }

@@ -128,6 +128,10 @@ pub enum BodyShape {
     Polygon,
     /// 3D, axis along z: `centre` of its bottom face, `radius`, `height`.
     Cylinder,
+    /// 3D, a polygon extruded along an axis: `vertices` in the plane of the
+    /// other two axes (in increasing order: x–z for the default axis y),
+    /// `extent` = [from, to] along `axis`.
+    Prism,
 }
 
 impl BodyShape {
@@ -150,6 +154,10 @@ pub struct BodyConfig {
     pub vertices: Option<Vec<Vec<f64>>>,
     /// Length along its axis (cylinder).
     pub height: Option<f64>,
+    /// The axis a prism is extruded along: "x", "y" (default) or "z".
+    pub axis: Option<String>,
+    /// [from, to] of a prism along its axis.
+    pub extent: Option<Vec<f64>>,
     /// Particles per cell per direction: one number or one per direction.
     #[serde(default = "default_ppc")]
     pub particles_per_cell: PerDirection,
@@ -214,7 +222,38 @@ impl BodyConfig {
                     .collect();
                 (lo, hi)
             }
+            BodyShape::Prism => {
+                let (v, e) = (
+                    self.vertices.as_ref().unwrap(),
+                    self.extent.as_ref().unwrap(),
+                );
+                let plane = prism_plane(self.prism_axis());
+                let (mut lo, mut hi) = (vec![e[0]; 3], vec![e[1]; 3]);
+                for (k, &d) in plane.iter().enumerate() {
+                    lo[d] = v.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min);
+                    hi[d] = v.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max);
+                }
+                (lo, hi)
+            }
         }
+    }
+
+    /// A prism's axis (validated): 0, 1 or 2; y when not given.
+    pub fn prism_axis(&self) -> usize {
+        self.axis
+            .as_deref()
+            .and_then(crate::scene::grid::axis)
+            .unwrap_or(1)
+    }
+}
+
+/// The two axes of a prism's cross-section (its `vertices`' coordinates), in
+/// increasing order: the axes other than `axis`.
+pub fn prism_plane(axis: usize) -> [usize; 2] {
+    match axis {
+        0 => [1, 2],
+        1 => [0, 2],
+        _ => [0, 1],
     }
 }
 

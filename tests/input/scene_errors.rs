@@ -588,3 +588,43 @@ fn a_reference_that_does_not_fit_is_rejected() {
         "bench stopped before running"
     );
 }
+
+#[test]
+fn prism_mistakes_are_named() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("problems/slope_3d.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    Scene::parse("slope.toml", &text, &[]).expect("the shipped prism is valid");
+    let with = |set: &str| {
+        Scene::parse("slope.toml", &text, &[set.into()])
+            .expect_err("must be rejected")
+            .to_string()
+    };
+    for (set, key, words) in [
+        ("body.0.extent=[5.0, 0.0]", "body.0.extent", "to > from"),
+        ("body.0.extent=[0.0]", "body.0.extent", "[from, to]"),
+        ("body.0.axis=\"w\"", "body.0.axis", "unknown axis `w`"),
+    ] {
+        let e = with(set);
+        assert!(
+            e.contains(&format!("key `{key}`")) && e.contains(words),
+            "{set}: {e}"
+        );
+    }
+    rejected(
+        &text.replace("extent = [0.0, 5.0]\n", ""),
+        &["key `body.0.extent`", "required"],
+    );
+    rejected(
+        &text.replace("[35.0, 0.0]", "[35.0]"),
+        &["key `body.0.vertices.1`", "2 finite coordinates"],
+    );
+    // A prism is 3D; `axis` and `extent` belong to prisms only.
+    rejected(
+        &GOOD.replace("shape = \"rectangle\"", "shape = \"prism\""),
+        &["key `body.0.shape`", "3D shape but dimension = 2"],
+    );
+    rejected(
+        &GOOD.replace("max = [2.0, 1.0]", "max = [2.0, 1.0]\naxis = \"y\""),
+        &["key `body.0.axis`", "does not apply"],
+    );
+}

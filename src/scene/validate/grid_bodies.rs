@@ -124,8 +124,12 @@ fn shape_keys(b: &BodyConfig, i: usize, dim: usize) -> Check {
     )?;
     let shape_dim = match b.shape {
         BodyShape::Rectangle | BodyShape::Disk | BodyShape::Polygon => 2,
-        BodyShape::Box | BodyShape::Sphere | BodyShape::Cylinder => 3,
+        BodyShape::Box | BodyShape::Sphere | BodyShape::Cylinder | BodyShape::Prism => 3,
     };
+    if b.shape != BodyShape::Prism {
+        forbidden(&b.axis, key("axis"), &what)?;
+        forbidden(&b.extent, key("extent"), &what)?;
+    }
     ensure(
         shape_dim == dim,
         key("shape"),
@@ -171,16 +175,30 @@ fn shape_keys(b: &BodyConfig, i: usize, dim: usize) -> Check {
             forbidden(&b.centre, key("centre"), &what)?;
             forbidden(&b.radius, key("radius"), &what)?;
             forbidden(&b.height, key("height"), &what)?;
-            let v = b.vertices.as_ref().unwrap();
-            ensure(
-                v.len() >= 3,
-                key("vertices"),
-                "a polygon needs at least 3 vertices",
-            )?;
-            for (k, p) in v.iter().enumerate() {
-                vector(p, 2, &format!("body.{i}.vertices.{k}"))?;
+            polygon_vertices(b, i)
+        }
+        BodyShape::Prism => {
+            required(&b.vertices, key("vertices"), &what)?;
+            required(&b.extent, key("extent"), &what)?;
+            forbidden(&b.min, key("min"), &what)?;
+            forbidden(&b.max, key("max"), &what)?;
+            forbidden(&b.centre, key("centre"), &what)?;
+            forbidden(&b.radius, key("radius"), &what)?;
+            forbidden(&b.height, key("height"), &what)?;
+            if let Some(a) = &b.axis {
+                ensure(
+                    crate::scene::grid::axis(a).is_some(),
+                    key("axis"),
+                    format!("unknown axis `{a}`: expected \"x\", \"y\" or \"z\""),
+                )?;
             }
-            Ok(())
+            polygon_vertices(b, i)?;
+            let e = b.extent.as_ref().unwrap();
+            ensure(
+                e.len() == 2 && e.iter().all(|x| x.is_finite()) && e[1] > e[0],
+                key("extent"),
+                "needs [from, to] along the axis, finite, with to > from",
+            )
         }
         BodyShape::Cylinder => {
             required(&b.centre, key("centre"), &what)?;
@@ -200,4 +218,23 @@ fn shape_keys(b: &BodyConfig, i: usize, dim: usize) -> Check {
             Ok(())
         }
     }
+}
+
+/// A polygon's (or a prism's cross-section's) vertices: at least 3 points in
+/// the plane.
+fn polygon_vertices(b: &BodyConfig, i: usize) -> Check {
+    let v = b.vertices.as_ref().unwrap();
+    ensure(
+        v.len() >= 3,
+        format!("body.{i}.vertices"),
+        "a polygon needs at least 3 vertices",
+    )?;
+    for (k, p) in v.iter().enumerate() {
+        ensure(
+            p.len() == 2 && p.iter().all(|x| x.is_finite()),
+            format!("body.{i}.vertices.{k}"),
+            format!("needs 2 finite coordinates in the polygon's plane, has {p:?}"),
+        )?;
+    }
+    Ok(())
 }

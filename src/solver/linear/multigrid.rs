@@ -11,7 +11,13 @@
 //! level a Chebyshev smoother on the nodal block-Jacobi preconditioned operator
 //! D_l⁻¹ A_l, the residual restricted by P_lᵀ, the coarse correction prolongated
 //! by P_l, the same smoother again; on the coarsest level the sparse direct solver
-//! (LLᵀ, else LBLᵀ, else LU). Pre- and post-smoother are the same polynomial in
+//! (LLᵀ, else LBLᵀ, else LU). A singular coarsest operator is factorized with its
+//! diagonal raised by [`COARSE_SHIFT`] of its mean: on a ragged active set two
+//! coarse basis functions can coincide on the fine unknowns they reach, P z = 0,
+//! so that A_c z = 0; the restricted residual Pᵀ r has no component along z and
+//! the prolongated correction none either, so the shift leaves the V-cycle as it
+//! would be with a pseudo-inverse (the plastic 2D slope at F = 1.3 had two such
+//! modes on its 1,187-unknown coarse level). Pre- and post-smoother are the same polynomial in
 //! D⁻¹A, so for symmetric A the V-cycle is a symmetric operator and CG stays
 //! valid (ibid. §A.2.3).
 //!
@@ -37,6 +43,10 @@ use super::iterative::Preconditioner;
 use super::preconditioner::BlockJacobi;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use rayon::prelude::*;
+
+/// The diagonal shift of a singular coarsest operator, relative to its mean
+/// diagonal entry (module doc).
+pub const COARSE_SHIFT: f64 = 1e-8;
 
 /// Degree of the Chebyshev polynomial of each pre- and post-smoothing.
 pub const SMOOTHING_STEPS: usize = 2;
@@ -315,6 +325,9 @@ pub struct Shape {
     pub unknowns: Vec<usize>,
     /// Stored entries of every level's operator (both triangles).
     pub entries: Vec<usize>,
+    /// The coarsest operator's diagonal shift relative to its mean diagonal (0
+    /// unless it was singular).
+    pub coarse_shift: f64,
 }
 
 impl Multigrid {
@@ -345,13 +358,14 @@ impl Multigrid {
             operators.push(coarse);
         }
         let mut used = self.transfers.len();
+        let mut shift = 0.0;
         loop {
-            let (pattern, values) = operators[used].to_csc(symmetric);
-            let matrix = SparseColMatRef::new(pattern.as_ref(), &values);
-            match self
-                .coarse
-                .factorize(matrix, Structure::of(symmetric), Ordering::Amd)
-            {
+            let plain = self.factorize_coarse(&operators[used], symmetric, 0.0);
+            let shifted = plain.or_else(|_| {
+                self.factorize_coarse(&operators[used], symmetric, COARSE_SHIFT)
+                    .map(|_| shift = COARSE_SHIFT)
+            });
+            match shifted {
                 Ok(_) => break,
                 Err(e) if used == 0 => return Err(format!("coarse factorization failed: {e}")),
                 Err(_) => used -= 1,
@@ -360,6 +374,7 @@ impl Multigrid {
         let shape = Shape {
             unknowns: operators[..=used].iter().map(|a| a.rows).collect(),
             entries: operators[..=used].iter().map(|a| a.nnz()).collect(),
+            coarse_shift: shift,
         };
         operators.truncate(used + 1);
         self.smoothers = operators[..used]
@@ -380,6 +395,27 @@ impl Multigrid {
             .collect();
         self.operators = operators;
         Ok(shape)
+    }
+
+    /// Factorize `a` as the coarsest operator, its diagonal raised by `shift`
+    /// times the mean |a_ii|.
+    fn factorize_coarse(&mut self, a: &Csr, symmetric: bool, shift: f64) -> Result<(), String> {
+        let (pattern, mut values) = a.to_csc(symmetric);
+        if shift > 0.0 {
+            let (col_ptr, rows) = (pattern.col_ptr(), pattern.row_idx());
+            let diagonal: Vec<usize> = (0..a.rows)
+                .filter_map(|j| (col_ptr[j]..col_ptr[j + 1]).find(|&k| rows[k] == j))
+                .collect();
+            let mean = diagonal.iter().map(|&k| values[k].abs()).sum::<f64>() / a.rows as f64;
+            for k in diagonal {
+                values[k] += shift * mean * values[k].signum();
+            }
+        }
+        let matrix = SparseColMatRef::new(pattern.as_ref(), &values);
+        self.coarse
+            .factorize(matrix, Structure::of(symmetric), Ordering::Amd)
+            .map(|_| ())
+            .map_err(|e| e.to_string())
     }
 
     /// Levels in use (with the coarsest).
@@ -563,5 +599,82 @@ mod tests {
         assert_eq!(t.val[2], 3.0);
         let tt = t.transpose();
         assert_eq!((tt.row_ptr, tt.col, tt.val), (a.row_ptr, a.col, a.val));
+    }
+
+    /// Linear interpolation from coarse node i (at fine node 2i + 1) to the
+    /// fine nodes of a 1D grid of `n` = 2 n_c + 1 unknowns, with column
+    /// `n_c − 1` given twice when `duplicate` (columns n_c − 1 and n_c equal).
+    fn interpolation(n: usize, duplicate: bool) -> Csr {
+        let nc = (n - 1) / 2;
+        let mut p = Csr {
+            rows: n,
+            cols: nc + usize::from(duplicate),
+            row_ptr: vec![0],
+            ..Default::default()
+        };
+        for i in 0..n {
+            let mut entries: Vec<(usize, f64)> = match i % 2 {
+                1 => vec![(i / 2, 1.0)],
+                _ => [i / 2, (i / 2).wrapping_sub(1)]
+                    .into_iter()
+                    .filter(|&c| c < nc)
+                    .map(|c| (c, 0.5))
+                    .collect(),
+            };
+            if duplicate {
+                if let Some(&(_, w)) = entries.iter().find(|e| e.0 == nc - 1) {
+                    entries.push((nc, w));
+                }
+            }
+            entries.sort_by_key(|e| e.0);
+            for (c, w) in entries {
+                p.col.push(c as u32);
+                p.val.push(w);
+            }
+            p.row_ptr.push(p.col.len());
+        }
+        p
+    }
+
+    #[test]
+    fn a_singular_coarse_operator_is_shifted_not_replaced_by_the_fine_one() {
+        // Two coinciding coarse basis functions (P z = 0) make A_c = Pᵀ A P
+        // singular. The hierarchy keeps its coarse level, factorized with the
+        // shift, and the V-cycle is the one without the duplicate (the
+        // restricted residual has no component along z, P x_c none either).
+        let n = 31;
+        let a = laplacian(n);
+        let blocks: Vec<Vec<usize>> = (0..n).map(|i| vec![i]).collect();
+        let cycle = |duplicate: bool| {
+            let transfer = Transfer {
+                prolongation: interpolation(n, duplicate),
+                fine_blocks: blocks.clone(),
+            };
+            let mut mg = Multigrid::new(vec![transfer]);
+            let shape = mg.refresh(a.clone(), true).unwrap();
+            let r: Vec<f64> = (0..n).map(|i| ((i * 7 % 11) as f64 - 5.0) / 3.0).collect();
+            let mut z = vec![0.0; n];
+            mg.apply(&r, &mut z);
+            (shape, mg.depth(), z)
+        };
+        let (plain, depth, z) = cycle(false);
+        assert_eq!(
+            (plain.coarse_shift, depth, plain.unknowns.clone()),
+            (0.0, 2, vec![31, 15])
+        );
+        let (shifted, depth, z_dup) = cycle(true);
+        assert_eq!(
+            (shifted.coarse_shift, depth, shifted.unknowns),
+            (COARSE_SHIFT, 2, vec![31, 16])
+        );
+        let scale = z.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let diff = z
+            .iter()
+            .zip(&z_dup)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(
+            diff < 1e-6 * scale,
+            "V-cycles differ by {diff:.2e} of {scale:.2e}"
+        );
     }
 }
