@@ -68,6 +68,22 @@ pub struct SolverReport {
     /// converged step (m).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub contact_penetration: Option<f64>,
+    /// The multigrid preconditioner's refreshes (multigrid only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub multigrid: Option<MultigridCounts>,
+}
+
+/// What the multigrid preconditioner did over a stage: how often its operators
+/// were refreshed, how often the coarsest one was singular and factorized with
+/// a diagonal shift, how often a refresh had to end its hierarchy on a finer
+/// level (its coarsest operator could not be factorized even shifted), and the
+/// largest coarsest level factorized.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct MultigridCounts {
+    pub refreshes: usize,
+    pub shifted: usize,
+    pub truncated: usize,
+    pub largest_coarse_unknowns: usize,
 }
 
 impl SolverReport {
@@ -87,6 +103,7 @@ impl SolverReport {
             beta: None,
             gamma: None,
             contact_penetration: None,
+            multigrid: None,
         }
     }
 }

@@ -7,7 +7,7 @@ use crate::physics::contact::PairTotal;
 use crate::scene::LinearSystems;
 use crate::solver::divergence::Divergence;
 use crate::solver::linear::direct::Statistics;
-use crate::solver::report::{NewtonRow, SolverReport};
+use crate::solver::report::{MultigridCounts, NewtonRow, SolverReport};
 use serde::{Deserialize, Serialize};
 
 /// What a stepper carries from one step to the next that a restart needs
@@ -29,6 +29,9 @@ pub struct SolverState {
     /// the last step, D values per particle (empty without friction).
     #[serde(default)]
     pub contact_tangential: Vec<f64>,
+    /// The multigrid's counts (zero in checkpoints written before they were kept).
+    #[serde(default)]
+    pub multigrid: MultigridCounts,
 }
 
 pub trait Stepper<const D: usize> {

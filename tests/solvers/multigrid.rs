@@ -149,26 +149,47 @@ frames = 0
         let summary = result.unwrap_or_else(|e| panic!("slope {overrides:?}: {e}"));
         let table = Table::read(&dir.path().join("particles_final.csv")).unwrap();
         let s = &summary.solver;
-        (
-            table,
+        let counts = (
             s.krylov_iterations.unwrap_or(0),
             s.newton_iterations.unwrap(),
-        )
+        );
+        (table, counts, s.multigrid)
     };
-    let (direct, _, _) = run(&[]);
-    let mut args = vec!["solver.linear_solver=gmres"];
-    args.extend(MULTIGRID);
-    let (mg, krylov, newton) = run(&args);
-    let d = difference(&direct, &mg, &["sxx", "syy", "sxy"]);
-    println!("slope gmres/multigrid: difference {d:.1e}, {krylov} Krylov iterations in {newton} Newton iterations");
-    assert!(d < 1e-8, "slope: difference {d:.2e}");
-    // A Krylov iteration per Newton iteration would mean a direct solve of the
-    // fine level: the plastic coarse operators are singular, and before they
-    // were shifted the hierarchy fell back to its finest level (docs/multigrid.md).
-    assert!(
-        krylov > 2 * newton,
-        "{krylov} Krylov for {newton} Newton iterations"
-    );
+    let (direct, _, none) = run(&[]);
+    assert_eq!(none, None, "no multigrid counts without multigrid");
+    // Down to 8 coarse unknowns, and down to ≤ 200: its 147-unknown level is
+    // singular at every refresh (two coarse basis functions coincide on the
+    // active fine nodes) and is factorized shifted (docs/multigrid.md).
+    for (coarse, singular) in [("8", false), ("200", true)] {
+        let set = format!("solver.multigrid_coarse_unknowns={coarse}");
+        let args = [
+            "solver.linear_solver=gmres",
+            "solver.preconditioner=multigrid",
+            "solver.krylov_tolerance=1e-10",
+            &set,
+        ];
+        let (mg, (krylov, newton), counts) = run(&args);
+        let counts = counts.expect("summary.json reports the multigrid");
+        let d = difference(&direct, &mg, &["sxx", "syy", "sxy"]);
+        println!(
+            "slope gmres/multigrid to ≤ {coarse}: difference {d:.1e}, {krylov} Krylov \
+             iterations in {newton} Newton iterations, {counts:?}"
+        );
+        assert!(d < 1e-8, "slope: difference {d:.2e}");
+        // A Krylov iteration per Newton iteration would mean a direct solve of
+        // the fine level, which is what the hierarchy fell back to before
+        // singular coarse operators were shifted.
+        assert!(
+            krylov > 2 * newton,
+            "{krylov} Krylov for {newton} Newton iterations"
+        );
+        assert!(
+            counts.refreshes == newton && counts.truncated == 0,
+            "{counts:?}"
+        );
+        let shifted = if singular { newton } else { 0 };
+        assert_eq!(counts.shifted, shifted, "{counts:?}");
+    }
 }
 
 /// CG with the multigrid gives byte-identical particles with 1 and 2 threads

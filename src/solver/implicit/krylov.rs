@@ -58,6 +58,7 @@ use crate::solver::linear::gmres::gmres;
 use crate::solver::linear::iterative::{norm, Identity, Outcome, Preconditioner, Settings};
 use crate::solver::linear::multigrid::{Csr, Multigrid};
 use crate::solver::linear::preconditioner::{BlockJacobi, Factorized, Jacobi};
+use crate::solver::report::MultigridCounts;
 use nalgebra::SMatrix;
 
 /// The lagged factorization is refreshed when a linear solve with it needed more
@@ -170,6 +171,8 @@ pub struct KrylovState {
     multigrid: Option<(Vec<u32>, Vec<u32>, Multigrid)>,
     /// Multigrid hierarchies built so far.
     pub hierarchies: usize,
+    /// What the multigrid's refreshes did so far.
+    pub multigrid_counts: MultigridCounts,
     /// Lagged factorizations computed so far.
     pub factorizations: usize,
     /// Krylov iterations over all Newton corrections.
@@ -251,6 +254,7 @@ impl KrylovState {
             refresh: true,
             multigrid: None,
             hierarchies: 0,
+            multigrid_counts: MultigridCounts::default(),
             factorizations: 0,
             iterations: 0,
         }
@@ -446,10 +450,16 @@ impl KrylovState {
         let k = tangent(m, sys, true)?;
         let a = Csr::from_csc(k.matrix(), k.symmetric());
         let (_, _, mg) = self.multigrid.as_mut().expect("built above");
-        mg.refresh(a, k.symmetric()).map_err(|e| Failure {
+        let shape = mg.refresh(a, k.symmetric()).map_err(|e| Failure {
             particle: None,
             message: format!("multigrid preconditioner: {e}"),
         })?;
+        let counts = &mut self.multigrid_counts;
+        counts.refreshes += 1;
+        counts.shifted += usize::from(shape.coarse_shift > 0.0);
+        counts.truncated += usize::from(shape.unknowns.len() < mg.built_levels());
+        let coarse = *shape.unknowns.last().expect("a level");
+        counts.largest_coarse_unknowns = counts.largest_coarse_unknowns.max(coarse);
         Ok(())
     }
 

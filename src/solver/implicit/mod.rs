@@ -237,6 +237,15 @@ impl<const D: usize> Stepper<D> for Implicit<D> {
             beta: newmark.then_some(self.settings.newmark.beta),
             gamma: newmark.then_some(self.settings.newmark.gamma),
             contact_penetration: self.system.contact.as_ref().map(|c| c.deepest),
+            multigrid: self.newton.krylov().and_then(|k| {
+                let multigrid = [
+                    PreconditionerKind::Multigrid,
+                    PreconditionerKind::LaggedMultigrid,
+                ];
+                multigrid
+                    .contains(&k.config.preconditioner)
+                    .then_some(k.multigrid_counts)
+            }),
         }
     }
 
@@ -256,6 +265,7 @@ impl<const D: usize> Stepper<D> for Implicit<D> {
                 .map_or_else(Default::default, |d| d.statistics()),
             contact_tangential: (self.system.contact.as_ref())
                 .map_or_else(Vec::new, |c| c.tangential_state()),
+            multigrid: krylov.map_or_else(Default::default, |k| k.multigrid_counts),
         }
     }
 
@@ -270,6 +280,7 @@ impl<const D: usize> Stepper<D> for Implicit<D> {
             newton::Linear::Krylov(k) => {
                 k.iterations = s.krylov_iterations;
                 k.factorizations = s.lagged_factorizations;
+                k.multigrid_counts = s.multigrid;
                 k.lagged.restore_statistics(s.direct);
             }
             newton::Linear::Direct(d) => d.restore_statistics(s.direct),

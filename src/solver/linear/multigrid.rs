@@ -16,8 +16,10 @@
 //! coarse basis functions can coincide on the fine unknowns they reach, P z = 0,
 //! so that A_c z = 0; the restricted residual Pᵀ r has no component along z and
 //! the prolongated correction none either, so the shift leaves the V-cycle as it
-//! would be with a pseudo-inverse (the plastic 2D slope at F = 1.3 had two such
-//! modes on its 1,187-unknown coarse level). Pre- and post-smoother are the same polynomial in
+//! would be with a pseudo-inverse. (The 2D Griffiths–Lane slope's 1,187-unknown
+//! coarse level had two zero singular values already in the elastic first
+//! iteration, where A is positive definite and Pᵀ A P z = 0 only if P z = 0.)
+//! Pre- and post-smoother are the same polynomial in
 //! D⁻¹A, so for symmetric A the V-cycle is a symmetric operator and CG stays
 //! valid (ibid. §A.2.3).
 //!
@@ -416,6 +418,11 @@ impl Multigrid {
             .factorize(matrix, Structure::of(symmetric), Ordering::Amd)
             .map(|_| ())
             .map_err(|e| e.to_string())
+    }
+
+    /// Levels of the hierarchy (with the coarsest), whether or not in use.
+    pub fn built_levels(&self) -> usize {
+        self.transfers.len() + 1
     }
 
     /// Levels in use (with the coarsest).
