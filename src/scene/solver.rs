@@ -142,6 +142,9 @@ pub struct SolverConfig {
     /// Quasi-static: ramp gravity from zero over the stage (default true); false
     /// applies it in full from the first step (after a geostatic initialisation).
     pub gravity_ramp: Option<bool>,
+    /// Explicit: raise gravity linearly from zero over this time on the run's
+    /// clock (default: in full from the start).
+    pub gravity_ramp_time: Option<f64>,
     /// F-bar against volumetric locking (explicit and implicit; default false).
     pub fbar: Option<bool>,
 }
@@ -270,6 +273,7 @@ pub const SCOPES: &[Scope] = &[
     scope!(cfl, EXPLICIT, &[], &[], ""),
     scope!(flip, EXPLICIT, &[], &[], ""),
     scope!(damping, EXPLICIT, &[], &[], ""),
+    scope!(gravity_ramp_time, EXPLICIT, &[], &[], ""),
     scope!(bulk_viscosity_quadratic, EXPLICIT, &[], &[], ""),
     scope!(bulk_viscosity_linear, EXPLICIT, &[], &[], ""),
     scope!(integrator, IMPLICIT, &[], &[], ""),
@@ -320,6 +324,10 @@ impl SolverConfig {
     /// Local damping α (default 0).
     pub fn damping(&self) -> f64 {
         self.damping.unwrap_or(0.0)
+    }
+    /// The explicit gravity ramp's duration (0: gravity in full from the start).
+    pub fn gravity_ramp_time(&self) -> f64 {
+        self.gravity_ramp_time.unwrap_or(0.0)
     }
     pub fn integrator(&self) -> Integrator {
         self.integrator.unwrap_or(Integrator::Newmark)

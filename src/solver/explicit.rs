@@ -35,6 +35,9 @@ pub struct Explicit<const D: usize> {
     pub fixed_dt: Option<f64>,
     pub flip: f64,
     pub damping: f64,
+    /// Gravity rises linearly from zero over this time on the run's clock (0: in
+    /// full from the start).
+    pub gravity_ramp_time: f64,
     /// F-bar against volumetric locking (`crate::physics::fbar`).
     pub fbar: bool,
     stencils: Stencils<D>,
@@ -55,6 +58,7 @@ impl<const D: usize> Explicit<D> {
             fixed_dt: s.dt,
             flip: s.flip(),
             damping: s.damping(),
+            gravity_ramp_time: s.gravity_ramp_time(),
             fbar: s.fbar(),
             stencils: Stencils::default(),
             map: NodeMap::default(),
@@ -170,7 +174,8 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
         // Nodal forces, damping, acceleration and updated velocity (2-23, 2-29).
         let scales = m.load_scales(t);
         let load_factor = |q: usize| load_factor(&m.load_ramp_of, q, &scales);
-        let mut force = nodal_force(map, st, p, &m.gravity, &load_factor);
+        let gravity = m.gravity * ramp_factor(t, self.gravity_ramp_time);
+        let mut force = nodal_force(map, st, p, &gravity, &load_factor);
         if let Some(v) = &self.viscosity {
             let l = m.grid.h_min();
             v.add_force(map, st, p, &m.materials, &velocity, l, &mut force);
@@ -232,7 +237,7 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
         // the applied forces (`physics::rigid_body`).
         if let Some(free) = self.contact.as_mut().and_then(|c| c.free_bodies()) {
             let force: Vec<Vector<D>> = (free.particles())
-                .map(|q| applied_force(&m.particles, q, &m.gravity, &load_factor))
+                .map(|q| applied_force(&m.particles, q, &gravity, &load_factor))
                 .collect();
             free.advance(&mut m.particles, &force, m.axisymmetric, dt);
         }
@@ -253,7 +258,7 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
                 if rigid(q) {
                     return 0.0;
                 }
-                let f = applied_force(p, q, &m.gravity, &load_factor);
+                let f = applied_force(p, q, &gravity, &load_factor);
                 f.dot(&(old_v[q] + p.v[q])) * 0.5
             });
 
@@ -289,6 +294,15 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
         self.contact
             .as_mut()
             .map_or_else(Vec::new, |c| c.take_totals())
+    }
+}
+
+/// The fraction of gravity at time t under a linear ramp over `ramp` (0: none).
+fn ramp_factor(t: f64, ramp: f64) -> f64 {
+    if ramp > 0.0 {
+        (t / ramp).min(1.0)
+    } else {
+        1.0
     }
 }
 

@@ -628,3 +628,15 @@ fn prism_mistakes_are_named() {
         &["key `body.0.axis`", "does not apply"],
     );
 }
+
+#[test]
+fn gravity_ramp_time_is_checked() {
+    rejected(
+        &GOOD.replace("cfl = 0.5", "cfl = 0.5\ngravity_ramp_time = -1.0"),
+        &["key `solver.gravity_ramp_time`", "finite time ≥ 0"],
+    );
+    rejected(
+        &implicit("gravity_ramp_time = 0.1\n"),
+        &["key `solver.gravity_ramp_time`", "does not apply"],
+    );
+}

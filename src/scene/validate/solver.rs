@@ -120,6 +120,12 @@ fn explicit(s: &SolverConfig, prefix: &str) -> Check {
         format!("{prefix}.damping"),
         "must lie in [0, 1)",
     )?;
+    let ramp = s.gravity_ramp_time();
+    ensure(
+        ramp >= 0.0 && ramp.is_finite(),
+        format!("{prefix}.gravity_ramp_time"),
+        format!("must be a finite time ≥ 0; got {ramp}"),
+    )?;
     for (key, value) in [
         ("bulk_viscosity_quadratic", s.bulk_viscosity_quadratic),
         ("bulk_viscosity_linear", s.bulk_viscosity_linear),
