@@ -383,13 +383,10 @@ fn rolling_cylinder_filled_in_rings_with_contact_at_touch_is_within_3_percent() 
     // (−5.4 %) at R/20; slipping at μ = 0.1 −0.56 % (−1.2 %) at R/10, −1.05 %
     // (−0.58 %) at R/20. (With the smallest gap in the support the spin was
     // −5.2 %, −7.1 %, −28 % and −4.8 %.) Rolling, the disk still slips at 0.5 s
-    // (v + ωR = 0.13 and 0.16 m/s): the spin misses the 3 % there.
-    for (mu, cells, spin_bound) in [
-        (0.5, "[60,28]", 0.07),
-        (0.5, "[120,56]", 0.07),
-        (0.1, "[60,28]", 0.03),
-        (0.1, "[120,56]", 0.03),
-    ] {
+    // (v + ωR = 0.13 and 0.16 m/s): the spin misses the 3 % there;
+    // gravity raised over 0.1 s removes that (the next test, which also runs
+    // R/20; this one keeps R/10 for time).
+    for (mu, cells, spin_bound) in [(0.5, "[60,28]", 0.07), (0.1, "[60,28]", 0.03)] {
         let (x, spin) = roll_at_touch(mu, cells, 0.0);
         println!("cylinder in rings, λ = 0.02, μ = {mu}, {cells}: centre {x:+.4}, spin {spin:+.4}");
         assert!(x.abs() < 0.03, "μ = {mu}, {cells}: centre {x}");
