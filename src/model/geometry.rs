@@ -5,7 +5,7 @@
 //! validation also uses) and measures the depth of a particle below its body's
 //! top surface for geostatic stresses (`top`).
 
-use crate::scene::{prism_plane, BodyConfig, BodyShape};
+use crate::scene::{prism_bounds, prism_plane, BodyConfig, BodyShape};
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Geometry {
@@ -21,12 +21,11 @@ pub enum Geometry {
         radius: f64,
         height: f64,
     },
-    /// The polygon `section` (coordinates along the axes `plane`) extruded over
-    /// `from..to` along `axis`.
+    /// The polygon `section` (coordinates along the other two axes,
+    /// `prism_plane(axis)`) extruded over `from..to` along `axis`.
     Prism {
         section: Vec<Vec<f64>>,
         axis: usize,
-        plane: [usize; 2],
         from: f64,
         to: f64,
     },
@@ -55,7 +54,6 @@ impl Geometry {
                 Geometry::Prism {
                     section: b.vertices.clone().expect("validated"),
                     axis: b.prism_axis(),
-                    plane: prism_plane(b.prism_axis()),
                     from: extent[0],
                     to: extent[1],
                 }
@@ -83,10 +81,10 @@ impl Geometry {
             Geometry::Prism {
                 section,
                 axis,
-                plane,
                 from,
                 to,
             } => {
+                let plane = prism_plane(*axis);
                 x[*axis] > *from
                     && x[*axis] < *to
                     && point_in_polygon(x[plane[0]], x[plane[1]], section)
@@ -117,8 +115,9 @@ impl Geometry {
                 up * base[v] + (radius.powi(2) - r2).max(0.0).sqrt()
             }
             Geometry::Prism { axis, from, to, .. } if v == *axis => (up * from).max(up * to),
-            Geometry::Prism { section, plane, .. } => {
+            Geometry::Prism { section, axis, .. } => {
                 // v is one of the section's axes: its top on the line through x.
+                let plane = prism_plane(*axis);
                 let k = usize::from(plane[1] == v);
                 polygon_top(section, x[plane[1 - k]], k, up)
             }
@@ -152,21 +151,9 @@ impl Geometry {
             Geometry::Prism {
                 section,
                 axis,
-                plane,
                 from,
                 to,
-            } => {
-                let (mut lo, mut hi) = (vec![0.0; 3], vec![0.0; 3]);
-                (lo[*axis], hi[*axis]) = (*from, *to);
-                for (k, &d) in plane.iter().enumerate() {
-                    lo[d] = section.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min);
-                    hi[d] = section
-                        .iter()
-                        .map(|p| p[k])
-                        .fold(f64::NEG_INFINITY, f64::max);
-                }
-                (lo, hi)
-            }
+            } => prism_bounds(section, *axis, [*from, *to]),
         }
     }
 
@@ -243,11 +230,11 @@ impl Geometry {
             Geometry::Prism {
                 section,
                 axis,
-                plane,
                 from,
                 to,
             } => {
                 // The section's edges, extruded: points and normals in the plane.
+                let plane = prism_plane(*axis);
                 let xs = [x[plane[0]], x[plane[1]]];
                 let in_plane = |d: usize, c: f64| on_boundary(plane[d], c);
                 for (l, y, n) in polygon_faces(section, &xs, &in_plane) {
@@ -574,7 +561,6 @@ mod tests {
         let prism = Geometry::Prism {
             section: section.clone(),
             axis: 1,
-            plane: prism_plane(1),
             from: 0.0,
             to: 4.0,
         };

@@ -223,17 +223,12 @@ impl BodyConfig {
                 (lo, hi)
             }
             BodyShape::Prism => {
-                let (v, e) = (
+                let e = self.extent.as_ref().unwrap();
+                prism_bounds(
                     self.vertices.as_ref().unwrap(),
-                    self.extent.as_ref().unwrap(),
-                );
-                let plane = prism_plane(self.prism_axis());
-                let (mut lo, mut hi) = (vec![e[0]; 3], vec![e[1]; 3]);
-                for (k, &d) in plane.iter().enumerate() {
-                    lo[d] = v.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min);
-                    hi[d] = v.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max);
-                }
-                (lo, hi)
+                    self.prism_axis(),
+                    [e[0], e[1]],
+                )
             }
         }
     }
@@ -245,6 +240,20 @@ impl BodyConfig {
             .and_then(crate::scene::grid::axis)
             .unwrap_or(1)
     }
+}
+
+/// The bounds (min, max) of the polygon `section` extruded over `extent`
+/// along `axis`.
+pub fn prism_bounds(section: &[Vec<f64>], axis: usize, extent: [f64; 2]) -> (Vec<f64>, Vec<f64>) {
+    let (mut lo, mut hi) = (vec![extent[0]; 3], vec![extent[1]; 3]);
+    for (k, &d) in prism_plane(axis).iter().enumerate() {
+        lo[d] = section.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min);
+        hi[d] = section
+            .iter()
+            .map(|p| p[k])
+            .fold(f64::NEG_INFINITY, f64::max);
+    }
+    (lo, hi)
 }
 
 /// The two axes of a prism's cross-section (its `vertices`' coordinates), in

@@ -5,6 +5,7 @@
 
 use crate::dim::Vector;
 use crate::model::conditions::{Constraint, FrictionFace};
+use crate::model::loads::LoadTime;
 use crate::model::{load_factor, Model};
 use crate::parallel::{deterministic_sum, MIN_PARALLEL_LEN};
 use crate::physics::absorbing;
@@ -35,9 +36,9 @@ pub struct Explicit<const D: usize> {
     pub fixed_dt: Option<f64>,
     pub flip: f64,
     pub damping: f64,
-    /// Gravity rises linearly from zero over this time on the run's clock (0: in
-    /// full from the start).
-    pub gravity_ramp_time: f64,
+    /// Gravity rises linearly from zero over `gravity_ramp_time` on the run's
+    /// clock, as a load's `ramp_time` (0: in full from the start).
+    pub gravity_ramp: LoadTime,
     /// F-bar against volumetric locking (`crate::physics::fbar`).
     pub fbar: bool,
     stencils: Stencils<D>,
@@ -58,7 +59,7 @@ impl<const D: usize> Explicit<D> {
             fixed_dt: s.dt,
             flip: s.flip(),
             damping: s.damping(),
-            gravity_ramp_time: s.gravity_ramp_time(),
+            gravity_ramp: LoadTime::Ramp(s.gravity_ramp_time()),
             fbar: s.fbar(),
             stencils: Stencils::default(),
             map: NodeMap::default(),
@@ -174,7 +175,7 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
         // Nodal forces, damping, acceleration and updated velocity (2-23, 2-29).
         let scales = m.load_scales(t);
         let load_factor = |q: usize| load_factor(&m.load_ramp_of, q, &scales);
-        let gravity = m.gravity * ramp_factor(t, self.gravity_ramp_time);
+        let gravity = m.gravity * self.gravity_ramp.factor(t);
         let mut force = nodal_force(map, st, p, &gravity, &load_factor);
         if let Some(v) = &self.viscosity {
             let l = m.grid.h_min();
@@ -294,15 +295,6 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
         self.contact
             .as_mut()
             .map_or_else(Vec::new, |c| c.take_totals())
-    }
-}
-
-/// The fraction of gravity at time t under a linear ramp over `ramp` (0: none).
-fn ramp_factor(t: f64, ramp: f64) -> f64 {
-    if ramp > 0.0 {
-        (t / ramp).min(1.0)
-    } else {
-        1.0
     }
 }
 

@@ -238,12 +238,8 @@ impl<const D: usize> Stepper<D> for Implicit<D> {
             gamma: newmark.then_some(self.settings.newmark.gamma),
             contact_penetration: self.system.contact.as_ref().map(|c| c.deepest),
             multigrid: self.newton.krylov().and_then(|k| {
-                let multigrid = [
-                    PreconditionerKind::Multigrid,
-                    PreconditionerKind::LaggedMultigrid,
-                ];
-                multigrid
-                    .contains(&k.config.preconditioner)
+                use PreconditionerKind::{LaggedMultigrid, Multigrid};
+                matches!(k.config.preconditioner, Multigrid | LaggedMultigrid)
                     .then_some(k.multigrid_counts)
             }),
         }

@@ -360,19 +360,19 @@ impl Multigrid {
             operators.push(coarse);
         }
         let mut used = self.transfers.len();
-        let mut shift = 0.0;
-        loop {
-            let plain = self.factorize_coarse(&operators[used], symmetric, 0.0);
-            let shifted = plain.or_else(|_| {
-                self.factorize_coarse(&operators[used], symmetric, COARSE_SHIFT)
-                    .map(|_| shift = COARSE_SHIFT)
-            });
-            match shifted {
-                Ok(_) => break,
+        let shift = loop {
+            let a = &operators[used];
+            let factorized =
+                (self.factorize_coarse(a, symmetric, 0.0).map(|_| 0.0)).or_else(|_| {
+                    self.factorize_coarse(a, symmetric, COARSE_SHIFT)
+                        .map(|_| COARSE_SHIFT)
+                });
+            match factorized {
+                Ok(shift) => break shift,
                 Err(e) if used == 0 => return Err(format!("coarse factorization failed: {e}")),
                 Err(_) => used -= 1,
             }
-        }
+        };
         let shape = Shape {
             unknowns: operators[..=used].iter().map(|a| a.rows).collect(),
             entries: operators[..=used].iter().map(|a| a.nnz()).collect(),
