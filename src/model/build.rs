@@ -195,7 +195,7 @@ fn fill_body<const D: usize>(
     let spacing = Vector::<D>::from_fn(|d, _| grid.h[d] / b.particles_per_cell.get(d) as f64);
     let points = match b.fill {
         Fill::Lattice => lattice(grid, b, geometry, &spacing),
-        Fill::Polar => polar(b, spacing.min()),
+        Fill::Polar => polar(b, spacing[0].min(spacing[1]), spacing[D - 1]),
     };
     let uniform = b
         .velocity
@@ -267,25 +267,51 @@ fn lattice<const D: usize>(
 /// A disk in n = round(R/δ) rings of width Δ = R/n about its centre: ring k
 /// (area π(2k + 1)Δ²) holds N_k = round(π(2k + 1)) particles of equal area at its
 /// mid radius (k + ½)Δ, every other ring turned by half a pitch; each particle's
-/// domain is the square of its area.
-fn polar<const D: usize>(b: &BodyConfig, spacing: f64) -> Vec<Point<D>> {
+/// domain is the square of its area. A cylinder (3D, axis z) is that disk
+/// repeated in layers of thickness about `spacing_z` along its height.
+fn polar<const D: usize>(b: &BodyConfig, spacing: f64, spacing_z: f64) -> Vec<Point<D>> {
     let (c, radius) = (
         b.centre.as_ref().expect("validated"),
         b.radius.expect("validated"),
     );
+    // Layers along a cylinder's axis (a disk is one layer of unit thickness).
+    let (layers, thickness) = match b.height {
+        Some(height) if D == 3 => {
+            let n = (height / spacing_z).round().max(1.0) as usize;
+            (n, height / n as f64)
+        }
+        _ => (1, 1.0),
+    };
+    let side = |area: f64, d: usize| {
+        if d < 2 {
+            0.5 * area.sqrt()
+        } else {
+            0.5 * thickness
+        }
+    };
     let rings = (radius / spacing).round().max(1.0) as usize;
     let width = radius / rings as f64;
     let mut points = Vec::new();
-    for k in 0..rings {
-        let band = std::f64::consts::PI * (2 * k + 1) as f64;
-        let count = band.round().max(1.0) as usize;
-        let area = band * width * width / count as f64;
-        let r = (k as f64 + 0.5) * width;
-        for j in 0..count {
-            let turn = (j as f64 + 0.5 * (k % 2) as f64) / count as f64;
-            let (sin, cos) = (2.0 * std::f64::consts::PI * turn).sin_cos();
-            let x = Vector::<D>::from_fn(|d, _| c[d] + r * if d == 0 { cos } else { sin });
-            points.push((x, area, Vector::<D>::repeat(0.5 * area.sqrt())));
+    for layer in 0..layers {
+        let z = c
+            .get(2)
+            .map_or(0.0, |base| base + (layer as f64 + 0.5) * thickness);
+        for k in 0..rings {
+            let band = std::f64::consts::PI * (2 * k + 1) as f64;
+            let count = band.round().max(1.0) as usize;
+            let area = band * width * width / count as f64;
+            let r = (k as f64 + 0.5) * width;
+            for j in 0..count {
+                let turn = (j as f64 + 0.5 * (k % 2) as f64) / count as f64;
+                let (sin, cos) = (2.0 * std::f64::consts::PI * turn).sin_cos();
+                let x = Vector::<D>::from_fn(|d, _| match d {
+                    0 => c[0] + r * cos,
+                    1 => c[1] + r * sin,
+                    _ => z,
+                });
+                let half = Vector::<D>::from_fn(|d, _| side(area, d));
+                points.push((x, area * thickness, half));
+            }
         }
     }
     points

@@ -103,7 +103,7 @@ fn a_polar_fill_of_a_rectangle_is_refused_at_its_key() {
         &GOOD.replace("max = [2.0, 1.0]\n", "max = [2.0, 1.0]\nfill = \"polar\"\n"),
         "body.0.fill",
         (20, 8),
-        "`polar` fills a disk only",
+        "`polar` fills a disk or a cylinder only",
     );
     at(
         &GOOD.replace("max = [2.0, 1.0]\n", "max = [2.0, 1.0]\nfill = \"rings\"\n"),

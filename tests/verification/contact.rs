@@ -440,6 +440,49 @@ fn a_polar_fill_has_the_disk_s_area_and_centre() {
 }
 
 #[test]
+fn a_polar_fill_of_a_cylinder_is_the_disk_s_fill_in_layers() {
+    // papers/contact/seed_cylinder_3d.toml: R = 3.2 m, 4 m long, spacing 0.2 m:
+    // 20 layers of 0.2 m, each the rings of the 2D disk of the same radius and
+    // spacing; the volumes sum to πR²H and the centroid is on the axis at
+    // mid-length, to round-off.
+    let read = |name: &str| {
+        let path = format!("{}/papers/contact/{name}", env!("CARGO_MANIFEST_DIR"));
+        let text = std::fs::read_to_string(&path).unwrap();
+        mpm::scene::Scene::parse(&path, &text, &[]).unwrap()
+    };
+    let m = mpm::model::Model::<3>::build(&read("seed_cylinder_3d.toml")).unwrap();
+    let p = &m.particles;
+    let cyl: Vec<usize> = (0..p.len()).filter(|&q| p.body[q] == 1).collect();
+    let volume: f64 = cyl.iter().map(|&q| p.volume[q]).sum();
+    let exact = std::f64::consts::PI * 3.2 * 3.2 * 4.0;
+    assert!(
+        (volume / exact - 1.0).abs() < 1e-12,
+        "volume {volume} vs {exact}"
+    );
+    let centroid = cyl
+        .iter()
+        .fold(nalgebra::Vector3::zeros(), |c, &q| c + p.volume[q] * p.x[q])
+        / volume;
+    let err = (centroid - nalgebra::Vector3::new(4.0, 5.2, 2.0)).norm();
+    assert!(err < 1e-12, "centroid {centroid:?}");
+    let disk = mpm::model::Model::<2>::build(&read("seed_cylinder.toml")).unwrap();
+    let in_disk = (0..disk.particles.len())
+        .filter(|&q| disk.particles.body[q] == 1)
+        .count();
+    assert_eq!(cyl.len(), 20 * in_disk);
+    // Every domain is 0.2 m long along the axis, and inside the cylinder.
+    for &q in &cyl {
+        let r = (p.x[q].xy() - nalgebra::Vector2::new(4.0, 5.2)).norm();
+        assert!(
+            (p.half_length0[q].z - 0.1).abs() < 1e-12
+                && r < 3.2
+                && p.x[q].z > 0.0
+                && p.x[q].z < 4.0
+        );
+    }
+}
+
+#[test]
 fn rigid_plate_compresses_a_block_to_the_hencky_stress() {
     // problems/contact_plate.toml without its local damping: a rigid plate pushed
     // at 0.1 m/s 0.25 m into a 1 m block (Hencky, ν = 0, lateral rollers), so that

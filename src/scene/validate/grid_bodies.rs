@@ -118,9 +118,9 @@ fn shape_keys(b: &BodyConfig, i: usize, dim: usize) -> Check {
     let key = |k: &str| format!("body.{i}.{k}");
     let what = format!("shape `{}`", b.shape.name());
     ensure(
-        b.fill == Fill::Lattice || b.shape == BodyShape::Disk,
+        b.fill == Fill::Lattice || matches!(b.shape, BodyShape::Disk | BodyShape::Cylinder),
         key("fill"),
-        format!("`polar` fills a disk only, not {what}"),
+        format!("`polar` fills a disk or a cylinder only, not {what}"),
     )?;
     let shape_dim = match b.shape {
         BodyShape::Rectangle | BodyShape::Disk | BodyShape::Polygon => 2,
