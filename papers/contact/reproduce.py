@@ -98,7 +98,7 @@ def rolling_closed_form(g, theta, mu, radius, t, ramp):
     else:
         a = 2.0 / 3.0 * g * math.sin(theta)
         omega = -a * te / radius
-    return a * (0.5 * te * te + ramp * ramp / 24.0), omega
+    return a * (0.5 * te * te + ramp * ramp / 24.0), omega + 0.0  # no −0 when μ = 0
 
 
 def cylinder_row(out, label, g, theta, mu, radius, ramp):
