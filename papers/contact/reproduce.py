@@ -9,7 +9,7 @@ usage (from the repository root, after `cargo build --release`):
 MPM=path/to/mpm picks the binary (default target/release/mpm, else `mpm`).
 --quick leaves out the finest grids (R/20 and R/16 cylinders, the h = B/32
 footings); NAME is one of cylinder, seed, seed3d, incline, terrain, disks,
-plate, footing. The whole run takes about 25 minutes on 2 cores.
+plate, footing. The whole run takes 15–25 minutes on 2 cores.
 """
 import csv
 import json
