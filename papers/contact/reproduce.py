@@ -179,6 +179,10 @@ def incline(out, quick):
         t, x = moved(d)
         label = f"{100 * damping:.0f} % local damping" if damping else "undamped"
         print(f"| {mu} (tan θ ≤ μ: sticks), {label}, t = {t:.1f} s | {x:.2e} | 0 | — |")
+    # θ = 30°: the weight meets the base within its middle third, so the whole
+    # base stays in compression; gravity raised over 0.3 s, no damping.
+    g30 = [f"gravity=[{g * 0.5},{-g * math.sqrt(3.0) / 2.0}]", "solver.gravity_ramp_time=0.3",
+           "solver.end_time=1.0", "output.frames=0"]
     # The same block on a rigid base (the base a `model = "rigid"` body).
     text = scene.read_text().replace(
         '[[body]]\nname = "base"\nmaterial = "elastic"',
@@ -197,6 +201,12 @@ def incline(out, quick):
         label = f"{100 * damping:.0f} % local damping" if damping else "undamped"
         err = pct(x, x0) if x0 > 0.0 else "—"
         print(f"| rigid base, {mu}, {label}, t = {t:.1f} s | {x:.4g} | {x0:.4g} | {err} |")
+    for base, path in (("elastic", scene), ("rigid", rigid)):
+        d = out / f"stick30_{base}"
+        run(path, d, ["contact.0.friction_coefficient=0.7"] + g30)
+        t, x = moved(d)
+        print(f"| {base} base, θ = 30°, 0.7 (= 1.21 tan θ), undamped, gravity over 0.3 s, t = {t:.1f} s "
+              f"| {x:.2e} | 0 | — |")
 
 
 def terrain(out, quick):
