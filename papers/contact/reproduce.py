@@ -20,6 +20,7 @@ import shutil
 import subprocess
 import sys
 import time
+import tomllib
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 HERE = pathlib.Path(__file__).resolve().parent
@@ -101,13 +102,30 @@ def rolling_closed_form(g, theta, mu, radius, t, ramp):
     return a * (0.5 * te * te + ramp * ramp / 24.0), omega + 0.0  # no −0 when μ = 0
 
 
-def cylinder_row(out, label, g, theta, mu, radius, ramp):
-    t, x = moved(out)
-    w = spin(particles(out, 1))
-    x0, w0 = rolling_closed_form(g, theta, mu, radius, t, ramp)
+def cylinder_setup(scene):
+    """g, θ, the cylinder's radius and the gravity ramp of a rolling-cylinder
+    scene (gravity tilted in x–y, the cylinder its second body)."""
+    with open(scene, "rb") as f:
+        config = tomllib.load(f)
+    gx, gy = config["gravity"][:2]
+    ramp = config["solver"].get("gravity_ramp_time", 0.0)
+    return math.hypot(gx, gy), math.atan2(gx, -gy), config["body"][1]["radius"], ramp
+
+
+def roll(out, scene, tag, label, mu, sets=(), ramp=None):
+    """Run the cylinder of `scene` at friction μ with `sets` and print its row
+    against the rigid cylinder's closed form (`ramp` if the sets change the
+    scene's gravity ramp). `label` may hold {wall}, the run's wall time."""
+    g, theta, radius, shipped_ramp = cylinder_setup(scene)
+    d = out / tag
+    wall = run(scene, d, [f"contact.0.friction_coefficient={mu}", *sets])
+    t, x = moved(d)
+    w = spin(particles(d, 1))
+    x0, w0 = rolling_closed_form(g, theta, mu, radius, t, shipped_ramp if ramp is None else ramp)
     regime = "slip" if math.tan(theta) > 3.0 * mu else "rolling"
     spin_err = pct(w, w0) if w0 != 0.0 else f"ω = {w:+.3f} rad/s"
-    return f"| {label} | {mu} ({regime}) | {x:.4f} | {x0:.4f} | {pct(x, x0)} | {w:+.4f} | {w0:+.4f} | {spin_err} |"
+    print(f"| {label.format(wall=wall)} | {mu} ({regime}) | {x:.4f} | {x0:.4f} | {pct(x, x0)} "
+          f"| {w:+.4f} | {w0:+.4f} | {spin_err} |")
 
 
 CYL_HEADER = ("| case | μ | centre moved (m) | closed form (m) | error | spin (rad/s) | closed form | error |\n"
@@ -118,46 +136,37 @@ def cylinder(out, quick):
     """problems/contact_cylinder.toml as shipped (polar fill, λ = 0.02, gravity
     over 0.1 s), both regimes at R/10 and R/20, and the lattice cylinder."""
     scene = ROOT / "problems" / "contact_cylinder.toml"
-    th, g, radius = math.radians(45.0), 9.81, 0.5
     print("\n### Rolling cylinder, `problems/contact_cylinder.toml` (θ = 45°, R = 0.5 m, E = 10 MPa)\n")
     print(CYL_HEADER)
     grids = [("[60,28]", "R/10")] + ([] if quick else [("[120,56]", "R/20")])
     for cells, h in grids:
         for mu in (0.0, 0.1, 0.5):
-            d = out / f"cylinder_{h[2:]}_{mu}"
-            run(scene, d, [f"grid.cells={cells}", f"contact.0.friction_coefficient={mu}"])
-            print(cylinder_row(d, f"shipped, h = {h}", g, th, mu, radius, 0.1))
+            roll(out, scene, f"cylinder_{h[2:]}_{mu}", f"shipped, h = {h}", mu, [f"grid.cells={cells}"])
     lattice = ['body.1.fill="lattice"', "contact.0.gap_factor=0.5", "solver.gravity_ramp_time=0"]
     for cells, h in grids:
-        d = out / f"cylinder_lattice_{h[2:]}"
-        run(scene, d, [f"grid.cells={cells}", "contact.0.friction_coefficient=0.5"] + lattice)
-        print(cylinder_row(d, f"lattice, λ = 0.5, no ramp, h = {h}", g, th, 0.5, radius, 0.0))
+        roll(out, scene, f"cylinder_lattice_{h[2:]}", f"lattice, λ = 0.5, no ramp, h = {h}", 0.5,
+             [f"grid.cells={cells}"] + lattice, ramp=0.0)
 
 
 def seed(out, quick):
     """The seed's cylinder (report 001 Part 2 §3.1) in plane strain, θ = 30°."""
     scene = HERE / "seed_cylinder.toml"
-    th, g, radius = math.radians(30.0), 10.0, 3.2
     print("\n### Rolling cylinder at the seed's scale, `seed_cylinder.toml` (θ = 30°, R = 3.2 m, E = 42 MPa on 420 MPa)\n")
     print(CYL_HEADER)
     grids = [("[50,23]", "0.4 m = R/8 (the seed's)")] + ([] if quick else [("[100,46]", "0.2 m = R/16")])
     for cells, h in grids:
         for mu in (0.0, 0.1, 0.3):
-            d = out / f"seed_{cells.strip('[]').replace(',', 'x')}_{mu}"
-            run(scene, d, [f"grid.cells={cells}", f"contact.0.friction_coefficient={mu}"])
-            print(cylinder_row(d, f"h = {h}", g, th, mu, radius, 0.3))
+            tag = f"seed_{cells.strip('[]').replace(',', 'x')}_{mu}"
+            roll(out, scene, tag, f"h = {h}", mu, [f"grid.cells={cells}"])
 
 
 def seed3d(out, quick):
     """The seed's cylinder in 3D (4 m long, free ends), as the report ran it."""
     scene = HERE / "seed_cylinder_3d.toml"
-    th, g, radius = math.radians(30.0), 10.0, 3.2
     print("\n### The same in 3D, `seed_cylinder_3d.toml` (a cylinder 4 m long, h = 0.4 m)\n")
     print(CYL_HEADER)
     for mu in (0.0, 0.1, 0.3):
-        d = out / f"seed3d_{mu}"
-        wall = run(scene, d, [f"contact.0.friction_coefficient={mu}"])
-        print(cylinder_row(d, f"3D, {wall:.0f} s", g, th, mu, radius, 0.3))
+        roll(out, scene, f"seed3d_{mu}", "3D, {wall:.0f} s", mu)
 
 
 def incline(out, quick):

@@ -274,6 +274,21 @@ fn polar<const D: usize>(b: &BodyConfig, spacing: f64, spacing_z: f64) -> Vec<Po
         b.centre.as_ref().expect("validated"),
         b.radius.expect("validated"),
     );
+    // The disk: (x, y, area) of each particle.
+    let rings = (radius / spacing).round().max(1.0) as usize;
+    let width = radius / rings as f64;
+    let mut disk = Vec::new();
+    for k in 0..rings {
+        let band = std::f64::consts::PI * (2 * k + 1) as f64;
+        let count = band.round().max(1.0) as usize;
+        let area = band * width * width / count as f64;
+        let r = (k as f64 + 0.5) * width;
+        for j in 0..count {
+            let turn = (j as f64 + 0.5 * (k % 2) as f64) / count as f64;
+            let (sin, cos) = (2.0 * std::f64::consts::PI * turn).sin_cos();
+            disk.push((c[0] + r * cos, c[1] + r * sin, area));
+        }
+    }
     // Layers along a cylinder's axis (a disk is one layer of unit thickness).
     let (layers, thickness) = match b.height {
         Some(height) if D == 3 => {
@@ -282,37 +297,17 @@ fn polar<const D: usize>(b: &BodyConfig, spacing: f64, spacing_z: f64) -> Vec<Po
         }
         _ => (1, 1.0),
     };
-    let side = |area: f64, d: usize| {
-        if d < 2 {
-            0.5 * area.sqrt()
-        } else {
-            0.5 * thickness
-        }
+    let z = |layer: usize| {
+        c.get(2)
+            .map_or(0.0, |base| base + (layer as f64 + 0.5) * thickness)
     };
-    let rings = (radius / spacing).round().max(1.0) as usize;
-    let width = radius / rings as f64;
-    let mut points = Vec::new();
-    for layer in 0..layers {
-        let z = c
-            .get(2)
-            .map_or(0.0, |base| base + (layer as f64 + 0.5) * thickness);
-        for k in 0..rings {
-            let band = std::f64::consts::PI * (2 * k + 1) as f64;
-            let count = band.round().max(1.0) as usize;
-            let area = band * width * width / count as f64;
-            let r = (k as f64 + 0.5) * width;
-            for j in 0..count {
-                let turn = (j as f64 + 0.5 * (k % 2) as f64) / count as f64;
-                let (sin, cos) = (2.0 * std::f64::consts::PI * turn).sin_cos();
-                let x = Vector::<D>::from_fn(|d, _| match d {
-                    0 => c[0] + r * cos,
-                    1 => c[1] + r * sin,
-                    _ => z,
-                });
-                let half = Vector::<D>::from_fn(|d, _| side(area, d));
-                points.push((x, area * thickness, half));
-            }
-        }
-    }
-    points
+    (0..layers)
+        .flat_map(|layer| disk.iter().map(move |&p| (layer, p)))
+        .map(|(layer, (x, y, area))| {
+            let at = Vector::<D>::from_fn(|d, _| [x, y, z(layer)][d]);
+            let side = 0.5 * area.sqrt();
+            let half = Vector::<D>::from_fn(|d, _| if d < 2 { side } else { 0.5 * thickness });
+            (at, area * thickness, half)
+        })
+        .collect()
 }
