@@ -55,6 +55,11 @@ impl History {
         split_slots(&self.len, data)
     }
 
+    /// The per-particle slices of `data` itself, to update in place.
+    pub fn own_slots_mut(&mut self) -> Vec<&mut [f64]> {
+        split_slots(&self.len, &mut self.data)
+    }
+
     /// The per-particle slices of another buffer laid out like `data`.
     pub fn slots<'a>(&self, data: &'a [f64]) -> Vec<&'a [f64]> {
         let mut rest = data;
