@@ -130,7 +130,7 @@ fn add_layer_forces<const D: usize>(
         let q = lp.q;
         let f = lp.force(&interpolate(map, st, q, v), &displacement(q));
         for e in st.range(q) {
-            out[map.local_of(st, e)] += f * (st.weight[e] * sign);
+            out[map.local_of(st, e)] += f * (st.weight(e) * sign);
         }
     }
 }

@@ -32,19 +32,20 @@ use rayon::prelude::*;
 /// entry of the stencils computed at the positions `x`.
 pub fn hoop_gradients<const D: usize>(st: &mut Stencils<D>, x: &[Vector<D>]) {
     let stride = st.stride;
-    st.hoop.resize(st.weight.len(), 0.0);
-    st.hoop
-        .par_chunks_mut(stride)
-        .zip(st.weight.par_chunks(stride))
+    let mut hoop = std::mem::take(&mut st.hoop);
+    hoop.resize(st.len(), 0.0);
+    let values = &*st;
+    hoop.par_chunks_mut(stride)
         .enumerate()
         .with_min_len(MIN_PARALLEL_LEN)
-        .for_each(|(p, (hoop, w))| {
+        .for_each(|(p, hoop)| {
             // S_Ip / r_p: the hoop gradient of node I.
             let r = x[p][0];
-            for (h, w) in hoop.iter_mut().zip(w) {
-                *h = w / r;
+            for (k, h) in hoop.iter_mut().enumerate() {
+                *h = values.weight(p * stride + k) / r;
             }
         });
+    st.hoop = hoop;
 }
 
 /// ΔF_θθ = 1 + Σ_I u_Ir S_Ip / r_p from a particle's entries as pairs

@@ -96,7 +96,7 @@ impl BulkViscosity {
             .collect();
         // −(−q I) : ∇S V, with the hoop part q V S_Ip/r_p on the radial component.
         let viscous = map.gather(st.stride, Vector::<D>::zeros(), |q, e| {
-            let mut f = st.grad[e] * qv[q];
+            let mut f = st.grad(e) * qv[q];
             if let Some(h) = st.hoop.get(e) {
                 f[0] += h * qv[q];
             }

@@ -227,7 +227,7 @@ impl FieldSplit {
                 map.node_entries(a)
                     .iter()
                     .fold(Vector::<D>::zeros(), |acc, &e| {
-                        acc + st.grad[e as usize] * weight(owner.of(e))
+                        acc + st.grad(e as usize) * weight(owner.of(e))
                     })
             })
             .collect();

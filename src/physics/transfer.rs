@@ -247,8 +247,9 @@ pub fn mass_momentum<const D: usize>(
             let (mut mass, mut momentum) = (0.0, Vector::<D>::zeros());
             for &e in map.node_entries(a) {
                 let (q, e) = (owner.of(e), e as usize);
-                mass += p.mass[q] * st.weight[e];
-                momentum += p.v[q] * (p.mass[q] * st.weight[e]);
+                let w = st.weight_at(q, e);
+                mass += p.mass[q] * w;
+                momentum += p.v[q] * (p.mass[q] * w);
             }
             (mass, momentum)
         })
@@ -265,7 +266,7 @@ pub fn mass_weighted<const D: usize>(
     a: &[Vector<D>],
 ) -> Vec<Vector<D>> {
     map.gather(st.stride, Vector::<D>::zeros(), |q, e| {
-        a[q] * (p.mass[q] * st.weight[e])
+        a[q] * (p.mass[q] * st.weight_at(q, e))
     })
 }
 
@@ -293,7 +294,7 @@ pub fn consistent_mass_product<const D: usize>(
 ) -> Vec<Vector<D>> {
     let at_particles: Vec<Vector<D>> = (0..p.len()).map(|q| interpolate(map, st, q, w)).collect();
     map.gather(st.stride, Vector::<D>::zeros(), |q, e| {
-        at_particles[q] * (p.mass[q] * st.weight[e] * scale)
+        at_particles[q] * (p.mass[q] * st.weight(e) * scale)
     })
 }
 
@@ -342,7 +343,7 @@ pub fn internal_force<const D: usize>(
     stress: &[Mat3],
 ) -> Vec<Vector<D>> {
     map.gather(st.stride, Vector::<D>::zeros(), |q, e| {
-        internal_force_at(&stress[q], volume[q], &st.grad[e], hoop_at(st, e))
+        internal_force_at(&stress[q], volume[q], &st.grad(e), hoop_at(st, e))
     })
 }
 
@@ -355,7 +356,7 @@ pub fn external_force<const D: usize>(
     load_factor: &(impl Fn(usize) -> f64 + Sync),
 ) -> Vec<Vector<D>> {
     map.gather(st.stride, Vector::<D>::zeros(), |q, e| {
-        external_force_at(p, q, st.weight[e], gravity, load_factor)
+        external_force_at(p, q, st.weight(e), gravity, load_factor)
     })
 }
 
@@ -391,7 +392,8 @@ pub fn nodal_force<const D: usize>(
         .collect();
     map.gather(st.stride, Vector::<D>::zeros(), |q, e| {
         let s = &sources[q];
-        let mut f = s.applied * st.weight[e] - s.stress * st.grad[e] * s.volume;
+        let (weight, grad) = st.value_at(q, e);
+        let mut f = s.applied * weight - s.stress * grad * s.volume;
         if let Some(h) = hoop_at(st, e) {
             // f_Ir −= V_p σ_θθ S_Ip / r_p (the hoop term of the internal force).
             f[0] -= s.hoop_stress * h * s.volume;
@@ -418,7 +420,7 @@ pub fn interpolate<const D: usize>(
     u: &[Vector<D>],
 ) -> Vector<D> {
     st.range(p).fold(Vector::<D>::zeros(), |acc, e| {
-        acc + u[map.local_of(st, e)] * st.weight[e]
+        acc + u[map.local_of(st, e)] * st.weight_at(p, e)
     })
 }
 
@@ -434,7 +436,7 @@ pub fn interpolate_two<const D: usize>(
     st.range(p).fold(
         (Vector::<D>::zeros(), Vector::<D>::zeros()),
         |(su, sw), e| {
-            let (a, weight) = (map.local_of(st, e), st.weight[e]);
+            let (a, weight) = (map.local_of(st, e), st.weight_at(p, e));
             (su + u[a] * weight, sw + w[a] * weight)
         },
     )
@@ -448,7 +450,7 @@ pub fn gradient<const D: usize>(
     u: &[Vector<D>],
 ) -> Tensor<D> {
     st.range(p).fold(Tensor::<D>::zeros(), |acc, e| {
-        acc + u[map.local_of(st, e)] * st.grad[e].transpose()
+        acc + u[map.local_of(st, e)] * st.grad_at(p, e).transpose()
     })
 }
 

@@ -91,6 +91,15 @@ impl ShapeFunction {
     }
 
     /// Largest number of nodes one particle can touch.
+    /// Nodes per direction of a separable family (a product of 1D factors);
+    /// `None` for CPDI.
+    pub fn per_axis(&self) -> Option<usize> {
+        match self {
+            ShapeFunction::Cpdi => None,
+            _ => Some(self.max_support(1)),
+        }
+    }
+
     pub fn max_support(&self, dim: usize) -> usize {
         let per_dir: usize = match self {
             ShapeFunction::Linear => 2,

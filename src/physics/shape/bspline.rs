@@ -272,17 +272,27 @@ pub fn evaluate_domain<const D: usize>(
     w: &mut [f64],
     grad: &mut [Vector<D>],
 ) -> usize {
+    tensor_product(grid, &domain_axes(grid, x, half, degree), node, w, grad)
+}
+
+/// The domain-averaged B-splines of a particle at `x` with domain half-lengths
+/// `half`, axis by axis, derivatives per physical length.
+pub(super) fn domain_axes<const D: usize>(
+    grid: &Grid<D>,
+    x: &Vector<D>,
+    half: &Vector<D>,
+    degree: usize,
+) -> [AxisFactors; D] {
     debug_assert_eq!(
         grid.degree, degree,
         "the grid must be laid out for this degree"
     );
-    let axes: [AxisFactors; D] = std::array::from_fn(|d| {
+    std::array::from_fn(|d| {
         let xi = cell_coordinate(grid, x, d);
         let mut f = domain_basis(xi, half[d] / grid.h[d], degree, grid.cells[d]);
         f.slope.iter_mut().for_each(|s| *s /= grid.h[d]);
         f
-    });
-    tensor_product(grid, &axes, node, w, grad)
+    })
 }
 
 /// The basis functions of degree `p` on `cells` cells that are nonzero at `xi`
@@ -303,6 +313,16 @@ pub fn evaluate<const D: usize>(
     w: &mut [f64],
     grad: &mut [Vector<D>],
 ) -> usize {
+    tensor_product(grid, &axes(grid, x, degree), node, w, grad)
+}
+
+/// The B-splines of a particle at `x`, axis by axis, derivatives per physical
+/// length.
+pub(super) fn axes<const D: usize>(
+    grid: &Grid<D>,
+    x: &Vector<D>,
+    degree: usize,
+) -> [AxisFactors; D] {
     assert!(
         (1..MAX_PER_AXIS).contains(&degree),
         "B-spline degree {degree} not in 1..=3"
@@ -311,13 +331,12 @@ pub fn evaluate<const D: usize>(
         grid.degree, degree,
         "the grid must be laid out for this degree"
     );
-    let axes: [AxisFactors; D] = std::array::from_fn(|d| {
+    std::array::from_fn(|d| {
         let mut f = basis(cell_coordinate(grid, x, d), degree, grid.cells[d]);
         // Derivatives from cell units to physical units.
-        f.slope.iter_mut().for_each(|s| *s /= grid.h[d]);
+        f.slope[..=degree].iter_mut().for_each(|s| *s /= grid.h[d]);
         f
-    });
-    tensor_product(grid, &axes, node, w, grad)
+    })
 }
 
 #[cfg(test)]

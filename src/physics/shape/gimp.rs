@@ -93,9 +93,18 @@ pub fn evaluate<const D: usize>(
     w: &mut [f64],
     grad: &mut [Vector<D>],
 ) -> usize {
+    tensor_product(grid, &axes(grid, x, half), node, w, grad)
+}
+
+/// The GIMP factors of a particle at `x` with domain half-lengths `half`, axis
+/// by axis.
+pub(super) fn axes<const D: usize>(
+    grid: &Grid<D>,
+    x: &Vector<D>,
+    half: &Vector<D>,
+) -> [AxisFactors; D] {
     debug_assert_eq!(grid.degree, 1, "GIMP lives on a degree-1 grid");
-    let axes: [AxisFactors; D] = std::array::from_fn(|d| domain_factors(grid, x, half, d));
-    tensor_product(grid, &axes, node, w, grad)
+    std::array::from_fn(|d| domain_factors(grid, x, half, d))
 }
 
 /// Ψ(t) = ∫_{−∞}^t s φ(s) ds, the first moment of the unit hat (piecewise cubic).

@@ -26,9 +26,12 @@ pub(crate) fn cell_coordinate<const D: usize>(grid: &Grid<D>, x: &Vector<D>, d: 
     ((x[d] - grid.min[d]) / grid.h[d]).clamp(0.0, grid.cells[d] as f64)
 }
 
-/// Cell containing cell coordinate `xi`; a point on the max face belongs to the last cell.
+/// Cell containing cell coordinate `xi` ≥ 0; a point on the max face belongs to
+/// the last cell. (The cast truncates, which is ⌊xi⌋ for xi ≥ 0, without a call
+/// to libm's `floor`; NaN gives 0 either way.)
 pub(crate) fn cell_index(xi: f64, cells: usize) -> usize {
-    (xi.floor() as usize).min(cells - 1)
+    debug_assert!(xi >= 0.0 || xi.is_nan(), "cell coordinate {xi} < 0");
+    (xi as usize).min(cells - 1)
 }
 
 /// The two hats of the cell containing `xi` along axis `d`.
@@ -58,6 +61,35 @@ pub(super) fn tensor_product<const D: usize>(
     w: &mut [f64],
     grad: &mut [Vector<D>],
 ) -> usize {
+    nonzero_entries(grid, axes, |n, index, _, weight, gradient| {
+        node[n] = index;
+        w[n] = weight;
+        grad[n] = gradient;
+    })
+}
+
+/// The entries of `tensor_product` (same skips, same order) without their
+/// values: the node of each and its slot on every axis, 2 bits per axis with x
+/// lowest (`Stencils` forms the values from the axis factors when read).
+pub(super) fn tensor_slots<const D: usize>(
+    grid: &Grid<D>,
+    axes: &[AxisFactors; D],
+    node: &mut [u32],
+    slot: &mut [u8],
+) -> usize {
+    nonzero_entries(grid, axes, |n, index, local, _, _| {
+        node[n] = index;
+        slot[n] = (0..D).map(|d| (local[d] as u8) << (2 * d)).sum();
+    })
+}
+
+/// Calls `visit(n, node, local, S_I, ∇S_I)` for the n-th entry of the tensor
+/// product whose weight or gradient is nonzero, x fastest; returns the count.
+fn nonzero_entries<const D: usize>(
+    grid: &Grid<D>,
+    axes: &[AxisFactors; D],
+    mut visit: impl FnMut(usize, u32, &[usize; D], f64, Vector<D>),
+) -> usize {
     // Flat node index = Σ_d ijk_d · stride_d (`Grid::node_index`).
     let mut stride = [1usize; D];
     for d in 1..D {
@@ -73,9 +105,7 @@ pub(super) fn tensor_product<const D: usize>(
         let (weight, gradient) = weight_and_gradient(axes, &local);
         if weight != 0.0 || gradient.iter().any(|g| *g != 0.0) {
             let index: usize = (0..D).map(|d| (axes[d].first + local[d]) * stride[d]).sum();
-            node[n] = index as u32;
-            w[n] = weight;
-            grad[n] = gradient;
+            visit(n, index as u32, &local, weight, gradient);
             n += 1;
         }
         if !next_local(&mut local, &count) {
@@ -166,9 +196,13 @@ pub fn evaluate<const D: usize>(
     w: &mut [f64],
     grad: &mut [Vector<D>],
 ) -> usize {
+    tensor_product(grid, &axes(grid, x), node, w, grad)
+}
+
+/// The hats of a particle at `x`, axis by axis.
+pub(super) fn axes<const D: usize>(grid: &Grid<D>, x: &Vector<D>) -> [AxisFactors; D] {
     debug_assert_eq!(grid.degree, 1, "hat functions live on a degree-1 grid");
-    let axes: [AxisFactors; D] = std::array::from_fn(|d| hat_factors(grid, x, d));
-    tensor_product(grid, &axes, node, w, grad)
+    std::array::from_fn(|d| hat_factors(grid, x, d))
 }
 
 #[cfg(test)]

@@ -127,18 +127,82 @@ pub(crate) fn contiguous_half_length<const D: usize>(
     })
 }
 
+/// Where the factor of each axis of an entry with slot code `code` is in the
+/// axis-factor arrays of particle p (`Values::Axes`).
+#[inline(always)]
+fn slots<const D: usize>(p: usize, per_axis: usize, code: u8) -> [usize; D] {
+    let base = p * D * per_axis;
+    std::array::from_fn(|d| base + d * per_axis + (code >> (2 * d) & 3) as usize)
+}
+
+/// The per-axis factors of a particle for the separable families (all but
+/// CPDI), as `evaluate` forms its tensor product from them.
+fn separable_axes<const D: usize>(
+    shape: ShapeFunction,
+    grid: &Grid<D>,
+    x: &Vector<D>,
+    half_length0: &Vector<D>,
+    f: &Mat3,
+) -> [linear::AxisFactors; D] {
+    match shape {
+        ShapeFunction::Linear => linear::axes(grid, x),
+        ShapeFunction::Ugimp => gimp::axes(grid, x, half_length0),
+        ShapeFunction::Cpgimp => {
+            gimp::axes(grid, x, &contiguous_half_length(grid, half_length0, f))
+        }
+        ShapeFunction::Cpbspline2 => {
+            bspline::domain_axes(grid, x, &contiguous_half_length(grid, half_length0, f), 2)
+        }
+        ShapeFunction::Bspline2 => bspline::axes(grid, x, 2),
+        ShapeFunction::Bspline3 => bspline::axes(grid, x, 3),
+        ShapeFunction::Cpdi => unreachable!("CPDI is not separable"),
+    }
+}
+
 /// Shape-function values of all particles for one step, in fixed-stride storage:
-/// particle p owns entries `p*stride .. p*stride + count[p]`.
+/// particle p owns entries `p*stride .. p*stride + count[p]`, each with its node.
+/// Read an entry's S_Ip and ∇S_Ip with `weight(e)` and `grad(e)`.
 #[derive(Clone, Debug, Default)]
 pub struct Stencils<const D: usize> {
     pub stride: usize,
     pub count: Vec<u32>,
     pub node: Vec<u32>,
-    pub weight: Vec<f64>,
-    pub grad: Vec<Vector<D>>,
+    values: Values<D>,
+    owner: Owner,
     /// Axisymmetric mode only (else empty): S_Ip / r_p per entry, the hoop
     /// gradient (`physics::axisymmetry`).
     pub hoop: Vec<f64>,
+}
+
+/// Where the values of the entries are kept.
+#[derive(Clone, Debug)]
+enum Values<const D: usize> {
+    /// Per entry: CPDI, whose functions are not products of 1D factors.
+    Entries {
+        weight: Vec<f64>,
+        grad: Vec<Vector<D>>,
+    },
+    /// Per particle and axis, for the separable families (linear, GIMP,
+    /// B-splines): factors S_d and S'_d at `per_axis` slots per axis, and each
+    /// entry's slot on every axis (2 bits per axis); S_I = Π_d S_d and
+    /// ∂S_I/∂x_d = S'_d Π_{e≠d} S_e are formed when read, with the arithmetic of
+    /// `linear::tensor_product`. In 2D quadratic B-splines take 141 bytes per
+    /// particle instead of 252, in 3D 279 instead of 972.
+    Axes {
+        per_axis: usize,
+        slot: Vec<u8>,
+        weight: Vec<f64>,
+        slope: Vec<f64>,
+    },
+}
+
+impl<const D: usize> Default for Values<D> {
+    fn default() -> Self {
+        Values::Entries {
+            weight: Vec::new(),
+            grad: Vec::new(),
+        }
+    }
 }
 
 impl<const D: usize> Stencils<D> {
@@ -155,16 +219,39 @@ impl<const D: usize> Stencils<D> {
         let n = x.len();
         let stride = shape.max_support(D);
         self.stride = stride;
+        self.owner = Owner::new(stride);
         self.count.resize(n, 0);
         self.node.resize(n * stride, 0);
-        self.weight.resize(n * stride, 0.0);
-        self.grad.resize(n * stride, Vector::<D>::zeros());
         self.hoop.clear();
+        match shape.per_axis() {
+            Some(per_axis) => self.compute_axes(shape, per_axis, grid, x, half_length0, f),
+            None => self.compute_entries(shape, grid, x, half_length0, f),
+        }
+    }
+
+    /// `compute` for a family without per-axis factors: values per entry.
+    fn compute_entries(
+        &mut self,
+        shape: ShapeFunction,
+        grid: &Grid<D>,
+        x: &[Vector<D>],
+        half_length0: &[Vector<D>],
+        f: &[Mat3],
+    ) {
+        let (n, stride) = (x.len(), self.stride);
+        if !matches!(self.values, Values::Entries { .. }) {
+            self.values = Values::default();
+        }
+        let Values::Entries { weight, grad } = &mut self.values else {
+            unreachable!()
+        };
+        weight.resize(n * stride, 0.0);
+        grad.resize(n * stride, Vector::<D>::zeros());
         self.count
             .par_iter_mut()
             .zip(self.node.par_chunks_mut(stride))
-            .zip(self.weight.par_chunks_mut(stride))
-            .zip(self.grad.par_chunks_mut(stride))
+            .zip(weight.par_chunks_mut(stride))
+            .zip(grad.par_chunks_mut(stride))
             .enumerate()
             .with_min_len(crate::parallel::MIN_PARALLEL_LEN)
             .for_each(|(p, (((c, nd), w), g))| {
@@ -174,6 +261,132 @@ impl<const D: usize> Stencils<D> {
                     false => 0,
                 };
             });
+    }
+
+    /// `compute` for a separable family: the axis factors of every particle and
+    /// the slots of its entries.
+    fn compute_axes(
+        &mut self,
+        shape: ShapeFunction,
+        per_axis: usize,
+        grid: &Grid<D>,
+        x: &[Vector<D>],
+        half_length0: &[Vector<D>],
+        f: &[Mat3],
+    ) {
+        let (n, stride) = (x.len(), self.stride);
+        if !matches!(self.values, Values::Axes { .. }) {
+            self.values = Values::Axes {
+                per_axis,
+                slot: Vec::new(),
+                weight: Vec::new(),
+                slope: Vec::new(),
+            };
+        }
+        let Values::Axes {
+            per_axis: kept,
+            slot,
+            weight,
+            slope,
+        } = &mut self.values
+        else {
+            unreachable!()
+        };
+        *kept = per_axis;
+        slot.resize(n * stride, 0);
+        weight.resize(n * D * per_axis, 0.0);
+        slope.resize(n * D * per_axis, 0.0);
+        self.count
+            .par_iter_mut()
+            .zip(self.node.par_chunks_mut(stride))
+            .zip(slot.par_chunks_mut(stride))
+            .zip(weight.par_chunks_mut(D * per_axis))
+            .zip(slope.par_chunks_mut(D * per_axis))
+            .enumerate()
+            .with_min_len(crate::parallel::MIN_PARALLEL_LEN)
+            .for_each(|(p, ((((c, nd), sl), w), s))| {
+                // A particle outside the grid (removed, `Model::removed`) has no nodes.
+                if !grid.contains(&x[p]) {
+                    *c = 0;
+                    return;
+                }
+                let axes = separable_axes(shape, grid, &x[p], &half_length0[p], &f[p]);
+                for (d, a) in axes.iter().enumerate() {
+                    w[d * per_axis..(d + 1) * per_axis].copy_from_slice(&a.weight[..per_axis]);
+                    s[d * per_axis..(d + 1) * per_axis].copy_from_slice(&a.slope[..per_axis]);
+                }
+                *c = linear::tensor_slots(grid, &axes, nd, sl) as u32;
+            });
+    }
+
+    /// S_Ip of entry e.
+    #[inline(always)]
+    pub fn weight(&self, e: usize) -> f64 {
+        self.weight_at(self.owner.of(e as u32), e)
+    }
+
+    /// ∇S_Ip of entry e.
+    #[inline(always)]
+    pub fn grad(&self, e: usize) -> Vector<D> {
+        self.grad_at(self.owner.of(e as u32), e)
+    }
+
+    /// S_Ip of entry e of particle p (the caller knows p).
+    #[inline(always)]
+    pub fn weight_at(&self, p: usize, e: usize) -> f64 {
+        match &self.values {
+            Values::Entries { weight, .. } => weight[e],
+            Values::Axes {
+                per_axis,
+                slot,
+                weight,
+                ..
+            } => {
+                let at = slots::<D>(p, *per_axis, slot[e]);
+                (0..D).map(|d| weight[at[d]]).product()
+            }
+        }
+    }
+
+    /// ∇S_Ip of entry e of particle p.
+    #[inline(always)]
+    pub fn grad_at(&self, p: usize, e: usize) -> Vector<D> {
+        self.value_at(p, e).1
+    }
+
+    /// (S_Ip, ∇S_Ip) of entry e of particle p.
+    #[inline(always)]
+    pub fn value_at(&self, p: usize, e: usize) -> (f64, Vector<D>) {
+        match &self.values {
+            Values::Entries { weight, grad } => (weight[e], grad[e]),
+            Values::Axes {
+                per_axis,
+                slot,
+                weight,
+                slope,
+            } => {
+                let at = slots::<D>(p, *per_axis, slot[e]);
+                let w: [f64; D] = std::array::from_fn(|d| weight[at[d]]);
+                let grad = Vector::<D>::from_fn(|d, _| {
+                    (0..D)
+                        .map(|k| match k == d {
+                            true => slope[at[k]],
+                            false => w[k],
+                        })
+                        .product()
+                });
+                (w.iter().product(), grad)
+            }
+        }
+    }
+
+    /// The number of entry slots (particles × stride).
+    pub fn len(&self) -> usize {
+        self.node.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.node.is_empty()
     }
 
     /// Entry range of particle p.
@@ -190,7 +403,7 @@ impl<const D: usize> Stencils<D> {
 /// The particle that owns stencil entry e, ⌊e / stride⌋, by one multiplication
 /// instead of a division: ⌊e/d⌋ = ⌊c·e / 2⁶⁴⌋ with c = ⌈2⁶⁴/d⌉, exact for every
 /// 32-bit e and 1 < d < 2³² (Lemire, Kaser & Kurz 2019, Softw. Pract. Exp. 49).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub struct Owner {
     c: u64,
 }
@@ -550,5 +763,70 @@ pub(crate) mod tests {
     #[test]
     fn all_families_respect_max_support_3d() {
         all_families_respect_max_support::<3>();
+    }
+
+    /// The stencils read back, entry by entry, exactly what `evaluate` writes:
+    /// the same nodes, counts and bits, for every family (per-axis factors for
+    /// the separable ones), deformed particles, points on nodes and faces (zero
+    /// entries skipped) and a particle outside the grid.
+    fn stencils_read_back_evaluate<const D: usize>() {
+        let mut rng = Rng::new(5);
+        for shape in ShapeFunction::iter() {
+            let g = test_grid::<D>(shape.degree());
+            let mut x = sample_points(&g, 300);
+            x.push(g.min);
+            x.push(g.max);
+            x.push(g.min + g.h);
+            x.push(g.max + g.h);
+            let f: Vec<Mat3> = (0..x.len())
+                .map(|_| {
+                    let mut f = random_deformation::<D>(&mut rng, &g.h, 0.4);
+                    let widest = (0..D).map(|d| f[(d, d)]).fold(0.0, f64::max);
+                    f *= 0.8 / widest.max(0.8);
+                    f
+                })
+                .collect();
+            let half0 = vec![g.h / 4.0; x.len()];
+            let mut st = Stencils::<D>::default();
+            st.compute(shape, &g, &x, &half0, &f);
+            let cap = shape.max_support(D);
+            for (p, xp) in x.iter().enumerate() {
+                let (mut node, mut w, mut grad) = (
+                    vec![0; cap],
+                    vec![0.0; cap],
+                    vec![Vector::<D>::zeros(); cap],
+                );
+                let n = match g.contains(xp) {
+                    true => evaluate(
+                        shape, &g, xp, &half0[p], &f[p], &mut node, &mut w, &mut grad,
+                    ),
+                    false => 0,
+                };
+                assert_eq!(st.count[p] as usize, n, "{shape:?} particle {p}");
+                for (k, e) in st.range(p).enumerate() {
+                    assert_eq!(st.node[e], node[k], "{shape:?} particle {p} entry {k}");
+                    assert_eq!(st.weight(e).to_bits(), w[k].to_bits(), "{shape:?} {p} {k}");
+                    assert_eq!(st.weight_at(p, e).to_bits(), w[k].to_bits());
+                    for d in 0..D {
+                        assert_eq!(
+                            st.grad(e)[d].to_bits(),
+                            grad[k][d].to_bits(),
+                            "{shape:?} {p} {k}"
+                        );
+                        assert_eq!(st.value_at(p, e).1[d].to_bits(), grad[k][d].to_bits());
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn stencils_read_back_evaluate_2d() {
+        stencils_read_back_evaluate::<2>();
+    }
+
+    #[test]
+    fn stencils_read_back_evaluate_3d() {
+        stencils_read_back_evaluate::<3>();
     }
 }

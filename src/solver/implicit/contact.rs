@@ -416,7 +416,7 @@ impl<const D: usize> PenaltyContact<D> {
     pub fn add_residual(&self, map: &NodeMap, st: &Stencils<D>, r: &mut [Vector<D>]) {
         for t in &self.touches {
             for e in st.range(t.particle) {
-                r[map.local_of(st, e)] -= t.contact.force * st.weight[e];
+                r[map.local_of(st, e)] -= t.contact.force * st.weight(e);
             }
         }
         for (f, t) in self.node_touches() {
@@ -482,7 +482,7 @@ impl<const D: usize> PenaltyContact<D> {
                     if !needed[local] {
                         continue;
                     }
-                    let w = -st.weight[e1] * st.weight[e2];
+                    let w = -st.weight(e1) * st.weight(e2);
                     for a in 0..D {
                         for b in 0..D {
                             block[local * D * D + a * D + b] = w * d[(a, b)];

@@ -207,7 +207,7 @@ pub fn diagonal_blocks<const D: usize>(
     let mut blocks = sys
         .map
         .gather(st.stride, SMatrix::<f64, D, D>::zeros(), |q, e| {
-            let g = &st.grad[e];
+            let g = &st.grad(e);
             let hoop = a.hoop_of(q);
             let mut b = SMatrix::<f64, D, D>::from_fn(|i, k| {
                 let mut v = coupling(g, a.of(q), g, i, k);
@@ -217,7 +217,7 @@ pub fn diagonal_blocks<const D: usize>(
                 v * p.volume[q]
             });
             if consistent {
-                let w = st.weight[e];
+                let w = st.weight(e);
                 b += SMatrix::<f64, D, D>::identity() * (p.mass[q] * w * w * inertia);
             }
             b

@@ -100,7 +100,7 @@ pub fn nodal_support<const D: usize>(
     cell_volume: f64,
 ) -> Vec<f64> {
     map.gather(st.stride, 0.0, |q, e| {
-        volume[q] * st.weight[e] / cell_volume
+        volume[q] * st.weight(e) / cell_volume
     })
 }
 

@@ -41,7 +41,7 @@ pub fn add_absorbing<const D: usize>(
                 return false;
             };
             for (local, e1) in st.range(q).enumerate() {
-                let w = st.weight[e1] * st.weight[e2];
+                let w = st.weight(e1) * st.weight(e2);
                 for d in 0..D {
                     block[local * D * D + d * D + d] = w * c[d];
                 }

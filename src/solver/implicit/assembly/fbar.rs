@@ -147,7 +147,7 @@ pub fn add_fbar_stiffness<const D: usize>(
                 let coef_a = volume[q] * beta[q] / (n * dj_bar);
                 let coef_h = volume[q] / v_cell * dj[q];
                 for e in st.range(q) {
-                    let grad = &st.grad[e];
+                    let grad = &st.grad(e);
                     let hoop = st.hoop.get(e).copied().unwrap_or(0.0);
                     let av = Vector::<D>::from_fn(|i, _| {
                         let mut s: f64 = (0..D).map(|j| grad[j] * m[q][(i, j)]).sum();

@@ -36,7 +36,7 @@ pub fn add_linear_stress_stiffness<const D: usize>(
     let at = ParticleTangents::<D>::at;
     let (csc, storage) = (k.pattern, k.storage);
     pattern.add_listed_terms(&mut k.values, csc, storage, map, st, dofs, |q, e2, out| {
-        let (aq, g2) = (a.of(q), &st.grad[e2]);
+        let (aq, g2) = (a.of(q), &st.grad(e2));
         for (node, l) in &rows[q] {
             let mut block = [0.0; 9];
             for i in 0..D {

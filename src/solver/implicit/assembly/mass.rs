@@ -46,7 +46,7 @@ pub fn add_consistent_mass<const D: usize>(
         Components::Diagonal,
         |q, e2, _needed, block| {
             for (local, e1) in st.range(q).enumerate() {
-                let v = particle_mass[q] * st.weight[e1] * st.weight[e2] * inertia;
+                let v = particle_mass[q] * st.weight(e1) * st.weight(e2) * inertia;
                 for i in 0..D {
                     block[local * D * D + i * D + i] = v;
                 }

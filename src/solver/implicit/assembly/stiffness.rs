@@ -306,7 +306,7 @@ pub fn add_stiffness<const D: usize>(
         Components::All,
         |q, e2, needed, block| {
             // b_ijk = Σ_l A_ijkl ∂S_J/∂X_l, then V Σ_j ∂S_I/∂X_j b_ijk for each node I.
-            let (ap, g2) = (a.of(q), &st.grad[e2]);
+            let (ap, g2) = (a.of(q), &st.grad(e2));
             let mut b = [[[0.0; D]; D]; D];
             for (i, bi) in b.iter_mut().enumerate() {
                 for (j, bij) in bi.iter_mut().enumerate() {
@@ -317,7 +317,7 @@ pub fn add_stiffness<const D: usize>(
             }
             let hoop = a.hoop_of(q);
             for (local, e1) in st.range(q).enumerate().filter(|&(l, _)| needed[l]) {
-                let g1 = &st.grad[e1];
+                let g1 = &st.grad(e1);
                 let out = &mut block[local * D * D..(local + 1) * D * D];
                 for i in 0..D {
                     for kk in 0..D {
