@@ -807,14 +807,9 @@ pub(crate) mod tests {
                     assert_eq!(st.node[e], node[k], "{shape:?} particle {p} entry {k}");
                     assert_eq!(st.weight(e).to_bits(), w[k].to_bits(), "{shape:?} {p} {k}");
                     assert_eq!(st.weight_at(p, e).to_bits(), w[k].to_bits());
-                    for d in 0..D {
-                        assert_eq!(
-                            st.grad(e)[d].to_bits(),
-                            grad[k][d].to_bits(),
-                            "{shape:?} {p} {k}"
-                        );
-                        assert_eq!(st.value_at(p, e).1[d].to_bits(), grad[k][d].to_bits());
-                    }
+                    let bits = |v: Vector<D>| v.map(f64::to_bits);
+                    assert_eq!(bits(st.grad(e)), bits(grad[k]), "{shape:?} {p} {k}");
+                    assert_eq!(bits(st.value_at(p, e).1), bits(grad[k]));
                 }
             }
         }
