@@ -14,8 +14,8 @@ use crate::parallel::MIN_PARALLEL_LEN;
 use crate::physics::axisymmetry::hoop_gradients;
 use crate::physics::shape::{Owner, ShapeFunction, Stencils};
 use rayon::prelude::*;
+use std::sync::atomic::AtomicBool;
 use std::sync::atomic::Ordering::Relaxed;
-use std::sync::atomic::{AtomicBool, AtomicU32};
 
 /// Active nodes of one step and, for each, the stencil entries that touch it.
 #[derive(Clone, Debug, Default)]
@@ -36,13 +36,31 @@ pub struct NodeMap {
     scratch: BuildScratch,
 }
 
-/// The buffers the parallel `NodeMap::build` writes through shared references.
+/// The buffer the parallel `NodeMap::build` writes through shared references.
 #[derive(Debug, Default)]
 struct BuildScratch {
     /// Per grid node: touched by an entry this step (cleared after the build).
     touched: Vec<AtomicBool>,
-    /// Entries at their sorted positions.
-    placed: Vec<AtomicU32>,
+}
+
+/// `NodeMap::entries` as the chunks of `NodeMap::build` fill it in parallel:
+/// each chunk writes only the positions its counts reserved (node a's range
+/// from start[a] + the entries of the chunks before it), so no two threads
+/// write the same element and nothing is read until all have finished. (An
+/// array of atomics would do it safely but needs a second array of the same
+/// size, 4 bytes per stencil entry, and a copy.)
+#[derive(Clone, Copy)]
+struct Placement(*mut u32);
+
+// SAFETY: the writes go to disjoint positions within the vector's length (above).
+unsafe impl Send for Placement {}
+unsafe impl Sync for Placement {}
+
+impl Placement {
+    fn write(self, at: usize, e: u32) {
+        // SAFETY: `at` < entries.len() (a counted position) and is written once.
+        unsafe { self.0.add(at).write(e) }
+    }
 }
 
 impl Clone for BuildScratch {
@@ -125,28 +143,19 @@ impl NodeMap {
             }
         }
         let total = self.start[n] as usize;
-        let placed = &mut self.scratch.placed;
-        if placed.len() < total {
-            placed.resize_with(total, || AtomicU32::new(0));
-        }
-        let (placed, local) = (&self.scratch.placed, &self.local);
+        self.entries.resize(total, 0);
+        let (entries, local) = (Placement(self.entries.as_mut_ptr()), &self.local);
         next.par_chunks_mut(n.max(1))
             .enumerate()
             .for_each(|(c, next)| {
                 for p in c * chunk..((c + 1) * chunk).min(n_particles) {
                     for e in st.range(p) {
                         let a = local[st.node[e] as usize] as usize;
-                        placed[next[a] as usize].store(e as u32, Relaxed);
+                        entries.write(next[a] as usize, e as u32);
                         next[a] += 1;
                     }
                 }
             });
-        self.entries.resize(total, 0);
-        self.entries
-            .par_iter_mut()
-            .zip(&placed[..total])
-            .with_min_len(MIN_PARALLEL_LEN)
-            .for_each(|(e, p)| *e = p.load(Relaxed));
     }
 
     pub fn len(&self) -> usize {
