@@ -354,6 +354,8 @@ impl Multigrid {
     /// factorized (a coarse space that lost its rank at a ragged boundary), the
     /// next finer level becomes the coarsest.
     pub fn refresh(&mut self, a: Csr, symmetric: bool) -> Result<Shape, String> {
+        // On an error no operator is kept.
+        self.release();
         let mut operators = vec![a];
         for (t, r) in self.transfers.iter().zip(&self.restrictions) {
             let coarse = galerkin(r, operators.last().unwrap(), &t.prolongation);
@@ -397,6 +399,14 @@ impl Multigrid {
             .collect();
         self.operators = operators;
         Ok(shape)
+    }
+
+    /// Drop the operators and smoothers of the last refresh (the hierarchy
+    /// stays): call it before assembling the next fine operator, so that the old
+    /// and the new ones are never held together.
+    pub fn release(&mut self) {
+        self.operators = Vec::new();
+        self.smoothers = Vec::new();
     }
 
     /// Factorize `a` as the coarsest operator, its diagonal raised by `shift`
