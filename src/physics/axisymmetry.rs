@@ -41,8 +41,8 @@ pub fn hoop_gradients<const D: usize>(st: &mut Stencils<D>, x: &[Vector<D>]) {
         .for_each(|(p, hoop)| {
             // S_Ip / r_p: the hoop gradient of node I.
             let r = x[p][0];
-            for (k, h) in hoop.iter_mut().enumerate() {
-                *h = values.weight(p * stride + k) / r;
+            for (h, e) in hoop.iter_mut().zip(values.range(p)) {
+                *h = values.weight_at(p, e) / r;
             }
         });
     st.hoop = hoop;

@@ -40,12 +40,6 @@ impl Trial {
         state.cells = Cells::locate(grid, x);
     }
 
-    /// Whether F-bar is on (then the particles need the whole step's ΔF before any
-    /// stress update, so the update goes through the trial buffers).
-    pub fn uses_fbar(&self) -> bool {
-        self.fbar.is_some()
-    }
-
     /// Evaluate the trial state under nodal displacements `u` (one per active node).
     /// Returns the first particle whose deformation inverts (det F ≤ 0), if any.
     pub fn evaluate<const D: usize>(
@@ -109,6 +103,7 @@ impl Trial {
             .enumerate()
             .with_min_len(MIN_PARALLEL_LEN)
             .map(|(q, ((((df, f), stress), volume), hist))| {
+                let material = materials[p.material[q] as usize].as_ref();
                 let inc = Increment {
                     f_old: p.f[q],
                     df: *df,
@@ -116,19 +111,40 @@ impl Trial {
                     stress_old: p.stress[q],
                     history_old: history_old[q],
                 };
-                *stress = materials[p.material[q] as usize].update(&inc, hist);
-                *f = *df * p.f[q];
-                let j = f.determinant();
-                *volume = j * p.volume0[q];
-                if j > 0.0 {
-                    usize::MAX
-                } else {
-                    q
-                }
+                let new = advance(material, &inc, p.volume0[q], hist);
+                (*stress, *f, *volume) = (new.stress, new.f, new.volume);
+                new.inverted_at(q)
             })
             .min()
             .unwrap_or(usize::MAX);
         (inverted != usize::MAX).then_some(inverted)
+    }
+
+    /// The explicit step's update: the particles take the state of the
+    /// displacement increment `u` (`evaluate` and `commit` with F-bar, else
+    /// `update_in_place`). On an inversion, the particle and its det F (the
+    /// particles are then not, or only partly, updated, and the run stops).
+    #[allow(clippy::too_many_arguments)]
+    pub fn advance<const D: usize>(
+        &mut self,
+        p: &mut Particles<D>,
+        materials: &[Box<dyn Material>],
+        st: &Stencils<D>,
+        map: &NodeMap,
+        u: &[Vector<D>],
+        dt: f64,
+    ) -> Result<(), (usize, f64)> {
+        if self.fbar.is_none() {
+            return match update_in_place(p, materials, st, map, u, dt) {
+                Some(q) => Err((q, p.f[q].determinant())),
+                None => Ok(()),
+            };
+        }
+        if let Some(q) = self.evaluate(p, materials, st, map, u, dt) {
+            return Err((q, self.f[q].determinant()));
+        }
+        self.commit(p);
+        Ok(())
     }
 
     /// Make the trial state the particles' state (buffers are swapped, not copied).
@@ -138,6 +154,45 @@ impl Trial {
         std::mem::swap(&mut p.stress, &mut self.stress);
         std::mem::swap(&mut p.volume, &mut self.volume);
         std::mem::swap(&mut p.history.data, &mut self.history);
+    }
+}
+
+/// A particle's state after an increment: the material's stress, F = ΔF F_old
+/// and V = det F V0 (2-31, 2-32).
+struct Advanced {
+    stress: Mat3,
+    f: Mat3,
+    volume: f64,
+    det: f64,
+}
+
+impl Advanced {
+    /// q if the deformation inverted (det F ≤ 0), else `usize::MAX` (for a
+    /// `min` over the particles).
+    fn inverted_at(&self, q: usize) -> usize {
+        match self.det > 0.0 {
+            true => usize::MAX,
+            false => q,
+        }
+    }
+}
+
+/// The stress update of one particle under `inc` (writing its new history into
+/// `history`), its new F and volume.
+fn advance(
+    material: &dyn Material,
+    inc: &Increment,
+    volume0: f64,
+    history: &mut [f64],
+) -> Advanced {
+    let stress = material.update(inc, history);
+    let f = inc.df * inc.f_old;
+    let det = f.determinant();
+    Advanced {
+        stress,
+        f,
+        volume: det * volume0,
+        det,
     }
 }
 
@@ -163,7 +218,7 @@ fn increment<const D: usize>(
 /// with the same arithmetic (bit-identical), and no trial buffers (216 bytes per
 /// particle less). Returns the first particle whose deformation inverts (det F ≤
 /// 0), if any; the state is then part updated, and the run stops.
-pub fn update_in_place<const D: usize>(
+fn update_in_place<const D: usize>(
     p: &mut Particles<D>,
     materials: &[Box<dyn Material>],
     st: &Stencils<D>,
@@ -195,22 +250,21 @@ pub fn update_in_place<const D: usize>(
                 &old
             }
         };
-        let df = increment(st, map, q, u, axisymmetric);
         let inc = Increment {
             f_old: *f,
-            df,
+            df: increment(st, map, q, u, axisymmetric),
             dt,
             stress_old: *stress,
             history_old,
         };
-        *stress = materials[material[q] as usize].update(&inc, hist);
-        *f = df * *f;
-        let j = f.determinant();
-        *volume = j * volume0[q];
-        match j > 0.0 {
-            true => usize::MAX,
-            false => q,
-        }
+        let new = advance(
+            materials[material[q] as usize].as_ref(),
+            &inc,
+            volume0[q],
+            hist,
+        );
+        (*stress, *f, *volume) = (new.stress, new.f, new.volume);
+        new.inverted_at(q)
     };
     let states = f
         .par_iter_mut()

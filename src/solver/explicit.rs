@@ -12,7 +12,7 @@ use crate::physics::absorbing;
 use crate::physics::boundary::{friction_contact, node_constraint, node_friction};
 use crate::physics::bulk_viscosity::BulkViscosity;
 use crate::physics::contact::{Contact, PairTotal};
-use crate::physics::deformation::{update_in_place, Trial};
+use crate::physics::deformation::Trial;
 use crate::physics::mirror::Mirror;
 use crate::physics::shape::{ShapeFunction, Stencils};
 use crate::physics::transfer::{
@@ -362,24 +362,12 @@ fn update_stress<const D: usize>(
     t: f64,
 ) -> Result<(), Divergence> {
     let u: Vec<Vector<D>> = velocity.iter().map(|v| v * dt).collect();
-    let inverted = match trial.uses_fbar() {
-        true => trial.evaluate(&m.particles, &m.materials, st, map, &u, dt),
-        false => update_in_place(&mut m.particles, &m.materials, st, map, &u, dt),
-    };
-    if let Some(q) = inverted {
-        let f = match trial.uses_fbar() {
-            true => trial.f[q],
-            false => m.particles.f[q],
-        };
-        return Err(Divergence {
+    trial
+        .advance(&mut m.particles, &m.materials, st, map, &u, dt)
+        .map_err(|(q, det)| Divergence {
             step: step + 1,
             time: t + dt,
             particle: Some(q),
-            message: format!("inverted: det F = {:.3e} ≤ 0", f.determinant()),
-        });
-    }
-    if trial.uses_fbar() {
-        trial.commit(&mut m.particles);
-    }
-    Ok(())
+            message: format!("inverted: det F = {det:.3e} ≤ 0"),
+        })
 }

@@ -275,24 +275,16 @@ impl<const D: usize> Stencils<D> {
         f: &[Mat3],
     ) {
         let (n, stride) = (x.len(), self.stride);
-        if !matches!(self.values, Values::Axes { .. }) {
-            self.values = Values::Axes {
-                per_axis,
-                slot: Vec::new(),
-                weight: Vec::new(),
-                slope: Vec::new(),
-            };
-        }
-        let Values::Axes {
-            per_axis: kept,
-            slot,
-            weight,
-            slope,
-        } = &mut self.values
-        else {
-            unreachable!()
+        // The buffers of the last step are reused.
+        let (mut slot, mut weight, mut slope) = match std::mem::take(&mut self.values) {
+            Values::Axes {
+                slot,
+                weight,
+                slope,
+                ..
+            } => (slot, weight, slope),
+            Values::Entries { .. } => Default::default(),
         };
-        *kept = per_axis;
         slot.resize(n * stride, 0);
         weight.resize(n * D * per_axis, 0.0);
         slope.resize(n * D * per_axis, 0.0);
@@ -317,6 +309,12 @@ impl<const D: usize> Stencils<D> {
                 }
                 *c = linear::tensor_slots(grid, &axes, nd, sl) as u32;
             });
+        self.values = Values::Axes {
+            per_axis,
+            slot,
+            weight,
+            slope,
+        };
     }
 
     /// S_Ip of entry e.
