@@ -45,9 +45,10 @@
 
 use super::assembly::stiffness::{coupling, hoop_coupling, particle_tangents, ParticleTangents};
 use super::assembly::Dofs;
+use super::assembly::Storage;
 use super::coarsening::hierarchy;
 use super::failure::Failure;
-use super::residual::{ordering, residual, tangent};
+use super::residual::{ordering, residual, step_pattern, tangent};
 use super::step::StepSystem;
 use crate::dim::Vector;
 use crate::model::Model;
@@ -56,10 +57,11 @@ use crate::solver::linear::cg::cg;
 use crate::solver::linear::direct::{DirectSolver, Structure};
 use crate::solver::linear::gmres::gmres;
 use crate::solver::linear::iterative::{norm, Identity, Outcome, Preconditioner, Settings};
-use crate::solver::linear::multigrid::{Csr, Multigrid};
+use crate::solver::linear::multigrid::{Csr, Fine, Multigrid};
 use crate::solver::linear::preconditioner::{BlockJacobi, Factorized, Jacobi};
 use crate::solver::report::MultigridCounts;
 use nalgebra::SMatrix;
+use std::sync::Arc;
 
 /// The lagged factorization is refreshed when a linear solve with it needed more
 /// than this many iterations (or failed), and whenever the unknowns change.
@@ -453,9 +455,18 @@ impl KrylovState {
         }
         // Materials without an analytic tangent use a numerical one.
         let k = tangent(m, sys, true)?;
-        let (a, symmetric) = (Csr::from_csc(k.matrix(), k.symmetric()), k.symmetric());
-        // The assembled values are not needed beside the multigrid's copy.
-        drop(k);
+        // A symmetric tangent serves as it is (its lower triangle, read by
+        // rows); an unsymmetric one is copied into rows, and its columns dropped.
+        let symmetric = k.symmetric();
+        let a = if symmetric {
+            let pattern = step_pattern(sys).csc(Storage::Lower);
+            debug_assert!(std::ptr::eq(&**pattern, k.pattern));
+            Fine::Lower(Arc::clone(pattern), k.values)
+        } else {
+            let rows = Csr::from_csc(k.matrix(), false);
+            drop(k);
+            Fine::Rows(rows)
+        };
         let (_, _, mg) = self.multigrid.as_mut().expect("built above");
         let shape = mg.refresh(a, symmetric).map_err(|e| Failure {
             particle: None,

@@ -45,6 +45,7 @@ use super::iterative::Preconditioner;
 use super::preconditioner::BlockJacobi;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use rayon::prelude::*;
+use std::sync::Arc;
 
 /// The diagonal shift of a singular coarsest operator, relative to its mean
 /// diagonal entry (module doc).
@@ -149,13 +150,7 @@ impl Csr {
 
     /// y = A x, rows in parallel (each row summed in column order).
     pub fn apply(&self, x: &[f64], y: &mut [f64]) {
-        y.par_iter_mut()
-            .enumerate()
-            .with_min_len(ROWS_PER_TASK)
-            .for_each(|(i, yi)| {
-                let (c, v) = self.row(i);
-                *yi = c.iter().zip(v).map(|(&j, a)| a * x[j as usize]).sum();
-            });
+        apply_rows(self, x, y);
     }
 
     /// Aᵀ as a matrix of its own.
@@ -189,18 +184,6 @@ impl Csr {
         }
     }
 
-    /// The diagonal blocks of the unknowns `block` (row-major values).
-    fn block_values(&self, block: &[usize]) -> Vec<f64> {
-        let mut out = Vec::with_capacity(block.len() * block.len());
-        for &i in block {
-            let (c, v) = self.row(i);
-            for &j in block {
-                out.push(c.binary_search(&(j as u32)).map_or(0.0, |k| v[k]));
-            }
-        }
-        out
-    }
-
     /// The lower triangle (or the whole matrix) in compressed columns, for the
     /// direct solver. For a symmetric matrix the lower triangle's columns are
     /// the upper triangle's rows.
@@ -231,11 +214,211 @@ impl Csr {
     }
 }
 
+/// A square matrix read row by row, each row's columns ascending: what the
+/// products, the Galerkin triple product and the smoother need of an operator.
+pub trait Rows: Sync {
+    fn rows(&self) -> usize;
+    /// f(j, a_ij) for the stored entries of row i, j ascending.
+    fn for_each_in_row(&self, i: usize, f: impl FnMut(u32, f64));
+}
+
+impl Rows for Csr {
+    fn rows(&self) -> usize {
+        self.rows
+    }
+
+    fn for_each_in_row(&self, i: usize, mut f: impl FnMut(u32, f64)) {
+        let (c, v) = self.row(i);
+        c.iter().zip(v).for_each(|(&j, &a)| f(j, a));
+    }
+}
+
+/// y = A x, rows in parallel (each row summed in column order).
+fn apply_rows(a: &impl Rows, x: &[f64], y: &mut [f64]) {
+    y.par_iter_mut()
+        .enumerate()
+        .with_min_len(ROWS_PER_TASK)
+        .for_each(|(i, yi)| {
+            let mut sum = 0.0;
+            a.for_each_in_row(i, |j, aij| sum += aij * x[j as usize]);
+            *yi = sum;
+        });
+}
+
+/// The diagonal block of A over the unknowns `block` (row-major values).
+fn block_values(a: &impl Rows, block: &[usize]) -> Vec<f64> {
+    let mut out = vec![0.0; block.len() * block.len()];
+    for (r, &i) in block.iter().enumerate() {
+        a.for_each_in_row(i, |j, aij| {
+            if let Some(c) = block.iter().position(|&b| b == j as usize) {
+                out[r * block.len() + c] = aij;
+            }
+        });
+    }
+    out
+}
+
+/// Where each row's entries left of the diagonal sit in a lower triangle
+/// stored by columns: row i's entries (i, j), j < i, are the entries (i, j) of
+/// columns j, at value positions `pos`, columns `col` ascending.
+#[derive(Debug)]
+struct Mirror {
+    row_ptr: Vec<usize>,
+    col: Vec<u32>,
+    pos: Vec<u32>,
+}
+
+impl Mirror {
+    /// The mirror of the lower-triangle pattern `lower` (rows ≥ column,
+    /// ascending within each column): its transpose, counted, then filled in
+    /// column order, so each row's columns come out ascending. (Sequential: a
+    /// parallel version by chunks of rows measured slower on two cores, the
+    /// pass being bound by memory.)
+    fn of(lower: &SymbolicSparseColMat<usize>) -> Mirror {
+        let n = lower.nrows();
+        let (col_ptr, row_idx) = (lower.col_ptr(), lower.row_idx());
+        let below = |j: usize| (col_ptr[j]..col_ptr[j + 1]).filter(move |&k| row_idx[k] > j);
+        let mut row_ptr = vec![0usize; n + 1];
+        for j in 0..n {
+            for k in below(j) {
+                row_ptr[row_idx[k] + 1] += 1;
+            }
+        }
+        for i in 0..n {
+            row_ptr[i + 1] += row_ptr[i];
+        }
+        let mut next = row_ptr.clone();
+        let len = row_ptr[n];
+        let (mut col, mut pos) = (vec![0u32; len], vec![0u32; len]);
+        for j in 0..n {
+            for k in below(j) {
+                let at = &mut next[row_idx[k]];
+                col[*at] = j as u32;
+                pos[*at] = k as u32;
+                *at += 1;
+            }
+        }
+        Mirror { row_ptr, col, pos }
+    }
+}
+
+/// A symmetric matrix kept as the direct solver keeps it, its lower triangle
+/// in compressed columns (the pattern shared with the step), read by rows
+/// through a [`Mirror`] of the pattern: row i is (i, j < i) from the columns
+/// left of it, then column i from its diagonal down. Row i therefore has the
+/// entries, values and order of row i of the whole matrix in compressed rows,
+/// without a second copy of the values.
+#[derive(Debug)]
+pub struct LowerSymmetric {
+    pattern: Arc<SymbolicSparseColMat<usize>>,
+    values: Vec<f64>,
+    mirror: Mirror,
+}
+
+impl LowerSymmetric {
+    /// Both triangles' stored entries.
+    fn nnz(&self) -> usize {
+        self.values.len() + self.mirror.col.len()
+    }
+}
+
+impl Rows for LowerSymmetric {
+    fn rows(&self) -> usize {
+        self.pattern.nrows()
+    }
+
+    fn for_each_in_row(&self, i: usize, mut f: impl FnMut(u32, f64)) {
+        let m = &self.mirror;
+        let left = m.row_ptr[i]..m.row_ptr[i + 1];
+        for (&j, &k) in m.col[left.clone()].iter().zip(&m.pos[left]) {
+            f(j, self.values[k as usize]);
+        }
+        let down = self.pattern.col_ptr()[i]..self.pattern.col_ptr()[i + 1];
+        for (&r, &a) in self.pattern.row_idx()[down.clone()]
+            .iter()
+            .zip(&self.values[down])
+        {
+            f(r as u32, a);
+        }
+    }
+}
+
+/// The fine operator handed to [`Multigrid::refresh`]: a matrix in compressed
+/// rows, or a symmetric tangent as assembled, by the lower triangle of its
+/// shared pattern (rows ≥ column, ascending) and its values.
+#[derive(Debug)]
+pub enum Fine {
+    Rows(Csr),
+    Lower(Arc<SymbolicSparseColMat<usize>>, Vec<f64>),
+}
+
+impl From<Csr> for Fine {
+    fn from(a: Csr) -> Fine {
+        Fine::Rows(a)
+    }
+}
+
+/// The operator of one level: a matrix in compressed rows (the coarse levels,
+/// unsymmetric fine tangents), or a symmetric fine tangent as assembled
+/// ([`LowerSymmetric`]).
+#[derive(Debug)]
+pub enum Operator {
+    Rows(Csr),
+    Lower(LowerSymmetric),
+}
+
+impl Operator {
+    pub fn rows(&self) -> usize {
+        match self {
+            Operator::Rows(a) => a.rows,
+            Operator::Lower(a) => a.rows(),
+        }
+    }
+
+    /// Stored entries, both triangles.
+    pub fn nnz(&self) -> usize {
+        match self {
+            Operator::Rows(a) => a.nnz(),
+            Operator::Lower(a) => a.nnz(),
+        }
+    }
+
+    /// y = A x.
+    pub fn apply(&self, x: &[f64], y: &mut [f64]) {
+        match self {
+            Operator::Rows(a) => apply_rows(a, x, y),
+            Operator::Lower(a) => apply_rows(a, x, y),
+        }
+    }
+
+    fn block_values(&self, block: &[usize]) -> Vec<f64> {
+        match self {
+            Operator::Rows(a) => block_values(a, block),
+            Operator::Lower(a) => block_values(a, block),
+        }
+    }
+
+    fn galerkin(&self, r: &Csr, p: &Csr) -> Csr {
+        match self {
+            Operator::Rows(a) => galerkin(r, a, p),
+            Operator::Lower(a) => galerkin(r, a, p),
+        }
+    }
+
+    /// The lower triangle (or the whole matrix) in compressed columns.
+    fn to_csc(&self, symmetric: bool) -> (SymbolicSparseColMat<usize>, Vec<f64>) {
+        match self {
+            Operator::Rows(a) => a.to_csc(symmetric),
+            Operator::Lower(a) => ((*a.pattern).clone(), a.values.clone()),
+        }
+    }
+}
+
 /// A_c = R A P with R = Pᵀ (Galerkin): every coarse row i is Σ_k R_ik Σ_j A_kj P_j·,
 /// summed in the fixed order of k, j and P's columns, into a dense accumulator;
 /// the coarse row's pattern is every column reached (kept when a sum cancels,
 /// so it depends only on the patterns).
-pub fn galerkin(r: &Csr, a: &Csr, p: &Csr) -> Csr {
+pub fn galerkin(r: &Csr, a: &impl Rows, p: &Csr) -> Csr {
     let n = r.rows;
     let chunks: Vec<(Vec<usize>, Vec<u32>, Vec<f64>)> = (0..n.div_ceil(ROWS_PER_TASK))
         .into_par_iter()
@@ -248,8 +431,7 @@ pub fn galerkin(r: &Csr, a: &Csr, p: &Csr) -> Csr {
                     touched.clear();
                     let (rc, rv) = r.row(i);
                     for (&k, &rik) in rc.iter().zip(rv) {
-                        let (ac, av) = a.row(k as usize);
-                        for (&j, &akj) in ac.iter().zip(av) {
+                        a.for_each_in_row(k as usize, |j, akj| {
                             let ra = rik * akj;
                             let (pc, pv) = p.row(j as usize);
                             for (&l, &pjl) in pc.iter().zip(pv) {
@@ -260,7 +442,7 @@ pub fn galerkin(r: &Csr, a: &Csr, p: &Csr) -> Csr {
                                 }
                                 acc[l] += ra * pjl;
                             }
-                        }
+                        });
                     }
                     touched.sort_unstable();
                     for &l in touched.iter() {
@@ -315,7 +497,7 @@ pub struct Multigrid {
     /// Pᵀ of every transfer.
     restrictions: Vec<Csr>,
     /// The operator of every level in use, finest first (the last one factorized).
-    operators: Vec<Csr>,
+    operators: Vec<Operator>,
     smoothers: Vec<Smoother>,
     coarse: DirectSolver,
 }
@@ -347,19 +529,41 @@ impl Multigrid {
         }
     }
 
+    /// The fine operator of `a`: a symmetric tangent is read through a mirror
+    /// of its pattern, built here. (Keeping the mirror while the pattern stays
+    /// would save its build but hold it beside the next tangent's assembly,
+    /// which is the peak of a Newton iteration.)
+    fn fine(a: Fine) -> Operator {
+        match a {
+            Fine::Rows(a) => Operator::Rows(a),
+            Fine::Lower(pattern, values) => {
+                assert!(
+                    pattern.row_idx().len() <= u32::MAX as usize,
+                    "a lower triangle of more than 2³² entries"
+                );
+                let mirror = Mirror::of(&pattern);
+                Operator::Lower(LowerSymmetric {
+                    pattern,
+                    values,
+                    mirror,
+                })
+            }
+        }
+    }
+
     /// Galerkin operators, smoothers and the coarse factorization for the fine
     /// operator `a` (both triangles); `symmetric` selects LLᵀ/LBLᵀ or LU on the
     /// coarsest level. The coarse symbolic factorization is kept while its
     /// pattern is unchanged (`DirectSolver`). If the coarsest operator cannot be
     /// factorized (a coarse space that lost its rank at a ragged boundary), the
     /// next finer level becomes the coarsest.
-    pub fn refresh(&mut self, a: Csr, symmetric: bool) -> Result<Shape, String> {
+    pub fn refresh(&mut self, a: impl Into<Fine>, symmetric: bool) -> Result<Shape, String> {
         // On an error no operator is kept.
         self.release();
-        let mut operators = vec![a];
+        let mut operators = vec![Self::fine(a.into())];
         for (t, r) in self.transfers.iter().zip(&self.restrictions) {
-            let coarse = galerkin(r, operators.last().unwrap(), &t.prolongation);
-            operators.push(coarse);
+            let coarse = operators.last().unwrap().galerkin(r, &t.prolongation);
+            operators.push(Operator::Rows(coarse));
         }
         let mut used = self.transfers.len();
         let shift = loop {
@@ -376,7 +580,7 @@ impl Multigrid {
             }
         };
         let shape = Shape {
-            unknowns: operators[..=used].iter().map(|a| a.rows).collect(),
+            unknowns: operators[..=used].iter().map(|a| a.rows()).collect(),
             entries: operators[..=used].iter().map(|a| a.nnz()).collect(),
             coarse_shift: shift,
         };
@@ -411,14 +615,19 @@ impl Multigrid {
 
     /// Factorize `a` as the coarsest operator, its diagonal raised by `shift`
     /// times the mean |a_ii|.
-    fn factorize_coarse(&mut self, a: &Csr, symmetric: bool, shift: f64) -> Result<(), String> {
+    fn factorize_coarse(
+        &mut self,
+        a: &Operator,
+        symmetric: bool,
+        shift: f64,
+    ) -> Result<(), String> {
         let (pattern, mut values) = a.to_csc(symmetric);
         if shift > 0.0 {
             let (col_ptr, rows) = (pattern.col_ptr(), pattern.row_idx());
-            let diagonal: Vec<usize> = (0..a.rows)
+            let diagonal: Vec<usize> = (0..a.rows())
                 .filter_map(|j| (col_ptr[j]..col_ptr[j + 1]).find(|&k| rows[k] == j))
                 .collect();
-            let mean = diagonal.iter().map(|&k| values[k].abs()).sum::<f64>() / a.rows as f64;
+            let mean = diagonal.iter().map(|&k| values[k].abs()).sum::<f64>() / a.rows() as f64;
             for k in diagonal {
                 values[k] += shift * mean * values[k].signum();
             }
@@ -441,7 +650,7 @@ impl Multigrid {
     }
 
     /// The fine operator of the last refresh.
-    pub fn fine_operator(&self) -> &Csr {
+    pub fn fine_operator(&self) -> &Operator {
         &self.operators[0]
     }
 
@@ -482,8 +691,8 @@ impl Preconditioner for Multigrid {
 /// by D on A x = b with a fixed b: the largest eigenvalue of the Lanczos
 /// tridiagonal matrix that CG's coefficients define (Saad 2003, §6.7.3), a lower
 /// bound that converges fast to the top of the spectrum.
-fn largest_eigenvalue(a: &Csr, d: &BlockJacobi) -> f64 {
-    let n = a.rows;
+fn largest_eigenvalue(a: &Operator, d: &BlockJacobi) -> f64 {
+    let n = a.rows();
     if n == 0 {
         return 1.0;
     }
@@ -535,7 +744,7 @@ fn largest_eigenvalue(a: &Csr, d: &BlockJacobi) -> f64 {
 
 /// SMOOTHING_STEPS Chebyshev iterations for A x = b preconditioned by the
 /// level's block Jacobi D, on [λ/EIGEN_RATIO, λ] (Saad 2003, Algorithm 12.1).
-fn chebyshev(a: &Csr, smoother: &Smoother, b: &[f64], x: &mut [f64]) {
+fn chebyshev(a: &Operator, smoother: &Smoother, b: &[f64], x: &mut [f64]) {
     let n = b.len();
     let upper = smoother.lambda;
     let lower = upper / EIGEN_RATIO;
@@ -651,6 +860,75 @@ mod tests {
             p.row_ptr.push(p.col.len());
         }
         p
+    }
+
+    /// A symmetric matrix of order n with a ragged pattern (some columns hold
+    /// only their diagonal, some rows reach far), as its lower triangle in
+    /// compressed columns.
+    fn ragged_lower(n: usize) -> (Arc<SymbolicSparseColMat<usize>>, Vec<f64>) {
+        let (mut col_ptr, mut rows, mut vals) = (vec![0usize], Vec::new(), Vec::new());
+        for j in 0..n {
+            for i in j..n {
+                let coupled = i == j || (i - j) % 3 == 1 || (j % 5 == 0 && i == n - 1);
+                if coupled && !(j % 7 == 3 && i > j) {
+                    rows.push(i);
+                    vals.push(if i == j {
+                        4.0 + j as f64
+                    } else {
+                        -1.0 / (1 + i + j) as f64
+                    });
+                }
+            }
+            col_ptr.push(rows.len());
+        }
+        let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows);
+        (Arc::new(pattern), vals)
+    }
+
+    #[test]
+    fn the_lower_triangle_read_by_rows_is_the_whole_matrix() {
+        // Row for row, the same columns, values and order as the copy into
+        // compressed rows, so products, Galerkin operators and V-cycles are
+        // the same bits.
+        let n = 23;
+        let (pattern, vals) = ragged_lower(n);
+        let rows = Csr::from_csc(SparseColMatRef::new((*pattern).as_ref(), &vals), true);
+        let lower = Multigrid::fine(Fine::Lower(Arc::clone(&pattern), vals.clone()));
+        assert_eq!(lower.nnz(), rows.nnz());
+        for i in 0..n {
+            let mut entries = Vec::new();
+            match &lower {
+                Operator::Lower(a) => a.for_each_in_row(i, |j, v| entries.push((j, v))),
+                Operator::Rows(_) => panic!("a symmetric tangent is read in place"),
+            }
+            let (c, v) = rows.row(i);
+            let expected: Vec<(u32, f64)> = c.iter().copied().zip(v.iter().copied()).collect();
+            assert_eq!(entries, expected, "row {i}");
+        }
+        let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
+        let (mut y, mut z) = (vec![0.0; n], vec![0.0; n]);
+        lower.apply(&x, &mut y);
+        rows.apply(&x, &mut z);
+        assert_eq!(y, z);
+        let p = interpolation(n, false);
+        let (a, b) = (
+            lower.galerkin(&p.transpose(), &p),
+            galerkin(&p.transpose(), &rows, &p),
+        );
+        assert_eq!((a.row_ptr, a.col, a.val), (b.row_ptr, b.col, b.val));
+        let blocks: Vec<Vec<usize>> = (0..n).map(|i| vec![i]).collect();
+        let cycle = |fine: Fine| {
+            let transfer = Transfer {
+                prolongation: p.clone(),
+                fine_blocks: blocks.clone(),
+            };
+            let mut mg = Multigrid::new(vec![transfer]);
+            mg.refresh(fine, true).unwrap();
+            let mut z = vec![0.0; n];
+            mg.apply(&x, &mut z);
+            z
+        };
+        assert_eq!(cycle(Fine::Lower(pattern, vals)), cycle(Fine::Rows(rows)));
     }
 
     #[test]

@@ -1,0 +1,182 @@
+//! Which large heap arrays are live at the peak of an implicit step: a
+//! counting allocator records every allocation of at least 1 MiB with its
+//! call stack, and at the end prints the arrays live at the step's peak of
+//! live heap, largest first.
+//!
+//! `cargo run --release --example heap_peak -- SCENE STEP [--set key=value ...]`
+
+use mpm::model::Model;
+use mpm::scene::Scene;
+use mpm::solver::implicit::Implicit;
+use mpm::solver::stepper::Stepper;
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+use std::collections::HashMap;
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Mutex;
+
+const LARGE: usize = 1 << 20;
+
+struct Counting;
+static LIVE: AtomicUsize = AtomicUsize::new(0);
+static PEAK: AtomicUsize = AtomicUsize::new(0);
+static RECORD: AtomicBool = AtomicBool::new(false);
+thread_local! { static INSIDE: Cell<bool> = const { Cell::new(false) }; }
+
+struct Large {
+    size: usize,
+    stack: String,
+}
+static LIVE_LARGE: Mutex<Option<HashMap<usize, Large>>> = Mutex::new(None);
+static AT_PEAK: Mutex<Vec<(usize, String)>> = Mutex::new(Vec::new());
+
+fn stack() -> String {
+    let bt = std::backtrace::Backtrace::force_capture().to_string();
+    bt.lines()
+        .filter(|l| {
+            (l.contains("mpm::") || l.contains("faer"))
+                && !l.contains("heap_peak")
+                && !l.contains("at /")
+        })
+        .map(|l| {
+            l.trim()
+                .trim_start_matches(|c: char| c.is_ascii_digit() || c == ':')
+                .trim()
+        })
+        .take(4)
+        .collect::<Vec<_>>()
+        .join(" < ")
+}
+
+fn on_alloc(ptr: usize, size: usize) {
+    let live = LIVE.fetch_add(size, Ordering::SeqCst) + size;
+    if !RECORD.load(Ordering::SeqCst) {
+        return;
+    }
+    INSIDE.with(|inside| {
+        if inside.get() {
+            return;
+        }
+        inside.set(true);
+        if size >= LARGE {
+            let s = stack();
+            LIVE_LARGE
+                .lock()
+                .unwrap()
+                .get_or_insert_with(HashMap::new)
+                .insert(ptr, Large { size, stack: s });
+        }
+        if live > PEAK.load(Ordering::SeqCst) {
+            PEAK.store(live, Ordering::SeqCst);
+            if size >= LARGE {
+                let snap: Vec<(usize, String)> = LIVE_LARGE
+                    .lock()
+                    .unwrap()
+                    .as_ref()
+                    .map(|m| m.values().map(|l| (l.size, l.stack.clone())).collect())
+                    .unwrap_or_default();
+                *AT_PEAK.lock().unwrap() = snap;
+            }
+        }
+        inside.set(false);
+    });
+}
+
+fn on_free(ptr: usize, size: usize) {
+    LIVE.fetch_sub(size, Ordering::SeqCst);
+    if size >= LARGE && RECORD.load(Ordering::SeqCst) {
+        INSIDE.with(|inside| {
+            if inside.get() {
+                return;
+            }
+            inside.set(true);
+            if let Some(m) = LIVE_LARGE.lock().unwrap().as_mut() {
+                m.remove(&ptr);
+            }
+            inside.set(false);
+        });
+    }
+}
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        let p = System.alloc(layout);
+        on_alloc(p as usize, layout.size());
+        p
+    }
+    unsafe fn dealloc(&self, p: *mut u8, layout: Layout) {
+        on_free(p as usize, layout.size());
+        System.dealloc(p, layout)
+    }
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        let p = System.alloc_zeroed(layout);
+        on_alloc(p as usize, layout.size());
+        p
+    }
+    unsafe fn realloc(&self, p: *mut u8, layout: Layout, new: usize) -> *mut u8 {
+        on_free(p as usize, layout.size());
+        let q = System.realloc(p, layout, new);
+        on_alloc(q as usize, new);
+        q
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn run<const D: usize>(scene: &Scene, step_of_interest: usize) {
+    let stage = scene.config.stages()[0];
+    let shape = scene.config.grid.shape_function;
+    let mut model = Model::<D>::build(scene).expect("model");
+    let mut solver = Implicit::<D>::new(shape, stage, 0.0);
+    let dt = stage.implicit_dt();
+    let model_bytes = LIVE.load(Ordering::SeqCst);
+    RECORD.store(true, Ordering::SeqCst);
+    let mut t = 0.0;
+    for step in 0..step_of_interest {
+        if step + 1 == step_of_interest {
+            PEAK.store(LIVE.load(Ordering::SeqCst), Ordering::SeqCst);
+        }
+        solver.step(&mut model, t, dt, step).expect("converged");
+        t += dt;
+    }
+    RECORD.store(false, Ordering::SeqCst);
+    let mib = |b: usize| b as f64 / (1 << 20) as f64;
+    let peak = PEAK.load(Ordering::SeqCst);
+    println!(
+        "model {:.1} MiB; step {step_of_interest} live-heap peak {:.1} MiB, solver {:.1} MiB",
+        mib(model_bytes),
+        mib(peak),
+        mib(peak - model_bytes)
+    );
+    let mut groups: HashMap<String, (usize, usize)> = HashMap::new();
+    for (size, s) in AT_PEAK.lock().unwrap().iter() {
+        let g = groups
+            .entry(format!("{s} [{:.1}]", *size as f64 / 1048576.0))
+            .or_default();
+        g.0 += size;
+        g.1 += 1;
+    }
+    let mut rows: Vec<_> = groups.into_iter().collect();
+    rows.sort_by_key(|r| std::cmp::Reverse(r.1 .0));
+    for (s, (size, n)) in rows {
+        println!("{:9.1} MiB {n:4}x  {s}", mib(size));
+    }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let scene_path = &args[0];
+    let step: usize = args[1].parse().unwrap();
+    let sets: Vec<String> = args
+        .windows(2)
+        .filter(|w| w[0] == "--set")
+        .map(|w| w[1].clone())
+        .collect();
+    let scene = Scene::load(Path::new(scene_path), &sets).unwrap_or_else(|e| panic!("{e}"));
+    match scene.config.dimension.spatial() {
+        3 => run::<3>(&scene, step),
+        _ => run::<2>(&scene, step),
+    }
+}
