@@ -339,7 +339,6 @@ impl LowerSymmetric {
     /// adds the buffers that reach it, chunk by chunk. Fixed chunks and orders:
     /// the same bits on any number of threads.
     fn apply(&self, x: &[f64], y: &mut [f64]) {
-        let n = self.rows();
         let (col_ptr, rows, values) =
             (self.pattern.col_ptr(), self.pattern.row_idx(), &self.values);
         let scattered: Vec<(usize, Vec<f64>)> = y
