@@ -23,7 +23,6 @@ use rayon::prelude::*;
 pub struct Trial {
     /// Incremental deformation gradient ΔF_p (ΔF̄_p with F-bar).
     pub df: Vec<Mat3>,
-    pub f: Vec<Mat3>,
     pub stress: Vec<Mat3>,
     pub volume: Vec<f64>,
     /// History variables, laid out like `Particles::history.data`.
@@ -53,7 +52,6 @@ impl Trial {
     ) -> Option<usize> {
         let n = p.len();
         self.df.resize(n, Mat3::identity());
-        self.f.resize(n, Mat3::identity());
         self.stress.resize(n, Mat3::zeros());
         self.volume.resize(n, 0.0);
         self.history.clone_from(&p.history.data);
@@ -71,7 +69,6 @@ impl Trial {
             fbar.dj.clear();
             fbar.dj.extend(self.df.iter().map(|f| f.determinant()));
             if let Some(q) = fbar.dj.iter().position(|&j| j <= 0.0) {
-                self.f[q] = self.df[q] * p.f[q];
                 return Some(q);
             }
             fbar.dj_bar = fbar.cells.mean_dilatation(&p.volume, &fbar.dj);
@@ -96,13 +93,12 @@ impl Trial {
         let inverted = self
             .df
             .par_iter()
-            .zip(self.f.par_iter_mut())
             .zip(self.stress.par_iter_mut())
             .zip(self.volume.par_iter_mut())
             .zip(history.par_iter_mut())
             .enumerate()
             .with_min_len(MIN_PARALLEL_LEN)
-            .map(|(q, ((((df, f), stress), volume), hist))| {
+            .map(|(q, (((df, stress), volume), hist))| {
                 let material = materials[p.material[q] as usize].as_ref();
                 let inc = Increment {
                     f_old: p.f[q],
@@ -112,7 +108,7 @@ impl Trial {
                     history_old: history_old[q],
                 };
                 let new = advance(material, &inc, p.volume0[q], hist);
-                (*stress, *f, *volume) = (new.stress, new.f, new.volume);
+                (*stress, *volume) = (new.stress, new.volume);
                 new.inverted_at(q)
             })
             .min()
@@ -141,16 +137,26 @@ impl Trial {
             };
         }
         if let Some(q) = self.evaluate(p, materials, st, map, u, dt) {
-            return Err((q, self.f[q].determinant()));
+            return Err((q, self.f(p, q).determinant()));
         }
         self.commit(p);
         Ok(())
     }
 
-    /// Make the trial state the particles' state (buffers are swapped, not copied).
-    /// (`update_in_place` is this and `evaluate` in one pass, without F-bar.)
+    /// The trial deformation gradient of particle q, F = ΔF F_old (2-31); not
+    /// stored: only a commit and an inversion's report need it.
+    pub fn f<const D: usize>(&self, p: &Particles<D>, q: usize) -> Mat3 {
+        self.df[q] * p.f[q]
+    }
+
+    /// Make the trial state the particles' state: F = ΔF F_old formed in place,
+    /// the other buffers swapped, not copied. (`update_in_place` is this and
+    /// `evaluate` in one pass, without F-bar.)
     pub fn commit<const D: usize>(&mut self, p: &mut Particles<D>) {
-        std::mem::swap(&mut p.f, &mut self.f);
+        (p.f.par_iter_mut())
+            .zip(&self.df)
+            .with_min_len(MIN_PARALLEL_LEN)
+            .for_each(|(f, df)| *f = df * *f);
         std::mem::swap(&mut p.stress, &mut self.stress);
         std::mem::swap(&mut p.volume, &mut self.volume);
         std::mem::swap(&mut p.history.data, &mut self.history);
