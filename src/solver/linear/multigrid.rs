@@ -37,8 +37,14 @@
 //! take the grid's exact two-scale prolongations with ties and Dirichlet
 //! components, and do not keep a hierarchy while refreshing only values.
 //!
-//! Every product is a row-parallel CSR product and every sum runs in a fixed
-//! order, so the result is the same bits on any number of threads.
+//! A symmetric fine tangent is used where the assembly left it, as the lower
+//! triangle of the step's pattern ([`LowerSymmetric`]): no copy of both
+//! triangles (at 32³ cells in 3D that copy was 400 MiB beside a 134 MiB
+//! triangle). The coarse levels are matrices in compressed rows.
+//!
+//! Every product is a row-parallel CSR product, or over the lower triangle by
+//! fixed column chunks, and every sum runs in a fixed order, so the result is
+//! the same bits on any number of threads.
 
 use super::direct::{DirectSolver, Ordering, Structure};
 use super::iterative::Preconditioner;
