@@ -311,12 +311,13 @@ impl Mirror {
 /// A symmetric matrix kept as the direct solver keeps it, its lower triangle
 /// in compressed columns (the pattern shared with the step).
 ///
-/// While the hierarchy is refreshed it is read by rows through a [`Mirror`] of
+/// For the first Galerkin product it is read by rows through a [`Mirror`] of
 /// the pattern: row i is (i, j < i) from the columns left of it, then column i
 /// from its diagonal down, the entries, values and order of row i of the whole
-/// matrix in compressed rows, so the Galerkin operators and smoothers are those
-/// of that matrix. The mirror is then dropped: products y = A x go over the
-/// stored triangle once (below), reading less memory than the whole matrix.
+/// matrix in compressed rows, so the coarse operators are those of that
+/// matrix. The mirror is then dropped: the smoother's blocks are read from the
+/// columns, and products y = A x go over the stored triangle once (below),
+/// reading less memory than the whole matrix.
 #[derive(Debug)]
 pub struct LowerSymmetric {
     pattern: Arc<SymbolicSparseColMat<usize>>,
@@ -389,6 +390,22 @@ impl LowerSymmetric {
                     }
                 }
             });
+    }
+}
+
+impl LowerSymmetric {
+    /// The diagonal block over the unknowns `block` (row-major values), each
+    /// entry (i, j) from column min(i, j) of the triangle: no mirror needed.
+    fn block_values(&self, block: &[usize]) -> Vec<f64> {
+        let (col_ptr, rows) = (self.pattern.col_ptr(), self.pattern.row_idx());
+        let entry = |i: usize, j: usize| {
+            let (r, c) = (i.max(j), i.min(j));
+            let column = col_ptr[c]..col_ptr[c + 1];
+            (rows[column.clone()].binary_search(&r)).map_or(0.0, |k| self.values[column.start + k])
+        };
+        (block.iter())
+            .flat_map(|&i| block.iter().map(move |&j| entry(i, j)))
+            .collect()
     }
 }
 
@@ -467,7 +484,7 @@ impl Operator {
     fn block_values(&self, block: &[usize]) -> Vec<f64> {
         match self {
             Operator::Rows(a) => block_values(a, block),
-            Operator::Lower(a) => block_values(a, block),
+            Operator::Lower(a) => a.block_values(block),
         }
     }
 
@@ -530,12 +547,16 @@ pub fn galerkin(r: &Csr, a: &impl Rows, p: &Csr) -> Csr {
             },
         )
         .collect();
+    // Each chunk is freed once copied: the operator is not held twice.
+    let nnz = chunks.iter().map(|c| c.1.len()).sum();
     let mut out = Csr {
         rows: n,
         cols: p.cols,
-        row_ptr: vec![0],
-        ..Default::default()
+        row_ptr: Vec::with_capacity(n + 1),
+        col: Vec::with_capacity(nnz),
+        val: Vec::with_capacity(nnz),
     };
+    out.row_ptr.push(0);
     for (len, cols, vals) in chunks {
         for l in len {
             out.row_ptr.push(out.row_ptr.last().unwrap() + l);
@@ -637,6 +658,10 @@ impl Multigrid {
         for (t, r) in self.transfers.iter().zip(&self.restrictions) {
             let coarse = operators.last().unwrap().galerkin(r, &t.prolongation);
             operators.push(Operator::Rows(coarse));
+            // The fine level's mirror served its Galerkin product only.
+            if let Operator::Lower(fine) = &mut operators[0] {
+                fine.mirror = None;
+            }
         }
         let mut used = self.transfers.len();
         let shift = loop {
@@ -674,10 +699,6 @@ impl Multigrid {
                 Smoother { blocks, lambda }
             })
             .collect();
-        // Products need no mirror (LowerSymmetric::apply).
-        if let Some(Operator::Lower(fine)) = operators.first_mut() {
-            fine.mirror = None;
-        }
         self.operators = operators;
         Ok(shape)
     }
@@ -981,6 +1002,9 @@ mod tests {
             let (c, v) = rows.row(i);
             let expected: Vec<(u32, f64)> = c.iter().copied().zip(v.iter().copied()).collect();
             assert_eq!(entries, expected, "row {i}");
+        }
+        for block in [vec![0, 1], vec![3, 4, 5], vec![22, 9, 1], vec![7]] {
+            assert_eq!(lower.block_values(&block), block_values(&rows, &block));
         }
         let p = interpolation(n, false);
         let (a, b) = (
