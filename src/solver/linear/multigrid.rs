@@ -627,20 +627,21 @@ impl Multigrid {
     /// of its pattern, built here. (Keeping the mirror while the pattern stays
     /// would save its build but hold it beside the next tangent's assembly,
     /// which is the peak of a Newton iteration.)
-    fn fine(a: Fine) -> Operator {
+    fn fine(a: Fine) -> Result<Operator, String> {
         match a {
-            Fine::Rows(a) => Operator::Rows(a),
+            Fine::Rows(a) => Ok(Operator::Rows(a)),
+            Fine::Lower(pattern, _) if pattern.row_idx().len() > u32::MAX as usize => Err(format!(
+                "the tangent's lower triangle has {} entries, more than the 2³² the mirror's \
+                 32-bit positions address",
+                pattern.row_idx().len()
+            )),
             Fine::Lower(pattern, values) => {
-                assert!(
-                    pattern.row_idx().len() <= u32::MAX as usize,
-                    "a lower triangle of more than 2³² entries"
-                );
                 let mirror = Some(Mirror::of(&pattern));
-                Operator::Lower(LowerSymmetric {
+                Ok(Operator::Lower(LowerSymmetric {
                     pattern,
                     values,
                     mirror,
-                })
+                }))
             }
         }
     }
@@ -654,7 +655,7 @@ impl Multigrid {
     pub fn refresh(&mut self, a: impl Into<Fine>, symmetric: bool) -> Result<Shape, String> {
         // On an error no operator is kept.
         self.release();
-        let mut operators = vec![Self::fine(a.into())];
+        let mut operators = vec![Self::fine(a.into())?];
         for (t, r) in self.transfers.iter().zip(&self.restrictions) {
             let coarse = operators.last().unwrap().galerkin(r, &t.prolongation);
             operators.push(Operator::Rows(coarse));
@@ -991,7 +992,7 @@ mod tests {
         let n = 23;
         let (pattern, vals) = ragged_lower(n);
         let rows = Csr::from_csc(SparseColMatRef::new((*pattern).as_ref(), &vals), true);
-        let lower = Multigrid::fine(Fine::Lower(Arc::clone(&pattern), vals.clone()));
+        let lower = Multigrid::fine(Fine::Lower(Arc::clone(&pattern), vals.clone())).unwrap();
         assert_eq!(lower.nnz(), rows.nnz());
         for i in 0..n {
             let mut entries = Vec::new();
@@ -1041,7 +1042,7 @@ mod tests {
         for n in [1, 7, COLUMNS_PER_TASK + 1, 2 * COLUMNS_PER_TASK + 77] {
             let (pattern, vals) = ragged_lower(n);
             let rows = Csr::from_csc(SparseColMatRef::new((*pattern).as_ref(), &vals), true);
-            let lower = Multigrid::fine(Fine::Lower(pattern, vals));
+            let lower = Multigrid::fine(Fine::Lower(pattern, vals)).unwrap();
             let x: Vec<f64> = (0..n).map(|i| 1.0 + (i as f64 * 0.37).sin()).collect();
             let mut expected = vec![0.0; n];
             rows.apply(&x, &mut expected);
