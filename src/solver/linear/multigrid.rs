@@ -391,9 +391,7 @@ impl LowerSymmetric {
                 }
             });
     }
-}
 
-impl LowerSymmetric {
     /// The diagonal block over the unknowns `block` (row-major values), each
     /// entry (i, j) from column min(i, j) of the triangle: no mirror needed.
     fn block_values(&self, block: &[usize]) -> Vec<f64> {
