@@ -5,14 +5,14 @@
 //!
 //! `cargo run --release --example heap_peak -- SCENE STEP [--set key=value ...]`
 
-use mpm::model::Model;
+#[path = "../common/implicit_steps.rs"]
+mod implicit_steps;
+
+use implicit_steps::{scene_and_steps, steps, Moment};
 use mpm::scene::Scene;
-use mpm::solver::implicit::Implicit;
-use mpm::solver::stepper::Stepper;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::collections::HashMap;
-use std::path::Path;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
 
@@ -126,21 +126,17 @@ unsafe impl GlobalAlloc for Counting {
 static GLOBAL: Counting = Counting;
 
 fn run<const D: usize>(scene: &Scene, step_of_interest: usize) {
-    let stage = scene.config.stages()[0];
-    let shape = scene.config.grid.shape_function;
-    let mut model = Model::<D>::build(scene).expect("model");
-    let mut solver = Implicit::<D>::new(shape, stage, 0.0);
-    let dt = stage.implicit_dt();
-    let model_bytes = LIVE.load(Ordering::SeqCst);
-    RECORD.store(true, Ordering::SeqCst);
-    let mut t = 0.0;
-    for step in 0..step_of_interest {
-        if step + 1 == step_of_interest {
-            PEAK.store(LIVE.load(Ordering::SeqCst), Ordering::SeqCst);
+    let mut model_bytes = 0;
+    steps::<D>(scene, step_of_interest, |moment| match moment {
+        Moment::Built => {
+            model_bytes = LIVE.load(Ordering::SeqCst);
+            RECORD.store(true, Ordering::SeqCst);
         }
-        solver.step(&mut model, t, dt, step).expect("converged");
-        t += dt;
-    }
+        Moment::Before(step) if step == step_of_interest => {
+            PEAK.store(LIVE.load(Ordering::SeqCst), Ordering::SeqCst)
+        }
+        _ => {}
+    });
     RECORD.store(false, Ordering::SeqCst);
     let mib = |b: usize| b as f64 / (1 << 20) as f64;
     let peak = PEAK.load(Ordering::SeqCst);
@@ -166,15 +162,7 @@ fn run<const D: usize>(scene: &Scene, step_of_interest: usize) {
 }
 
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let scene_path = &args[0];
-    let step: usize = args[1].parse().unwrap();
-    let sets: Vec<String> = args
-        .windows(2)
-        .filter(|w| w[0] == "--set")
-        .map(|w| w[1].clone())
-        .collect();
-    let scene = Scene::load(Path::new(scene_path), &sets).unwrap_or_else(|e| panic!("{e}"));
+    let (scene, step) = scene_and_steps("heap_peak SCENE STEP [--set k=v ...]", 1);
     match scene.config.dimension.spatial() {
         3 => run::<3>(&scene, step),
         _ => run::<2>(&scene, step),

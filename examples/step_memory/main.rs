@@ -9,11 +9,12 @@
 //!
 //! `cargo run --release --example step_memory -- SCENE [STEPS] [--set key=value ...]`
 
-use mpm::model::Model;
+#[path = "../common/implicit_steps.rs"]
+mod implicit_steps;
+
+use implicit_steps::{scene_and_steps, steps, Moment};
 use mpm::scene::Scene;
-use mpm::solver::implicit::Implicit;
 use mpm::solver::stepper::Stepper;
-use std::path::Path;
 
 /// A field of /proc/self/status in MiB (VmRSS: now, VmHWM: peak).
 fn status_mib(field: &str) -> f64 {
@@ -36,47 +37,33 @@ fn reset_peak() {
     std::fs::write("/proc/self/clear_refs", "5").expect("reset the peak (Linux)");
 }
 
-fn run<const D: usize>(scene: &Scene, steps: usize) {
-    let stage = scene.config.stages()[0];
-    let shape = scene.config.grid.shape_function;
-    let mut model = Model::<D>::build(scene).expect("model");
-    let mut solver = Implicit::<D>::new(shape, stage, 0.0);
-    let dt = stage.implicit_dt();
-    let mut t = 0.0;
-    let model_mib = status_mib("VmRSS:");
-    println!("model built: resident {model_mib:.1} MiB");
-    for step in 0..steps {
-        reset_peak();
-        solver.step(&mut model, t, dt, step).expect("converged");
-        t += dt;
-        let peak = status_mib("VmHWM:");
-        let report = solver.report();
-        let factor = report.direct.as_ref().map_or(0.0, |d| d.largest_factor_mib);
-        let solver_mib = peak - model_mib;
-        println!(
-            "step {}: peak {peak:.1} MiB, solver {solver_mib:.1} MiB, largest factor's values \
-             {factor:.1} MiB, solver / factor {:.2}; {} active nodes",
-            step + 1,
-            solver_mib / factor,
-            solver.active_nodes()
-        );
-    }
+fn run<const D: usize>(scene: &Scene, n: usize) {
+    let mut model_mib = 0.0;
+    steps::<D>(scene, n, |moment| match moment {
+        Moment::Built => {
+            model_mib = status_mib("VmRSS:");
+            println!("model built: resident {model_mib:.1} MiB");
+        }
+        Moment::Before(_) => reset_peak(),
+        Moment::After(step, solver) => {
+            let peak = status_mib("VmHWM:");
+            let report = solver.report();
+            let factor = report.direct.as_ref().map_or(0.0, |d| d.largest_factor_mib);
+            let solver_mib = peak - model_mib;
+            println!(
+                "step {step}: peak {peak:.1} MiB, solver {solver_mib:.1} MiB, largest factor's \
+                 values {factor:.1} MiB, solver / factor {:.2}; {} active nodes",
+                solver_mib / factor,
+                solver.active_nodes()
+            );
+        }
+    });
 }
 
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let scene_path = args
-        .first()
-        .expect("usage: step_memory SCENE [STEPS] [--set k=v ...]");
-    let steps = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(3usize);
-    let sets: Vec<String> = args
-        .windows(2)
-        .filter(|w| w[0] == "--set")
-        .map(|w| w[1].clone())
-        .collect();
-    let scene = Scene::load(Path::new(scene_path), &sets).unwrap_or_else(|e| panic!("{e}"));
+    let (scene, n) = scene_and_steps("step_memory SCENE [STEPS] [--set k=v ...]", 3);
     match scene.config.dimension.spatial() {
-        3 => run::<3>(&scene, steps),
-        _ => run::<2>(&scene, steps),
+        3 => run::<3>(&scene, n),
+        _ => run::<2>(&scene, n),
     }
 }

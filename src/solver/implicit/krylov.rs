@@ -463,7 +463,7 @@ impl KrylovState {
             debug_assert!(std::ptr::eq(&**pattern, k.pattern));
             Fine::Lower(Arc::clone(pattern), k.values)
         } else {
-            let rows = Csr::from_csc(k.matrix(), false);
+            let rows = Csr::from_csc(k.matrix());
             drop(k);
             Fine::Rows(rows)
         };

@@ -77,71 +77,17 @@ pub struct Csr {
 }
 
 impl Csr {
-    /// The whole matrix of a compressed-column one that stores its lower
-    /// triangle (`symmetric`) or every entry.
-    pub fn from_csc(a: SparseColMatRef<usize, f64>, symmetric: bool) -> Csr {
-        let n = a.nrows();
-        let mut count = vec![0usize; n + 1];
-        for j in 0..a.ncols() {
-            for &i in a.row_idx_of_col_raw(j) {
-                count[i + 1] += 1;
-                if symmetric && i != j {
-                    count[j + 1] += 1;
-                }
-            }
-        }
-        for i in 0..n {
-            count[i + 1] += count[i];
-        }
-        let row_ptr = count.clone();
-        let mut next = count;
-        let nnz = row_ptr[n];
-        let (mut col, mut val) = (vec![0u32; nnz], vec![0.0; nnz]);
-        // Rows fill in column order; a symmetric matrix's mirrored entries can
-        // arrive out of order, so the rows are sorted afterwards.
-        for j in 0..a.ncols() {
-            for (&i, &v) in a.row_idx_of_col_raw(j).iter().zip(a.val_of_col(j)) {
-                col[next[i]] = j as u32;
-                val[next[i]] = v;
-                next[i] += 1;
-                if symmetric && i != j {
-                    col[next[j]] = i as u32;
-                    val[next[j]] = v;
-                    next[j] += 1;
-                }
-            }
-        }
-        let mut m = Csr {
+    /// The matrix of a compressed-column one (every entry stored): its
+    /// transpose's pattern, read as rows, is its own.
+    pub fn from_csc(a: SparseColMatRef<usize, f64>) -> Csr {
+        let (n, m) = (a.nrows(), a.ncols());
+        let t = Mirror::transpose(a.col_ptr(), |k| a.row_idx()[k], n, |_, _| true);
+        Csr {
             rows: n,
-            cols: a.ncols(),
-            row_ptr,
-            col,
-            val,
-        };
-        m.sort_rows();
-        m
-    }
-
-    fn sort_rows(&mut self) {
-        let (ptr, col, val) = (&self.row_ptr, &mut self.col, &mut self.val);
-        let mut pairs: Vec<(u32, f64)> = Vec::new();
-        for r in 0..self.rows {
-            let range = ptr[r]..ptr[r + 1];
-            if col[range.clone()].windows(2).all(|w| w[0] < w[1]) {
-                continue;
-            }
-            pairs.clear();
-            pairs.extend(
-                col[range.clone()]
-                    .iter()
-                    .copied()
-                    .zip(val[range.clone()].iter().copied()),
-            );
-            pairs.sort_by_key(|&(c, _)| c);
-            for (k, (c, v)) in range.zip(&pairs) {
-                col[k] = *c;
-                val[k] = *v;
-            }
+            cols: m,
+            row_ptr: t.row_ptr,
+            col: t.col,
+            val: t.pos.iter().map(|&k| a.val()[k as usize]).collect(),
         }
     }
 
@@ -156,38 +102,42 @@ impl Csr {
 
     /// y = A x, rows in parallel (each row summed in column order).
     pub fn apply(&self, x: &[f64], y: &mut [f64]) {
-        apply_rows(self, x, y);
+        y.par_iter_mut()
+            .enumerate()
+            .with_min_len(ROWS_PER_TASK)
+            .for_each(|(i, yi)| {
+                let (c, v) = self.row(i);
+                *yi = c.iter().zip(v).map(|(&j, a)| a * x[j as usize]).sum();
+            });
     }
 
     /// Aᵀ as a matrix of its own.
     pub fn transpose(&self) -> Csr {
-        let mut count = vec![0usize; self.cols + 1];
-        for &c in &self.col {
-            count[c as usize + 1] += 1;
-        }
-        for j in 0..self.cols {
-            count[j + 1] += count[j];
-        }
-        let row_ptr = count.clone();
-        let mut next = count;
-        let (mut col, mut val) = (vec![0u32; self.nnz()], vec![0.0; self.nnz()]);
-        // Rows in increasing order: each transposed row gets its columns ascending.
-        for i in 0..self.rows {
-            let (c, v) = self.row(i);
-            for (&j, &a) in c.iter().zip(v) {
-                let k = &mut next[j as usize];
-                col[*k] = i as u32;
-                val[*k] = a;
-                *k += 1;
-            }
-        }
+        let t = Mirror::transpose(
+            &self.row_ptr,
+            |k| self.col[k] as usize,
+            self.cols,
+            |_, _| true,
+        );
         Csr {
             rows: self.cols,
             cols: self.rows,
-            row_ptr,
-            col,
-            val,
+            row_ptr: t.row_ptr,
+            col: t.col,
+            val: t.pos.iter().map(|&k| self.val[k as usize]).collect(),
         }
+    }
+
+    /// The diagonal blocks of the unknowns `block` (row-major values).
+    fn block_values(&self, block: &[usize]) -> Vec<f64> {
+        let mut out = Vec::with_capacity(block.len() * block.len());
+        for &i in block {
+            let (c, v) = self.row(i);
+            for &j in block {
+                out.push(c.binary_search(&(j as u32)).map_or(0.0, |k| v[k]));
+            }
+        }
+        out
     }
 
     /// The lower triangle (or the whole matrix) in compressed columns, for the
@@ -221,7 +171,7 @@ impl Csr {
 }
 
 /// A square matrix read row by row, each row's columns ascending: what the
-/// products, the Galerkin triple product and the smoother need of an operator.
+/// Galerkin triple product needs of an operator.
 pub trait Rows: Sync {
     fn rows(&self) -> usize;
     /// f(j, a_ij) for the stored entries of row i, j ascending.
@@ -239,34 +189,11 @@ impl Rows for Csr {
     }
 }
 
-/// y = A x, rows in parallel (each row summed in column order).
-fn apply_rows(a: &impl Rows, x: &[f64], y: &mut [f64]) {
-    y.par_iter_mut()
-        .enumerate()
-        .with_min_len(ROWS_PER_TASK)
-        .for_each(|(i, yi)| {
-            let mut sum = 0.0;
-            a.for_each_in_row(i, |j, aij| sum += aij * x[j as usize]);
-            *yi = sum;
-        });
-}
-
-/// The diagonal block of A over the unknowns `block` (row-major values).
-fn block_values(a: &impl Rows, block: &[usize]) -> Vec<f64> {
-    let mut out = vec![0.0; block.len() * block.len()];
-    for (r, &i) in block.iter().enumerate() {
-        a.for_each_in_row(i, |j, aij| {
-            if let Some(c) = block.iter().position(|&b| b == j as usize) {
-                out[r * block.len() + c] = aij;
-            }
-        });
-    }
-    out
-}
-
-/// Where each row's entries left of the diagonal sit in a lower triangle
-/// stored by columns: row i's entries (i, j), j < i, are the entries (i, j) of
-/// columns j, at value positions `pos`, columns `col` ascending.
+/// A transposed pattern with the positions of its entries in the original:
+/// for each row i, the columns j ascending and where entry (i, j) is stored in
+/// the compressed lines it came from. The transpose of a matrix in compressed
+/// rows ([`Csr::transpose`]); the rows of a lower triangle stored by columns
+/// left of the diagonal ([`LowerSymmetric`]).
 #[derive(Debug)]
 struct Mirror {
     row_ptr: Vec<usize>,
@@ -275,19 +202,27 @@ struct Mirror {
 }
 
 impl Mirror {
-    /// The mirror of the lower-triangle pattern `lower` (rows ≥ column,
-    /// ascending within each column): its transpose, counted, then filled in
-    /// column order, so each row's columns come out ascending. (Sequential: a
-    /// parallel version by chunks of rows measured slower on two cores, the
-    /// pass being bound by memory.)
-    fn of(lower: &SymbolicSparseColMat<usize>) -> Mirror {
-        let n = lower.nrows();
-        let (col_ptr, row_idx) = (lower.col_ptr(), lower.row_idx());
-        let below = |j: usize| (col_ptr[j]..col_ptr[j + 1]).filter(move |&k| row_idx[k] > j);
+    /// The transpose of the pattern of `lines` compressed lines (`ptr`, and
+    /// `index(k)` < `n` the index within its line of entry k), of the entries
+    /// (line j, index i) that `keep(j, i)`: counted, then filled in line order,
+    /// so each row's columns come out ascending. (Sequential: a parallel
+    /// version by chunks of rows measured slower on two cores, the pass being
+    /// bound by memory.)
+    fn transpose(
+        ptr: &[usize],
+        index: impl Fn(usize) -> usize,
+        n: usize,
+        keep: impl Fn(usize, usize) -> bool,
+    ) -> Mirror {
+        let lines = ptr.len() - 1;
+        // Within the memory limit of any scene (48 GB of entries).
+        assert!(ptr[lines] <= u32::MAX as usize, "positions beyond 32 bits");
+        let (index, keep) = (&index, &keep);
+        let kept = |j: usize| (ptr[j]..ptr[j + 1]).filter(move |&k| keep(j, index(k)));
         let mut row_ptr = vec![0usize; n + 1];
-        for j in 0..n {
-            for k in below(j) {
-                row_ptr[row_idx[k] + 1] += 1;
+        for j in 0..lines {
+            for k in kept(j) {
+                row_ptr[index(k) + 1] += 1;
             }
         }
         for i in 0..n {
@@ -296,15 +231,22 @@ impl Mirror {
         let mut next = row_ptr.clone();
         let len = row_ptr[n];
         let (mut col, mut pos) = (vec![0u32; len], vec![0u32; len]);
-        for j in 0..n {
-            for k in below(j) {
-                let at = &mut next[row_idx[k]];
+        for j in 0..lines {
+            for k in kept(j) {
+                let at = &mut next[index(k)];
                 col[*at] = j as u32;
                 pos[*at] = k as u32;
                 *at += 1;
             }
         }
         Mirror { row_ptr, col, pos }
+    }
+
+    /// The rows left of the diagonal of a lower triangle stored by columns
+    /// (rows ≥ column, ascending within each column).
+    fn of(lower: &SymbolicSparseColMat<usize>) -> Mirror {
+        let rows = lower.row_idx();
+        Mirror::transpose(lower.col_ptr(), |k| rows[k], lower.nrows(), |j, i| i > j)
     }
 }
 
@@ -474,14 +416,14 @@ impl Operator {
     /// y = A x.
     pub fn apply(&self, x: &[f64], y: &mut [f64]) {
         match self {
-            Operator::Rows(a) => apply_rows(a, x, y),
+            Operator::Rows(a) => a.apply(x, y),
             Operator::Lower(a) => a.apply(x, y),
         }
     }
 
     fn block_values(&self, block: &[usize]) -> Vec<f64> {
         match self {
-            Operator::Rows(a) => block_values(a, block),
+            Operator::Rows(a) => a.block_values(block),
             Operator::Lower(a) => a.block_values(block),
         }
     }
@@ -924,6 +866,30 @@ mod tests {
         assert_eq!((tt.row_ptr, tt.col, tt.val), (a.row_ptr, a.col, a.val));
     }
 
+    #[test]
+    fn compressed_columns_read_as_rows_are_the_matrix() {
+        // P's arrays read as compressed columns are Pᵀ; entry by entry
+        // against P itself.
+        let p = interpolation(23, false);
+        let rows: Vec<usize> = p.col.iter().map(|&c| c as usize).collect();
+        let pattern =
+            SymbolicSparseColMat::new_checked(p.cols, p.rows, p.row_ptr.clone(), None, rows);
+        let t = Csr::from_csc(SparseColMatRef::new(pattern.as_ref(), &p.val));
+        assert_eq!((t.rows, t.cols), (p.cols, p.rows));
+        for i in 0..p.rows {
+            let (c, v) = p.row(i);
+            for (&j, &a) in c.iter().zip(v) {
+                let (tc, tv) = t.row(j as usize);
+                assert_eq!(
+                    tc.binary_search(&(i as u32)).map(|k| tv[k]),
+                    Ok(a),
+                    "({i}, {j})"
+                );
+            }
+        }
+        assert_eq!(t.nnz(), p.nnz());
+    }
+
     /// Linear interpolation from coarse node i (at fine node 2i + 1) to the
     /// fine nodes of a 1D grid of `n` = 2 n_c + 1 unknowns, with column
     /// `n_c − 1` given twice when `duplicate` (columns n_c − 1 and n_c equal).
@@ -960,27 +926,42 @@ mod tests {
     }
 
     /// A symmetric matrix of order n with a ragged pattern (some columns hold
-    /// only their diagonal, some rows reach far), as its lower triangle in
-    /// compressed columns.
-    fn ragged_lower(n: usize) -> (Arc<SymbolicSparseColMat<usize>>, Vec<f64>) {
+    /// only their diagonal, some rows reach far): its lower triangle in
+    /// compressed columns, and the whole matrix in compressed rows built
+    /// directly from the same rule (the reference).
+    #[allow(clippy::type_complexity)]
+    fn ragged(n: usize) -> (Arc<SymbolicSparseColMat<usize>>, Vec<f64>, Csr) {
+        // Entry (i, j) for i ≥ j, if stored.
+        let entry = |i: usize, j: usize| {
+            let coupled = i == j || (i - j < 10 && (i - j) % 3 == 1) || (j % 5 == 0 && i == n - 1);
+            (coupled && !(j % 7 == 3 && i > j)).then(|| match i == j {
+                true => 4.0 + j as f64,
+                false => -1.0 / (1 + i + j) as f64,
+            })
+        };
         let (mut col_ptr, mut rows, mut vals) = (vec![0usize], Vec::new(), Vec::new());
         for j in 0..n {
-            for i in j..n {
-                let coupled =
-                    i == j || (i - j < 10 && (i - j) % 3 == 1) || (j % 5 == 0 && i == n - 1);
-                if coupled && !(j % 7 == 3 && i > j) {
-                    rows.push(i);
-                    vals.push(if i == j {
-                        4.0 + j as f64
-                    } else {
-                        -1.0 / (1 + i + j) as f64
-                    });
-                }
+            for (i, v) in (j..n).filter_map(|i| entry(i, j).map(|v| (i, v))) {
+                rows.push(i);
+                vals.push(v);
             }
             col_ptr.push(rows.len());
         }
         let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows);
-        (Arc::new(pattern), vals)
+        let mut whole = Csr {
+            rows: n,
+            cols: n,
+            row_ptr: vec![0],
+            ..Default::default()
+        };
+        for i in 0..n {
+            for (j, v) in (0..n).filter_map(|j| entry(i.max(j), i.min(j)).map(|v| (j, v))) {
+                whole.col.push(j as u32);
+                whole.val.push(v);
+            }
+            whole.row_ptr.push(whole.col.len());
+        }
+        (Arc::new(pattern), vals, whole)
     }
 
     #[test]
@@ -988,8 +969,7 @@ mod tests {
         // Row for row, the same columns, values and order as the copy into
         // compressed rows, so the Galerkin operators are the same bits.
         let n = 23;
-        let (pattern, vals) = ragged_lower(n);
-        let rows = Csr::from_csc(SparseColMatRef::new((*pattern).as_ref(), &vals), true);
+        let (pattern, vals, rows) = ragged(n);
         let lower = Multigrid::fine(Fine::Lower(Arc::clone(&pattern), vals.clone())).unwrap();
         assert_eq!(lower.nnz(), rows.nnz());
         for i in 0..n {
@@ -1003,7 +983,7 @@ mod tests {
             assert_eq!(entries, expected, "row {i}");
         }
         for block in [vec![0, 1], vec![3, 4, 5], vec![22, 9, 1], vec![7]] {
-            assert_eq!(lower.block_values(&block), block_values(&rows, &block));
+            assert_eq!(lower.block_values(&block), rows.block_values(&block));
         }
         let p = interpolation(n, false);
         let (a, b) = (
@@ -1038,8 +1018,7 @@ mod tests {
         // Several column chunks, columns that reach the last row from far
         // above, and columns holding only their diagonal.
         for n in [1, 7, COLUMNS_PER_TASK + 1, 2 * COLUMNS_PER_TASK + 77] {
-            let (pattern, vals) = ragged_lower(n);
-            let rows = Csr::from_csc(SparseColMatRef::new((*pattern).as_ref(), &vals), true);
+            let (pattern, vals, rows) = ragged(n);
             let lower = Multigrid::fine(Fine::Lower(pattern, vals)).unwrap();
             let x: Vec<f64> = (0..n).map(|i| 1.0 + (i as f64 * 0.37).sin()).collect();
             let mut expected = vec![0.0; n];
