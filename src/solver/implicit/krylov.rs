@@ -325,6 +325,12 @@ impl KrylovState {
             LinearSolver::Gmres => gmres(product, pre, &b, &mut du, &settings),
             LinearSolver::Direct => unreachable!("KrylovConfig::of is None for the direct solver"),
         }?;
+        // A multigrid refreshed at every iteration is not used again before the
+        // next refresh: its operators, the fine tangent among them, are not held
+        // through the residuals of the line search and the next iterate.
+        if let (Built::Multigrid, Some((_, _, mg))) = (&built, self.multigrid.as_mut()) {
+            mg.release();
+        }
         self.iterations += outcome.iterations;
         if !outcome.converged || outcome.iterations > LAGGED_REFRESH_ITERATIONS {
             self.refresh = true;
@@ -461,7 +467,7 @@ impl KrylovState {
         let a = if symmetric {
             let pattern = step_pattern(sys).csc(Storage::Lower);
             debug_assert!(std::ptr::eq(&**pattern, k.pattern));
-            Fine::Lower(Arc::clone(pattern), k.values)
+            Fine::Lower(Arc::clone(pattern), k.values, step_pattern(sys).graph())
         } else {
             let rows = Csr::from_csc(k.matrix());
             drop(k);

@@ -40,7 +40,8 @@
 //! A symmetric fine tangent is used where the assembly left it, as the lower
 //! triangle of the step's pattern ([`LowerSymmetric`]): no copy of both
 //! triangles (at 32³ cells in 3D that copy was 400 MiB beside a 134 MiB
-//! triangle). The coarse levels are matrices in compressed rows.
+//! triangle). Its rows are found through the node graph the pattern was built
+//! from ([`LowerRows`]). The coarse levels are matrices in compressed rows.
 //!
 //! Every product is a row-parallel CSR product, or over the lower triangle by
 //! fixed column chunks, and every sum runs in a fixed order, so the result is
@@ -48,6 +49,7 @@
 
 use super::direct::{DirectSolver, Ordering, Structure};
 use super::iterative::Preconditioner;
+use super::ordering::NodeGraph;
 use super::preconditioner::BlockJacobi;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use rayon::prelude::*;
@@ -81,7 +83,7 @@ impl Csr {
     /// transpose's pattern, read as rows, is its own.
     pub fn from_csc(a: SparseColMatRef<usize, f64>) -> Csr {
         let (n, m) = (a.nrows(), a.ncols());
-        let t = Mirror::transpose(a.col_ptr(), |k| a.row_idx()[k], n, |_, _| true);
+        let t = Transposed::of(a.col_ptr(), |k| a.row_idx()[k], n);
         Csr {
             rows: n,
             cols: m,
@@ -113,12 +115,7 @@ impl Csr {
 
     /// Aᵀ as a matrix of its own.
     pub fn transpose(&self) -> Csr {
-        let t = Mirror::transpose(
-            &self.row_ptr,
-            |k| self.col[k] as usize,
-            self.cols,
-            |_, _| true,
-        );
+        let t = Transposed::of(&self.row_ptr, |k| self.col[k] as usize, self.cols);
         Csr {
             rows: self.cols,
             cols: self.rows,
@@ -191,39 +188,28 @@ impl Rows for Csr {
 
 /// A transposed pattern with the positions of its entries in the original:
 /// for each row i, the columns j ascending and where entry (i, j) is stored in
-/// the compressed lines it came from. The transpose of a matrix in compressed
-/// rows ([`Csr::transpose`]); the rows of a lower triangle stored by columns
-/// left of the diagonal ([`LowerSymmetric`]).
+/// the compressed lines it came from: the transpose of a matrix in compressed
+/// rows ([`Csr::transpose`]) or columns ([`Csr::from_csc`]).
 #[derive(Debug)]
-struct Mirror {
+struct Transposed {
     row_ptr: Vec<usize>,
     col: Vec<u32>,
     pos: Vec<u32>,
 }
 
-impl Mirror {
+impl Transposed {
     /// The transpose of the pattern of `lines` compressed lines (`ptr`, and
-    /// `index(k)` < `n` the index within its line of entry k), of the entries
-    /// (line j, index i) that `keep(j, i)`: counted, then filled in line order,
-    /// so each row's columns come out ascending. (Sequential: a parallel
-    /// version by chunks of rows measured slower on two cores, the pass being
-    /// bound by memory.)
-    fn transpose(
-        ptr: &[usize],
-        index: impl Fn(usize) -> usize,
-        n: usize,
-        keep: impl Fn(usize, usize) -> bool,
-    ) -> Mirror {
+    /// `index(k)` < `n` the index within its line of entry k): counted, then
+    /// filled in line order, so each row's columns come out ascending.
+    /// (Sequential: a parallel version by chunks of rows measured slower on two
+    /// cores, the pass being bound by memory.)
+    fn of(ptr: &[usize], index: impl Fn(usize) -> usize, n: usize) -> Transposed {
         let lines = ptr.len() - 1;
         // Within the memory limit of any scene (48 GB of entries).
         assert!(ptr[lines] <= u32::MAX as usize, "positions beyond 32 bits");
-        let (index, keep) = (&index, &keep);
-        let kept = |j: usize| (ptr[j]..ptr[j + 1]).filter(move |&k| keep(j, index(k)));
         let mut row_ptr = vec![0usize; n + 1];
-        for j in 0..lines {
-            for k in kept(j) {
-                row_ptr[index(k) + 1] += 1;
-            }
+        for k in 0..ptr[lines] {
+            row_ptr[index(k) + 1] += 1;
         }
         for i in 0..n {
             row_ptr[i + 1] += row_ptr[i];
@@ -232,39 +218,28 @@ impl Mirror {
         let len = row_ptr[n];
         let (mut col, mut pos) = (vec![0u32; len], vec![0u32; len]);
         for j in 0..lines {
-            for k in kept(j) {
+            for k in ptr[j]..ptr[j + 1] {
                 let at = &mut next[index(k)];
                 col[*at] = j as u32;
                 pos[*at] = k as u32;
                 *at += 1;
             }
         }
-        Mirror { row_ptr, col, pos }
-    }
-
-    /// The rows left of the diagonal of a lower triangle stored by columns
-    /// (rows ≥ column, ascending within each column).
-    fn of(lower: &SymbolicSparseColMat<usize>) -> Mirror {
-        let rows = lower.row_idx();
-        Mirror::transpose(lower.col_ptr(), |k| rows[k], lower.nrows(), |j, i| i > j)
+        Transposed { row_ptr, col, pos }
     }
 }
 
 /// A symmetric matrix kept as the direct solver keeps it, its lower triangle
 /// in compressed columns (the pattern shared with the step).
 ///
-/// For the first Galerkin product it is read by rows through a [`Mirror`] of
-/// the pattern: row i is (i, j < i) from the columns left of it, then column i
-/// from its diagonal down, the entries, values and order of row i of the whole
-/// matrix in compressed rows, so the coarse operators are those of that
-/// matrix. The mirror is then dropped: the smoother's blocks are read from the
+/// The first Galerkin product reads it by rows ([`LowerRows`], through the
+/// node graph of the pattern); the smoother's blocks are read from the
 /// columns, and products y = A x go over the stored triangle once (below),
 /// reading less memory than the whole matrix.
 #[derive(Debug)]
 pub struct LowerSymmetric {
     pattern: Arc<SymbolicSparseColMat<usize>>,
     values: Vec<f64>,
-    mirror: Option<Mirror>,
 }
 
 /// Columns per parallel task of [`LowerSymmetric::apply`]: fixed, so the sums
@@ -272,6 +247,10 @@ pub struct LowerSymmetric {
 const COLUMNS_PER_TASK: usize = 2048;
 
 impl LowerSymmetric {
+    fn rows(&self) -> usize {
+        self.pattern.nrows()
+    }
+
     /// Both triangles' stored entries.
     fn nnz(&self) -> usize {
         let (col_ptr, rows) = (self.pattern.col_ptr(), self.pattern.row_idx());
@@ -349,25 +328,79 @@ impl LowerSymmetric {
     }
 }
 
-impl Rows for LowerSymmetric {
+/// The rows of a symmetric matrix stored as its lower triangle, found through
+/// the node graph its pattern was built from (unknowns numbered node by node,
+/// node a coupling all its unknowns to all those of its neighbours): row i of
+/// node a is (i, j) for the unknowns j < i of a's neighbours b ≤ a, each found
+/// in column j by a search, then column i from its diagonal down. These are
+/// the entries, values and order of row i of the whole matrix in compressed
+/// rows, so the Galerkin operators are those of that matrix; nothing is stored
+/// (a transposed pattern of the triangle, 8 bytes per entry, was the 2D
+/// multigrid's largest own array).
+pub struct LowerRows<'a> {
+    a: &'a LowerSymmetric,
+    graph: NodeGraph<'a>,
+}
+
+impl<'a> LowerRows<'a> {
+    /// The rows of `a` through `graph`, if the graph has the triangle's
+    /// entries: checked by their number (the pattern is built from the graph,
+    /// `Pattern::csc`, so a mismatch is a wrong graph).
+    pub fn new(a: &'a LowerSymmetric, graph: NodeGraph<'a>) -> Result<LowerRows<'a>, String> {
+        let n = a.rows();
+        let (first, unknowns) = (graph.first, |b: usize| graph.first[b + 1] - graph.first[b]);
+        let nodes = first.len() - 1;
+        let described: usize = (0..nodes)
+            .map(|b| {
+                let below = graph.neighbours(b).iter().map(|&c| c as usize);
+                below
+                    .take_while(|&c| c <= b)
+                    .map(|c| match c == b {
+                        true => unknowns(b) * (unknowns(b) + 1) / 2,
+                        false => unknowns(b) * unknowns(c),
+                    })
+                    .sum::<usize>()
+            })
+            .sum();
+        if first[nodes] != n || described != a.values.len() {
+            return Err(format!(
+                "the node graph ({} unknowns, {described} entries of a lower triangle) does not \
+                 describe the tangent's pattern ({n} unknowns, {} entries)",
+                first[nodes],
+                a.values.len()
+            ));
+        }
+        Ok(LowerRows { a, graph })
+    }
+}
+
+impl Rows for LowerRows<'_> {
     fn rows(&self) -> usize {
-        self.pattern.nrows()
+        self.a.rows()
     }
 
     fn for_each_in_row(&self, i: usize, mut f: impl FnMut(u32, f64)) {
-        let m = self
-            .mirror
-            .as_ref()
-            .expect("read by rows only while refreshed");
-        let left = m.row_ptr[i]..m.row_ptr[i + 1];
-        for (&j, &k) in m.col[left.clone()].iter().zip(&m.pos[left]) {
-            f(j, self.values[k as usize]);
+        let (col_ptr, rows, values) = (
+            self.a.pattern.col_ptr(),
+            self.a.pattern.row_idx(),
+            &self.a.values,
+        );
+        let first = self.graph.first;
+        let node = first.partition_point(|&u| u <= i) - 1;
+        for &b in self.graph.neighbours(node) {
+            let b = b as usize;
+            if b > node {
+                break;
+            }
+            for j in first[b]..first[b + 1].min(i) {
+                let column = col_ptr[j]..col_ptr[j + 1];
+                if let Ok(k) = rows[column.clone()].binary_search(&i) {
+                    f(j as u32, values[column.start + k]);
+                }
+            }
         }
-        let down = self.pattern.col_ptr()[i]..self.pattern.col_ptr()[i + 1];
-        for (&r, &a) in self.pattern.row_idx()[down.clone()]
-            .iter()
-            .zip(&self.values[down])
-        {
+        let down = col_ptr[i]..col_ptr[i + 1];
+        for (&r, &a) in rows[down.clone()].iter().zip(&values[down]) {
             f(r as u32, a);
         }
     }
@@ -375,15 +408,16 @@ impl Rows for LowerSymmetric {
 
 /// The fine operator handed to [`Multigrid::refresh`]: a matrix in compressed
 /// rows, or a symmetric tangent as assembled, by the lower triangle of its
-/// shared pattern (rows ≥ column, ascending) and its values.
+/// shared pattern (rows ≥ column, ascending), its values and the node graph the
+/// pattern was built from (its rows are found through it, [`LowerRows`]).
 #[derive(Debug)]
-pub enum Fine {
+pub enum Fine<'g> {
     Rows(Csr),
-    Lower(Arc<SymbolicSparseColMat<usize>>, Vec<f64>),
+    Lower(Arc<SymbolicSparseColMat<usize>>, Vec<f64>, NodeGraph<'g>),
 }
 
-impl From<Csr> for Fine {
-    fn from(a: Csr) -> Fine {
+impl From<Csr> for Fine<'_> {
+    fn from(a: Csr) -> Self {
         Fine::Rows(a)
     }
 }
@@ -428,10 +462,12 @@ impl Operator {
         }
     }
 
-    fn galerkin(&self, r: &Csr, p: &Csr) -> Csr {
-        match self {
-            Operator::Rows(a) => galerkin(r, a, p),
-            Operator::Lower(a) => galerkin(r, a, p),
+    /// Pᵀ A P (R = Pᵀ); a lower triangle is read by rows through `graph`.
+    fn galerkin(&self, r: &Csr, p: &Csr, graph: Option<NodeGraph>) -> Result<Csr, String> {
+        match (self, graph) {
+            (Operator::Rows(a), _) => Ok(galerkin(r, a, p)),
+            (Operator::Lower(a), Some(graph)) => Ok(galerkin(r, &LowerRows::new(a, graph)?, p)),
+            (Operator::Lower(_), None) => Err("a lower triangle without its node graph".into()),
         }
     }
 
@@ -563,26 +599,14 @@ impl Multigrid {
         }
     }
 
-    /// The fine operator of `a`: a symmetric tangent is read through a mirror
-    /// of its pattern, built here. (Keeping the mirror while the pattern stays
-    /// would save its build but hold it beside the next tangent's assembly,
-    /// which is the peak of a Newton iteration.)
-    fn fine(a: Fine) -> Result<Operator, String> {
+    /// The fine operator of `a`, and the node graph of a lower triangle.
+    fn fine(a: Fine) -> (Operator, Option<NodeGraph>) {
         match a {
-            Fine::Rows(a) => Ok(Operator::Rows(a)),
-            Fine::Lower(pattern, _) if pattern.row_idx().len() > u32::MAX as usize => Err(format!(
-                "the tangent's lower triangle has {} entries, more than the 2³² the mirror's \
-                 32-bit positions address",
-                pattern.row_idx().len()
-            )),
-            Fine::Lower(pattern, values) => {
-                let mirror = Some(Mirror::of(&pattern));
-                Ok(Operator::Lower(LowerSymmetric {
-                    pattern,
-                    values,
-                    mirror,
-                }))
-            }
+            Fine::Rows(a) => (Operator::Rows(a), None),
+            Fine::Lower(pattern, values, graph) => (
+                Operator::Lower(LowerSymmetric { pattern, values }),
+                Some(graph),
+            ),
         }
     }
 
@@ -592,17 +616,18 @@ impl Multigrid {
     /// pattern is unchanged (`DirectSolver`). If the coarsest operator cannot be
     /// factorized (a coarse space that lost its rank at a ragged boundary), the
     /// next finer level becomes the coarsest.
-    pub fn refresh(&mut self, a: impl Into<Fine>, symmetric: bool) -> Result<Shape, String> {
+    pub fn refresh<'g>(
+        &mut self,
+        a: impl Into<Fine<'g>>,
+        symmetric: bool,
+    ) -> Result<Shape, String> {
         // On an error no operator is kept.
         self.release();
-        let mut operators = vec![Self::fine(a.into())?];
+        let (fine, mut graph) = Self::fine(a.into());
+        let mut operators = vec![fine];
         for (t, r) in self.transfers.iter().zip(&self.restrictions) {
-            let coarse = operators.last().unwrap().galerkin(r, &t.prolongation);
+            let coarse = (operators.last().unwrap()).galerkin(r, &t.prolongation, graph.take())?;
             operators.push(Operator::Rows(coarse));
-            // The fine level's mirror served its Galerkin product only.
-            if let Operator::Lower(fine) = &mut operators[0] {
-                fine.mirror = None;
-            }
         }
         let mut used = self.transfers.len();
         let shift = loop {
@@ -904,12 +929,10 @@ mod tests {
         for i in 0..n {
             let mut entries: Vec<(usize, f64)> = match i % 2 {
                 1 => vec![(i / 2, 1.0)],
-                _ => [i / 2, (i / 2).wrapping_sub(1)]
-                    .into_iter()
-                    .filter(|&c| c < nc)
-                    .map(|c| (c, 0.5))
-                    .collect(),
+                _ => vec![(i / 2, 0.5), ((i / 2).wrapping_sub(1), 0.5)],
             };
+            // An even n leaves the last unknown without a coarse parent.
+            entries.retain(|&(c, _)| c < nc);
             if duplicate {
                 if let Some(&(_, w)) = entries.iter().find(|e| e.0 == nc - 1) {
                     entries.push((nc, w));
@@ -925,92 +948,195 @@ mod tests {
         p
     }
 
-    /// A symmetric matrix of order n with a ragged pattern (some columns hold
-    /// only their diagonal, some rows reach far): its lower triangle in
-    /// compressed columns, and the whole matrix in compressed rows built
-    /// directly from the same rule (the reference).
-    #[allow(clippy::type_complexity)]
-    fn ragged(n: usize) -> (Arc<SymbolicSparseColMat<usize>>, Vec<f64>, Csr) {
-        // Entry (i, j) for i ≥ j, if stored.
-        let entry = |i: usize, j: usize| {
+    /// A symmetric matrix whose unknowns come in nodes (node a owns
+    /// `first[a]..first[a + 1]`, and nodes a, b couple all their unknowns when
+    /// `coupled(max(a, b), min(a, b))`): its lower triangle in compressed
+    /// columns with the node graph, and the whole matrix in compressed rows
+    /// built directly from the same rule (the reference).
+    struct Nodal {
+        pattern: Arc<SymbolicSparseColMat<usize>>,
+        vals: Vec<f64>,
+        whole: Csr,
+        start: Vec<usize>,
+        adjacency: Vec<u32>,
+        first: Vec<usize>,
+    }
+
+    impl Nodal {
+        fn new(first: Vec<usize>, coupled: impl Fn(usize, usize) -> bool) -> Nodal {
+            let nodes = first.len() - 1;
+            let n = first[nodes];
+            let node_of = |i: usize| first.partition_point(|&u| u <= i) - 1;
+            let entry = |i: usize, j: usize| {
+                let (a, b) = (node_of(i), node_of(j));
+                coupled(a.max(b), a.min(b)).then(|| match i == j {
+                    true => 4.0 + j as f64,
+                    false => -1.0 / (1 + i + j) as f64,
+                })
+            };
+            let (mut col_ptr, mut rows, mut vals) = (vec![0usize], Vec::new(), Vec::new());
+            for j in 0..n {
+                for (i, v) in (j..n).filter_map(|i| entry(i, j).map(|v| (i, v))) {
+                    rows.push(i);
+                    vals.push(v);
+                }
+                col_ptr.push(rows.len());
+            }
+            let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows);
+            let mut whole = Csr {
+                rows: n,
+                cols: n,
+                row_ptr: vec![0],
+                ..Default::default()
+            };
+            for i in 0..n {
+                for (j, v) in (0..n).filter_map(|j| entry(i, j).map(|v| (j, v))) {
+                    whole.col.push(j as u32);
+                    whole.val.push(v);
+                }
+                whole.row_ptr.push(whole.col.len());
+            }
+            let (mut start, mut adjacency) = (vec![0], Vec::new());
+            for a in 0..nodes {
+                adjacency.extend(
+                    (0..nodes)
+                        .filter(|&b| coupled(a.max(b), a.min(b)))
+                        .map(|b| b as u32),
+                );
+                start.push(adjacency.len());
+            }
+            Nodal {
+                pattern: Arc::new(pattern),
+                vals,
+                whole,
+                start,
+                adjacency,
+                first,
+            }
+        }
+
+        fn graph(&self) -> NodeGraph<'_> {
+            NodeGraph {
+                start: &self.start,
+                adjacency: &self.adjacency,
+                first: &self.first,
+            }
+        }
+
+        fn fine(&self) -> Fine<'_> {
+            Fine::Lower(Arc::clone(&self.pattern), self.vals.clone(), self.graph())
+        }
+    }
+
+    /// A ragged pattern of order n, one unknown per node (some columns hold
+    /// only their diagonal, some rows reach far).
+    fn ragged(n: usize) -> Nodal {
+        Nodal::new((0..=n).collect(), |i, j| {
             let coupled = i == j || (i - j < 10 && (i - j) % 3 == 1) || (j % 5 == 0 && i == n - 1);
-            (coupled && !(j % 7 == 3 && i > j)).then(|| match i == j {
-                true => 4.0 + j as f64,
-                false => -1.0 / (1 + i + j) as f64,
-            })
-        };
-        let (mut col_ptr, mut rows, mut vals) = (vec![0usize], Vec::new(), Vec::new());
-        for j in 0..n {
-            for (i, v) in (j..n).filter_map(|i| entry(i, j).map(|v| (i, v))) {
-                rows.push(i);
-                vals.push(v);
-            }
-            col_ptr.push(rows.len());
+            coupled && !(j % 7 == 3 && i > j)
+        })
+    }
+
+    /// Nodes of 2 unknowns, some of 1 or none (eliminated components), each
+    /// coupled to the nodes two either side of it and the first to the last.
+    fn nodal(nodes: usize) -> Nodal {
+        let mut first = vec![0];
+        for a in 0..nodes {
+            let own = match (a % 5, a % 7) {
+                (_, 4) => 0,
+                (2, _) => 1,
+                _ => 2,
+            };
+            first.push(first[a] + own);
         }
-        let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows);
-        let mut whole = Csr {
-            rows: n,
-            cols: n,
-            row_ptr: vec![0],
-            ..Default::default()
-        };
-        for i in 0..n {
-            for (j, v) in (0..n).filter_map(|j| entry(i.max(j), i.min(j)).map(|v| (j, v))) {
-                whole.col.push(j as u32);
-                whole.val.push(v);
-            }
-            whole.row_ptr.push(whole.col.len());
-        }
-        (Arc::new(pattern), vals, whole)
+        Nodal::new(first, |a, b| a - b <= 2 || (b == 0 && a == nodes - 1))
     }
 
     #[test]
     fn the_lower_triangle_read_by_rows_is_the_whole_matrix() {
         // Row for row, the same columns, values and order as the copy into
-        // compressed rows, so the Galerkin operators are the same bits.
-        let n = 23;
-        let (pattern, vals, rows) = ragged(n);
-        let lower = Multigrid::fine(Fine::Lower(Arc::clone(&pattern), vals.clone())).unwrap();
-        assert_eq!(lower.nnz(), rows.nnz());
-        for i in 0..n {
-            let mut entries = Vec::new();
-            match &lower {
-                Operator::Lower(a) => a.for_each_in_row(i, |j, v| entries.push((j, v))),
-                Operator::Rows(_) => panic!("a symmetric tangent is read in place"),
-            }
-            let (c, v) = rows.row(i);
-            let expected: Vec<(u32, f64)> = c.iter().copied().zip(v.iter().copied()).collect();
-            assert_eq!(entries, expected, "row {i}");
-        }
-        for block in [vec![0, 1], vec![3, 4, 5], vec![22, 9, 1], vec![7]] {
-            assert_eq!(lower.block_values(&block), rows.block_values(&block));
-        }
-        let p = interpolation(n, false);
-        let (a, b) = (
-            lower.galerkin(&p.transpose(), &p),
-            galerkin(&p.transpose(), &rows, &p),
-        );
-        assert_eq!((a.row_ptr, a.col, a.val), (b.row_ptr, b.col, b.val));
-        // A V-cycle differs from the one on the copy only by the order of the
-        // products' sums.
-        let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
-        let blocks: Vec<Vec<usize>> = (0..n).map(|i| vec![i]).collect();
-        let cycle = |fine: Fine| {
-            let transfer = Transfer {
-                prolongation: p.clone(),
-                fine_blocks: blocks.clone(),
+        // compressed rows, so the Galerkin operators are the same bits: on a
+        // ragged pattern of single unknowns, and on nodes of 2, 1 and 0
+        // unknowns.
+        for (case, m) in [("ragged", ragged(23)), ("nodal", nodal(20))] {
+            let (lower, graph) = Multigrid::fine(m.fine());
+            let (rows, n) = (&m.whole, m.whole.rows);
+            assert_eq!(lower.nnz(), rows.nnz(), "{case}");
+            let Operator::Lower(a) = &lower else {
+                panic!("a symmetric tangent is read in place")
             };
-            let mut mg = Multigrid::new(vec![transfer]);
-            mg.refresh(fine, true).unwrap();
-            let mut z = vec![0.0; n];
-            mg.apply(&x, &mut z);
-            z
-        };
-        let (z, z_rows) = (cycle(Fine::Lower(pattern, vals)), cycle(Fine::Rows(rows)));
-        let scale = z_rows.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        for (a, b) in z.iter().zip(&z_rows) {
-            assert!((a - b).abs() <= 1e-13 * scale, "V-cycle {a} against {b}");
+            let by_rows = LowerRows::new(a, graph.unwrap()).unwrap();
+            for i in 0..n {
+                let mut entries = Vec::new();
+                by_rows.for_each_in_row(i, |j, v| entries.push((j, v)));
+                let (c, v) = rows.row(i);
+                let expected: Vec<(u32, f64)> = c.iter().copied().zip(v.iter().copied()).collect();
+                assert_eq!(entries, expected, "{case}: row {i}");
+            }
+            for block in [vec![0, 1], vec![3, 4, 5], vec![n - 1, 9, 1], vec![7]] {
+                assert_eq!(
+                    lower.block_values(&block),
+                    rows.block_values(&block),
+                    "{case}"
+                );
+            }
+            let p = interpolation(n, false);
+            let (a, b) = (
+                lower.galerkin(&p.transpose(), &p, graph).unwrap(),
+                galerkin(&p.transpose(), rows, &p),
+            );
+            assert_eq!(
+                (a.row_ptr, a.col, a.val),
+                (b.row_ptr, b.col, b.val),
+                "{case}"
+            );
+            // A V-cycle differs from the one on the copy only by the order of
+            // the products' sums.
+            let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
+            let blocks: Vec<Vec<usize>> = (0..n).map(|i| vec![i]).collect();
+            let cycle = |fine: Fine| {
+                let transfer = Transfer {
+                    prolongation: p.clone(),
+                    fine_blocks: blocks.clone(),
+                };
+                let mut mg = Multigrid::new(vec![transfer]);
+                mg.refresh(fine, true).unwrap();
+                let mut z = vec![0.0; n];
+                mg.apply(&x, &mut z);
+                z
+            };
+            let (z, z_rows) = (cycle(m.fine()), cycle(Fine::Rows(rows.clone())));
+            let scale = z_rows.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            for (a, b) in z.iter().zip(&z_rows) {
+                assert!(
+                    (a - b).abs() <= 1e-13 * scale,
+                    "{case}: V-cycle {a} against {b}"
+                );
+            }
         }
+    }
+
+    #[test]
+    fn a_node_graph_that_misses_entries_of_the_triangle_is_refused() {
+        // The graph of another pattern (node 0 no longer coupled to the last):
+        // its rows would silently lack entries.
+        let m = nodal(20);
+        let other = Nodal::new(m.first.clone(), |a, b| a - b <= 2);
+        let (lower, _) = Multigrid::fine(m.fine());
+        let p = interpolation(m.whole.rows, false);
+        let error = lower
+            .galerkin(&p.transpose(), &p, Some(other.graph()))
+            .unwrap_err();
+        assert!(
+            error.contains("does not describe the tangent's pattern"),
+            "{error}"
+        );
+        let mut mg = Multigrid::new(vec![Transfer {
+            prolongation: p,
+            fine_blocks: (0..m.whole.rows).map(|i| vec![i]).collect(),
+        }]);
+        let wrong = Fine::Lower(Arc::clone(&m.pattern), m.vals.clone(), other.graph());
+        assert!(mg.refresh(wrong, true).is_err());
     }
 
     #[test]
@@ -1018,11 +1144,11 @@ mod tests {
         // Several column chunks, columns that reach the last row from far
         // above, and columns holding only their diagonal.
         for n in [1, 7, COLUMNS_PER_TASK + 1, 2 * COLUMNS_PER_TASK + 77] {
-            let (pattern, vals, rows) = ragged(n);
-            let lower = Multigrid::fine(Fine::Lower(pattern, vals)).unwrap();
+            let m = ragged(n);
+            let (lower, _) = Multigrid::fine(m.fine());
             let x: Vec<f64> = (0..n).map(|i| 1.0 + (i as f64 * 0.37).sin()).collect();
             let mut expected = vec![0.0; n];
-            rows.apply(&x, &mut expected);
+            m.whole.apply(&x, &mut expected);
             let product = |threads: usize| {
                 let pool = rayon::ThreadPoolBuilder::new()
                     .num_threads(threads)

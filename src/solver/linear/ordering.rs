@@ -38,7 +38,8 @@ impl NodeGraph<'_> {
         self.first.len() - 1
     }
 
-    fn neighbours(&self, a: usize) -> &[u32] {
+    /// The neighbours of node a, ascending.
+    pub fn neighbours(&self, a: usize) -> &[u32] {
         &self.adjacency[self.start[a]..self.start[a + 1]]
     }
 
