@@ -19,10 +19,15 @@ use crate::physics::transfer::{gradient, NodeMap};
 use rayon::prelude::*;
 
 /// The state the particles would reach under a displacement increment.
+///
+/// ΔF_p is not stored: [`Trial::df`] forms it again from the increment's nodal
+/// displacements (with F-bar, from the plain ΔF_p and the cells' mean
+/// dilatation), with the arithmetic of `evaluate`, so every reader sees the
+/// same bits (72 bytes per particle less in every implicit step).
 #[derive(Clone, Debug, Default)]
-pub struct Trial {
-    /// Incremental deformation gradient ΔF_p (ΔF̄_p with F-bar).
-    pub df: Vec<Mat3>,
+pub struct Trial<const D: usize> {
+    /// The nodal displacements u of the increment (one per active node).
+    u: Vec<Vector<D>>,
     pub stress: Vec<Mat3>,
     pub volume: Vec<f64>,
     /// History variables, laid out like `Particles::history.data`.
@@ -31,17 +36,17 @@ pub struct Trial {
     pub fbar: Option<FBarState>,
 }
 
-impl Trial {
+impl<const D: usize> Trial<D> {
     /// Turn F-bar on for the coming evaluations, with the particles grouped by
     /// the cells of their step-start positions `x` (call once per step).
-    pub fn use_fbar<const D: usize>(&mut self, grid: &Grid<D>, x: &[Vector<D>]) {
+    pub fn use_fbar(&mut self, grid: &Grid<D>, x: &[Vector<D>]) {
         let state = self.fbar.get_or_insert_with(FBarState::default);
         state.cells = Cells::locate(grid, x);
     }
 
     /// Evaluate the trial state under nodal displacements `u` (one per active node).
     /// Returns the first particle whose deformation inverts (det F ≤ 0), if any.
-    pub fn evaluate<const D: usize>(
+    pub fn evaluate(
         &mut self,
         p: &Particles<D>,
         materials: &[Box<dyn Material>],
@@ -51,58 +56,40 @@ impl Trial {
         dt: f64,
     ) -> Option<usize> {
         let n = p.len();
-        self.df.resize(n, Mat3::identity());
+        self.u.clear();
+        self.u.extend_from_slice(u);
         self.stress.resize(n, Mat3::zeros());
         self.volume.resize(n, 0.0);
         self.history.clone_from(&p.history.data);
-        // ΔF_p = I + Σ_I u_I ⊗ ∇S_Ip; axisymmetric: ΔF_θθ = 1 + Σ_I u_Ir S_Ip / r_p.
         let axisymmetric = !st.hoop.is_empty();
-        self.df
-            .par_iter_mut()
-            .enumerate()
-            .with_min_len(MIN_PARALLEL_LEN)
-            .for_each(|(q, df)| {
-                *df = increment(st, map, q, u, axisymmetric);
-            });
         if let Some(fbar) = &mut self.fbar {
             // ΔF̄_p = (ΔJ̄_c / ΔJ_p)^{1/n} ΔF_p (Coombs et al. 2018); needs ΔJ_p > 0.
+            fbar.df.clear();
+            (0..n)
+                .into_par_iter()
+                .with_min_len(MIN_PARALLEL_LEN)
+                .map(|q| increment(st, map, q, u, axisymmetric))
+                .collect_into_vec(&mut fbar.df);
             fbar.dj.clear();
-            fbar.dj.extend(self.df.iter().map(|f| f.determinant()));
+            fbar.dj.extend(fbar.df.iter().map(|f| f.determinant()));
             if let Some(q) = fbar.dj.iter().position(|&j| j <= 0.0) {
                 return Some(q);
             }
             fbar.dj_bar = fbar.cells.mean_dilatation(&p.volume, &fbar.dj);
-            fbar.df.clone_from(&self.df);
-            let (cells, dj, dj_bar) = (&fbar.cells, &fbar.dj, &fbar.dj_bar);
-            self.df
-                .par_iter_mut()
-                .enumerate()
-                .with_min_len(MIN_PARALLEL_LEN)
-                .for_each(|(q, df)| {
-                    let (dj_bar, dj) = (dj_bar[cells.of[q] as usize], dj[q]);
-                    // Axisymmetric: n = 3, the hoop stretch is scaled too.
-                    *df = if axisymmetric {
-                        scaled::<3>(df, scale_factor::<3>(dj_bar, dj))
-                    } else {
-                        scaled::<D>(df, scale_factor::<D>(dj_bar, dj))
-                    };
-                });
         }
         let history_old = p.history.slots(&p.history.data);
         let mut history = p.history.slots_mut(&mut self.history);
-        let inverted = self
-            .df
-            .par_iter()
-            .zip(self.stress.par_iter_mut())
+        let (u, fbar) = (&self.u, self.fbar.as_ref());
+        let inverted = (self.stress.par_iter_mut())
             .zip(self.volume.par_iter_mut())
             .zip(history.par_iter_mut())
             .enumerate()
             .with_min_len(MIN_PARALLEL_LEN)
-            .map(|(q, (((df, stress), volume), hist))| {
+            .map(|(q, ((stress, volume), hist))| {
                 let material = materials[p.material[q] as usize].as_ref();
                 let inc = Increment {
                     f_old: p.f[q],
-                    df: *df,
+                    df: df_of(u, fbar, st, map, q),
                     dt,
                     stress_old: p.stress[q],
                     history_old: history_old[q],
@@ -116,12 +103,17 @@ impl Trial {
         (inverted != usize::MAX).then_some(inverted)
     }
 
+    /// ΔF_p of the last evaluation (ΔF̄_p with F-bar), formed as `evaluate`
+    /// formed it.
+    pub fn df(&self, st: &Stencils<D>, map: &NodeMap, q: usize) -> Mat3 {
+        df_of(&self.u, self.fbar.as_ref(), st, map, q)
+    }
+
     /// The explicit step's update: the particles take the state of the
     /// displacement increment `u` (`evaluate` and `commit` with F-bar, else
     /// `update_in_place`). On an inversion, the particle and its det F (the
     /// particles are then not, or only partly, updated, and the run stops).
-    #[allow(clippy::too_many_arguments)]
-    pub fn advance<const D: usize>(
+    pub fn advance(
         &mut self,
         p: &mut Particles<D>,
         materials: &[Box<dyn Material>],
@@ -137,29 +129,50 @@ impl Trial {
             };
         }
         if let Some(q) = self.evaluate(p, materials, st, map, u, dt) {
-            return Err((q, self.f(p, q).determinant()));
+            return Err((q, self.f(p, st, map, q).determinant()));
         }
-        self.commit(p);
+        self.commit(p, st, map);
         Ok(())
     }
 
     /// The trial deformation gradient of particle q, F = ΔF F_old (2-31); not
     /// stored: only a commit and an inversion's report need it.
-    pub fn f<const D: usize>(&self, p: &Particles<D>, q: usize) -> Mat3 {
-        self.df[q] * p.f[q]
+    pub fn f(&self, p: &Particles<D>, st: &Stencils<D>, map: &NodeMap, q: usize) -> Mat3 {
+        self.df(st, map, q) * p.f[q]
     }
 
     /// Make the trial state the particles' state: F = ΔF F_old formed in place,
     /// the other buffers swapped, not copied. (`update_in_place` is this and
     /// `evaluate` in one pass, without F-bar.)
-    pub fn commit<const D: usize>(&mut self, p: &mut Particles<D>) {
+    pub fn commit(&mut self, p: &mut Particles<D>, st: &Stencils<D>, map: &NodeMap) {
         (p.f.par_iter_mut())
-            .zip(&self.df)
+            .enumerate()
             .with_min_len(MIN_PARALLEL_LEN)
-            .for_each(|(f, df)| *f = df * *f);
+            .for_each(|(q, f)| *f = self.df(st, map, q) * *f);
         std::mem::swap(&mut p.stress, &mut self.stress);
         std::mem::swap(&mut p.volume, &mut self.volume);
         std::mem::swap(&mut p.history.data, &mut self.history);
+    }
+}
+
+/// ΔF_p under the nodal displacements `u`; with F-bar, ΔF̄_p from the plain
+/// ΔF_p and dilatations that `fbar` holds.
+fn df_of<const D: usize>(
+    u: &[Vector<D>],
+    fbar: Option<&FBarState>,
+    st: &Stencils<D>,
+    map: &NodeMap,
+    q: usize,
+) -> Mat3 {
+    let axisymmetric = !st.hoop.is_empty();
+    let Some(fbar) = fbar else {
+        return increment(st, map, q, u, axisymmetric);
+    };
+    let (dj_bar, dj) = (fbar.dj_bar[fbar.cells.of[q] as usize], fbar.dj[q]);
+    // Axisymmetric: n = 3, the hoop stretch is scaled too.
+    match axisymmetric {
+        true => scaled::<3>(&fbar.df[q], scale_factor::<3>(dj_bar, dj)),
+        false => scaled::<D>(&fbar.df[q], scale_factor::<D>(dj_bar, dj)),
     }
 }
 

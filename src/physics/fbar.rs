@@ -163,8 +163,27 @@ end_time = 1.0
 load_steps = 1
 "#;
 
+    /// A trial state with the ΔF of every particle.
+    struct Evaluated {
+        df: Vec<Mat3>,
+        stress: Vec<Mat3>,
+        volume: Vec<f64>,
+        fbar: Option<super::FBarState>,
+    }
+
+    impl Evaluated {
+        fn of(t: Trial<2>, st: &Stencils<2>, map: &NodeMap) -> Evaluated {
+            Evaluated {
+                df: (0..t.stress.len()).map(|q| t.df(st, map, q)).collect(),
+                stress: t.stress,
+                volume: t.volume,
+                fbar: t.fbar,
+            }
+        }
+    }
+
     /// Trial states without and with F-bar under nodal displacements u(x).
-    fn trials(shape: &str, u: impl Fn(&Vector<2>) -> Vector<2>) -> (Trial, Trial) {
+    fn trials(shape: &str, u: impl Fn(&Vector<2>) -> Vector<2>) -> (Evaluated, Evaluated) {
         let overrides = vec![format!("grid.shape_function={shape}")];
         let scene = Scene::parse("block.toml", BLOCK, &overrides).unwrap();
         let m = Model::<2>::build(&scene).unwrap();
@@ -189,7 +208,10 @@ load_steps = 1
         assert!(fbar
             .evaluate(p, &m.materials, &st, &map, &nodal, 1.0)
             .is_none());
-        (plain, fbar)
+        (
+            Evaluated::of(plain, &st, &map),
+            Evaluated::of(fbar, &st, &map),
+        )
     }
 
     fn max_difference(a: &[Mat3], b: &[Mat3]) -> f64 {

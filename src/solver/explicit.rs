@@ -43,7 +43,7 @@ pub struct Explicit<const D: usize> {
     pub fbar: bool,
     stencils: Stencils<D>,
     map: NodeMap,
-    trial: Trial,
+    trial: Trial<D>,
     /// Contact between bodies (`crate::physics::contact`), when the scene has some.
     contact: Option<Contact<D>>,
     /// Artificial bulk viscosity (`crate::physics::bulk_viscosity`), if asked for.
@@ -353,7 +353,7 @@ fn apply_friction<const D: usize>(
 #[allow(clippy::too_many_arguments)]
 fn update_stress<const D: usize>(
     m: &mut Model<D>,
-    trial: &mut Trial,
+    trial: &mut Trial<D>,
     st: &Stencils<D>,
     map: &NodeMap,
     velocity: &[Vector<D>],

@@ -371,7 +371,7 @@ impl KrylovState {
     ) -> Result<Built, Failure> {
         let dofs = &sys.dofs;
         let blocks = || -> Result<Vec<SMatrix<f64, D, D>>, Failure> {
-            let a = particle_tangents(m, &sys.trial, true)?;
+            let a = particle_tangents(m, (&sys.trial, &sys.stencils, &sys.map), true)?;
             Ok(diagonal_blocks(m, sys, &a))
         };
         Ok(match self.config.preconditioner {

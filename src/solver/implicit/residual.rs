@@ -26,6 +26,7 @@ use crate::dim::Vector;
 use crate::model::conditions::Constraint;
 use crate::model::particles::Particles;
 use crate::model::Model;
+use crate::parallel::MIN_PARALLEL_LEN;
 use crate::physics::transfer::{consistent_mass_product, internal_force};
 use crate::scene::MassMatrix;
 use crate::solver::linear::direct::Ordering;
@@ -46,7 +47,9 @@ pub fn residual<const D: usize>(
         });
     }
     let pk1: Vec<_> = (0..p.len())
-        .map(|q| relative_pk1(&sys.trial.df[q], &sys.trial.stress[q]))
+        .into_par_iter()
+        .with_min_len(MIN_PARALLEL_LEN)
+        .map(|q| relative_pk1(&sys.trial.df(st, map, q), &sys.trial.stress[q]))
         .collect();
     let mut f_int = internal_force(map, st, &p.volume, &pk1);
     // A stress linear within each particle domain (`physics::stress_gradient`).
@@ -113,7 +116,7 @@ pub fn tangent<'s, const D: usize>(
 ) -> Result<Tangent<'s>, Failure> {
     let p = &m.particles;
     let (st, map, dofs) = (&sys.stencils, &sys.map, &sys.dofs);
-    let a = particle_tangents(m, &sys.trial, numerical)?;
+    let a = particle_tangents(m, (&sys.trial, &sys.stencils, &sys.map), numerical)?;
     let fbar = sys.trial.fbar.as_ref();
     let pattern = step_pattern(sys);
     // Symmetric unless F-bar or a non-associated material breaks it.

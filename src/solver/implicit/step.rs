@@ -84,7 +84,7 @@ pub struct StepSystem<const D: usize> {
     pub g_new: f64,
     pub scales_new: Vec<f64>,
     /// The particles' state at the latest iterate.
-    pub trial: Trial,
+    pub trial: Trial<D>,
     /// The fill-reducing ordering of the direct factorizations.
     pub direct_ordering: DirectOrdering,
     /// The tangent's sparsity pattern (built at the step's first assembly, kept
@@ -352,7 +352,7 @@ impl StepSettings {
         let load_new = |q: usize| load_factor(&m.load_ramp_of, q, &sys.scales_new);
         let dx = self.particle_displacements(m, sys, u);
         let p = &mut m.particles;
-        sys.trial.commit(p);
+        sys.trial.commit(p, &sys.stencils, &sys.map);
         let (map, st) = (&sys.map, &sys.stencils);
         let work: f64 = (0..p.len())
             .map(|q| {

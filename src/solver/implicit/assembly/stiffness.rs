@@ -121,7 +121,7 @@ pub fn pk1_derivative<const D: usize>(
 /// only), from central differences of its stress update if it has none.
 pub fn particle_tangents<const D: usize>(
     m: &Model<D>,
-    trial: &Trial,
+    (trial, st, map): (&Trial<D>, &Stencils<D>, &NodeMap),
     numerical: bool,
 ) -> Result<ParticleTangents<D>, Failure> {
     let p = &m.particles;
@@ -144,9 +144,10 @@ pub fn particle_tangents<const D: usize>(
         .enumerate()
         .with_min_len(MIN_PARALLEL_LEN)
         .filter_map(|(q, (a_q, hoop_q))| {
+            let df = trial.df(st, map, q);
             let inc = Increment {
                 f_old: p.f[q],
-                df: trial.df[q],
+                df,
                 dt: 0.0,
                 stress_old: p.stress[q],
                 history_old: history_old[q],
@@ -157,7 +158,7 @@ pub fn particle_tangents<const D: usize>(
                     numerical.then(|| numerical_stress_derivative(mat, &inc, NUMERICAL_STEP))
                 })
                 .map(|ds| {
-                    let full = pk1_derivative::<D>(&trial.df[q], &trial.stress[q], &ds, hoop);
+                    let full = pk1_derivative::<D>(&df, &trial.stress[q], &ds, hoop);
                     compact::<D>(&full, a_q);
                     if hoop {
                         compact_hoop::<D>(&full, hoop_q);
