@@ -57,6 +57,7 @@ use mpm::solver::linear::direct::{
     cholesky_parallelism, parallelism, DirectSolver, Ordering, Structure,
 };
 use mpm::solver::linear::ordering::{fill_reducing, node_amd, node_metis};
+use mpm::solver::linear::Index;
 use mpm::solver::stepper::Stepper;
 use std::hint::black_box;
 use std::time::Instant;
@@ -139,7 +140,7 @@ impl<const D: usize> Problem<D> {
         let s = &self.sys;
         let cells = s.trial.fbar.as_ref().map(|f| &f.cells);
         let p = Pattern::new(&s.map, &s.stencils, &s.dofs, cells, None, &[]);
-        p.csc(Storage::Lower);
+        p.csc(Storage::Lower).unwrap();
         p
     }
 }
@@ -147,8 +148,8 @@ impl<const D: usize> Problem<D> {
 /// faer's numeric LLᵀ alone into fresh buffers, with the direct solver's
 /// parallelism (`par`: `direct::cholesky_parallelism`), sequential or with two tasks.
 fn numeric_llt(
-    sym: &SymbolicCholesky<usize>,
-    a: faer::sparse::SparseColMatRef<usize, f64>,
+    sym: &SymbolicCholesky<Index>,
+    a: faer::sparse::SparseColMatRef<Index, f64>,
     par: faer::Par,
 ) -> Vec<f64> {
     let mut values = vec![0.0; sym.len_val()];
@@ -159,8 +160,8 @@ fn numeric_llt(
 
 /// faer's numeric LLᵀ into the given factor buffer and workspace.
 fn numeric_llt_into(
-    sym: &SymbolicCholesky<usize>,
-    a: faer::sparse::SparseColMatRef<usize, f64>,
+    sym: &SymbolicCholesky<Index>,
+    a: faer::sparse::SparseColMatRef<Index, f64>,
     par: faer::Par,
     values: &mut [f64],
     mem: &mut MemBuffer,
@@ -190,12 +191,15 @@ fn bench_problem<const D: usize>(c: &mut Criterion, p: &mut Problem<D>) {
         .factorize(k.matrix(), Structure::Symmetric, order)
         .expect("factorize");
     let symbolic = |perm: Option<&[usize]>| {
+        let fwd: Option<Vec<Index>> = perm.map(|p| p.iter().map(|&i| i as Index).collect());
         let inv = perm.map(|p| {
-            let mut inv = vec![0; p.len()];
-            p.iter().enumerate().for_each(|(new, &old)| inv[old] = new);
+            let mut inv: Vec<Index> = vec![0; p.len()];
+            p.iter()
+                .enumerate()
+                .for_each(|(new, &old)| inv[old] = new as Index);
             inv
         });
-        let ordering = match (perm, &inv) {
+        let ordering = match (&fwd, &inv) {
             (Some(p), Some(i)) => SymmetricOrdering::Custom(PermRef::new_checked(p, i, n)),
             _ => SymmetricOrdering::Amd,
         };
@@ -366,7 +370,7 @@ fn bench_problem<const D: usize>(c: &mut Criterion, p: &mut Problem<D>) {
 fn alternate<const D: usize>(
     p: &Problem<D>,
     k: &Tangent,
-    sym: &SymbolicCholesky<usize>,
+    sym: &SymbolicCholesky<Index>,
     b: &[f64],
     rounds: usize,
 ) {
@@ -432,7 +436,7 @@ fn alternate<const D: usize>(
 fn export(
     dir: &std::path::Path,
     name: &str,
-    k: faer::sparse::SparseColMatRef<usize, f64>,
+    k: faer::sparse::SparseColMatRef<Index, f64>,
     b: &[f64],
 ) -> std::io::Result<()> {
     std::fs::create_dir_all(dir)?;

@@ -5,6 +5,7 @@
 //! solvers. Values are written in Rust's shortest round-trip form, so they read
 //! back bit for bit.
 
+use crate::solver::linear::Index;
 use faer::sparse::SparseColMatRef;
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -14,7 +15,7 @@ use std::path::Path;
 /// triangle of a symmetric matrix (Matrix Market's convention), else `general`.
 pub fn write_sparse(
     path: &Path,
-    a: SparseColMatRef<usize, f64>,
+    a: SparseColMatRef<Index, f64>,
     symmetric: bool,
 ) -> std::io::Result<()> {
     let mut f = BufWriter::new(File::create(path)?);
@@ -52,7 +53,7 @@ mod tests {
             Triplet::new(2, 0, -1.0 / 3.0),
             Triplet::new(1, 1, 1e-300),
         ];
-        let a = SparseColMat::<usize, f64>::try_new_from_triplets(3, 3, &t).unwrap();
+        let a = SparseColMat::<Index, f64>::try_new_from_triplets(3, 3, &t).unwrap();
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("k.mtx");
         write_sparse(&path, a.as_ref(), true).unwrap();

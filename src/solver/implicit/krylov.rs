@@ -465,7 +465,10 @@ impl KrylovState {
         // rows); an unsymmetric one is copied into rows, and its columns dropped.
         let symmetric = k.symmetric();
         let a = if symmetric {
-            let pattern = step_pattern(sys).csc(Storage::Lower);
+            // The tangent was assembled in this pattern.
+            let pattern = step_pattern(sys)
+                .csc(Storage::Lower)
+                .expect("built by the tangent");
             debug_assert!(std::ptr::eq(&**pattern, k.pattern));
             Fine::Lower(Arc::clone(pattern), k.values, step_pattern(sys).graph())
         } else {

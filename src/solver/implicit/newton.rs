@@ -296,10 +296,12 @@ pub fn factorized_tangent<'s, const D: usize>(
         || tangent(m, sys, false),
         || {
             if symmetric {
-                let lower = pattern.csc(Storage::Lower);
-                let order = Ordering::Given(pattern.ordering::<D>(sys.direct_ordering));
-                // An error here comes back from the factorization below.
-                let _ = solver.analyse(lower, order);
+                // An error here comes back from the assembly or the
+                // factorization below.
+                if let Ok(lower) = pattern.csc(Storage::Lower) {
+                    let order = Ordering::Given(pattern.ordering::<D>(sys.direct_ordering));
+                    let _ = solver.analyse(lower, order);
+                }
             }
         },
     );

@@ -136,7 +136,10 @@ pub fn tangent<'s, const D: usize>(
     } else {
         Storage::Full
     };
-    let csc = pattern.csc(storage);
+    let csc = pattern.csc(storage).map_err(|message| Failure {
+        particle: None,
+        message,
+    })?;
     let mut k = Tangent {
         pattern: csc,
         values: vec![0.0; csc.row_idx().len()],

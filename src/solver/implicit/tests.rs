@@ -122,6 +122,7 @@ fn tangent_error_of<const D: usize>(
     let km = kt.matrix();
     for c in 0..n {
         for (&r, &v) in km.row_idx_of_col_raw(c).iter().zip(km.val_of_col(c)) {
+            let r = r as usize;
             k[r * n + c] += v;
             if kt.symmetric() && r != c {
                 k[c * n + r] += v;
@@ -158,7 +159,7 @@ fn lower_equals_full_stiffness<const D: usize>(m: &Model<D>, sys: &StepSystem<D>
     let a = particle_tangents(m, (&sys.trial, &sys.stencils, &sys.map), false).unwrap();
     let pattern = super::residual::step_pattern(sys);
     let assemble = |storage| {
-        let csc = pattern.csc(storage);
+        let csc = pattern.csc(storage).unwrap();
         let values = vec![0.0; csc.row_idx().len()];
         let mut t = Tangent {
             pattern: csc,
@@ -175,14 +176,14 @@ fn lower_equals_full_stiffness<const D: usize>(m: &Model<D>, sys: &StepSystem<D>
         let full_col: Vec<(usize, f64)> = f
             .row_idx_of_col_raw(c)
             .iter()
-            .copied()
+            .map(|&r| r as usize)
             .zip(f.val_of_col(c).iter().copied())
             .filter(|&(r, _)| r >= c)
             .collect();
         let lower_col: Vec<(usize, f64)> = l
             .row_idx_of_col_raw(c)
             .iter()
-            .copied()
+            .map(|&r| r as usize)
             .zip(l.val_of_col(c).iter().copied())
             .collect();
         assert_eq!(lower_col, full_col, "column {c}");

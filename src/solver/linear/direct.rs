@@ -9,6 +9,7 @@
 //! instead of a garbage solution; [`DirectSolver::factorize_and_solve`] solves a right-hand
 //! side together with the probe (one pass over the factor for both).
 
+use super::Index;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::perm::PermRef;
 use faer::sparse::linalg::cholesky::{
@@ -52,7 +53,7 @@ pub const PARALLEL_MEAN_COLUMN: usize = 800;
 /// faer's parallelism for the numeric factorization and solves with `sym`:
 /// sequential for sparse factors, [`FACTOR_TASKS`] tasks for dense ones. It
 /// depends on the pattern only, so the results do not depend on the threads.
-pub fn cholesky_parallelism(sym: &SymbolicCholesky<usize>) -> Par {
+pub fn cholesky_parallelism(sym: &SymbolicCholesky<Index>) -> Par {
     if sym.len_val() >= PARALLEL_MEAN_COLUMN * sym.nrows() {
         Par::rayon(FACTOR_TASKS)
     } else {
@@ -140,16 +141,16 @@ struct Pattern {
     structure: Structure,
     /// The caller's own pattern when it came through [`DirectSolver::analyse`]
     /// (no copy), else a copy.
-    columns: Arc<SymbolicSparseColMat<usize>>,
+    columns: Arc<SymbolicSparseColMat<Index>>,
     perm: Option<Vec<usize>>,
 }
 
 /// Whether `a` has the columns `stored`: the same arrays (a matrix on the
 /// shared pattern: they are immutable and kept alive by the handle), or equal
 /// ones.
-fn same_columns(stored: &SymbolicSparseColMat<usize>, a: SymbolicSparseColMatRef<usize>) -> bool {
+fn same_columns(stored: &SymbolicSparseColMat<Index>, a: SymbolicSparseColMatRef<Index>) -> bool {
     let same =
-        |x: &[usize], y: &[usize]| (x.as_ptr() == y.as_ptr() && x.len() == y.len()) || x == y;
+        |x: &[Index], y: &[Index]| (x.as_ptr() == y.as_ptr() && x.len() == y.len()) || x == y;
     same(stored.col_ptr(), a.col_ptr()) && same(stored.row_idx(), a.row_idx())
 }
 
@@ -161,10 +162,10 @@ enum Numeric {
     Lblt {
         values: Vec<f64>,
         subdiag: Vec<f64>,
-        fwd: Vec<usize>,
-        inv: Vec<usize>,
+        fwd: Vec<Index>,
+        inv: Vec<Index>,
     },
-    Lu(Box<NumericLu<usize, f64>>),
+    Lu(Box<NumericLu<Index, f64>>),
 }
 
 /// Sparse direct solver holding the symbolic factorizations and the pattern they belong to.
@@ -176,8 +177,8 @@ pub struct DirectSolver {
     work: MemBuffer,
     work_size: StackReq,
     pattern: Option<Pattern>,
-    chol: Option<SymbolicCholesky<usize>>,
-    lu: Option<SymbolicLu<usize>>,
+    chol: Option<SymbolicCholesky<Index>>,
+    lu: Option<SymbolicLu<Index>>,
     numeric: Numeric,
     statistics: Statistics,
 }
@@ -221,7 +222,7 @@ impl DirectSolver {
     /// else LBLᵀ, else LU; General: LU. On error no factorization is kept.
     pub fn factorize(
         &mut self,
-        a: SparseColMatRef<usize, f64>,
+        a: SparseColMatRef<Index, f64>,
         structure: Structure,
         ordering: Ordering,
     ) -> Result<Method, SolveError> {
@@ -235,7 +236,7 @@ impl DirectSolver {
     /// the check with a second column only.
     pub fn factorize_and_solve(
         &mut self,
-        a: SparseColMatRef<usize, f64>,
+        a: SparseColMatRef<Index, f64>,
         structure: Structure,
         ordering: Ordering,
         b: &[f64],
@@ -256,7 +257,7 @@ impl DirectSolver {
     /// The factorization with its check; with `b`, also the solution of K x = b.
     fn factorize_with(
         &mut self,
-        a: SparseColMatRef<usize, f64>,
+        a: SparseColMatRef<Index, f64>,
         structure: Structure,
         ordering: Ordering,
         b: Option<&[f64]>,
@@ -296,7 +297,7 @@ impl DirectSolver {
     /// The solver keeps the handle `lower` (not a copy) as its pattern.
     pub fn analyse(
         &mut self,
-        lower: &Arc<SymbolicSparseColMat<usize>>,
+        lower: &Arc<SymbolicSparseColMat<Index>>,
         ordering: Ordering,
     ) -> Result<(), SolveError> {
         let n = lower.nrows();
@@ -392,9 +393,9 @@ impl DirectSolver {
         &mut self,
         n: usize,
         structure: Structure,
-        a: SymbolicSparseColMatRef<usize>,
+        a: SymbolicSparseColMatRef<Index>,
         ordering: Ordering,
-        shared: Option<Arc<SymbolicSparseColMat<usize>>>,
+        shared: Option<Arc<SymbolicSparseColMat<Index>>>,
     ) -> Result<bool, SolveError> {
         let perm = match ordering {
             Ordering::Amd => None,
@@ -428,7 +429,7 @@ impl DirectSolver {
     /// LLᵀ, then LBLᵀ, then LU on the mirrored full matrix; `lower` holds the lower triangle.
     fn factor_symmetric(
         &mut self,
-        lower: SparseColMatRef<usize, f64>,
+        lower: SparseColMatRef<Index, f64>,
         b: Option<&[f64]>,
     ) -> Result<(Method, Option<Vec<f64>>), SolveError> {
         self.ensure_chol(lower.symbolic())?;
@@ -444,12 +445,13 @@ impl DirectSolver {
 
     /// Compute the symbolic Cholesky of the lower triangle unless cached (with
     /// the given ordering, else AMD).
-    fn ensure_chol(&mut self, lower: SymbolicSparseColMatRef<usize>) -> Result<(), SolveError> {
+    fn ensure_chol(&mut self, lower: SymbolicSparseColMatRef<Index>) -> Result<(), SolveError> {
         if self.chol.is_none() {
             let params = CholeskySymbolicParams::default();
             let perm = self.pattern.as_ref().and_then(|p| p.perm.as_ref());
-            let inverse = perm.map(|p| inverse(p));
-            let ordering = match (perm, &inverse) {
+            let fwd: Option<Vec<Index>> = perm.map(|p| p.iter().map(|&i| i as Index).collect());
+            let inv = perm.map(|p| inverse(p));
+            let ordering = match (&fwd, &inv) {
                 (Some(fwd), Some(inv)) => {
                     SymmetricOrdering::Custom(PermRef::new_checked(fwd, inv, fwd.len()))
                 }
@@ -464,7 +466,7 @@ impl DirectSolver {
     }
 
     /// Compute the symbolic LU (COLAMD ordering) of the full matrix unless cached.
-    fn ensure_lu(&mut self, a: SparseColMatRef<usize, f64>) -> Result<(), SolveError> {
+    fn ensure_lu(&mut self, a: SparseColMatRef<Index, f64>) -> Result<(), SolveError> {
         if self.lu.is_none() {
             let sym = factorize_symbolic_lu(a.symbolic(), LuSymbolicParams::default())
                 .map_err(backend)?;
@@ -489,7 +491,7 @@ impl DirectSolver {
     /// factor's buffer when there is one), then the probe check.
     fn try_llt(
         &mut self,
-        lower: SparseColMatRef<usize, f64>,
+        lower: SparseColMatRef<Index, f64>,
         b: Option<&[f64]>,
     ) -> Result<Option<Vec<f64>>, SolveError> {
         let sym = self.chol.take().ok_or(SolveError::NotFactorized)?;
@@ -533,14 +535,14 @@ impl DirectSolver {
     /// Numeric intranodal LBLᵀ with the cached symbolic factorization, then the probe check.
     fn try_lblt(
         &mut self,
-        lower: SparseColMatRef<usize, f64>,
+        lower: SparseColMatRef<Index, f64>,
         b: Option<&[f64]>,
     ) -> Result<Option<Vec<f64>>, SolveError> {
         let sym = self.chol.as_ref().ok_or(SolveError::NotFactorized)?;
         let (n, par) = (sym.nrows(), cholesky_parallelism(sym));
         let mut values = vec![0.0; sym.len_val()];
         let mut subdiag = vec![0.0; n];
-        let (mut fwd, mut inv) = (vec![0usize; n], vec![0usize; n]);
+        let (mut fwd, mut inv): (Vec<Index>, Vec<Index>) = (vec![0; n], vec![0; n]);
         let req = sym.factorize_numeric_intranode_lblt_scratch::<f64>(par, Default::default());
         let mut mem = buffer(req)?;
         let stack = MemStack::new(&mut mem);
@@ -567,7 +569,7 @@ impl DirectSolver {
     /// Symbolic (cached) + numeric LU of the full matrix `a`, then the probe check.
     fn factor_lu(
         &mut self,
-        a: SparseColMatRef<usize, f64>,
+        a: SparseColMatRef<Index, f64>,
         b: Option<&[f64]>,
     ) -> Result<(Method, Option<Vec<f64>>), SolveError> {
         self.ensure_lu(a)?;
@@ -614,7 +616,7 @@ impl DirectSolver {
     /// Solve in place with the LU factors.
     fn solve_lu(
         &self,
-        num: &NumericLu<usize, f64>,
+        num: &NumericLu<Index, f64>,
         rhs: MatMut<f64>,
         par: Par,
     ) -> Result<(), SolveError> {
@@ -634,7 +636,7 @@ impl DirectSolver {
     /// (singular). With `b`, `K x = b` is solved in the same pass and x returned.
     fn check(
         &mut self,
-        a: SparseColMatRef<usize, f64>,
+        a: SparseColMatRef<Index, f64>,
         sym: bool,
         b: Option<&[f64]>,
     ) -> Result<Option<Vec<f64>>, SolveError> {
@@ -648,7 +650,7 @@ impl DirectSolver {
     /// The probe solve of [`Self::check`], without the cleanup.
     fn probe(
         &self,
-        a: SparseColMatRef<usize, f64>,
+        a: SparseColMatRef<Index, f64>,
         sym: bool,
         b: Option<&[f64]>,
     ) -> Result<Option<Vec<f64>>, SolveError> {
@@ -684,10 +686,10 @@ impl DirectSolver {
 }
 
 /// The inverse of a permutation.
-fn inverse(perm: &[usize]) -> Vec<usize> {
+fn inverse(perm: &[usize]) -> Vec<Index> {
     let mut inv = vec![0; perm.len()];
     for (new, &old) in perm.iter().enumerate() {
-        inv[old] = new;
+        inv[old] = new as Index;
     }
     inv
 }
@@ -698,11 +700,11 @@ fn probe_entry(i: usize) -> f64 {
 }
 
 /// `y = A x` (or `|A| x` when `abs`); with `sym`, `a` holds the lower triangle of a symmetric matrix.
-pub fn spmv(a: SparseColMatRef<usize, f64>, sym: bool, x: &[f64], abs: bool) -> Vec<f64> {
+pub fn spmv(a: SparseColMatRef<Index, f64>, sym: bool, x: &[f64], abs: bool) -> Vec<f64> {
     let mut y = vec![0.0; a.nrows()];
     for j in 0..a.ncols() {
         for (&i, &v) in a.row_idx_of_col_raw(j).iter().zip(a.val_of_col(j)) {
-            let v = if abs { v.abs() } else { v };
+            let (i, v) = (i as usize, if abs { v.abs() } else { v });
             y[i] += v * x[j];
             if sym && i != j {
                 y[j] += v * x[i];
@@ -724,7 +726,7 @@ fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
 
 /// Non-finite values, and entries above the diagonal of a `Symmetric` matrix, are
 /// invalid input.
-fn check_entries(a: SparseColMatRef<usize, f64>, structure: Structure) -> Result<(), SolveError> {
+fn check_entries(a: SparseColMatRef<Index, f64>, structure: Structure) -> Result<(), SolveError> {
     for j in 0..a.ncols() {
         for (&i, &v) in a.row_idx_of_col_raw(j).iter().zip(a.val_of_col(j)) {
             if !v.is_finite() {
@@ -732,7 +734,7 @@ fn check_entries(a: SparseColMatRef<usize, f64>, structure: Structure) -> Result
                     "non-finite value {v} at ({i}, {j})"
                 )));
             }
-            if structure == Structure::Symmetric && i < j {
+            if structure == Structure::Symmetric && (i as usize) < j {
                 let msg =
                     "Symmetric structure reads the lower triangle, but an upper entry was given";
                 return Err(SolveError::InvalidInput(msg.into()));
@@ -748,7 +750,7 @@ fn csc_from_triplets(
     n: usize,
     triplets: &[(usize, usize, f64)],
     structure: Structure,
-) -> Result<SparseColMat<usize, f64>, SolveError> {
+) -> Result<SparseColMat<Index, f64>, SolveError> {
     if let Some(&(r, c, v)) = triplets.iter().find(|t| !t.2.is_finite()) {
         return Err(SolveError::InvalidInput(format!(
             "non-finite value {v} at ({r}, {c})"
@@ -761,21 +763,27 @@ fn csc_from_triplets(
         let msg = "Symmetric structure reads the lower triangle, but only upper entries were given";
         return Err(SolveError::InvalidInput(msg.into()));
     }
-    let entries: Vec<Triplet<usize, usize, f64>> = triplets
+    if n > Index::MAX as usize {
+        return Err(SolveError::InvalidInput(format!(
+            "{n} unknowns, more than 32-bit indices number"
+        )));
+    }
+    let entries: Vec<Triplet<Index, Index, f64>> = triplets
         .iter()
         .filter(|t| structure == Structure::General || t.0 >= t.1)
-        .map(|&(r, c, v)| Triplet::new(r, c, v))
+        .map(|&(r, c, v)| Triplet::new(r as Index, c as Index, v))
         .collect();
     SparseColMat::try_new_from_triplets(n, n, &entries).map_err(creation_error)
 }
 
 /// Full symmetric matrix from its lower triangle (for the LU fallback).
 fn mirror_lower(
-    lower: SparseColMatRef<usize, f64>,
-) -> Result<SparseColMat<usize, f64>, SolveError> {
+    lower: SparseColMatRef<Index, f64>,
+) -> Result<SparseColMat<Index, f64>, SolveError> {
     let mut entries = Vec::with_capacity(2 * lower.compute_nnz());
     for j in 0..lower.ncols() {
         for (&i, &v) in lower.row_idx_of_col_raw(j).iter().zip(lower.val_of_col(j)) {
+            let j = j as Index;
             entries.push(Triplet::new(i, j, v));
             if i != j {
                 entries.push(Triplet::new(j, i, v));

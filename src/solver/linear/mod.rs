@@ -1,6 +1,12 @@
 //! Linear solvers of the implicit Newton step: sparse direct (faer) and Krylov
 //! (GMRES, CG) with their preconditioners.
 
+/// The index type of the sparse matrices (tangent patterns, factors, coarse
+/// operators): 32 bits, half the memory of `usize` row indices. A pattern or
+/// factor beyond 2³² entries (32 GiB of values alone) is refused with an
+/// error.
+pub type Index = u32;
+
 pub mod cg;
 pub mod direct;
 pub mod gmres;

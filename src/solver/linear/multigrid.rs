@@ -51,6 +51,7 @@ use super::direct::{DirectSolver, Ordering, Structure};
 use super::iterative::Preconditioner;
 use super::ordering::NodeGraph;
 use super::preconditioner::BlockJacobi;
+use super::Index;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -81,9 +82,9 @@ pub struct Csr {
 impl Csr {
     /// The matrix of a compressed-column one (every entry stored): its
     /// transpose's pattern, read as rows, is its own.
-    pub fn from_csc(a: SparseColMatRef<usize, f64>) -> Csr {
+    pub fn from_csc(a: SparseColMatRef<Index, f64>) -> Csr {
         let (n, m) = (a.nrows(), a.ncols());
-        let t = Transposed::of(a.col_ptr(), |k| a.row_idx()[k], n);
+        let t = Transposed::of(a.col_ptr(), |k| a.row_idx()[k] as usize, n);
         Csr {
             rows: n,
             cols: m,
@@ -140,24 +141,24 @@ impl Csr {
     /// The lower triangle (or the whole matrix) in compressed columns, for the
     /// direct solver. For a symmetric matrix the lower triangle's columns are
     /// the upper triangle's rows.
-    fn to_csc(&self, symmetric: bool) -> (SymbolicSparseColMat<usize>, Vec<f64>) {
+    fn to_csc(&self, symmetric: bool) -> (SymbolicSparseColMat<Index>, Vec<f64>) {
         let t = if symmetric {
             self.clone()
         } else {
             self.transpose()
         };
         // Rows of t are the columns of the matrix; keep rows ≥ column if symmetric.
-        let mut col_ptr = vec![0usize];
-        let (mut rows, mut vals) = (Vec::new(), Vec::new());
+        let mut col_ptr: Vec<Index> = vec![0];
+        let (mut rows, mut vals): (Vec<Index>, Vec<f64>) = (Vec::new(), Vec::new());
         for j in 0..t.rows {
             let (c, v) = t.row(j);
             for (&i, &a) in c.iter().zip(v) {
                 if !symmetric || i as usize >= j {
-                    rows.push(i as usize);
+                    rows.push(i);
                     vals.push(a);
                 }
             }
-            col_ptr.push(rows.len());
+            col_ptr.push(rows.len() as Index);
         }
         let n = self.rows;
         (
@@ -203,12 +204,13 @@ impl Transposed {
     /// filled in line order, so each row's columns come out ascending.
     /// (Sequential: a parallel version by chunks of rows measured slower on two
     /// cores, the pass being bound by memory.)
-    fn of(ptr: &[usize], index: impl Fn(usize) -> usize, n: usize) -> Transposed {
+    fn of<I: faer::Index>(ptr: &[I], index: impl Fn(usize) -> usize, n: usize) -> Transposed {
         let lines = ptr.len() - 1;
+        let ptr = |j: usize| ptr[j].zx();
         // Within the memory limit of any scene (48 GB of entries).
-        assert!(ptr[lines] <= u32::MAX as usize, "positions beyond 32 bits");
+        assert!(ptr(lines) <= u32::MAX as usize, "positions beyond 32 bits");
         let mut row_ptr = vec![0usize; n + 1];
-        for k in 0..ptr[lines] {
+        for k in 0..ptr(lines) {
             row_ptr[index(k) + 1] += 1;
         }
         for i in 0..n {
@@ -218,7 +220,7 @@ impl Transposed {
         let len = row_ptr[n];
         let (mut col, mut pos) = (vec![0u32; len], vec![0u32; len]);
         for j in 0..lines {
-            for k in ptr[j]..ptr[j + 1] {
+            for k in ptr(j)..ptr(j + 1) {
                 let at = &mut next[index(k)];
                 col[*at] = j as u32;
                 pos[*at] = k as u32;
@@ -238,7 +240,7 @@ impl Transposed {
 /// reading less memory than the whole matrix.
 #[derive(Debug)]
 pub struct LowerSymmetric {
-    pattern: Arc<SymbolicSparseColMat<usize>>,
+    pattern: Arc<SymbolicSparseColMat<Index>>,
     values: Vec<f64>,
 }
 
@@ -251,11 +253,17 @@ impl LowerSymmetric {
         self.pattern.nrows()
     }
 
+    /// The positions of column j's entries.
+    fn column(&self, j: usize) -> std::ops::Range<usize> {
+        let col_ptr = self.pattern.col_ptr();
+        col_ptr[j] as usize..col_ptr[j + 1] as usize
+    }
+
     /// Both triangles' stored entries.
     fn nnz(&self) -> usize {
-        let (col_ptr, rows) = (self.pattern.col_ptr(), self.pattern.row_idx());
+        let rows = self.pattern.row_idx();
         let diagonal = (0..self.rows())
-            .filter(|&j| col_ptr[j] < col_ptr[j + 1] && rows[col_ptr[j]] == j)
+            .filter(|&j| self.column(j).next().is_some_and(|k| rows[k] as usize == j))
             .count();
         2 * self.values.len() - diagonal
     }
@@ -267,8 +275,7 @@ impl LowerSymmetric {
     /// adds the buffers that reach it, chunk by chunk. Fixed chunks and orders:
     /// the same bits on any number of threads.
     fn apply(&self, x: &[f64], y: &mut [f64]) {
-        let (col_ptr, rows, values) =
-            (self.pattern.col_ptr(), self.pattern.row_idx(), &self.values);
+        let (rows, values) = (self.pattern.row_idx(), &self.values);
         let scattered: Vec<(usize, Vec<f64>)> = y
             .par_chunks_mut(COLUMNS_PER_TASK)
             .enumerate()
@@ -276,13 +283,13 @@ impl LowerSymmetric {
                 let lo = c * COLUMNS_PER_TASK;
                 let hi = lo + y.len();
                 let reach = (lo..hi)
-                    .filter_map(|j| rows[col_ptr[j]..col_ptr[j + 1]].last())
-                    .fold(lo, |m, &r| m.max(r + 1));
+                    .filter_map(|j| rows[self.column(j)].last())
+                    .fold(lo, |m, &r| m.max(r as usize + 1));
                 let mut buffer = vec![0.0; reach - lo];
                 for (j, yj) in (lo..hi).zip(y.iter_mut()) {
                     let mut sum = 0.0;
-                    for k in col_ptr[j]..col_ptr[j + 1] {
-                        let (i, a) = (rows[k], values[k]);
+                    for k in self.column(j) {
+                        let (i, a) = (rows[k] as usize, values[k]);
                         sum += a * x[i];
                         if i > j {
                             buffer[i - lo] += a * x[j];
@@ -316,10 +323,10 @@ impl LowerSymmetric {
     /// The diagonal block over the unknowns `block` (row-major values), each
     /// entry (i, j) from column min(i, j) of the triangle: no mirror needed.
     fn block_values(&self, block: &[usize]) -> Vec<f64> {
-        let (col_ptr, rows) = (self.pattern.col_ptr(), self.pattern.row_idx());
+        let rows = self.pattern.row_idx();
         let entry = |i: usize, j: usize| {
-            let (r, c) = (i.max(j), i.min(j));
-            let column = col_ptr[c]..col_ptr[c + 1];
+            let (r, c) = (i.max(j) as Index, i.min(j));
+            let column = self.column(c);
             (rows[column.clone()].binary_search(&r)).map_or(0.0, |k| self.values[column.start + k])
         };
         (block.iter())
@@ -380,11 +387,7 @@ impl Rows for LowerRows<'_> {
     }
 
     fn for_each_in_row(&self, i: usize, mut f: impl FnMut(u32, f64)) {
-        let (col_ptr, rows, values) = (
-            self.a.pattern.col_ptr(),
-            self.a.pattern.row_idx(),
-            &self.a.values,
-        );
+        let (rows, values) = (self.a.pattern.row_idx(), &self.a.values);
         let first = self.graph.first;
         let node = first.partition_point(|&u| u <= i) - 1;
         for &b in self.graph.neighbours(node) {
@@ -393,15 +396,15 @@ impl Rows for LowerRows<'_> {
                 break;
             }
             for j in first[b]..first[b + 1].min(i) {
-                let column = col_ptr[j]..col_ptr[j + 1];
-                if let Ok(k) = rows[column.clone()].binary_search(&i) {
+                let column = self.a.column(j);
+                if let Ok(k) = rows[column.clone()].binary_search(&(i as Index)) {
                     f(j as u32, values[column.start + k]);
                 }
             }
         }
-        let down = col_ptr[i]..col_ptr[i + 1];
+        let down = self.a.column(i);
         for (&r, &a) in rows[down.clone()].iter().zip(&values[down]) {
-            f(r as u32, a);
+            f(r, a);
         }
     }
 }
@@ -413,7 +416,7 @@ impl Rows for LowerRows<'_> {
 #[derive(Debug)]
 pub enum Fine<'g> {
     Rows(Csr),
-    Lower(Arc<SymbolicSparseColMat<usize>>, Vec<f64>, NodeGraph<'g>),
+    Lower(Arc<SymbolicSparseColMat<Index>>, Vec<f64>, NodeGraph<'g>),
 }
 
 impl From<Csr> for Fine<'_> {
@@ -472,7 +475,7 @@ impl Operator {
     }
 
     /// The lower triangle (or the whole matrix) in compressed columns.
-    fn to_csc(&self, symmetric: bool) -> (SymbolicSparseColMat<usize>, Vec<f64>) {
+    fn to_csc(&self, symmetric: bool) -> (SymbolicSparseColMat<Index>, Vec<f64>) {
         match self {
             Operator::Rows(a) => a.to_csc(symmetric),
             Operator::Lower(a) => ((*a.pattern).clone(), a.values.clone()),
@@ -689,7 +692,9 @@ impl Multigrid {
         if shift > 0.0 {
             let (col_ptr, rows) = (pattern.col_ptr(), pattern.row_idx());
             let diagonal: Vec<usize> = (0..a.rows())
-                .filter_map(|j| (col_ptr[j]..col_ptr[j + 1]).find(|&k| rows[k] == j))
+                .filter_map(|j| {
+                    (col_ptr[j] as usize..col_ptr[j + 1] as usize).find(|&k| rows[k] as usize == j)
+                })
                 .collect();
             let mean = diagonal.iter().map(|&k| values[k].abs()).sum::<f64>() / a.rows() as f64;
             for k in diagonal {
@@ -896,9 +901,9 @@ mod tests {
         // P's arrays read as compressed columns are Pᵀ; entry by entry
         // against P itself.
         let p = interpolation(23, false);
-        let rows: Vec<usize> = p.col.iter().map(|&c| c as usize).collect();
+        let col_ptr: Vec<Index> = p.row_ptr.iter().map(|&k| k as Index).collect();
         let pattern =
-            SymbolicSparseColMat::new_checked(p.cols, p.rows, p.row_ptr.clone(), None, rows);
+            SymbolicSparseColMat::new_checked(p.cols, p.rows, col_ptr, None, p.col.clone());
         let t = Csr::from_csc(SparseColMatRef::new(pattern.as_ref(), &p.val));
         assert_eq!((t.rows, t.cols), (p.cols, p.rows));
         for i in 0..p.rows {
@@ -954,7 +959,7 @@ mod tests {
     /// columns with the node graph, and the whole matrix in compressed rows
     /// built directly from the same rule (the reference).
     struct Nodal {
-        pattern: Arc<SymbolicSparseColMat<usize>>,
+        pattern: Arc<SymbolicSparseColMat<Index>>,
         vals: Vec<f64>,
         whole: Csr,
         start: Vec<usize>,
@@ -974,13 +979,13 @@ mod tests {
                     false => -1.0 / (1 + i + j) as f64,
                 })
             };
-            let (mut col_ptr, mut rows, mut vals) = (vec![0usize], Vec::new(), Vec::new());
+            let (mut col_ptr, mut rows, mut vals) = (vec![0 as Index], Vec::new(), Vec::new());
             for j in 0..n {
                 for (i, v) in (j..n).filter_map(|i| entry(i, j).map(|v| (i, v))) {
-                    rows.push(i);
+                    rows.push(i as Index);
                     vals.push(v);
                 }
-                col_ptr.push(rows.len());
+                col_ptr.push(rows.len() as Index);
             }
             let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows);
             let mut whole = Csr {

@@ -24,6 +24,7 @@ use crate::physics::transfer::NodeMap;
 use crate::scene::DirectOrdering;
 use crate::solver::linear::direct::spmv;
 use crate::solver::linear::ordering::{node_amd, node_metis, NodeGraph};
+use crate::solver::linear::Index;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use rayon::prelude::*;
 use std::sync::{Arc, OnceLock};
@@ -62,8 +63,8 @@ pub struct Pattern {
     /// Per node: the nodes it couples to (masters for tied nodes), ascending.
     neighbour_start: Vec<usize>,
     neighbours: Vec<u32>,
-    lower: OnceLock<Arc<SymbolicSparseColMat<usize>>>,
-    full: OnceLock<Arc<SymbolicSparseColMat<usize>>>,
+    lower: OnceLock<Arc<SymbolicSparseColMat<Index>>>,
+    full: OnceLock<Arc<SymbolicSparseColMat<Index>>>,
     amd: OnceLock<Vec<usize>>,
     metis: OnceLock<Vec<usize>>,
     /// What the pattern was built from, to tell whether a later step's fits.
@@ -291,13 +292,18 @@ impl Pattern {
 
     /// The compressed-column pattern of the unknowns (built at the first call),
     /// shared: the direct solver keeps a handle to the pattern it analysed
-    /// instead of a copy.
-    pub fn csc(&self, storage: Storage) -> &Arc<SymbolicSparseColMat<usize>> {
+    /// instead of a copy. An error if it has more entries than [`Index`]
+    /// numbers.
+    pub fn csc(&self, storage: Storage) -> Result<&Arc<SymbolicSparseColMat<Index>>, String> {
         let cell = match storage {
             Storage::Lower => &self.lower,
             Storage::Full => &self.full,
         };
-        cell.get_or_init(|| Arc::new(self.build_csc(storage)))
+        if let Some(csc) = cell.get() {
+            return Ok(csc);
+        }
+        let csc = self.build_csc(storage)?;
+        Ok(cell.get_or_init(|| Arc::new(csc)))
     }
 
     /// Rows of column c of node b: the unknowns of b's neighbours (all
@@ -306,7 +312,7 @@ impl Pattern {
     /// a are `first[a]..first[a + 1]`. Counted, then filled, in parallel over
     /// the nodes (each node writes its own columns: the same result on any
     /// number of threads).
-    fn build_csc(&self, storage: Storage) -> SymbolicSparseColMat<usize> {
+    fn build_csc(&self, storage: Storage) -> Result<SymbolicSparseColMat<Index>, String> {
         let n = self.first[self.nodes()];
         let lowest = |c: usize| if storage == Storage::Lower { c } else { 0 };
         let rows_of = |a: u32, c: usize| {
@@ -324,12 +330,19 @@ impl Pattern {
                 })
             })
             .collect();
-        let mut col_ptr = Vec::with_capacity(n + 1);
+        let total: usize = lengths.iter().sum();
+        if total > Index::MAX as usize {
+            return Err(format!(
+                "the tangent's pattern has {total} entries, more than the 2³² that 32-bit \
+                 indices number"
+            ));
+        }
+        let mut col_ptr: Vec<Index> = Vec::with_capacity(n + 1);
         col_ptr.push(0);
         for len in lengths {
-            col_ptr.push(col_ptr.last().unwrap() + len);
+            col_ptr.push(col_ptr.last().unwrap() + len as Index);
         }
-        let mut rows = vec![0usize; col_ptr[n]];
+        let mut rows: Vec<Index> = vec![0; total];
         self.per_node(&col_ptr, &mut rows)
             .into_par_iter()
             .enumerate()
@@ -339,7 +352,7 @@ impl Pattern {
                 for c in self.columns(b) {
                     for &a in self.neighbours(b) {
                         for r in rows_of(a, c) {
-                            out[at] = r;
+                            out[at] = r as Index;
                             at += 1;
                         }
                     }
@@ -347,16 +360,17 @@ impl Pattern {
             });
         // Rows ascending within each column: neighbours ascending and unknowns
         // numbered node by node.
-        SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows)
+        Ok(SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows))
     }
 
     /// `entries` (a compressed-column array with `col_ptr`) split into the
     /// columns of each node: disjoint slices, in node order.
-    fn per_node<'v, T>(&self, col_ptr: &[usize], mut entries: &'v mut [T]) -> Vec<&'v mut [T]> {
+    fn per_node<'v, T>(&self, col_ptr: &[Index], mut entries: &'v mut [T]) -> Vec<&'v mut [T]> {
         let mut out = Vec::with_capacity(self.nodes());
         for b in 0..self.nodes() {
             let cols = self.columns(b);
-            let (head, tail) = entries.split_at_mut(col_ptr[cols.end] - col_ptr[cols.start]);
+            let len = col_ptr[cols.end] - col_ptr[cols.start];
+            let (head, tail) = entries.split_at_mut(len as usize);
             out.push(head);
             entries = tail;
         }
@@ -376,7 +390,7 @@ impl Pattern {
     pub fn add_stencil_terms<const D: usize>(
         &self,
         values: &mut [f64],
-        csc: &SymbolicSparseColMat<usize>,
+        csc: &SymbolicSparseColMat<Index>,
         storage: Storage,
         map: &NodeMap,
         st: &Stencils<D>,
@@ -417,7 +431,7 @@ impl Pattern {
     pub fn add_listed_terms<const D: usize>(
         &self,
         values: &mut [f64],
-        csc: &SymbolicSparseColMat<usize>,
+        csc: &SymbolicSparseColMat<Index>,
         storage: Storage,
         map: &NodeMap,
         st: &Stencils<D>,
@@ -435,7 +449,7 @@ impl Pattern {
                 if cols.is_empty() {
                     return;
                 }
-                let base = col_ptr[cols.start];
+                let base = col_ptr[cols.start] as usize;
                 let col_of: [Option<usize>; D] = std::array::from_fn(|k| dofs.of(b, k, D));
                 for (e2, cc) in sources(self.tied_sources.as_ref(), map, b) {
                     out.clear();
@@ -465,7 +479,7 @@ impl Pattern {
         &self,
         b: usize,
         vals: &mut [f64],
-        col_ptr: &[usize],
+        col_ptr: &[Index],
         storage: Storage,
         map: &NodeMap,
         st: &Stencils<D>,
@@ -480,7 +494,7 @@ impl Pattern {
         if cols.is_empty() {
             return;
         }
-        let base = col_ptr[cols.start];
+        let base = col_ptr[cols.start] as usize;
         let neighbours = self.neighbours(b);
         let m = neighbours.len();
         // Rows of column c: the unknowns first[a]..first[a + 1] of each
@@ -493,13 +507,13 @@ impl Pattern {
         for k in 0..D {
             let Some(c) = dofs.of(b, k, D) else { continue };
             col_of[k] = c;
-            let mut at = col_ptr[c] - base;
+            let mut at = col_ptr[c] as usize - base;
             for (j, &a) in neighbours.iter().enumerate() {
                 offsets[k * m + j] = at;
                 let (lo, hi) = (self.first[a as usize], self.first[a as usize + 1]);
                 at += hi.saturating_sub(lo.max(lowest(c)));
             }
-            debug_assert_eq!(at, col_ptr[c + 1] - base);
+            debug_assert_eq!(at, col_ptr[c + 1] as usize - base);
         }
         for (e2, cc) in sources(self.tied_sources.as_ref(), map, b) {
             let e2 = e2 as usize;
@@ -567,10 +581,10 @@ fn position(sorted: &[u32], a: u32, from: usize) -> Option<usize> {
 }
 
 /// Position of row r in column c of `csc`, if the pattern has it.
-pub fn slot(csc: &SymbolicSparseColMat<usize>, r: usize, c: usize) -> Option<usize> {
-    let (start, end) = (csc.col_ptr()[c], csc.col_ptr()[c + 1]);
+pub fn slot(csc: &SymbolicSparseColMat<Index>, r: usize, c: usize) -> Option<usize> {
+    let (start, end) = (csc.col_ptr()[c] as usize, csc.col_ptr()[c + 1] as usize);
     csc.row_idx()[start..end]
-        .binary_search(&r)
+        .binary_search(&(r as Index))
         .ok()
         .map(|s| start + s)
 }
@@ -734,14 +748,14 @@ fn with_pairs(
 
 /// The assembled tangent of one Newton iterate: values in the step's pattern.
 pub struct Tangent<'a> {
-    pub pattern: &'a SymbolicSparseColMat<usize>,
+    pub pattern: &'a SymbolicSparseColMat<Index>,
     pub values: Vec<f64>,
     /// `Lower` when the tangent is symmetric (only rows ≥ column stored).
     pub storage: Storage,
 }
 
 impl Tangent<'_> {
-    pub fn matrix(&self) -> SparseColMatRef<'_, usize, f64> {
+    pub fn matrix(&self) -> SparseColMatRef<'_, Index, f64> {
         SparseColMatRef::new(self.pattern.as_ref(), &self.values)
     }
 
