@@ -138,6 +138,38 @@ impl Csr {
         out
     }
 
+    /// The symmetric matrix of this one's upper triangle, kept as its lower
+    /// triangle in compressed columns ([`LowerSymmetric`]): the entries j ≥ i
+    /// of row i are the rows ≥ i of column i. Compacted in place and shrunk:
+    /// half the entries. (The two triangles of a Galerkin operator of a
+    /// symmetric matrix differ by round-off; the upper one is kept, as `to_csc`
+    /// keeps it for the coarse factorization.)
+    fn into_lower_symmetric(mut self) -> LowerSymmetric {
+        let n = self.rows;
+        assert_eq!(n, self.cols, "a symmetric matrix is square");
+        let mut col_ptr: Vec<Index> = Vec::with_capacity(n + 1);
+        col_ptr.push(0);
+        let mut at = 0;
+        for i in 0..n {
+            for k in self.row_ptr[i]..self.row_ptr[i + 1] {
+                if self.col[k] as usize >= i {
+                    (self.col[at], self.val[at]) = (self.col[k], self.val[k]);
+                    at += 1;
+                }
+            }
+            col_ptr.push(at as Index);
+        }
+        self.col.truncate(at);
+        self.col.shrink_to_fit();
+        self.val.truncate(at);
+        self.val.shrink_to_fit();
+        let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, self.col);
+        LowerSymmetric {
+            pattern: Arc::new(pattern),
+            values: self.val,
+        }
+    }
+
     /// The lower triangle (or the whole matrix) in compressed columns, for the
     /// direct solver. For a symmetric matrix the lower triangle's columns are
     /// the upper triangle's rows.
@@ -474,6 +506,14 @@ impl Operator {
         }
     }
 
+    /// A symmetric operator in compressed rows kept as its lower triangle
+    /// ([`Csr::into_lower_symmetric`]).
+    fn keep_lower_triangle(&mut self) {
+        if let Operator::Rows(a) = self {
+            *self = Operator::Lower(std::mem::take(a).into_lower_symmetric());
+        }
+    }
+
     /// The lower triangle (or the whole matrix) in compressed columns.
     fn to_csc(&self, symmetric: bool) -> (SymbolicSparseColMat<Index>, Vec<f64>) {
         match self {
@@ -631,6 +671,15 @@ impl Multigrid {
         for (t, r) in self.transfers.iter().zip(&self.restrictions) {
             let coarse = (operators.last().unwrap()).galerkin(r, &t.prolongation, graph.take())?;
             operators.push(Operator::Rows(coarse));
+            // A symmetric coarse level is read by rows no more once the next
+            // one is formed: it keeps its lower triangle only.
+            let used = operators.len() - 2;
+            if symmetric && used > 0 {
+                operators[used].keep_lower_triangle();
+            }
+        }
+        if symmetric && operators.len() > 1 {
+            operators.last_mut().unwrap().keep_lower_triangle();
         }
         let mut used = self.transfers.len();
         let shift = loop {
@@ -1119,6 +1168,51 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn a_symmetric_coarse_level_keeps_its_lower_triangle() {
+        // A Galerkin operator of the ragged symmetric matrix (a coarse level),
+        // kept as its lower triangle: half the stored entries, the same
+        // products (to the order of the sums), blocks and coarse
+        // factorization input.
+        let m = ragged(2 * COLUMNS_PER_TASK + 77);
+        let p = interpolation(m.whole.rows, false);
+        let coarse = galerkin(&p.transpose(), &m.whole, &p);
+        let n = coarse.rows;
+        let mut lower = Operator::Rows(coarse.clone());
+        lower.keep_lower_triangle();
+        let Operator::Lower(l) = &lower else {
+            panic!("kept as a lower triangle")
+        };
+        let diagonal = (0..n)
+            .filter(|&i| coarse.row(i).0.contains(&(i as u32)))
+            .count();
+        assert_eq!(l.values.len(), (coarse.nnz() + diagonal) / 2);
+        assert_eq!(lower.nnz(), coarse.nnz());
+        let x: Vec<f64> = (0..n).map(|i| 1.0 + (i as f64 * 0.37).sin()).collect();
+        let (mut y, mut expected) = (vec![0.0; n], vec![0.0; n]);
+        lower.apply(&x, &mut y);
+        coarse.apply(&x, &mut expected);
+        let scale = expected.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for (a, b) in y.iter().zip(&expected) {
+            assert!((a - b).abs() <= 1e-13 * scale, "{a} against {b}");
+        }
+        for block in [vec![0, 1], vec![3, 4, 5], vec![n - 1, 9, 1]] {
+            let (a, b) = (lower.block_values(&block), coarse.block_values(&block));
+            // The lower triangle's block is exactly symmetric, from the upper entries.
+            for (i, row) in block.iter().enumerate() {
+                for (j, col) in block.iter().enumerate() {
+                    let upper = &b[block.len() * i.min(j) + j.max(i)];
+                    assert_eq!(a[block.len() * i + j], *upper, "({row}, {col})");
+                }
+            }
+        }
+        let ((pa, va), (pb, vb)) = (lower.to_csc(true), Operator::Rows(coarse).to_csc(true));
+        assert_eq!(
+            (pa.col_ptr(), pa.row_idx(), va),
+            (pb.col_ptr(), pb.row_idx(), vb)
+        );
     }
 
     #[test]
