@@ -370,8 +370,8 @@ impl LowerSymmetric {
 /// The rows of a symmetric matrix stored as its lower triangle, found through
 /// the node graph its pattern was built from (unknowns numbered node by node,
 /// node a coupling all its unknowns to all those of its neighbours): row i of
-/// node a is (i, j) for the unknowns j < i of a's neighbours b ≤ a, each found
-/// in column j by a search, then column i from its diagonal down. These are
+/// node a is (i, j) for the unknowns j < i of a's neighbours b ≤ a, found by
+/// one search in b's first column, then column i from its diagonal down. These are
 /// the entries, values and order of row i of the whole matrix in compressed
 /// rows, so the Galerkin operators are those of that matrix; nothing is stored
 /// (a transposed pattern of the triangle, 8 bytes per entry, was the 2D
@@ -427,11 +427,22 @@ impl Rows for LowerRows<'_> {
             if b > node {
                 break;
             }
-            for j in first[b]..first[b + 1].min(i) {
-                let column = self.a.column(j);
-                if let Ok(k) = rows[column.clone()].binary_search(&(i as Index)) {
-                    f(j as u32, values[column.start + k]);
-                }
+            let (lo, hi) = (first[b], first[b + 1].min(i));
+            if lo == hi {
+                continue;
+            }
+            // Column lo holds b's own unknowns from lo on (if b couples to
+            // itself), then those of b's neighbours after b: row i is found
+            // there once, and sits one entry higher in each next column of b.
+            let column = self.a.column(lo);
+            let Ok(down) = rows[column.clone()].binary_search(&(i as Index)) else {
+                continue;
+            };
+            let own = usize::from(rows[column.start] as usize == lo);
+            for (t, j) in (lo..hi).enumerate() {
+                let k = self.a.column(j).start + down - own * t;
+                debug_assert_eq!(rows[k] as usize, i);
+                f(j as u32, values[k]);
             }
         }
         let down = self.a.column(i);
