@@ -5,7 +5,6 @@
 //! solvers. Values are written in Rust's shortest round-trip form, so they read
 //! back bit for bit.
 
-use crate::solver::linear::Index;
 use faer::sparse::SparseColMatRef;
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -13,9 +12,10 @@ use std::path::Path;
 
 /// Writes `a` in coordinate format: `symmetric` when `a` holds the lower
 /// triangle of a symmetric matrix (Matrix Market's convention), else `general`.
-pub fn write_sparse(
+/// Any index type of faer's.
+pub fn write_sparse<I: faer::Index>(
     path: &Path,
-    a: SparseColMatRef<Index, f64>,
+    a: SparseColMatRef<I, f64>,
     symmetric: bool,
 ) -> std::io::Result<()> {
     let mut f = BufWriter::new(File::create(path)?);
@@ -24,7 +24,7 @@ pub fn write_sparse(
     writeln!(f, "{} {} {}", a.nrows(), a.ncols(), a.compute_nnz())?;
     for c in 0..a.ncols() {
         for (&r, v) in a.row_idx_of_col_raw(c).iter().zip(a.val_of_col(c)) {
-            writeln!(f, "{} {} {v:e}", r + 1, c + 1)?;
+            writeln!(f, "{} {} {v:e}", r.zx() + 1, c + 1)?;
         }
     }
     f.flush()
@@ -53,7 +53,7 @@ mod tests {
             Triplet::new(2, 0, -1.0 / 3.0),
             Triplet::new(1, 1, 1e-300),
         ];
-        let a = SparseColMat::<Index, f64>::try_new_from_triplets(3, 3, &t).unwrap();
+        let a = SparseColMat::<u32, f64>::try_new_from_triplets(3, 3, &t).unwrap();
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("k.mtx");
         write_sparse(&path, a.as_ref(), true).unwrap();
