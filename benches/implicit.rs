@@ -273,7 +273,7 @@ fn bench_problem<const D: usize>(c: &mut Criterion, p: &mut Problem<D>) {
     group.bench_function("tangent_part/particle_tangents", |bch| {
         bch.iter(|| {
             black_box(
-                particle_tangents(m, (&sys.trial, &sys.stencils, &sys.map), false)
+                particle_tangents(m, &sys.trial, &sys.stencils, &sys.map, false)
                     .expect("A")
                     .values
                     .len(),

@@ -45,7 +45,6 @@
 
 use super::assembly::stiffness::{coupling, hoop_coupling, particle_tangents, ParticleTangents};
 use super::assembly::Dofs;
-use super::assembly::Storage;
 use super::coarsening::hierarchy;
 use super::failure::Failure;
 use super::residual::{ordering, residual, step_pattern, tangent};
@@ -371,7 +370,7 @@ impl KrylovState {
     ) -> Result<Built, Failure> {
         let dofs = &sys.dofs;
         let blocks = || -> Result<Vec<SMatrix<f64, D, D>>, Failure> {
-            let a = particle_tangents(m, (&sys.trial, &sys.stencils, &sys.map), true)?;
+            let a = particle_tangents(m, &sys.trial, &sys.stencils, &sys.map, true)?;
             Ok(diagonal_blocks(m, sys, &a))
         };
         Ok(match self.config.preconditioner {
@@ -465,12 +464,7 @@ impl KrylovState {
         // rows); an unsymmetric one is copied into rows, and its columns dropped.
         let symmetric = k.symmetric();
         let a = if symmetric {
-            // The tangent was assembled in this pattern.
-            let pattern = step_pattern(sys)
-                .csc(Storage::Lower)
-                .expect("built by the tangent");
-            debug_assert!(std::ptr::eq(&**pattern, k.pattern));
-            Fine::Lower(Arc::clone(pattern), k.values, step_pattern(sys).graph())
+            Fine::Lower(Arc::clone(k.pattern), k.values, step_pattern(sys).graph())
         } else {
             let rows = Csr::from_csc(k.matrix());
             drop(k);

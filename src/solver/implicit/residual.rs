@@ -116,7 +116,7 @@ pub fn tangent<'s, const D: usize>(
 ) -> Result<Tangent<'s>, Failure> {
     let p = &m.particles;
     let (st, map, dofs) = (&sys.stencils, &sys.map, &sys.dofs);
-    let a = particle_tangents(m, (&sys.trial, &sys.stencils, &sys.map), numerical)?;
+    let a = particle_tangents(m, &sys.trial, &sys.stencils, &sys.map, numerical)?;
     let fbar = sys.trial.fbar.as_ref();
     let pattern = step_pattern(sys);
     // Symmetric unless F-bar or a non-associated material breaks it.

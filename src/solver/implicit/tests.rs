@@ -156,7 +156,7 @@ fn tangent_error_of<const D: usize>(
 fn lower_equals_full_stiffness<const D: usize>(m: &Model<D>, sys: &StepSystem<D>) {
     use super::assembly::stiffness::{add_stiffness, particle_tangents};
     use super::assembly::{Storage, Tangent};
-    let a = particle_tangents(m, (&sys.trial, &sys.stencils, &sys.map), false).unwrap();
+    let a = particle_tangents(m, &sys.trial, &sys.stencils, &sys.map, false).unwrap();
     let pattern = super::residual::step_pattern(sys);
     let assemble = |storage| {
         let csc = pattern.csc(storage).unwrap();

@@ -41,7 +41,9 @@
 //! triangle of the step's pattern ([`LowerSymmetric`]): no copy of both
 //! triangles (at 32³ cells in 3D that copy was 400 MiB beside a 134 MiB
 //! triangle). Its rows are found through the node graph the pattern was built
-//! from ([`LowerRows`]). The coarse levels are matrices in compressed rows.
+//! from ([`LowerRows`]). The coarse levels are formed in compressed rows; once
+//! the Galerkin products are done, symmetric ones keep their lower triangle
+//! ([`Csr::into_lower_symmetric`]).
 //!
 //! Every product is a row-parallel CSR product, or over the lower triangle by
 //! fixed column chunks, and every sum runs in a fixed order, so the result is
@@ -353,7 +355,7 @@ impl LowerSymmetric {
     }
 
     /// The diagonal block over the unknowns `block` (row-major values), each
-    /// entry (i, j) from column min(i, j) of the triangle: no mirror needed.
+    /// entry (i, j) from column min(i, j) of the triangle.
     fn block_values(&self, block: &[usize]) -> Vec<f64> {
         let rows = self.pattern.row_idx();
         let entry = |i: usize, j: usize| {
@@ -682,15 +684,13 @@ impl Multigrid {
         for (t, r) in self.transfers.iter().zip(&self.restrictions) {
             let coarse = (operators.last().unwrap()).galerkin(r, &t.prolongation, graph.take())?;
             operators.push(Operator::Rows(coarse));
-            // A symmetric coarse level is read by rows no more once the next
-            // one is formed: it keeps its lower triangle only.
-            let used = operators.len() - 2;
-            if symmetric && used > 0 {
-                operators[used].keep_lower_triangle();
-            }
         }
-        if symmetric && operators.len() > 1 {
-            operators.last_mut().unwrap().keep_lower_triangle();
+        // Once the products are formed no level is read by rows again: a
+        // symmetric coarse level keeps its lower triangle only.
+        if symmetric {
+            operators[1..]
+                .iter_mut()
+                .for_each(Operator::keep_lower_triangle);
         }
         let mut used = self.transfers.len();
         let shift = loop {

@@ -748,7 +748,8 @@ fn with_pairs(
 
 /// The assembled tangent of one Newton iterate: values in the step's pattern.
 pub struct Tangent<'a> {
-    pub pattern: &'a SymbolicSparseColMat<Index>,
+    /// The step's shared pattern ([`Pattern::csc`]).
+    pub pattern: &'a Arc<SymbolicSparseColMat<Index>>,
     pub values: Vec<f64>,
     /// `Lower` when the tangent is symmetric (only rows ≥ column stored).
     pub storage: Storage,
@@ -756,7 +757,7 @@ pub struct Tangent<'a> {
 
 impl Tangent<'_> {
     pub fn matrix(&self) -> SparseColMatRef<'_, Index, f64> {
-        SparseColMatRef::new(self.pattern.as_ref(), &self.values)
+        SparseColMatRef::new((**self.pattern).as_ref(), &self.values)
     }
 
     pub fn symmetric(&self) -> bool {

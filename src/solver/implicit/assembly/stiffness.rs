@@ -121,7 +121,9 @@ pub fn pk1_derivative<const D: usize>(
 /// only), from central differences of its stress update if it has none.
 pub fn particle_tangents<const D: usize>(
     m: &Model<D>,
-    (trial, st, map): (&Trial<D>, &Stencils<D>, &NodeMap),
+    trial: &Trial<D>,
+    st: &Stencils<D>,
+    map: &NodeMap,
     numerical: bool,
 ) -> Result<ParticleTangents<D>, Failure> {
     let p = &m.particles;
