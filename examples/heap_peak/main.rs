@@ -30,6 +30,10 @@ struct Large {
 }
 static LIVE_LARGE: Mutex<Option<HashMap<usize, Large>>> = Mutex::new(None);
 static AT_PEAK: Mutex<Vec<(usize, String)>> = Mutex::new(Vec::new());
+/// Per phase (the call stack of the latest large allocation): the highest
+/// live heap reached in it.
+static PHASES: Mutex<Option<HashMap<String, usize>>> = Mutex::new(None);
+static PHASE: Mutex<String> = Mutex::new(String::new());
 
 fn stack() -> String {
     let bt = std::backtrace::Backtrace::force_capture().to_string();
@@ -61,11 +65,21 @@ fn on_alloc(ptr: usize, size: usize) {
         inside.set(true);
         if size >= LARGE {
             let s = stack();
+            *PHASE.lock().unwrap() = s.clone();
             LIVE_LARGE
                 .lock()
                 .unwrap()
                 .get_or_insert_with(HashMap::new)
                 .insert(ptr, Large { size, stack: s });
+        }
+        {
+            let phase = PHASE.lock().unwrap().clone();
+            let mut phases = PHASES.lock().unwrap();
+            let top = phases
+                .get_or_insert_with(HashMap::new)
+                .entry(phase)
+                .or_default();
+            *top = (*top).max(live);
         }
         if live > PEAK.load(Ordering::SeqCst) {
             PEAK.store(live, Ordering::SeqCst);
@@ -133,7 +147,8 @@ fn run<const D: usize>(scene: &Scene, step_of_interest: usize) {
             RECORD.store(true, Ordering::SeqCst);
         }
         Moment::Before(step) if step == step_of_interest => {
-            PEAK.store(LIVE.load(Ordering::SeqCst), Ordering::SeqCst)
+            PEAK.store(LIVE.load(Ordering::SeqCst), Ordering::SeqCst);
+            *PHASES.lock().unwrap() = Some(HashMap::new());
         }
         _ => {}
     });
@@ -158,6 +173,21 @@ fn run<const D: usize>(scene: &Scene, step_of_interest: usize) {
     rows.sort_by_key(|r| std::cmp::Reverse(r.1 .0));
     for (s, (size, n)) in rows {
         println!("{:9.1} MiB {n:4}x  {s}", mib(size));
+    }
+    // The highest live heap of each phase (after each large allocation's
+    // call stack), highest first: where the peak would move if the top
+    // phase shrank.
+    let mut phases: Vec<(String, usize)> = PHASES
+        .lock()
+        .unwrap()
+        .take()
+        .unwrap_or_default()
+        .into_iter()
+        .collect();
+    phases.sort_by_key(|p| std::cmp::Reverse(p.1));
+    println!("highest live heap per phase (after the large allocation of):");
+    for (s, top) in phases.iter().take(12) {
+        println!("{:9.1} MiB  {s}", mib(top - model_bytes));
     }
 }
 

@@ -54,11 +54,11 @@ pub struct Pattern {
     /// Unknowns of nodes 0..b: the columns of node b are `first[b]..first[b + 1]`
     /// (unknowns are numbered node by node).
     first: Vec<usize>,
-    /// Per node, when some node is tied: the stencil entries it takes terms
-    /// from (its own; for a master, also those of the nodes tied to it) with
-    /// the coefficient of the tie (1 for its own), in increasing entry order.
-    /// Without ties a node's sources are its own entries of the node map, with
-    /// coefficient 1, and nothing is stored (see `sources`).
+    /// When some node is tied: the stencil entries each master takes terms
+    /// from (its own and those of the nodes tied to it, with the coefficients
+    /// of the ties), and which nodes are masters or tied. Other nodes take
+    /// their own entries of the node map with coefficient 1, and nothing is
+    /// stored for them (see `sources`).
     tied_sources: Option<TiedSources>,
     /// Per node: the nodes it couples to (masters for tied nodes), ascending.
     neighbour_start: Vec<usize>,
@@ -71,12 +71,22 @@ pub struct Pattern {
     built_for: BuiltFor,
 }
 
-/// The sources of every node when some node is tied: those of node b are
-/// `list[start[b]..start[b + 1]]`.
+/// The sources of the nodes that ties touch: `of[b]` is `OWN` for a node
+/// that takes only its own entries (coefficient 1), `TIED` for a tied node
+/// (it takes none: its masters take its entries), else the number m of its
+/// merged list `list[start[m]..start[m + 1]]` (a master). Only the masters'
+/// lists are stored: a copy of every node's entries was the largest array of
+/// a 2D step with ties (108 MiB at 10⁶ particles).
 #[derive(Clone, Debug, Default)]
 struct TiedSources {
+    of: Vec<u32>,
     start: Vec<usize>,
     list: Vec<(u32, f64)>,
+}
+
+impl TiedSources {
+    const OWN: u32 = u32::MAX;
+    const TIED: u32 = u32::MAX - 1;
 }
 
 /// The stencil entries a node takes terms from, with their coefficients.
@@ -107,7 +117,8 @@ struct BuiltFor {
     neighbours: Option<(Vec<usize>, Vec<u32>)>,
     /// Node pairs coupled beyond the stencils (contact).
     coupled: Vec<(u32, u32)>,
-    dofs: Dofs,
+    /// A digest of the unknowns' numbering and ties ([`dofs_digest`]).
+    dofs: [u64; 2],
 }
 
 impl BuiltFor {
@@ -123,7 +134,7 @@ impl BuiltFor {
             cell_of: cells.map(|c| c.of.clone()),
             neighbours: fit.map(|f| (f.lists().0.to_vec(), f.lists().1.to_vec())),
             coupled: coupled.to_vec(),
-            dofs: dofs.clone(),
+            dofs: dofs_digest(dofs),
         }
     }
 
@@ -143,8 +154,25 @@ impl BuiltFor {
                 .as_ref()
                 .map(|(o, n)| (o.as_slice(), n.as_slice()))
                 == fit.map(|f| f.lists())
-            && self.dofs == *dofs
+            && self.dofs == dofs_digest(dofs)
     }
+}
+
+/// A 128-bit digest of the unknowns `dofs`: their numbering and the ties
+/// (masters and the bits of the coefficients), as [`stencil_digest`] makes it;
+/// a copy took 40 bytes per active node once some node was tied.
+fn dofs_digest(dofs: &Dofs) -> [u64; 2] {
+    use std::hash::{DefaultHasher, Hash, Hasher};
+    let sum = |prefix: u8| {
+        let mut h = DefaultHasher::new();
+        (prefix, &dofs.index, dofs.free, dofs.ties.len()).hash(&mut h);
+        for tie in &dofs.ties {
+            tie.map(|t| (t.master, t.coef.map(f64::to_bits)))
+                .hash(&mut h);
+        }
+        h.finish()
+    };
+    [sum(0), sum(1)]
 }
 
 /// A 128-bit digest of the stencils' node lists: two SipHash-1-3 sums
@@ -589,46 +617,50 @@ pub fn slot(csc: &SymbolicSparseColMat<Index>, r: usize, c: usize) -> Option<usi
         .map(|s| start + s)
 }
 
-/// Per node, the stencil entries it takes terms from: its own (coefficient 1)
-/// and, for a master, those of the nodes tied to it (the tie's coefficient),
-/// each list in increasing entry order.
+/// Per master of a tie, the stencil entries it takes terms from: its own
+/// (coefficient 1) and those of the nodes tied to it (the tie's coefficient),
+/// in increasing entry order; which nodes are tied.
 fn tied_sources(map: &NodeMap, dofs: &Dofs) -> TiedSources {
     let n = map.len();
-    // Entries of node a in increasing order: its own list from the node map,
-    // merged with those of the nodes tied to it.
     let mut tied_to: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
+    let mut of = vec![TiedSources::OWN; n];
     for (t, tie) in dofs.ties.iter().enumerate() {
         if let Some(tie) = tie {
+            of[t] = TiedSources::TIED;
             for (m, c) in tie.master.iter().zip(tie.coef) {
                 tied_to[*m].push((t, c));
             }
         }
     }
-    let mut start = Vec::with_capacity(n + 1);
+    let mut start = vec![0];
     let mut list: Vec<(u32, f64)> = Vec::new();
-    start.push(0);
     for (a, tied) in tied_to.iter().enumerate() {
+        if tied.is_empty() {
+            continue;
+        }
         let from = list.len();
-        if dofs.ties.get(a).is_none_or(|t| t.is_none()) {
+        if of[a] == TiedSources::OWN {
             list.extend(map.node_entries(a).iter().map(|&e| (e, 1.0)));
         }
         for &(t, c) in tied {
             list.extend(map.node_entries(t).iter().map(|&e| (e, c)));
         }
-        if !tied.is_empty() {
-            list[from..].sort_by_key(|&(e, _)| e);
-        }
+        list[from..].sort_by_key(|&(e, _)| e);
+        of[a] = (start.len() - 1) as u32;
         start.push(list.len());
     }
-    TiedSources { start, list }
+    TiedSources { of, start, list }
 }
 
-/// The sources of node b: the stored ones when some node is tied, else its
-/// own entries of the node map with coefficient 1.
+/// The sources of node b: its own entries of the node map with coefficient
+/// 1, unless ties touch it (`TiedSources`).
 fn sources<'a>(tied: Option<&'a TiedSources>, map: &'a NodeMap, b: usize) -> Sources<'a> {
-    match tied {
-        Some(t) => Sources::Tied(t.list[t.start[b]..t.start[b + 1]].iter()),
-        None => Sources::Own(map.node_entries(b).iter()),
+    let own = Sources::Own(map.node_entries(b).iter());
+    let Some(t) = tied else { return own };
+    match t.of[b] {
+        TiedSources::OWN => own,
+        TiedSources::TIED => Sources::Tied([].iter()),
+        m => Sources::Tied(t.list[t.start[m as usize]..t.start[m as usize + 1]].iter()),
     }
 }
 
