@@ -32,8 +32,38 @@ static LIVE_LARGE: Mutex<Option<HashMap<usize, Large>>> = Mutex::new(None);
 static AT_PEAK: Mutex<Vec<(usize, String)>> = Mutex::new(Vec::new());
 /// Per phase (the call stack of the latest large allocation): the highest
 /// live heap reached in it.
-static PHASES: Mutex<Option<HashMap<String, usize>>> = Mutex::new(None);
+#[allow(clippy::type_complexity)]
+static PHASES: Mutex<Option<HashMap<String, (usize, Vec<(usize, String)>)>>> = Mutex::new(None);
 static PHASE: Mutex<String> = Mutex::new(String::new());
+/// Per phase: the highest resident memory read at its large allocations and
+/// frees (/proc/self/statm, pages), with HEAP_PEAK_PHASES set.
+static RSS_PHASES: Mutex<Option<HashMap<String, usize>>> = Mutex::new(None);
+
+/// Resident pages now, read without allocating.
+fn resident_pages() -> usize {
+    use std::io::Read;
+    let mut buf = [0u8; 128];
+    let Ok(mut f) = std::fs::File::open("/proc/self/statm") else {
+        return 0;
+    };
+    let n = f.read(&mut buf).unwrap_or(0);
+    let text = std::str::from_utf8(&buf[..n]).unwrap_or("");
+    text.split_whitespace()
+        .nth(1)
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(0)
+}
+
+fn note_rss() {
+    if std::env::var_os("HEAP_PEAK_PHASES").is_none() {
+        return;
+    }
+    let phase = PHASE.lock().unwrap().clone();
+    let pages = resident_pages();
+    let mut m = RSS_PHASES.lock().unwrap();
+    let top = m.get_or_insert_with(HashMap::new).entry(phase).or_default();
+    *top = (*top).max(pages);
+}
 
 fn stack() -> String {
     let bt = std::backtrace::Backtrace::force_capture().to_string();
@@ -64,6 +94,7 @@ fn on_alloc(ptr: usize, size: usize) {
         }
         inside.set(true);
         if size >= LARGE {
+            note_rss();
             let s = stack();
             *PHASE.lock().unwrap() = s.clone();
             LIVE_LARGE
@@ -79,22 +110,31 @@ fn on_alloc(ptr: usize, size: usize) {
                 .get_or_insert_with(HashMap::new)
                 .entry(phase)
                 .or_default();
-            *top = (*top).max(live);
+            if live > top.0 {
+                top.0 = live;
+                if size >= LARGE && std::env::var_os("HEAP_PEAK_PHASES").is_some() {
+                    top.1 = snapshot();
+                }
+            }
         }
         if live > PEAK.load(Ordering::SeqCst) {
             PEAK.store(live, Ordering::SeqCst);
             if size >= LARGE {
-                let snap: Vec<(usize, String)> = LIVE_LARGE
-                    .lock()
-                    .unwrap()
-                    .as_ref()
-                    .map(|m| m.values().map(|l| (l.size, l.stack.clone())).collect())
-                    .unwrap_or_default();
-                *AT_PEAK.lock().unwrap() = snap;
+                *AT_PEAK.lock().unwrap() = snapshot();
             }
         }
         inside.set(false);
     });
+}
+
+/// The large arrays live now.
+fn snapshot() -> Vec<(usize, String)> {
+    LIVE_LARGE
+        .lock()
+        .unwrap()
+        .as_ref()
+        .map(|m| m.values().map(|l| (l.size, l.stack.clone())).collect())
+        .unwrap_or_default()
 }
 
 fn on_free(ptr: usize, size: usize) {
@@ -105,6 +145,7 @@ fn on_free(ptr: usize, size: usize) {
                 return;
             }
             inside.set(true);
+            note_rss();
             if let Some(m) = LIVE_LARGE.lock().unwrap().as_mut() {
                 m.remove(&ptr);
             }
@@ -149,6 +190,7 @@ fn run<const D: usize>(scene: &Scene, step_of_interest: usize) {
         Moment::Before(step) if step == step_of_interest => {
             PEAK.store(LIVE.load(Ordering::SeqCst), Ordering::SeqCst);
             *PHASES.lock().unwrap() = Some(HashMap::new());
+            *RSS_PHASES.lock().unwrap() = Some(HashMap::new());
         }
         _ => {}
     });
@@ -161,10 +203,46 @@ fn run<const D: usize>(scene: &Scene, step_of_interest: usize) {
         mib(peak),
         mib(peak - model_bytes)
     );
+    print_arrays(&AT_PEAK.lock().unwrap());
+    // The highest live heap of each phase (after each large allocation's
+    // call stack), highest first: where the peak would move if the top
+    // phase shrank. With HEAP_PEAK_PHASES set, the arrays live at each.
+    let mut phases: Vec<_> = PHASES
+        .lock()
+        .unwrap()
+        .take()
+        .unwrap_or_default()
+        .into_iter()
+        .collect();
+    phases.sort_by_key(|p| std::cmp::Reverse(p.1 .0));
+    let mut rss: Vec<_> = (RSS_PHASES
+        .lock()
+        .unwrap()
+        .take()
+        .unwrap_or_default()
+        .into_iter())
+    .collect();
+    rss.sort_by_key(|p| std::cmp::Reverse(p.1));
+    if !rss.is_empty() {
+        println!("highest resident memory per phase (read at large allocations and frees):");
+        for (s, pages) in rss.iter().take(12) {
+            println!("{:9.1} MiB  {s}", *pages as f64 * 4096.0 / 1048576.0);
+        }
+    }
+    println!("highest live heap per phase (after the large allocation of):");
+    for (s, (top, arrays)) in phases.iter().take(12) {
+        println!("{:9.1} MiB  {s}", mib(top - model_bytes));
+        print_arrays(arrays);
+    }
+}
+
+/// Arrays grouped by call stack and size, largest first.
+fn print_arrays(arrays: &[(usize, String)]) {
+    let mib = |b: usize| b as f64 / (1 << 20) as f64;
     let mut groups: HashMap<String, (usize, usize)> = HashMap::new();
-    for (size, s) in AT_PEAK.lock().unwrap().iter() {
+    for (size, s) in arrays {
         let g = groups
-            .entry(format!("{s} [{:.1}]", *size as f64 / 1048576.0))
+            .entry(format!("{s} [{:.1}]", mib(*size)))
             .or_default();
         g.0 += size;
         g.1 += 1;
@@ -173,21 +251,6 @@ fn run<const D: usize>(scene: &Scene, step_of_interest: usize) {
     rows.sort_by_key(|r| std::cmp::Reverse(r.1 .0));
     for (s, (size, n)) in rows {
         println!("{:9.1} MiB {n:4}x  {s}", mib(size));
-    }
-    // The highest live heap of each phase (after each large allocation's
-    // call stack), highest first: where the peak would move if the top
-    // phase shrank.
-    let mut phases: Vec<(String, usize)> = PHASES
-        .lock()
-        .unwrap()
-        .take()
-        .unwrap_or_default()
-        .into_iter()
-        .collect();
-    phases.sort_by_key(|p| std::cmp::Reverse(p.1));
-    println!("highest live heap per phase (after the large allocation of):");
-    for (s, top) in phases.iter().take(12) {
-        println!("{:9.1} MiB  {s}", mib(top - model_bytes));
     }
 }
 

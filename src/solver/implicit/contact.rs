@@ -46,7 +46,6 @@
 //! the penalty acts from D = 0 on (a node where the bodies touch at the step
 //! start carries stiffness but no force).
 
-use super::assembly::pattern::slot;
 use super::assembly::{Components, Dofs, Pattern, Storage, Tangent};
 use super::ties::NodeFields;
 use crate::dim::Mat3;
@@ -463,11 +462,11 @@ impl<const D: usize> PenaltyContact<D> {
         if self.touches.is_empty() {
             return;
         }
-        let (csc, storage) = (k.pattern, k.storage);
+        let (col_ptr, storage) = (k.col_ptr, k.storage);
         let touches = &self.touches;
         pattern.add_stencil_terms(
             &mut k.values,
-            csc,
+            col_ptr,
             storage,
             map,
             st,
@@ -633,7 +632,7 @@ fn add_node_block<const D: usize>(
             for &(r, cr) in rows.as_slice() {
                 for &(c, cc) in dofs.terms(b, j, D).as_slice() {
                     if k.storage == Storage::Full || r >= c {
-                        let s = slot(k.pattern, r, c).expect("contact entry in the pattern");
+                        let s = k.slot(r, c).expect("contact entry in the pattern");
                         k.values[s] += block[(i, j)] * cr * cc;
                     }
                 }

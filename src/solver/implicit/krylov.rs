@@ -47,7 +47,7 @@ use super::assembly::stiffness::{coupling, hoop_coupling, particle_tangents, Par
 use super::assembly::Dofs;
 use super::coarsening::hierarchy;
 use super::failure::Failure;
-use super::residual::{ordering, residual, step_pattern, tangent};
+use super::residual::{ordering, residual, tangent};
 use super::step::StepSystem;
 use crate::dim::Vector;
 use crate::model::Model;
@@ -464,7 +464,11 @@ impl KrylovState {
         // rows); an unsymmetric one is copied into rows, and its columns dropped.
         let symmetric = k.symmetric();
         let a = if symmetric {
-            Fine::Lower(Arc::clone(k.pattern), k.values, step_pattern(sys).graph())
+            Fine::Lower(
+                Arc::clone(k.col_ptr),
+                k.values,
+                Arc::clone(k.pattern.lists()),
+            )
         } else {
             let rows = Csr::from_csc(k.matrix());
             drop(k);

@@ -136,13 +136,14 @@ pub fn tangent<'s, const D: usize>(
     } else {
         Storage::Full
     };
-    let csc = pattern.csc(storage).map_err(|message| Failure {
+    let col_ptr = pattern.col_ptr(storage).map_err(|message| Failure {
         particle: None,
         message,
     })?;
     let mut k = Tangent {
-        pattern: csc,
-        values: vec![0.0; csc.row_idx().len()],
+        pattern,
+        col_ptr,
+        values: vec![0.0; col_ptr[col_ptr.len() - 1] as usize],
         storage,
     };
     match fbar {

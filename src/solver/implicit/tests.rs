@@ -159,10 +159,11 @@ fn lower_equals_full_stiffness<const D: usize>(m: &Model<D>, sys: &StepSystem<D>
     let a = particle_tangents(m, &sys.trial, &sys.stencils, &sys.map, false).unwrap();
     let pattern = super::residual::step_pattern(sys);
     let assemble = |storage| {
-        let csc = pattern.csc(storage).unwrap();
-        let values = vec![0.0; csc.row_idx().len()];
+        let col_ptr = pattern.col_ptr(storage).unwrap();
+        let values = vec![0.0; col_ptr[col_ptr.len() - 1] as usize];
         let mut t = Tangent {
-            pattern: csc,
+            pattern,
+            col_ptr,
             values,
             storage,
         };

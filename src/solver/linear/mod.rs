@@ -12,5 +12,6 @@ pub mod direct;
 pub mod gmres;
 pub mod iterative;
 pub mod multigrid;
+pub mod node_pattern;
 pub mod ordering;
 pub mod preconditioner;

@@ -40,8 +40,9 @@
 //! A symmetric fine tangent is used where the assembly left it, as the lower
 //! triangle of the step's pattern ([`LowerSymmetric`]): no copy of both
 //! triangles (at 32³ cells in 3D that copy was 400 MiB beside a 134 MiB
-//! triangle). Its rows are found through the node graph the pattern was built
-//! from ([`LowerRows`]). The coarse levels are formed in compressed rows; once
+//! triangle), and without its row indices: the rows of every column, and the
+//! columns of every row ([`LowerRows`]), follow from the node graph the
+//! pattern was built from (`node_pattern`). The coarse levels are formed in compressed rows; once
 //! the Galerkin products are done, symmetric ones keep their lower triangle
 //! ([`Csr::into_lower_symmetric`]).
 //!
@@ -51,7 +52,7 @@
 
 use super::direct::{DirectSolver, Ordering, Structure};
 use super::iterative::Preconditioner;
-use super::ordering::NodeGraph;
+use super::node_pattern::NodeLists;
 use super::preconditioner::BlockJacobi;
 use super::Index;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
@@ -165,9 +166,9 @@ impl Csr {
         self.col.shrink_to_fit();
         self.val.truncate(at);
         self.val.shrink_to_fit();
-        let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, self.col);
         LowerSymmetric {
-            pattern: Arc::new(pattern),
+            col_ptr: col_ptr.into(),
+            rows: RowIndex::Stored(self.col),
             values: self.val,
         }
     }
@@ -266,16 +267,33 @@ impl Transposed {
 }
 
 /// A symmetric matrix kept as the direct solver keeps it, its lower triangle
-/// in compressed columns (the pattern shared with the step).
+/// in compressed columns: the coarse levels with their row indices, the fine
+/// tangent with the column pointers of the step's pattern and the node graph
+/// that gives its rows ([`RowIndex`]).
 ///
-/// The first Galerkin product reads it by rows ([`LowerRows`], through the
-/// node graph of the pattern); the smoother's blocks are read from the
-/// columns, and products y = A x go over the stored triangle once (below),
-/// reading less memory than the whole matrix.
+/// The first Galerkin product reads it by rows ([`LowerRows`]); the
+/// smoother's blocks are read from the columns, and products y = A x go over
+/// the stored triangle once (below), reading less memory than the whole
+/// matrix.
 #[derive(Debug)]
 pub struct LowerSymmetric {
-    pattern: Arc<SymbolicSparseColMat<Index>>,
+    col_ptr: Arc<[Index]>,
+    rows: RowIndex,
     values: Vec<f64>,
+}
+
+/// A column's node and its neighbours from itself on (`LowerSymmetric::nodes_of`).
+type Node<'a> = (usize, &'a [u32]);
+
+/// Where the rows of a [`LowerSymmetric`] come from.
+#[derive(Debug)]
+enum RowIndex {
+    /// Stored, one per entry (the coarse levels).
+    Stored(Vec<Index>),
+    /// The node graph of the fine tangent's pattern (rows ≥ the column of the
+    /// unknowns of each neighbour node, `node_pattern`): 4 bytes per entry
+    /// less, 20 MiB of the 2D 320² block's multigrid.
+    Nodes(Arc<NodeLists>),
 }
 
 /// Columns per parallel task of [`LowerSymmetric::apply`]: fixed, so the sums
@@ -284,20 +302,79 @@ const COLUMNS_PER_TASK: usize = 2048;
 
 impl LowerSymmetric {
     fn rows(&self) -> usize {
-        self.pattern.nrows()
+        self.col_ptr.len() - 1
     }
 
     /// The positions of column j's entries.
     fn column(&self, j: usize) -> std::ops::Range<usize> {
-        let col_ptr = self.pattern.col_ptr();
-        col_ptr[j] as usize..col_ptr[j + 1] as usize
+        self.col_ptr[j] as usize..self.col_ptr[j + 1] as usize
+    }
+
+    /// f(k, i) for the entries of column j: position k, row i, ascending.
+    fn for_each_in_column(&self, j: usize, f: impl FnMut(usize, usize)) {
+        let node = self.nodes_of(j..j + 1).next().expect("a column");
+        self.for_each_in_column_of(j, node, f)
+    }
+
+    /// `for_each_in_column` with the node of column j and its neighbours
+    /// from it on given (`nodes_of`).
+    fn for_each_in_column_of(&self, j: usize, node: Node, mut f: impl FnMut(usize, usize)) {
+        match &self.rows {
+            RowIndex::Stored(rows) => self.column(j).for_each(|k| f(k, rows[k] as usize)),
+            RowIndex::Nodes(g) => g.for_each_in_column_among(&self.col_ptr, node.1, j, j, f),
+        }
+    }
+
+    /// The node of each column of `cols` in turn, with its neighbours from
+    /// itself on (the nodes of the rows of its columns); nothing when the
+    /// rows are stored.
+    fn nodes_of(&self, cols: std::ops::Range<usize>) -> impl Iterator<Item = Node<'_>> + '_ {
+        let graph = match &self.rows {
+            RowIndex::Nodes(g) if !cols.is_empty() => Some(&**g),
+            _ => None,
+        };
+        let mut node = graph.map_or(0, |g| g.node_of(cols.start));
+        let mut from: &[u32] = graph.map_or(&[], |g| g.neighbours_from(node, cols.start));
+        cols.map(move |j| {
+            if let Some(g) = graph {
+                if g.first[node + 1] <= j {
+                    while g.first[node + 1] <= j {
+                        node += 1;
+                    }
+                    from = g.neighbours_from(node, j);
+                }
+            }
+            (node, from)
+        })
+    }
+
+    /// The last row of column j (`node` as in `for_each_in_column_of`), if
+    /// it has entries.
+    fn last_row(&self, j: usize, node: Node) -> Option<usize> {
+        match &self.rows {
+            RowIndex::Stored(rows) => rows[self.column(j)].last().map(|&r| r as usize),
+            RowIndex::Nodes(g) => g.last_row(node.0, j),
+        }
+    }
+
+    /// The position of entry (r, c), r ≥ c, if stored.
+    fn position(&self, r: usize, c: usize) -> Option<usize> {
+        match &self.rows {
+            RowIndex::Stored(rows) => {
+                let column = self.column(c);
+                let at = rows[column.clone()].binary_search(&(r as Index)).ok()?;
+                Some(column.start + at)
+            }
+            RowIndex::Nodes(g) => {
+                g.position(&self.col_ptr, (g.node_of(r), r), (g.node_of(c), c), c)
+            }
+        }
     }
 
     /// Both triangles' stored entries.
     fn nnz(&self) -> usize {
-        let rows = self.pattern.row_idx();
         let diagonal = (0..self.rows())
-            .filter(|&j| self.column(j).next().is_some_and(|k| rows[k] as usize == j))
+            .filter(|&j| self.position(j, j).is_some())
             .count();
         2 * self.values.len() - diagonal
     }
@@ -309,7 +386,7 @@ impl LowerSymmetric {
     /// adds the buffers that reach it, chunk by chunk. Fixed chunks and orders:
     /// the same bits on any number of threads.
     fn apply(&self, x: &[f64], y: &mut [f64]) {
-        let (rows, values) = (self.pattern.row_idx(), &self.values);
+        let values = &self.values;
         let scattered: Vec<(usize, Vec<f64>)> = y
             .par_chunks_mut(COLUMNS_PER_TASK)
             .enumerate()
@@ -317,18 +394,19 @@ impl LowerSymmetric {
                 let lo = c * COLUMNS_PER_TASK;
                 let hi = lo + y.len();
                 let reach = (lo..hi)
-                    .filter_map(|j| rows[self.column(j)].last())
-                    .fold(lo, |m, &r| m.max(r as usize + 1));
+                    .zip(self.nodes_of(lo..hi))
+                    .filter_map(|(j, node)| self.last_row(j, node))
+                    .fold(lo, |m, r| m.max(r + 1));
                 let mut buffer = vec![0.0; reach - lo];
-                for (j, yj) in (lo..hi).zip(y.iter_mut()) {
+                for ((j, node), yj) in (lo..hi).zip(self.nodes_of(lo..hi)).zip(y.iter_mut()) {
                     let mut sum = 0.0;
-                    for k in self.column(j) {
-                        let (i, a) = (rows[k] as usize, values[k]);
+                    self.for_each_in_column_of(j, node, |k, i| {
+                        let a = values[k];
                         sum += a * x[i];
                         if i > j {
                             buffer[i - lo] += a * x[j];
                         }
-                    }
+                    });
                     *yj = sum;
                 }
                 (lo, buffer)
@@ -357,61 +435,111 @@ impl LowerSymmetric {
     /// The diagonal block over the unknowns `block` (row-major values), each
     /// entry (i, j) from column min(i, j) of the triangle.
     fn block_values(&self, block: &[usize]) -> Vec<f64> {
-        let rows = self.pattern.row_idx();
+        // A block of one node's unknowns, the node coupled to itself: column
+        // c holds rows c.. of the node first.
+        let own = match (&self.rows, block.first()) {
+            (RowIndex::Nodes(g), Some(&u)) => {
+                let b = g.node_of(u);
+                let rows = g.columns(b);
+                let coupled = g.neighbours(b).binary_search(&(b as u32)).is_ok();
+                (coupled && block.iter().all(|u| rows.contains(u))).then_some(())
+            }
+            _ => None,
+        };
         let entry = |i: usize, j: usize| {
-            let (r, c) = (i.max(j) as Index, i.min(j));
-            let column = self.column(c);
-            (rows[column.clone()].binary_search(&r)).map_or(0.0, |k| self.values[column.start + k])
+            let (r, c) = (i.max(j), i.min(j));
+            let at = match own {
+                Some(()) => Some(self.col_ptr[c] as usize + r - c),
+                None => self.position(r, c),
+            };
+            at.map_or(0.0, |k| self.values[k])
         };
         (block.iter())
             .flat_map(|&i| block.iter().map(move |&j| entry(i, j)))
             .collect()
     }
+
+    /// The triangle in compressed columns with its row indices, for the
+    /// direct solver.
+    fn to_csc(&self) -> (SymbolicSparseColMat<Index>, Vec<f64>) {
+        let rows = match &self.rows {
+            RowIndex::Stored(rows) => rows.clone(),
+            RowIndex::Nodes(_) => {
+                let mut rows = vec![0; self.values.len()];
+                for j in 0..self.rows() {
+                    self.for_each_in_column(j, |k, i| rows[k] = i as Index);
+                }
+                rows
+            }
+        };
+        let n = self.rows();
+        let pattern = SymbolicSparseColMat::new_checked(n, n, self.col_ptr.to_vec(), None, rows);
+        (pattern, self.values.clone())
+    }
 }
 
-/// The rows of a symmetric matrix stored as its lower triangle, found through
-/// the node graph its pattern was built from (unknowns numbered node by node,
-/// node a coupling all its unknowns to all those of its neighbours): row i of
-/// node a is (i, j) for the unknowns j < i of a's neighbours b ≤ a, found by
-/// one search in b's first column, then column i from its diagonal down. These are
-/// the entries, values and order of row i of the whole matrix in compressed
-/// rows, so the Galerkin operators are those of that matrix; nothing is stored
-/// (a transposed pattern of the triangle, 8 bytes per entry, was the 2D
-/// multigrid's largest own array).
+/// The rows of the symmetric fine tangent stored as its lower triangle, found
+/// through the node graph its pattern was built from (unknowns numbered node
+/// by node, node a coupling all its unknowns to all those of its neighbours):
+/// row i of node a is (i, j) for the unknowns j < i of a's neighbours b ≤ a,
+/// found once in b's first column, then column i from its diagonal down.
+/// These are the entries, values and order of row i of the whole matrix in
+/// compressed rows, so the Galerkin operators are those of that matrix;
+/// nothing is stored (a transposed pattern of the triangle, 8 bytes per
+/// entry, was the 2D multigrid's largest own array).
 pub struct LowerRows<'a> {
     a: &'a LowerSymmetric,
-    graph: NodeGraph<'a>,
+    graph: &'a NodeLists,
+    /// Per node a, for each neighbour b ≤ a (the first entries of a's
+    /// neighbour list): where a's rows start in b's first column, from its
+    /// top (node a's are `down[down_start[a]..]`). Built once per product
+    /// (4 bytes per such pair, dropped after it) instead of a search for every
+    /// row each time the product reads it.
+    down: Vec<u32>,
+    down_start: Vec<usize>,
+    /// Per node: whether it couples to itself (its own rows open its columns).
+    own: Vec<bool>,
 }
 
 impl<'a> LowerRows<'a> {
-    /// The rows of `a` through `graph`, if the graph has the triangle's
-    /// entries: checked by their number (the pattern is built from the graph,
-    /// `Pattern::csc`, so a mismatch is a wrong graph).
-    pub fn new(a: &'a LowerSymmetric, graph: NodeGraph<'a>) -> Result<LowerRows<'a>, String> {
-        let n = a.rows();
-        let (first, unknowns) = (graph.first, |b: usize| graph.first[b + 1] - graph.first[b]);
-        let nodes = first.len() - 1;
-        let described: usize = (0..nodes)
-            .map(|b| {
-                let below = graph.neighbours(b).iter().map(|&c| c as usize);
-                below
-                    .take_while(|&c| c <= b)
-                    .map(|c| match c == b {
-                        true => unknowns(b) * (unknowns(b) + 1) / 2,
-                        false => unknowns(b) * unknowns(c),
-                    })
-                    .sum::<usize>()
-            })
-            .sum();
-        if first[nodes] != n || described != a.values.len() {
-            return Err(format!(
-                "the node graph ({} unknowns, {described} entries of a lower triangle) does not \
-                 describe the tangent's pattern ({n} unknowns, {} entries)",
-                first[nodes],
-                a.values.len()
-            ));
+    /// The rows of `a`, if its rows come from a node graph.
+    pub fn new(a: &'a LowerSymmetric) -> Result<LowerRows<'a>, String> {
+        let RowIndex::Nodes(graph) = &a.rows else {
+            return Err("a lower triangle without its node graph".into());
+        };
+        let own: Vec<bool> = (0..graph.nodes())
+            .into_par_iter()
+            .map(|b| graph.neighbours(b).binary_search(&(b as u32)).is_ok())
+            .collect();
+        let below = |node: usize| {
+            let neighbours = graph.neighbours(node);
+            neighbours.partition_point(|&b| b as usize <= node)
+        };
+        let mut down_start = Vec::with_capacity(graph.nodes() + 1);
+        down_start.push(0);
+        for node in 0..graph.nodes() {
+            down_start.push(down_start[node] + below(node));
         }
-        Ok(LowerRows { a, graph })
+        let down: Vec<u32> = (0..graph.nodes())
+            .into_par_iter()
+            .flat_map_iter(|node| {
+                let below = graph.neighbours(node).iter().map(|&b| b as usize);
+                below.take_while(move |&b| b <= node).map(move |b| {
+                    let lo = graph.first[b];
+                    let from = graph.neighbours_from(b, lo);
+                    let i = graph.first[node];
+                    (graph.position_among(&a.col_ptr, from, (node, i), lo, lo))
+                        .map_or(u32::MAX, |at| (at - a.col_ptr[lo] as usize) as u32)
+                })
+            })
+            .collect();
+        Ok(LowerRows {
+            a,
+            graph,
+            down,
+            down_start,
+            own,
+        })
     }
 }
 
@@ -421,50 +549,48 @@ impl Rows for LowerRows<'_> {
     }
 
     fn for_each_in_row(&self, i: usize, mut f: impl FnMut(u32, f64)) {
-        let (rows, values) = (self.a.pattern.row_idx(), &self.a.values);
-        let first = self.graph.first;
-        let node = first.partition_point(|&u| u <= i) - 1;
-        for &b in self.graph.neighbours(node) {
+        let (g, values, col_ptr) = (self.graph, &self.a.values, &self.a.col_ptr);
+        let node = g.node_of(i);
+        let shift = i - g.first[node];
+        for (t, &b) in g.neighbours(node).iter().enumerate() {
             let b = b as usize;
             if b > node {
                 break;
             }
-            let (lo, hi) = (first[b], first[b + 1].min(i));
-            if lo == hi {
+            let (lo, hi) = (g.first[b], g.first[b + 1].min(i));
+            let down = self.down[self.down_start[node] + t];
+            if lo == hi || down == u32::MAX {
                 continue;
             }
             // Column lo holds b's own unknowns from lo on (if b couples to
-            // itself), then those of b's neighbours after b: row i is found
-            // there once, and sits one entry higher in each next column of b.
-            let column = self.a.column(lo);
-            let Ok(down) = rows[column.clone()].binary_search(&(i as Index)) else {
-                continue;
-            };
-            let own = usize::from(rows[column.start] as usize == lo);
+            // itself), then those of b's neighbours after b: row i sits
+            // `down + shift` entries from its top, and one entry higher in
+            // each next column of b.
+            let down = down as usize + shift;
+            let own = usize::from(self.own[b]);
             for (t, j) in (lo..hi).enumerate() {
-                let k = self.a.column(j).start + down - own * t;
-                debug_assert_eq!(rows[k] as usize, i);
+                let k = col_ptr[j] as usize + down - own * t;
                 f(j as u32, values[k]);
             }
         }
-        let down = self.a.column(i);
-        for (&r, &a) in rows[down.clone()].iter().zip(&values[down]) {
-            f(r, a);
-        }
+        let own = (node, g.neighbours_from(node, i));
+        self.a
+            .for_each_in_column_of(i, own, |k, r| f(r as u32, values[k]));
     }
 }
 
 /// The fine operator handed to [`Multigrid::refresh`]: a matrix in compressed
-/// rows, or a symmetric tangent as assembled, by the lower triangle of its
-/// shared pattern (rows ≥ column, ascending), its values and the node graph the
-/// pattern was built from (its rows are found through it, [`LowerRows`]).
+/// rows, or a symmetric tangent as assembled, by the column pointers of the
+/// lower triangle of its shared pattern (rows ≥ column, ascending), its values
+/// and the node graph the pattern was built from (its rows follow from it,
+/// `node_pattern`).
 #[derive(Debug)]
-pub enum Fine<'g> {
+pub enum Fine {
     Rows(Csr),
-    Lower(Arc<SymbolicSparseColMat<Index>>, Vec<f64>, NodeGraph<'g>),
+    Lower(Arc<[Index]>, Vec<f64>, Arc<NodeLists>),
 }
 
-impl From<Csr> for Fine<'_> {
+impl From<Csr> for Fine {
     fn from(a: Csr) -> Self {
         Fine::Rows(a)
     }
@@ -510,12 +636,12 @@ impl Operator {
         }
     }
 
-    /// Pᵀ A P (R = Pᵀ); a lower triangle is read by rows through `graph`.
-    fn galerkin(&self, r: &Csr, p: &Csr, graph: Option<NodeGraph>) -> Result<Csr, String> {
-        match (self, graph) {
-            (Operator::Rows(a), _) => Ok(galerkin(r, a, p)),
-            (Operator::Lower(a), Some(graph)) => Ok(galerkin(r, &LowerRows::new(a, graph)?, p)),
-            (Operator::Lower(_), None) => Err("a lower triangle without its node graph".into()),
+    /// Pᵀ A P (R = Pᵀ); a lower triangle is read by rows through its node
+    /// graph ([`LowerRows`]).
+    fn galerkin(&self, r: &Csr, p: &Csr) -> Result<Csr, String> {
+        match self {
+            Operator::Rows(a) => Ok(galerkin(r, a, p)),
+            Operator::Lower(a) => Ok(galerkin(r, &LowerRows::new(a)?, p)),
         }
     }
 
@@ -531,7 +657,7 @@ impl Operator {
     fn to_csc(&self, symmetric: bool) -> (SymbolicSparseColMat<Index>, Vec<f64>) {
         match self {
             Operator::Rows(a) => a.to_csc(symmetric),
-            Operator::Lower(a) => ((*a.pattern).clone(), a.values.clone()),
+            Operator::Lower(a) => a.to_csc(),
         }
     }
 }
@@ -655,15 +781,43 @@ impl Multigrid {
         }
     }
 
-    /// The fine operator of `a`, and the node graph of a lower triangle.
-    fn fine(a: Fine) -> (Operator, Option<NodeGraph>) {
-        match a {
-            Fine::Rows(a) => (Operator::Rows(a), None),
-            Fine::Lower(pattern, values, graph) => (
-                Operator::Lower(LowerSymmetric { pattern, values }),
-                Some(graph),
-            ),
+    /// The fine operator of `a`; a lower triangle only if the node graph
+    /// describes it (checked by the number of entries: the pattern is built
+    /// from the graph, `Pattern::col_ptr`, so a mismatch is a wrong graph).
+    fn fine(a: Fine) -> Result<Operator, String> {
+        let (col_ptr, values, graph) = match a {
+            Fine::Rows(a) => return Ok(Operator::Rows(a)),
+            Fine::Lower(col_ptr, values, graph) => (col_ptr, values, graph),
+        };
+        let n = col_ptr.len() - 1;
+        let unknowns = |b: usize| graph.columns(b).len();
+        let entries: usize = (0..graph.nodes())
+            .into_par_iter()
+            .map(|b| {
+                let below = graph.neighbours(b).iter().map(|&c| c as usize);
+                (below.take_while(|&c| c <= b))
+                    .map(|c| match c == b {
+                        true => unknowns(b) * (unknowns(b) + 1) / 2,
+                        false => unknowns(b) * unknowns(c),
+                    })
+                    .sum::<usize>()
+            })
+            .sum();
+        let described =
+            graph.unknowns() == n && col_ptr[n] as usize == values.len() && entries == values.len();
+        if !described {
+            return Err(format!(
+                "the node graph ({} unknowns) does not describe the tangent's pattern ({n} \
+                 unknowns, {} entries)",
+                graph.unknowns(),
+                values.len()
+            ));
         }
+        Ok(Operator::Lower(LowerSymmetric {
+            col_ptr,
+            rows: RowIndex::Nodes(graph),
+            values,
+        }))
     }
 
     /// Galerkin operators, smoothers and the coarse factorization for the fine
@@ -672,17 +826,12 @@ impl Multigrid {
     /// pattern is unchanged (`DirectSolver`). If the coarsest operator cannot be
     /// factorized (a coarse space that lost its rank at a ragged boundary), the
     /// next finer level becomes the coarsest.
-    pub fn refresh<'g>(
-        &mut self,
-        a: impl Into<Fine<'g>>,
-        symmetric: bool,
-    ) -> Result<Shape, String> {
+    pub fn refresh(&mut self, a: impl Into<Fine>, symmetric: bool) -> Result<Shape, String> {
         // On an error no operator is kept.
         self.release();
-        let (fine, mut graph) = Self::fine(a.into());
-        let mut operators = vec![fine];
+        let mut operators = vec![Self::fine(a.into())?];
         for (t, r) in self.transfers.iter().zip(&self.restrictions) {
-            let coarse = (operators.last().unwrap()).galerkin(r, &t.prolongation, graph.take())?;
+            let coarse = (operators.last().unwrap()).galerkin(r, &t.prolongation)?;
             operators.push(Operator::Rows(coarse));
         }
         // Once the products are formed no level is read by rows again: a
@@ -1019,12 +1168,12 @@ mod tests {
     /// columns with the node graph, and the whole matrix in compressed rows
     /// built directly from the same rule (the reference).
     struct Nodal {
-        pattern: Arc<SymbolicSparseColMat<Index>>,
+        col_ptr: Arc<[Index]>,
+        /// The triangle's rows, written out by the rule (the reference).
+        rows: Vec<Index>,
         vals: Vec<f64>,
         whole: Csr,
-        start: Vec<usize>,
-        adjacency: Vec<u32>,
-        first: Vec<usize>,
+        lists: Arc<NodeLists>,
     }
 
     impl Nodal {
@@ -1047,7 +1196,6 @@ mod tests {
                 }
                 col_ptr.push(rows.len() as Index);
             }
-            let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows);
             let mut whole = Csr {
                 rows: n,
                 cols: n,
@@ -1071,25 +1219,24 @@ mod tests {
                 start.push(adjacency.len());
             }
             Nodal {
-                pattern: Arc::new(pattern),
+                col_ptr: col_ptr.into(),
+                rows,
                 vals,
                 whole,
-                start,
-                adjacency,
-                first,
+                lists: Arc::new(NodeLists {
+                    start,
+                    adjacency,
+                    first,
+                }),
             }
         }
 
-        fn graph(&self) -> NodeGraph<'_> {
-            NodeGraph {
-                start: &self.start,
-                adjacency: &self.adjacency,
-                first: &self.first,
-            }
-        }
-
-        fn fine(&self) -> Fine<'_> {
-            Fine::Lower(Arc::clone(&self.pattern), self.vals.clone(), self.graph())
+        fn fine(&self) -> Fine {
+            Fine::Lower(
+                Arc::clone(&self.col_ptr),
+                self.vals.clone(),
+                Arc::clone(&self.lists),
+            )
         }
     }
 
@@ -1124,13 +1271,20 @@ mod tests {
         // ragged pattern of single unknowns, and on nodes of 2, 1 and 0
         // unknowns.
         for (case, m) in [("ragged", ragged(23)), ("nodal", nodal(20))] {
-            let (lower, graph) = Multigrid::fine(m.fine());
+            let lower = Multigrid::fine(m.fine()).unwrap();
             let (rows, n) = (&m.whole, m.whole.rows);
             assert_eq!(lower.nnz(), rows.nnz(), "{case}");
             let Operator::Lower(a) = &lower else {
                 panic!("a symmetric tangent is read in place")
             };
-            let by_rows = LowerRows::new(a, graph.unwrap()).unwrap();
+            // The rows that the node graph gives are those of the rule.
+            let (pattern, values) = a.to_csc();
+            assert_eq!(
+                (pattern.row_idx(), &values),
+                (&m.rows[..], &m.vals),
+                "{case}"
+            );
+            let by_rows = LowerRows::new(a).unwrap();
             for i in 0..n {
                 let mut entries = Vec::new();
                 by_rows.for_each_in_row(i, |j, v| entries.push((j, v)));
@@ -1147,7 +1301,7 @@ mod tests {
             }
             let p = interpolation(n, false);
             let (a, b) = (
-                lower.galerkin(&p.transpose(), &p, graph).unwrap(),
+                lower.galerkin(&p.transpose(), &p).unwrap(),
                 galerkin(&p.transpose(), rows, &p),
             );
             assert_eq!(
@@ -1231,22 +1385,25 @@ mod tests {
         // The graph of another pattern (node 0 no longer coupled to the last):
         // its rows would silently lack entries.
         let m = nodal(20);
-        let other = Nodal::new(m.first.clone(), |a, b| a - b <= 2);
-        let (lower, _) = Multigrid::fine(m.fine());
-        let p = interpolation(m.whole.rows, false);
-        let error = lower
-            .galerkin(&p.transpose(), &p, Some(other.graph()))
-            .unwrap_err();
+        let other = Nodal::new(m.lists.first.clone(), |a, b| a - b <= 2);
+        let wrong = || {
+            Fine::Lower(
+                Arc::clone(&m.col_ptr),
+                m.vals.clone(),
+                Arc::clone(&other.lists),
+            )
+        };
+        let error = Multigrid::fine(wrong()).unwrap_err();
         assert!(
             error.contains("does not describe the tangent's pattern"),
             "{error}"
         );
+        let p = interpolation(m.whole.rows, false);
         let mut mg = Multigrid::new(vec![Transfer {
             prolongation: p,
             fine_blocks: (0..m.whole.rows).map(|i| vec![i]).collect(),
         }]);
-        let wrong = Fine::Lower(Arc::clone(&m.pattern), m.vals.clone(), other.graph());
-        assert!(mg.refresh(wrong, true).is_err());
+        assert!(mg.refresh(wrong(), true).is_err());
     }
 
     #[test]
@@ -1255,7 +1412,7 @@ mod tests {
         // above, and columns holding only their diagonal.
         for n in [1, 7, COLUMNS_PER_TASK + 1, 2 * COLUMNS_PER_TASK + 77] {
             let m = ragged(n);
-            let (lower, _) = Multigrid::fine(m.fine());
+            let lower = Multigrid::fine(m.fine()).unwrap();
             let x: Vec<f64> = (0..n).map(|i| 1.0 + (i as f64 * 0.37).sin()).collect();
             let mut expected = vec![0.0; n];
             m.whole.apply(&x, &mut expected);

@@ -27,10 +27,10 @@ pub fn add_absorbing<const D: usize>(
         let c = lp.damping * step.rate + lp.stiffness;
         *coefficient[lp.q].get_or_insert_with(Vector::<D>::zeros) += c;
     }
-    let (csc, storage) = (k.pattern, k.storage);
+    let (col_ptr, storage) = (k.col_ptr, k.storage);
     pattern.add_stencil_terms(
         &mut k.values,
-        csc,
+        col_ptr,
         storage,
         map,
         st,

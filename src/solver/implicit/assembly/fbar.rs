@@ -3,7 +3,6 @@
 //! nodes of every particle in its cell. Axisymmetric: n = 3 and the hoop
 //! components join every contraction (`assembly::stiffness`).
 
-use super::pattern::slot;
 use super::stiffness::{add_stiffness, indices, ParticleTangents};
 use super::{Dofs, Pattern, Tangent};
 use crate::dim::{Mat3, Vector};
@@ -179,7 +178,7 @@ pub fn add_fbar_stiffness<const D: usize>(
                     for kk in 0..D {
                         for &(r, cr) in rows.as_slice() {
                             for &(c, cc) in dofs.terms(*n2, kk, D).as_slice() {
-                                let s = slot(k.pattern, r, c).expect("cell entry in the pattern");
+                                let s = k.slot(r, c).expect("cell entry in the pattern");
                                 k.values[s] += av[i] * hv[kk] * cr * cc;
                             }
                         }

@@ -34,8 +34,8 @@ pub fn add_linear_stress_stiffness<const D: usize>(
 ) {
     let rows = left_rows(map, st, volume, linear);
     let at = ParticleTangents::<D>::at;
-    let (csc, storage) = (k.pattern, k.storage);
-    pattern.add_listed_terms(&mut k.values, csc, storage, map, st, dofs, |q, e2, out| {
+    let storage = k.storage;
+    pattern.add_listed_terms(&mut k.values, storage, map, st, dofs, |q, e2, out| {
         let (aq, g2) = (a.of(q), &st.grad(e2));
         for (node, l) in &rows[q] {
             let mut block = [0.0; 9];

@@ -2,7 +2,6 @@
 //! lumped nodal mass m_I (2-24) or the consistent mass M_IJ = Σ_p m_p S_Ip S_Jp,
 //! diagonal in the components.
 
-use super::pattern::slot;
 use super::{Components, Dofs, Pattern, Storage, Tangent};
 use crate::physics::shape::Stencils;
 use crate::physics::transfer::NodeMap;
@@ -16,7 +15,7 @@ pub fn add_lumped_mass<const D: usize>(k: &mut Tangent, dofs: &Dofs, mass: &[f64
             for &(r, cr) in t.as_slice() {
                 for &(c, cc) in t.as_slice() {
                     if k.storage == Storage::Full || r >= c {
-                        let s = slot(k.pattern, r, c).expect("mass entry in the pattern");
+                        let s = k.slot(r, c).expect("mass entry in the pattern");
                         k.values[s] += m_i * inertia * cr * cc;
                     }
                 }
@@ -35,10 +34,10 @@ pub fn add_consistent_mass<const D: usize>(
     particle_mass: &[f64],
     inertia: f64,
 ) {
-    let (csc, storage) = (k.pattern, k.storage);
+    let (col_ptr, storage) = (k.col_ptr, k.storage);
     pattern.add_stencil_terms(
         &mut k.values,
-        csc,
+        col_ptr,
         storage,
         map,
         st,

@@ -23,9 +23,10 @@ use crate::physics::stress_gradient::LeastSquares;
 use crate::physics::transfer::NodeMap;
 use crate::scene::DirectOrdering;
 use crate::solver::linear::direct::spmv;
+use crate::solver::linear::node_pattern::NodeLists;
 use crate::solver::linear::ordering::{node_amd, node_metis, NodeGraph};
 use crate::solver::linear::Index;
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use rayon::prelude::*;
 use std::sync::{Arc, OnceLock};
 
@@ -51,18 +52,21 @@ pub enum Components {
 /// its unknowns.
 #[derive(Clone, Debug, Default)]
 pub struct Pattern {
-    /// Unknowns of nodes 0..b: the columns of node b are `first[b]..first[b + 1]`
-    /// (unknowns are numbered node by node).
-    first: Vec<usize>,
+    /// The node graph: per node, the nodes it couples to (masters for tied
+    /// nodes), ascending, and its unknowns (numbered node by node); shared with
+    /// the multigrid's fine level, which finds the rows through it.
+    lists: Arc<NodeLists>,
     /// When some node is tied: the stencil entries each master takes terms
     /// from (its own and those of the nodes tied to it, with the coefficients
     /// of the ties), and which nodes are masters or tied. Other nodes take
     /// their own entries of the node map with coefficient 1, and nothing is
     /// stored for them (see `sources`).
     tied_sources: Option<TiedSources>,
-    /// Per node: the nodes it couples to (masters for tied nodes), ascending.
-    neighbour_start: Vec<usize>,
-    neighbours: Vec<u32>,
+    /// Column pointers of the lower triangle and of the whole matrix.
+    lower_cols: OnceLock<Arc<[Index]>>,
+    full_cols: OnceLock<Arc<[Index]>>,
+    /// The compressed-column patterns with their row indices (only for a
+    /// consumer that needs them: the direct solver, an unsymmetric tangent).
     lower: OnceLock<Arc<SymbolicSparseColMat<Index>>>,
     full: OnceLock<Arc<SymbolicSparseColMat<Index>>>,
     amd: OnceLock<Vec<usize>>,
@@ -259,10 +263,14 @@ impl Pattern {
         };
         let (neighbour_start, neighbours) = with_pairs(neighbour_start, neighbours, coupled, dofs);
         Pattern {
-            first,
+            lists: Arc::new(NodeLists {
+                start: neighbour_start,
+                adjacency: neighbours,
+                first,
+            }),
             tied_sources,
-            neighbour_start,
-            neighbours,
+            lower_cols: OnceLock::new(),
+            full_cols: OnceLock::new(),
             lower: OnceLock::new(),
             full: OnceLock::new(),
             amd: OnceLock::new(),
@@ -287,11 +295,12 @@ impl Pattern {
 
     /// The node graph with the unknowns of each node.
     pub fn graph(&self) -> NodeGraph<'_> {
-        NodeGraph {
-            start: &self.neighbour_start,
-            adjacency: &self.neighbours,
-            first: &self.first,
-        }
+        self.lists.graph()
+    }
+
+    /// The node graph's arrays, shared.
+    pub fn lists(&self) -> &Arc<NodeLists> {
+        &self.lists
     }
 
     /// The fill-reducing ordering `kind` of the unknowns for a Cholesky
@@ -305,23 +314,59 @@ impl Pattern {
 
     /// Number of active nodes.
     pub fn nodes(&self) -> usize {
-        self.first.len() - 1
+        self.lists.nodes()
     }
 
     /// The nodes coupled to node b (ascending).
     pub fn neighbours(&self, b: usize) -> &[u32] {
-        &self.neighbours[self.neighbour_start[b]..self.neighbour_start[b + 1]]
+        self.lists.neighbours(b)
     }
 
     /// The unknowns of node b (consecutive).
     pub fn columns(&self, b: usize) -> std::ops::Range<usize> {
-        self.first[b]..self.first[b + 1]
+        self.lists.columns(b)
     }
 
-    /// The compressed-column pattern of the unknowns (built at the first call),
-    /// shared: the direct solver keeps a handle to the pattern it analysed
-    /// instead of a copy. An error if it has more entries than [`Index`]
-    /// numbers.
+    /// The column pointers of the compressed-column pattern of the unknowns
+    /// (counted at the first call, in parallel over the nodes): column c of
+    /// node b holds the unknowns of b's neighbours, those ≥ c with `Lower`
+    /// ([`NodeLists`]). An error if the pattern has more entries than
+    /// [`Index`] numbers.
+    pub fn col_ptr(&self, storage: Storage) -> Result<&Arc<[Index]>, String> {
+        let cell = match storage {
+            Storage::Lower => &self.lower_cols,
+            Storage::Full => &self.full_cols,
+        };
+        if let Some(ptr) = cell.get() {
+            return Ok(ptr);
+        }
+        let lowest = |c: usize| if storage == Storage::Lower { c } else { 0 };
+        let lengths: Vec<usize> = (0..self.nodes())
+            .into_par_iter()
+            .with_min_len(256)
+            .flat_map_iter(|b| {
+                self.columns(b)
+                    .map(move |c| self.lists.column_len(b, lowest(c)))
+            })
+            .collect();
+        let total: usize = lengths.iter().sum();
+        if total > Index::MAX as usize {
+            return Err(format!(
+                "the tangent's pattern has {total} entries, more than the 2³² that 32-bit \
+                 indices number"
+            ));
+        }
+        let mut col_ptr: Vec<Index> = Vec::with_capacity(lengths.len() + 1);
+        col_ptr.push(0);
+        for len in lengths {
+            col_ptr.push(col_ptr.last().unwrap() + len as Index);
+        }
+        Ok(cell.get_or_init(|| col_ptr.into()))
+    }
+
+    /// The compressed-column pattern with its row indices (built at the first
+    /// call), shared: the direct solver keeps a handle to the pattern it
+    /// analysed instead of a copy. An error as [`Pattern::col_ptr`].
     pub fn csc(&self, storage: Storage) -> Result<&Arc<SymbolicSparseColMat<Index>>, String> {
         let cell = match storage {
             Storage::Lower => &self.lower,
@@ -334,61 +379,34 @@ impl Pattern {
         Ok(cell.get_or_init(|| Arc::new(csc)))
     }
 
-    /// Rows of column c of node b: the unknowns of b's neighbours (all
-    /// components: the stiffness couples every pair), ascending; with `Lower`,
-    /// those ≥ c. Unknowns are numbered node by node, so the rows of neighbour
-    /// a are `first[a]..first[a + 1]`. Counted, then filled, in parallel over
-    /// the nodes (each node writes its own columns: the same result on any
-    /// number of threads).
+    /// The rows of every column ([`NodeLists::for_each_in_column`]), filled in
+    /// parallel over the nodes (each node writes its own columns: the same
+    /// result on any number of threads). Rows ascend within each column:
+    /// neighbours ascend and unknowns are numbered node by node.
     fn build_csc(&self, storage: Storage) -> Result<SymbolicSparseColMat<Index>, String> {
-        let n = self.first[self.nodes()];
+        let col_ptr = self.col_ptr(storage)?;
         let lowest = |c: usize| if storage == Storage::Lower { c } else { 0 };
-        let rows_of = |a: u32, c: usize| {
-            let (lo, hi) = (self.first[a as usize], self.first[a as usize + 1]);
-            let from = lo.max(lowest(c));
-            from..hi.max(from)
-        };
-        let lengths: Vec<usize> = (0..self.nodes())
-            .into_par_iter()
-            .with_min_len(256)
-            .flat_map_iter(|b| {
-                self.columns(b).map(move |c| {
-                    let neighbours = self.neighbours(b).iter();
-                    neighbours.map(|&a| rows_of(a, c).len()).sum::<usize>()
-                })
-            })
-            .collect();
-        let total: usize = lengths.iter().sum();
-        if total > Index::MAX as usize {
-            return Err(format!(
-                "the tangent's pattern has {total} entries, more than the 2³² that 32-bit \
-                 indices number"
-            ));
-        }
-        let mut col_ptr: Vec<Index> = Vec::with_capacity(n + 1);
-        col_ptr.push(0);
-        for len in lengths {
-            col_ptr.push(col_ptr.last().unwrap() + len as Index);
-        }
-        let mut rows: Vec<Index> = vec![0; total];
-        self.per_node(&col_ptr, &mut rows)
+        let mut rows: Vec<Index> = vec![0; col_ptr[col_ptr.len() - 1] as usize];
+        self.per_node(col_ptr, &mut rows)
             .into_par_iter()
             .enumerate()
             .with_min_len(256)
             .for_each(|(b, out)| {
-                let mut at = 0;
+                let base = col_ptr[self.columns(b).start] as usize;
                 for c in self.columns(b) {
-                    for &a in self.neighbours(b) {
-                        for r in rows_of(a, c) {
-                            out[at] = r as Index;
-                            at += 1;
-                        }
-                    }
+                    (self.lists).for_each_in_column(col_ptr, b, c, lowest(c), |k, i| {
+                        out[k - base] = i as Index
+                    });
                 }
             });
-        // Rows ascending within each column: neighbours ascending and unknowns
-        // numbered node by node.
-        Ok(SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows))
+        let n = col_ptr.len() - 1;
+        Ok(SymbolicSparseColMat::new_checked(
+            n,
+            n,
+            col_ptr.to_vec(),
+            None,
+            rows,
+        ))
     }
 
     /// `entries` (a compressed-column array with `col_ptr`) split into the
@@ -406,7 +424,8 @@ impl Pattern {
     }
 
     /// Adds the term of every particle q with `column(q, e2, needed, block)` true
-    /// to the values of `csc` (`Pattern::csc` with `storage`): for each stencil
+    /// to the values of the pattern with `storage` (its column pointers
+    /// `col_ptr`, [`Pattern::col_ptr`]): for each stencil
     /// entry e2 of q, `column` fills `block[(e1 − first entry of q)·D² + i·D + k]`
     /// with the term at (node of e1, component i) × (node of e2, component k) for
     /// every entry e1 of q with `needed[e1 − first entry of q]` (the others are
@@ -418,7 +437,7 @@ impl Pattern {
     pub fn add_stencil_terms<const D: usize>(
         &self,
         values: &mut [f64],
-        csc: &SymbolicSparseColMat<Index>,
+        col_ptr: &[Index],
         storage: Storage,
         map: &NodeMap,
         st: &Stencils<D>,
@@ -426,7 +445,6 @@ impl Pattern {
         components: Components,
         column: impl Fn(usize, usize, &[bool], &mut [f64]) -> bool + Sync,
     ) {
-        let col_ptr = csc.col_ptr();
         self.per_node(col_ptr, values)
             .into_par_iter()
             .enumerate()
@@ -459,7 +477,6 @@ impl Pattern {
     pub fn add_listed_terms<const D: usize>(
         &self,
         values: &mut [f64],
-        csc: &SymbolicSparseColMat<Index>,
         storage: Storage,
         map: &NodeMap,
         st: &Stencils<D>,
@@ -467,6 +484,9 @@ impl Pattern {
         rows: impl Fn(usize, usize, &mut Vec<(usize, [f64; 9])>) + Sync,
     ) {
         assert_eq!(storage, Storage::Full, "listed terms need the whole matrix");
+        let csc = &**self
+            .csc(storage)
+            .expect("counted by the tangent's column pointers");
         let col_ptr = csc.col_ptr();
         self.per_node(col_ptr, values)
             .into_par_iter()
@@ -488,7 +508,8 @@ impl Pattern {
                                 let Some(r) = dofs.of(a, i, D) else { continue };
                                 for (k, c) in col_of.iter().enumerate() {
                                     let Some(c) = *c else { continue };
-                                    let at = slot(csc, r, c).expect("listed entry in the pattern");
+                                    let at = slot(csc.as_ref(), r, c)
+                                        .expect("listed entry in the pattern");
                                     vals[at - base] += block[i * D + k] * cr * cc;
                                 }
                             }
@@ -538,7 +559,10 @@ impl Pattern {
             let mut at = col_ptr[c] as usize - base;
             for (j, &a) in neighbours.iter().enumerate() {
                 offsets[k * m + j] = at;
-                let (lo, hi) = (self.first[a as usize], self.first[a as usize + 1]);
+                let (lo, hi) = (
+                    self.lists.first[a as usize],
+                    self.lists.first[a as usize + 1],
+                );
                 at += hi.saturating_sub(lo.max(lowest(c)));
             }
             debug_assert_eq!(at, col_ptr[c + 1] as usize - base);
@@ -573,7 +597,7 @@ impl Pattern {
                         continue;
                     };
                     hint = j;
-                    let lo = self.first[a];
+                    let lo = self.lists.first[a];
                     for i in 0..D {
                         let Some(r) = dofs.of(a, i, D) else { continue };
                         let coupled = match components {
@@ -609,7 +633,7 @@ fn position(sorted: &[u32], a: u32, from: usize) -> Option<usize> {
 }
 
 /// Position of row r in column c of `csc`, if the pattern has it.
-pub fn slot(csc: &SymbolicSparseColMat<Index>, r: usize, c: usize) -> Option<usize> {
+pub fn slot(csc: SymbolicSparseColMatRef<Index>, r: usize, c: usize) -> Option<usize> {
     let (start, end) = (csc.col_ptr()[c] as usize, csc.col_ptr()[c + 1] as usize);
     csc.row_idx()[start..end]
         .binary_search(&(r as Index))
@@ -780,16 +804,21 @@ fn with_pairs(
 
 /// The assembled tangent of one Newton iterate: values in the step's pattern.
 pub struct Tangent<'a> {
-    /// The step's shared pattern ([`Pattern::csc`]).
-    pub pattern: &'a Arc<SymbolicSparseColMat<Index>>,
+    /// The step's pattern.
+    pub pattern: &'a Pattern,
+    /// Its column pointers for `storage` ([`Pattern::col_ptr`]).
+    pub col_ptr: &'a Arc<[Index]>,
     pub values: Vec<f64>,
     /// `Lower` when the tangent is symmetric (only rows ≥ column stored).
     pub storage: Storage,
 }
 
 impl Tangent<'_> {
+    /// The tangent as a compressed-column matrix (its row indices built at
+    /// the first call of the step, [`Pattern::csc`]).
     pub fn matrix(&self) -> SparseColMatRef<'_, Index, f64> {
-        SparseColMatRef::new((**self.pattern).as_ref(), &self.values)
+        let csc = (self.pattern.csc(self.storage)).expect("counted by the column pointers");
+        SparseColMatRef::new((**csc).as_ref(), &self.values)
     }
 
     pub fn symmetric(&self) -> bool {
@@ -799,5 +828,18 @@ impl Tangent<'_> {
     /// y = K x (both triangles when only the lower one is stored).
     pub fn apply(&self, x: &[f64]) -> Vec<f64> {
         spmv(self.matrix(), self.symmetric(), x, false)
+    }
+
+    /// The position of entry (r, c) among the values, if the pattern holds
+    /// it: a symmetric tangent finds it through the node graph (the multigrid
+    /// never builds its row indices), an unsymmetric one, whose rows every
+    /// solver builds, by a search in column c (F-bar asks for many entries).
+    pub fn slot(&self, r: usize, c: usize) -> Option<usize> {
+        if self.storage == Storage::Full {
+            return slot(self.matrix().symbolic(), r, c);
+        }
+        let lists = &self.pattern.lists;
+        let (a, b) = (lists.node_of(r), lists.node_of(c));
+        lists.position(self.col_ptr, (a, r), (b, c), c)
     }
 }

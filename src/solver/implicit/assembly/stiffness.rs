@@ -297,11 +297,11 @@ pub fn add_stiffness<const D: usize>(
     volume: &[f64],
     a: &ParticleTangents<D>,
 ) {
-    let (csc, storage) = (k.pattern, k.storage);
+    let (col_ptr, storage) = (k.col_ptr, k.storage);
     let at = ParticleTangents::<D>::at;
     pattern.add_stencil_terms(
         &mut k.values,
-        csc,
+        col_ptr,
         storage,
         map,
         st,
