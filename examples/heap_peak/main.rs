@@ -1,7 +1,12 @@
 //! Which large heap arrays are live at the peak of an implicit step: a
 //! counting allocator records every allocation of at least 1 MiB with its
 //! call stack, and at the end prints the arrays live at the step's peak of
-//! live heap, largest first.
+//! live heap, largest first. Then, per phase of the step (the call stack of
+//! the latest large allocation), the highest live heap it reached: where the
+//! peak would move if the top phase shrank. With HEAP_PEAK_PHASES set, also
+//! the large arrays live at the end of each phase's highest visit and the highest resident
+//! memory read at the phase's large allocations and frees (RSS can be far
+//! below the live heap where an allocation is never touched).
 //!
 //! `cargo run --release --example heap_peak -- SCENE STEP [--set key=value ...]`
 
@@ -35,6 +40,11 @@ static AT_PEAK: Mutex<Vec<(usize, String)>> = Mutex::new(Vec::new());
 #[allow(clippy::type_complexity)]
 static PHASES: Mutex<Option<HashMap<String, (usize, Vec<(usize, String)>)>>> = Mutex::new(None);
 static PHASE: Mutex<String> = Mutex::new(String::new());
+/// The highest live heap since the current phase began (updated on every
+/// allocation without a lock; folded into PHASES when the phase ends).
+static PHASE_TOP: AtomicUsize = AtomicUsize::new(0);
+/// HEAP_PEAK_PHASES is set (read once, not inside the allocator).
+static DETAILS: AtomicBool = AtomicBool::new(false);
 /// Per phase: the highest resident memory read at its large allocations and
 /// frees (/proc/self/statm, pages), with HEAP_PEAK_PHASES set.
 static RSS_PHASES: Mutex<Option<HashMap<String, usize>>> = Mutex::new(None);
@@ -55,7 +65,7 @@ fn resident_pages() -> usize {
 }
 
 fn note_rss() {
-    if std::env::var_os("HEAP_PEAK_PHASES").is_none() {
+    if !DETAILS.load(Ordering::SeqCst) {
         return;
     }
     let phase = PHASE.lock().unwrap().clone();
@@ -94,28 +104,19 @@ fn on_alloc(ptr: usize, size: usize) {
         }
         inside.set(true);
         if size >= LARGE {
+            // A new phase: the previous one ends without this allocation.
             note_rss();
             let s = stack();
+            end_phase();
             *PHASE.lock().unwrap() = s.clone();
+            PHASE_TOP.store(live, Ordering::SeqCst);
             LIVE_LARGE
                 .lock()
                 .unwrap()
                 .get_or_insert_with(HashMap::new)
                 .insert(ptr, Large { size, stack: s });
-        }
-        {
-            let phase = PHASE.lock().unwrap().clone();
-            let mut phases = PHASES.lock().unwrap();
-            let top = phases
-                .get_or_insert_with(HashMap::new)
-                .entry(phase)
-                .or_default();
-            if live > top.0 {
-                top.0 = live;
-                if size >= LARGE && std::env::var_os("HEAP_PEAK_PHASES").is_some() {
-                    top.1 = snapshot();
-                }
-            }
+        } else {
+            PHASE_TOP.fetch_max(live, Ordering::SeqCst);
         }
         if live > PEAK.load(Ordering::SeqCst) {
             PEAK.store(live, Ordering::SeqCst);
@@ -125,6 +126,25 @@ fn on_alloc(ptr: usize, size: usize) {
         }
         inside.set(false);
     });
+}
+
+/// Fold the current phase's highest live heap into PHASES (with the large
+/// arrays live now, at its end, when HEAP_PEAK_PHASES is set: its only large
+/// allocation is the one that began it).
+fn end_phase() {
+    let phase = PHASE.lock().unwrap().clone();
+    let top = PHASE_TOP.load(Ordering::SeqCst);
+    let mut phases = PHASES.lock().unwrap();
+    let Some(phases) = phases.as_mut() else {
+        return;
+    };
+    let entry = phases.entry(phase).or_default();
+    if top > entry.0 {
+        entry.0 = top;
+        if DETAILS.load(Ordering::SeqCst) {
+            entry.1 = snapshot();
+        }
+    }
 }
 
 /// The large arrays live now.
@@ -181,6 +201,8 @@ unsafe impl GlobalAlloc for Counting {
 static GLOBAL: Counting = Counting;
 
 fn run<const D: usize>(scene: &Scene, step_of_interest: usize) {
+    let details = std::env::var_os("HEAP_PEAK_PHASES").is_some();
+    DETAILS.store(details, Ordering::SeqCst);
     let mut model_bytes = 0;
     steps::<D>(scene, step_of_interest, |moment| match moment {
         Moment::Built => {
@@ -190,11 +212,13 @@ fn run<const D: usize>(scene: &Scene, step_of_interest: usize) {
         Moment::Before(step) if step == step_of_interest => {
             PEAK.store(LIVE.load(Ordering::SeqCst), Ordering::SeqCst);
             *PHASES.lock().unwrap() = Some(HashMap::new());
+            PHASE_TOP.store(LIVE.load(Ordering::SeqCst), Ordering::SeqCst);
             *RSS_PHASES.lock().unwrap() = Some(HashMap::new());
         }
         _ => {}
     });
     RECORD.store(false, Ordering::SeqCst);
+    end_phase();
     let mib = |b: usize| b as f64 / (1 << 20) as f64;
     let peak = PEAK.load(Ordering::SeqCst);
     println!(

@@ -282,9 +282,6 @@ pub struct LowerSymmetric {
     values: Vec<f64>,
 }
 
-/// A column's node and its neighbours from itself on (`LowerSymmetric::nodes_of`).
-type Node<'a> = (usize, &'a [u32]);
-
 /// Where the rows of a [`LowerSymmetric`] come from.
 #[derive(Debug)]
 enum RowIndex {
@@ -312,23 +309,23 @@ impl LowerSymmetric {
 
     /// f(k, i) for the entries of column j: position k, row i, ascending.
     fn for_each_in_column(&self, j: usize, f: impl FnMut(usize, usize)) {
-        let node = self.nodes_of(j..j + 1).next().expect("a column");
-        self.for_each_in_column_of(j, node, f)
+        let from = self.row_nodes(j..j + 1).next().expect("a column");
+        self.for_each_in_column_of(j, from, f)
     }
 
-    /// `for_each_in_column` with the node of column j and its neighbours
-    /// from it on given (`nodes_of`).
-    fn for_each_in_column_of(&self, j: usize, node: Node, mut f: impl FnMut(usize, usize)) {
+    /// `for_each_in_column` with the nodes of column j's rows given
+    /// (`row_nodes`).
+    fn for_each_in_column_of(&self, j: usize, from: &[u32], mut f: impl FnMut(usize, usize)) {
         match &self.rows {
             RowIndex::Stored(rows) => self.column(j).for_each(|k| f(k, rows[k] as usize)),
-            RowIndex::Nodes(g) => g.for_each_in_column_among(&self.col_ptr, node.1, j, j, f),
+            RowIndex::Nodes(g) => g.for_each_in_column(&self.col_ptr, from, j, j, f),
         }
     }
 
-    /// The node of each column of `cols` in turn, with its neighbours from
-    /// itself on (the nodes of the rows of its columns); nothing when the
-    /// rows are stored.
-    fn nodes_of(&self, cols: std::ops::Range<usize>) -> impl Iterator<Item = Node<'_>> + '_ {
+    /// For each column of `cols` in turn, the nodes its rows come from: the
+    /// neighbours of the column's node from itself on (found once per node);
+    /// none when the rows are stored.
+    fn row_nodes(&self, cols: std::ops::Range<usize>) -> impl Iterator<Item = &[u32]> + '_ {
         let graph = match &self.rows {
             RowIndex::Nodes(g) if !cols.is_empty() => Some(&**g),
             _ => None,
@@ -336,24 +333,22 @@ impl LowerSymmetric {
         let mut node = graph.map_or(0, |g| g.node_of(cols.start));
         let mut from: &[u32] = graph.map_or(&[], |g| g.neighbours_from(node, cols.start));
         cols.map(move |j| {
-            if let Some(g) = graph {
-                if g.first[node + 1] <= j {
-                    while g.first[node + 1] <= j {
-                        node += 1;
-                    }
-                    from = g.neighbours_from(node, j);
+            if let Some(g) = graph.filter(|g| g.first[node + 1] <= j) {
+                while g.first[node + 1] <= j {
+                    node += 1;
                 }
+                from = g.neighbours_from(node, j);
             }
-            (node, from)
+            from
         })
     }
 
-    /// The last row of column j (`node` as in `for_each_in_column_of`), if
+    /// The last row of column j (`from` as in `for_each_in_column_of`), if
     /// it has entries.
-    fn last_row(&self, j: usize, node: Node) -> Option<usize> {
+    fn last_row(&self, j: usize, from: &[u32]) -> Option<usize> {
         match &self.rows {
             RowIndex::Stored(rows) => rows[self.column(j)].last().map(|&r| r as usize),
-            RowIndex::Nodes(g) => g.last_row(node.0, j),
+            RowIndex::Nodes(g) => g.last_row(from, j),
         }
     }
 
@@ -394,13 +389,13 @@ impl LowerSymmetric {
                 let lo = c * COLUMNS_PER_TASK;
                 let hi = lo + y.len();
                 let reach = (lo..hi)
-                    .zip(self.nodes_of(lo..hi))
-                    .filter_map(|(j, node)| self.last_row(j, node))
+                    .zip(self.row_nodes(lo..hi))
+                    .filter_map(|(j, from)| self.last_row(j, from))
                     .fold(lo, |m, r| m.max(r + 1));
                 let mut buffer = vec![0.0; reach - lo];
-                for ((j, node), yj) in (lo..hi).zip(self.nodes_of(lo..hi)).zip(y.iter_mut()) {
+                for ((j, from), yj) in (lo..hi).zip(self.row_nodes(lo..hi)).zip(y.iter_mut()) {
                     let mut sum = 0.0;
-                    self.for_each_in_column_of(j, node, |k, i| {
+                    self.for_each_in_column_of(j, from, |k, i| {
                         let a = values[k];
                         sum += a * x[i];
                         if i > j {
@@ -440,17 +435,15 @@ impl LowerSymmetric {
         let own = match (&self.rows, block.first()) {
             (RowIndex::Nodes(g), Some(&u)) => {
                 let b = g.node_of(u);
-                let rows = g.columns(b);
-                let coupled = g.neighbours(b).binary_search(&(b as u32)).is_ok();
-                (coupled && block.iter().all(|u| rows.contains(u))).then_some(())
+                g.self_coupled(b) && block.iter().all(|u| g.columns(b).contains(u))
             }
-            _ => None,
+            _ => false,
         };
         let entry = |i: usize, j: usize| {
             let (r, c) = (i.max(j), i.min(j));
             let at = match own {
-                Some(()) => Some(self.col_ptr[c] as usize + r - c),
-                None => self.position(r, c),
+                true => Some(self.col_ptr[c] as usize + r - c),
+                false => self.position(r, c),
             };
             at.map_or(0.0, |k| self.values[k])
         };
@@ -509,26 +502,20 @@ impl<'a> LowerRows<'a> {
         };
         let own: Vec<bool> = (0..graph.nodes())
             .into_par_iter()
-            .map(|b| graph.neighbours(b).binary_search(&(b as u32)).is_ok())
+            .map(|b| graph.self_coupled(b))
             .collect();
-        let below = |node: usize| {
-            let neighbours = graph.neighbours(node);
-            neighbours.partition_point(|&b| b as usize <= node)
-        };
         let mut down_start = Vec::with_capacity(graph.nodes() + 1);
         down_start.push(0);
         for node in 0..graph.nodes() {
-            down_start.push(down_start[node] + below(node));
+            down_start.push(down_start[node] + graph.lower_neighbours(node).len());
         }
         let down: Vec<u32> = (0..graph.nodes())
             .into_par_iter()
             .flat_map_iter(|node| {
-                let below = graph.neighbours(node).iter().map(|&b| b as usize);
-                below.take_while(move |&b| b <= node).map(move |b| {
-                    let lo = graph.first[b];
-                    let from = graph.neighbours_from(b, lo);
-                    let i = graph.first[node];
-                    (graph.position_among(&a.col_ptr, from, (node, i), lo, lo))
+                let i = graph.first[node];
+                graph.lower_neighbours(node).iter().map(move |&b| {
+                    let lo = graph.first[b as usize];
+                    (graph.position(&a.col_ptr, (node, i), (b as usize, lo), lo))
                         .map_or(u32::MAX, |at| (at - a.col_ptr[lo] as usize) as u32)
                 })
             })
@@ -552,11 +539,8 @@ impl Rows for LowerRows<'_> {
         let (g, values, col_ptr) = (self.graph, &self.a.values, &self.a.col_ptr);
         let node = g.node_of(i);
         let shift = i - g.first[node];
-        for (t, &b) in g.neighbours(node).iter().enumerate() {
+        for (t, &b) in g.lower_neighbours(node).iter().enumerate() {
             let b = b as usize;
-            if b > node {
-                break;
-            }
             let (lo, hi) = (g.first[b], g.first[b + 1].min(i));
             let down = self.down[self.down_start[node] + t];
             if lo == hi || down == u32::MAX {
@@ -573,9 +557,9 @@ impl Rows for LowerRows<'_> {
                 f(j as u32, values[k]);
             }
         }
-        let own = (node, g.neighbours_from(node, i));
+        let from = g.neighbours_from(node, i);
         self.a
-            .for_each_in_column_of(i, own, |k, r| f(r as u32, values[k]));
+            .for_each_in_column_of(i, from, |k, r| f(r as u32, values[k]));
     }
 }
 
@@ -794,8 +778,7 @@ impl Multigrid {
         let entries: usize = (0..graph.nodes())
             .into_par_iter()
             .map(|b| {
-                let below = graph.neighbours(b).iter().map(|&c| c as usize);
-                (below.take_while(|&c| c <= b))
+                (graph.lower_neighbours(b).iter().map(|&c| c as usize))
                     .map(|c| match c == b {
                         true => unknowns(b) * (unknowns(b) + 1) / 2,
                         false => unknowns(b) * unknowns(c),

@@ -88,23 +88,24 @@ impl NodeLists {
             .sum()
     }
 
-    /// f(k, i) for every entry of column c (node b) of the layout, k its
-    /// position (from `col_ptr[c]` on) and i its row, ascending.
-    pub fn for_each_in_column(
-        &self,
-        col_ptr: &[Index],
-        b: usize,
-        c: usize,
-        lowest: usize,
-        f: impl FnMut(usize, usize),
-    ) {
-        self.for_each_in_column_among(col_ptr, self.neighbours_from(b, lowest), c, lowest, f)
+    /// The neighbours b ≤ a of node a (the nodes whose columns hold a's rows
+    /// in the lower triangle).
+    pub fn lower_neighbours(&self, a: usize) -> &[u32] {
+        let all = self.neighbours(a);
+        &all[..all.partition_point(|&b| b as usize <= a)]
     }
 
-    /// `for_each_in_column` with b's neighbours that have rows ≥ `lowest`
-    /// given (`neighbours_from`: the same for all the columns of b in the
-    /// lower triangle).
-    pub fn for_each_in_column_among(
+    /// Whether node b couples to itself (then its own rows open its columns
+    /// in the lower triangle).
+    pub fn self_coupled(&self, b: usize) -> bool {
+        self.neighbours(b).binary_search(&(b as u32)).is_ok()
+    }
+
+    /// f(k, i) for every entry of column c of the layout, k its position
+    /// (from `col_ptr[c]` on) and i its row, ascending; `neighbours` are
+    /// those of c's node from `neighbours_from(node, lowest)` (the same for
+    /// all the columns of a node in the lower triangle).
+    pub fn for_each_in_column(
         &self,
         col_ptr: &[Index],
         neighbours: &[u32],
@@ -122,9 +123,10 @@ impl NodeLists {
         debug_assert_eq!(k, col_ptr[c + 1] as usize);
     }
 
-    /// The last row of column c (node b) of the layout, if any.
-    pub fn last_row(&self, b: usize, lowest: usize) -> Option<usize> {
-        (self.neighbours(b).iter().rev())
+    /// The last row of a column of the layout, if any (`neighbours` as in
+    /// `for_each_in_column`).
+    pub fn last_row(&self, neighbours: &[u32], lowest: usize) -> Option<usize> {
+        (neighbours.iter().rev())
             .map(|&a| self.rows_of(a as usize, lowest))
             .find(|r| !r.is_empty())
             .map(|r| r.end - 1)
@@ -140,23 +142,11 @@ impl NodeLists {
         (b, c): (usize, usize),
         lowest: usize,
     ) -> Option<usize> {
-        self.position_among(col_ptr, self.neighbours_from(b, lowest), (a, r), c, lowest)
-    }
-
-    /// `position` with b's neighbours that have rows ≥ `lowest` given
-    /// ([`NodeLists::neighbours_from`]).
-    pub fn position_among(
-        &self,
-        col_ptr: &[Index],
-        neighbours: &[u32],
-        (a, r): (usize, usize),
-        c: usize,
-        lowest: usize,
-    ) -> Option<usize> {
         let rows = self.rows_of(a, lowest);
         if !rows.contains(&r) {
             return None;
         }
+        let neighbours = self.neighbours_from(b, lowest);
         let j = neighbours.binary_search(&(a as u32)).ok()?;
         let before: usize = (neighbours[..j].iter())
             .map(|&n| self.rows_of(n as usize, lowest).len())
@@ -211,14 +201,14 @@ mod tests {
             let ptr = col_ptr(&g, is_lower);
             for c in 0..5 {
                 let (b, lowest) = (g.node_of(c), if is_lower { c } else { 0 });
-                let mut rows = Vec::new();
-                g.for_each_in_column(&ptr, b, c, lowest, |k, i| rows.push((k, i)));
+                let (mut rows, from) = (Vec::new(), g.neighbours_from(b, lowest));
+                g.for_each_in_column(&ptr, from, c, lowest, |k, i| rows.push((k, i)));
                 let want: Vec<(usize, usize)> = (expected[c].iter())
                     .enumerate()
                     .map(|(t, &i)| (ptr[c] as usize + t, i))
                     .collect();
                 assert_eq!(rows, want, "column {c}, lower {is_lower}");
-                assert_eq!(g.last_row(b, lowest), expected[c].last().copied());
+                assert_eq!(g.last_row(from, lowest), expected[c].last().copied());
                 for r in 0..5 {
                     let at = g.position(&ptr, (g.node_of(r), r), (b, c), lowest);
                     let want = rows.iter().find(|&&(_, i)| i == r).map(|&(k, _)| k);

@@ -39,6 +39,17 @@ pub enum Storage {
     Full,
 }
 
+impl Storage {
+    /// The lowest row of column c that is stored: c itself in the lower
+    /// triangle, 0 in the whole matrix.
+    fn lowest(self, c: usize) -> usize {
+        match self {
+            Storage::Lower => c,
+            Storage::Full => 0,
+        }
+    }
+}
+
 /// Which component pairs (i, k) of two nodes a term couples.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Components {
@@ -340,13 +351,12 @@ impl Pattern {
         if let Some(ptr) = cell.get() {
             return Ok(ptr);
         }
-        let lowest = |c: usize| if storage == Storage::Lower { c } else { 0 };
         let lengths: Vec<usize> = (0..self.nodes())
             .into_par_iter()
             .with_min_len(256)
             .flat_map_iter(|b| {
                 self.columns(b)
-                    .map(move |c| self.lists.column_len(b, lowest(c)))
+                    .map(move |c| self.lists.column_len(b, storage.lowest(c)))
             })
             .collect();
         let total: usize = lengths.iter().sum();
@@ -385,7 +395,6 @@ impl Pattern {
     /// neighbours ascend and unknowns are numbered node by node.
     fn build_csc(&self, storage: Storage) -> Result<SymbolicSparseColMat<Index>, String> {
         let col_ptr = self.col_ptr(storage)?;
-        let lowest = |c: usize| if storage == Storage::Lower { c } else { 0 };
         let mut rows: Vec<Index> = vec![0; col_ptr[col_ptr.len() - 1] as usize];
         self.per_node(col_ptr, &mut rows)
             .into_par_iter()
@@ -394,7 +403,9 @@ impl Pattern {
             .for_each(|(b, out)| {
                 let base = col_ptr[self.columns(b).start] as usize;
                 for c in self.columns(b) {
-                    (self.lists).for_each_in_column(col_ptr, b, c, lowest(c), |k, i| {
+                    let lowest = storage.lowest(c);
+                    let from = self.lists.neighbours_from(b, lowest);
+                    (self.lists).for_each_in_column(col_ptr, from, c, lowest, |k, i| {
                         out[k - base] = i as Index
                     });
                 }
@@ -548,8 +559,8 @@ impl Pattern {
         let m = neighbours.len();
         // Rows of column c: the unknowns first[a]..first[a + 1] of each
         // neighbour a in order, those < c dropped when only the lower
-        // triangle is stored.
-        let lowest = |c: usize| if storage == Storage::Lower { c } else { 0 };
+        // triangle is stored (`NodeLists::rows_of`).
+        let lowest = |c: usize| storage.lowest(c);
         offsets.clear();
         offsets.resize(D * m, usize::MAX);
         let mut col_of = [usize::MAX; D];
@@ -559,11 +570,7 @@ impl Pattern {
             let mut at = col_ptr[c] as usize - base;
             for (j, &a) in neighbours.iter().enumerate() {
                 offsets[k * m + j] = at;
-                let (lo, hi) = (
-                    self.lists.first[a as usize],
-                    self.lists.first[a as usize + 1],
-                );
-                at += hi.saturating_sub(lo.max(lowest(c)));
+                at += self.lists.rows_of(a as usize, lowest(c)).len();
             }
             debug_assert_eq!(at, col_ptr[c + 1] as usize - base);
         }
@@ -840,6 +847,6 @@ impl Tangent<'_> {
         }
         let lists = &self.pattern.lists;
         let (a, b) = (lists.node_of(r), lists.node_of(c));
-        lists.position(self.col_ptr, (a, r), (b, c), c)
+        lists.position(self.col_ptr, (a, r), (b, c), self.storage.lowest(c))
     }
 }
