@@ -8,7 +8,7 @@
 //! memory read at the phase's large allocations and frees (RSS can be far
 //! below the live heap where an allocation is never touched).
 //!
-//! `cargo run --release --example heap_peak -- SCENE STEP [--set key=value ...]`
+//! `cargo run --release --features probes --example heap_peak -- SCENE STEP [--set key=value ...]`
 
 #[path = "../common/implicit_steps.rs"]
 mod implicit_steps;

@@ -7,7 +7,7 @@
 //! Runs the first stage of SCENE for `steps` steps (default 3); Linux only
 //! (reads /proc/self/status and resets the peak through /proc/self/clear_refs).
 //!
-//! `cargo run --release --example step_memory -- SCENE [STEPS] [--set key=value ...]`
+//! `cargo run --release --features probes --example step_memory -- SCENE [STEPS] [--set key=value ...]`
 
 #[path = "../common/implicit_steps.rs"]
 mod implicit_steps;

@@ -448,9 +448,10 @@ fn rolling_cylinder_under_ramped_gravity_rolls_within_3_percent() {
     // run (the normal force swings between 0 and twice the weight) and slip
     // while it is light. Raised over 0.1 s (about one period of that bounce) it
     // rolls: v + ωR = 0.012 m/s at R/10 against 0.13 without the ramp. Measured,
-    // centre (spin): rolling −0.91 % (−2.2 %) at R/10, −0.99 % (−2.0 %) at R/20;
-    // slipping −1.1 % (−2.15 %) at R/20 (at R/10 +0.01 % (−3.75 %), not run here).
-    for (mu, cells) in [(0.5, "[60,28]"), (0.5, "[120,56]"), (0.1, "[120,56]")] {
+    // centre (spin): rolling −0.91 % (−2.2 %) at R/10, −0.99 % (−2.0 %) at R/20
+    // (not run here, for time); slipping −1.1 % (−2.15 %) at R/20 (at R/10
+    // +0.01 % but the spin −3.75 %, so slipping is checked at R/20).
+    for (mu, cells) in [(0.5, "[60,28]"), (0.1, "[120,56]")] {
         let (x, spin) = roll_at_touch(mu, cells, 0.1);
         println!("cylinder in rings, gravity over 0.1 s, μ = {mu}, {cells}: centre {x:+.4}, spin {spin:+.4}");
         assert!(
