@@ -9,8 +9,9 @@
 //! deviator is 2G ē_a along the eigenvectors (Simo & Hughes, Computational
 //! Inelasticity, §9.2). A rigid rotation rotates the stress exactly.
 
+use super::spectral::symmetric_eigen;
 use crate::dim::Mat3;
-use nalgebra::{SymmetricEigen, Vector3};
+use nalgebra::Vector3;
 
 /// Deviatoric part of a tensor.
 pub fn deviator(a: &Mat3) -> Mat3 {
@@ -32,21 +33,20 @@ pub struct TrialDeviator {
 impl TrialDeviator {
     /// From the Kirchhoff deviator at the start of the increment and ΔF.
     pub fn of(tau_dev_old: &Mat3, shear_modulus: f64, df: &Mat3) -> Self {
-        let old = SymmetricEigen::new(tau_dev_old / (2.0 * shear_modulus));
-        let v = old.eigenvectors;
+        let (old, v) = symmetric_eigen(&(tau_dev_old / (2.0 * shear_modulus)));
         let be_old_minus_i =
-            v * Mat3::from_diagonal(&old.eigenvalues.map(|e| (2.0 * e).exp_m1())) * v.transpose();
+            v * Mat3::from_diagonal(&old.map(|e| (2.0 * e).exp_m1())) * v.transpose();
         let df_bar = df * df.determinant().cbrt().recip();
         // b̄^tr − I = ΔF̄ (b̄_e,old − I) ΔF̄ᵀ + (ΔF̄ ΔF̄ᵀ − I), without cancellation.
         let h = df_bar - Mat3::identity();
         let btr_minus_i =
             df_bar * be_old_minus_i * df_bar.transpose() + h + h.transpose() + h * h.transpose();
-        let eig = SymmetricEigen::new(btr_minus_i);
-        let e = eig.eigenvalues.map(|m| 0.5 * m.ln_1p());
+        let (m, n) = symmetric_eigen(&btr_minus_i);
+        let e = m.map(|m| 0.5 * m.ln_1p());
         let mean = e.sum() / 3.0;
         TrialDeviator {
             strain: e.map(|x| x - mean),
-            n: eig.eigenvectors,
+            n,
         }
     }
 

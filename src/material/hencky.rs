@@ -40,7 +40,8 @@
 use super::parameters::{FromParameters, KeyError, Parameters};
 use super::{lame, Increment, Material, StressDerivative};
 use crate::dim::Mat3;
-use nalgebra::{SymmetricEigen, Vector3};
+use super::spectral::symmetric_eigen;
+use nalgebra::Vector3;
 
 /// Hencky (logarithmic-strain) hyperelastic solid with Lamé constants from (E, ν).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -64,11 +65,8 @@ impl Spectral {
     pub(crate) fn of(f: &Mat3) -> Self {
         let h = f - Mat3::identity();
         let b_minus_i = h + h.transpose() + h * h.transpose();
-        let eig = SymmetricEigen::new(b_minus_i);
-        Self {
-            n: eig.eigenvectors,
-            m: eig.eigenvalues,
-        }
+        let (m, n) = symmetric_eigen(&b_minus_i);
+        Self { n, m }
     }
 
     /// Hencky strain ε = ½ ln b = Σ ½ ln β_a n_a⊗n_a.

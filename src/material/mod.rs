@@ -20,6 +20,7 @@ pub mod erosion;
 pub mod parameters;
 pub mod registry;
 pub mod return_mapping;
+pub mod spectral;
 #[cfg(test)]
 mod testing;
 

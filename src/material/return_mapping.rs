@@ -39,9 +39,10 @@
 
 use super::hencky::log_divided_difference;
 use super::parameters::FromParameters;
+use super::spectral::symmetric_eigen;
 use super::{lame, Increment, Material, Strength, StressDerivative};
 use crate::dim::Mat3;
-use nalgebra::{Matrix3, SymmetricEigen, Vector3};
+use nalgebra::{Matrix3, Vector3};
 
 /// Principal values (strains or stresses), in the order of the eigenvectors.
 pub type Principal = Vector3<f64>;
@@ -122,19 +123,16 @@ impl Trial {
     fn of(el: &Elasticity, inc: &Increment) -> Trial {
         let j_old = inc.f_old.determinant();
         // b_e,old − I = exp(2 ε_e,old) − I, exact at zero stress.
-        let eps_old = SymmetricEigen::new(el.strain_of_stress(&(inc.stress_old * j_old)));
-        let v = eps_old.eigenvectors;
-        let be_old_minus_i = v
-            * Mat3::from_diagonal(&eps_old.eigenvalues.map(|e| (2.0 * e).exp_m1()))
-            * v.transpose();
+        let (eps_old, v) = symmetric_eigen(&el.strain_of_stress(&(inc.stress_old * j_old)));
+        let be_old_minus_i =
+            v * Mat3::from_diagonal(&eps_old.map(|e| (2.0 * e).exp_m1())) * v.transpose();
         // b_e^tr − I = ΔF (b_e,old − I) ΔFᵀ + (ΔF ΔFᵀ − I), without cancellation.
         let h = inc.df - Mat3::identity();
         let btr_minus_i =
             inc.df * be_old_minus_i * inc.df.transpose() + h + h.transpose() + h * h.transpose();
-        let eig = SymmetricEigen::new(btr_minus_i);
-        let m = eig.eigenvalues;
+        let (m, n) = symmetric_eigen(&btr_minus_i);
         Trial {
-            n: eig.eigenvectors,
+            n,
             m,
             eps: m.map(|m| 0.5 * m.ln_1p()),
             be_old: be_old_minus_i + Mat3::identity(),
