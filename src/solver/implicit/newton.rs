@@ -290,15 +290,8 @@ pub fn factorized_tangent<'s, const D: usize>(
     solver: &mut DirectSolver,
     b: &[f64],
 ) -> Result<(Tangent<'s>, Method, Vec<f64>), Failure> {
-    let symmetric = sys.trial.fbar.is_none() && solver.structure() != Some(Structure::General);
-    // A pattern not carried over from the last step is new: the last step's
-    // factor, the largest array of the solver, goes before the assembly and
-    // the new pattern's analysis instead of beside them (the first
-    // factorization on the new pattern then allocates its factor anew).
-    if sys.pattern.get().is_none() {
-        solver.release_factors();
-    }
     let pattern = step_pattern(sys);
+    let symmetric = sys.trial.fbar.is_none() && solver.structure() != Some(Structure::General);
     let (k, _) = rayon::join(
         || tangent(m, sys, false),
         || {

@@ -366,16 +366,6 @@ impl DirectSolver {
         self.lu = None;
     }
 
-    /// Drop the factors, their kept buffers and the symbolic factorizations:
-    /// before a new pattern is assembled, so that the
-    /// old factor's memory is not held beside the assembly and the new
-    /// pattern's analysis. The next factorization allocates its factor anew.
-    pub fn release_factors(&mut self) {
-        self.numeric = Numeric::None;
-        self.kept = Numeric::None;
-        self.forget_pattern();
-    }
-
     /// How many symbolic factorizations (Cholesky or LU analyses) were computed so far.
     pub fn symbolic_count(&self) -> usize {
         self.statistics.symbolic_analyses
@@ -501,9 +491,10 @@ impl DirectSolver {
             }
             _ => vec![0.0; len],
         };
-        // The workspace is allocated per factorization, not kept: it would
-        // sit beside the next assembly (61 MiB at 2×10⁵ unknowns in 2D, 5 % of
-        // the step's peak), and allocating it again costs no measurable time.
+        // The workspace is allocated per factorization, not kept: kept, it sat
+        // beside the next assembly, the step's peak (61 MiB at 2×10⁵ unknowns
+        // in 2D: 1.58 → 1.49× the factor). Its page faults cost 6–8 % of a
+        // later Newton iteration at 5×10⁴ unknowns (docs/performance.md).
         let req = sym.factorize_numeric_llt_scratch::<f64>(par, Default::default());
         let mut work = match buffer(req) {
             Ok(work) => work,
@@ -1350,27 +1341,6 @@ mod tests {
             .unwrap();
         assert_eq!(ahead.symbolic_count(), 2);
         assert_eq!(x_shared, x);
-    }
-
-    /// Released factors: nothing to solve with, no buffer kept, the pattern
-    /// analysed again; the next factorization gives the same solution bits.
-    #[test]
-    fn released_factors_are_gone_and_recomputed_alike() {
-        let (n, t) = (2_500, laplace_2d(50, 1.0, 0.0));
-        let b = apply(n, &t, &x_star(n));
-        let mut solver = DirectSolver::new();
-        solver
-            .factorize_triplets(n, &t, Structure::Symmetric)
-            .unwrap();
-        let x = solver.solve(&b).unwrap();
-        solver.release_factors();
-        assert!(solver.solve(&b).is_err(), "no factors after the release");
-        assert!(matches!(solver.kept, Numeric::None) && solver.structure().is_none());
-        solver
-            .factorize_triplets(n, &t, Structure::Symmetric)
-            .unwrap();
-        assert_eq!(solver.symbolic_count(), 2, "the pattern analysed anew");
-        assert_eq!(solver.solve(&b).unwrap(), x);
     }
 
     /// A given ordering is used (the solution agrees with AMD's to round-off)
