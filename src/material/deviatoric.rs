@@ -9,7 +9,7 @@
 //! deviator is 2G ē_a along the eigenvectors (Simo & Hughes, Computational
 //! Inelasticity, §9.2). A rigid rotation rotates the stress exactly.
 
-use super::spectral::symmetric_eigen;
+use super::spectral::{from_principal, symmetric_eigen};
 use crate::dim::Mat3;
 use nalgebra::Vector3;
 
@@ -34,8 +34,7 @@ impl TrialDeviator {
     /// From the Kirchhoff deviator at the start of the increment and ΔF.
     pub fn of(tau_dev_old: &Mat3, shear_modulus: f64, df: &Mat3) -> Self {
         let (old, v) = symmetric_eigen(&(tau_dev_old / (2.0 * shear_modulus)));
-        let be_old_minus_i =
-            v * Mat3::from_diagonal(&old.map(|e| (2.0 * e).exp_m1())) * v.transpose();
+        let be_old_minus_i = from_principal(&v, &old.map(|e| (2.0 * e).exp_m1()));
         let df_bar = df * df.determinant().cbrt().recip();
         // b̄^tr − I = ΔF̄ (b̄_e,old − I) ΔF̄ᵀ + (ΔF̄ ΔF̄ᵀ − I), without cancellation.
         let h = df_bar - Mat3::identity();
@@ -52,7 +51,7 @@ impl TrialDeviator {
 
     /// The tensor with principal values `principal` on these eigenvectors.
     pub fn tensor(&self, principal: &Vector3<f64>) -> Mat3 {
-        self.n * Mat3::from_diagonal(principal) * self.n.transpose()
+        from_principal(&self.n, principal)
     }
 }
 

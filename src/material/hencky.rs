@@ -40,7 +40,7 @@
 use super::parameters::{FromParameters, KeyError, Parameters};
 use super::{lame, Increment, Material, StressDerivative};
 use crate::dim::Mat3;
-use super::spectral::symmetric_eigen;
+use super::spectral::{from_principal, symmetric_eigen};
 use nalgebra::Vector3;
 
 /// Hencky (logarithmic-strain) hyperelastic solid with Lamé constants from (E, ν).
@@ -72,7 +72,7 @@ impl Spectral {
     /// Hencky strain ε = ½ ln b = Σ ½ ln β_a n_a⊗n_a.
     fn log_strain(&self) -> Mat3 {
         let half_ln = self.m.map(|m| 0.5 * m.ln_1p());
-        self.n * Mat3::from_diagonal(&half_ln) * self.n.transpose()
+        from_principal(&self.n, &half_ln)
     }
 
     /// Principal Hencky strains ln λ_a = ½ ln β_a.

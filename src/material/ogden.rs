@@ -16,6 +16,7 @@
 
 use super::hencky::Spectral;
 use super::parameters::{FromParameters, KeyError, Parameters};
+use super::spectral::from_principal;
 use super::{Increment, Material};
 use crate::dim::Mat3;
 use nalgebra::Vector3;
@@ -71,7 +72,7 @@ impl Ogden {
                 .sum();
             deviatoric + lambda * j.ln()
         });
-        sp.n * Mat3::from_diagonal(&tau) * sp.n.transpose() / j
+        from_principal(&sp.n, &tau) / j
     }
 }
 

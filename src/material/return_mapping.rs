@@ -39,7 +39,7 @@
 
 use super::hencky::log_divided_difference;
 use super::parameters::FromParameters;
-use super::spectral::symmetric_eigen;
+use super::spectral::{from_principal, symmetric_eigen};
 use super::{lame, Increment, Material, Strength, StressDerivative};
 use crate::dim::Mat3;
 use nalgebra::{Matrix3, Vector3};
@@ -124,8 +124,7 @@ impl Trial {
         let j_old = inc.f_old.determinant();
         // b_e,old − I = exp(2 ε_e,old) − I, exact at zero stress.
         let (eps_old, v) = symmetric_eigen(&el.strain_of_stress(&(inc.stress_old * j_old)));
-        let be_old_minus_i =
-            v * Mat3::from_diagonal(&eps_old.map(|e| (2.0 * e).exp_m1())) * v.transpose();
+        let be_old_minus_i = from_principal(&v, &eps_old.map(|e| (2.0 * e).exp_m1()));
         // b_e^tr − I = ΔF (b_e,old − I) ΔFᵀ + (ΔF ΔFᵀ − I), without cancellation.
         let h = inc.df - Mat3::identity();
         let btr_minus_i =
@@ -141,7 +140,7 @@ impl Trial {
     }
 
     fn rotate(&self, principal: &Principal) -> Mat3 {
-        self.n * Mat3::from_diagonal(principal) * self.n.transpose()
+        from_principal(&self.n, principal)
     }
 }
 

@@ -24,6 +24,12 @@ pub fn symmetric_eigen(a: &Mat3) -> (Vector3<f64>, Mat3) {
     (eig.eigenvalues, eig.eigenvectors)
 }
 
+/// The symmetric tensor Σ_a p_a n_a ⊗ n_a with principal values `principal` on
+/// the eigenvectors `n` (its columns).
+pub fn from_principal(n: &Mat3, principal: &Vector3<f64>) -> Mat3 {
+    n * Mat3::from_diagonal(principal) * n.transpose()
+}
+
 /// The rotation (cos, sin) that diagonalises [[p, q], [q, r]] and the two
 /// eigenvalues: the first with eigenvector (cos, −sin), the second with
 /// (sin, cos). t = tan of the angle is the smaller root of t² + 2τt − 1 = 0,

@@ -514,7 +514,7 @@ impl DirectSolver {
                 Default::default(),
             )
             .map(|_| ());
-        drop(work);
+        drop(work); // before the check's solves
         self.chol = Some(sym);
         result.map_err(|e| SolveError::Singular(format!("LLT: {e:?}")))?;
         self.numeric = Numeric::Llt(values);
