@@ -17,6 +17,8 @@ pub struct NeoHookean {
     pub youngs_modulus: f64,
     /// Poisson's ratio ν (small-strain).
     pub poisson_ratio: f64,
+    /// (λ, μ) from (E, ν), formed once: every stress update reads them.
+    lame: (f64, f64),
 }
 
 impl NeoHookean {
@@ -26,12 +28,13 @@ impl NeoHookean {
             density,
             youngs_modulus,
             poisson_ratio,
+            lame: lame(youngs_modulus, poisson_ratio),
         }
     }
 
     /// Lamé constants (λ, μ).
     pub fn lame(&self) -> (f64, f64) {
-        lame(self.youngs_modulus, self.poisson_ratio)
+        self.lame
     }
 
     /// Cauchy stress at total deformation gradient `f`.

@@ -256,34 +256,18 @@ fn update_in_place<const D: usize>(
         ..
     } = p;
     let update = |q: usize, f: &mut Mat3, stress: &mut Mat3, volume: &mut f64, hist: &mut [f64]| {
-        // The material reads the step-start history and writes the new one.
-        let mut kept = [0.0; 8];
-        let old: Vec<f64>;
-        let history_old: &[f64] = match hist.len() <= kept.len() {
-            true => {
-                kept[..hist.len()].copy_from_slice(hist);
-                &kept[..hist.len()]
-            }
-            false => {
-                old = hist.to_vec();
-                &old
-            }
+        let material = materials[material[q] as usize].as_ref();
+        let df = increment(st, map, q, u, axisymmetric);
+        let state = ParticleState {
+            f,
+            stress,
+            volume,
+            history: hist,
         };
-        let inc = Increment {
-            f_old: *f,
-            df: increment(st, map, q, u, axisymmetric),
-            dt,
-            stress_old: *stress,
-            history_old,
-        };
-        let new = advance(
-            materials[material[q] as usize].as_ref(),
-            &inc,
-            volume0[q],
-            hist,
-        );
-        (*stress, *f, *volume) = (new.stress, new.f, new.volume);
-        new.inverted_at(q)
+        match update_particle(material, &df, dt, volume0[q], state) {
+            true => q,
+            false => usize::MAX,
+        }
     };
     let states = f
         .par_iter_mut()
@@ -302,4 +286,49 @@ fn update_in_place<const D: usize>(
     }
     .unwrap_or(usize::MAX);
     (inverted != usize::MAX).then_some(inverted)
+}
+
+/// The mutable state of one particle that a stress update changes.
+pub struct ParticleState<'a> {
+    pub f: &'a mut Mat3,
+    pub stress: &'a mut Mat3,
+    pub volume: &'a mut f64,
+    pub history: &'a mut [f64],
+}
+
+/// One particle's deformation and stress update under ΔF, in place: the
+/// material's stress from the step-start state, F = ΔF F_old, V = det F V0
+/// (2-31, 2-32). True if the deformation inverted (det F ≤ 0, or NaN).
+pub fn update_particle(
+    material: &dyn Material,
+    df: &Mat3,
+    dt: f64,
+    volume0: f64,
+    state: ParticleState,
+) -> bool {
+    // The material reads the step-start history and writes the new one.
+    let hist = state.history;
+    let mut kept = [0.0; 8];
+    let old: Vec<f64>;
+    let history_old: &[f64] = match hist.len() <= kept.len() {
+        true => {
+            kept[..hist.len()].copy_from_slice(hist);
+            &kept[..hist.len()]
+        }
+        false => {
+            old = hist.to_vec();
+            &old
+        }
+    };
+    let inc = Increment {
+        f_old: *state.f,
+        df: *df,
+        dt,
+        stress_old: *state.stress,
+        history_old,
+    };
+    let new = advance(material, &inc, volume0, hist);
+    (*state.stress, *state.f, *state.volume) = (new.stress, new.f, new.volume);
+    // NaN counts as inverted, as in `Advanced::inverted_at`.
+    !(new.det > 0.0)
 }

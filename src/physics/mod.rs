@@ -15,6 +15,7 @@ pub mod mirror;
 pub mod rigid_body;
 pub mod rigid_penalty;
 pub mod rigid_surface;
+pub mod scatter;
 pub mod shape;
 pub mod stress_gradient;
 pub mod transfer;

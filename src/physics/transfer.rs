@@ -10,7 +10,7 @@
 use crate::dim::{restrict, Mat3, Tensor, Vector};
 use crate::model::particles::Particles;
 use crate::model::Model;
-use crate::parallel::MIN_PARALLEL_LEN;
+use crate::parallel::{DisjointSlice, MIN_PARALLEL_LEN};
 use crate::physics::axisymmetry::hoop_gradients;
 use crate::physics::shape::{Owner, ShapeFunction, Stencils};
 use rayon::prelude::*;
@@ -41,26 +41,6 @@ pub struct NodeMap {
 struct BuildScratch {
     /// Per grid node: touched by an entry this step (cleared after the build).
     touched: Vec<AtomicBool>,
-}
-
-/// `NodeMap::entries` as the chunks of `NodeMap::build` fill it in parallel:
-/// each chunk writes only the positions its counts reserved (node a's range
-/// from start[a] + the entries of the chunks before it), so no two threads
-/// write the same element and nothing is read until all have finished. (An
-/// array of atomics would do it safely but needs a second array of the same
-/// size, 4 bytes per stencil entry, and a copy.)
-#[derive(Clone, Copy)]
-struct Placement(*mut u32);
-
-// SAFETY: the writes go to disjoint positions within the vector's length (above).
-unsafe impl Send for Placement {}
-unsafe impl Sync for Placement {}
-
-impl Placement {
-    fn write(self, at: usize, e: u32) {
-        // SAFETY: `at` < entries.len() (a counted position) and is written once.
-        unsafe { self.0.add(at).write(e) }
-    }
 }
 
 impl Clone for BuildScratch {
@@ -144,14 +124,17 @@ impl NodeMap {
         }
         let total = self.start[n] as usize;
         self.entries.resize(total, 0);
-        let (entries, local) = (Placement(self.entries.as_mut_ptr()), &self.local);
+        // Each chunk writes only the positions its counts reserved (node a's
+        // range from start[a] + the entries of the chunks before it).
+        let (entries, local) = (DisjointSlice::new(&mut self.entries), &self.local);
         next.par_chunks_mut(n.max(1))
             .enumerate()
             .for_each(|(c, next)| {
                 for p in c * chunk..((c + 1) * chunk).min(n_particles) {
                     for e in st.range(p) {
                         let a = local[st.node[e] as usize] as usize;
-                        entries.write(next[a] as usize, e as u32);
+                        // SAFETY: a position reserved for this chunk's entry e alone.
+                        unsafe { *entries.at(next[a] as usize) = e as u32 };
                         next[a] += 1;
                     }
                 }

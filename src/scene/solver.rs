@@ -69,6 +69,19 @@ pub enum DirectOrdering {
     Metis,
 }
 
+/// How the explicit step moves values between particles and nodes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize, IntoStaticStr, EnumIter)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum Transfer {
+    /// Particle-side scatter on a box of nodes (`physics::scatter`) where the
+    /// scene allows it, else `Gather`.
+    Auto,
+    /// Node-side gathers through the node map (`physics::transfer`): every
+    /// scene, and the reference the scatter is checked against.
+    Gather,
+}
+
 /// Preconditioner of the Krylov solvers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize, IntoStaticStr, EnumIter)]
 #[serde(rename_all = "snake_case")]
@@ -117,6 +130,8 @@ pub struct SolverConfig {
     /// unless one is given, the other then takes its standard value).
     pub bulk_viscosity_quadratic: Option<f64>,
     pub bulk_viscosity_linear: Option<f64>,
+    /// Explicit transfers (default `auto`).
+    pub transfer: Option<Transfer>,
     // Implicit keys.
     pub integrator: Option<Integrator>,
     pub beta: Option<f64>,
@@ -276,6 +291,7 @@ pub const SCOPES: &[Scope] = &[
     scope!(gravity_ramp_time, EXPLICIT, &[], &[], ""),
     scope!(bulk_viscosity_quadratic, EXPLICIT, &[], &[], ""),
     scope!(bulk_viscosity_linear, EXPLICIT, &[], &[], ""),
+    scope!(transfer, EXPLICIT, &[], &[], ""),
     scope!(integrator, IMPLICIT, &[], &[], ""),
     scope!(beta, IMPLICIT, NEWMARK, &[], ""),
     scope!(gamma, IMPLICIT, NEWMARK, &[], ""),
@@ -380,6 +396,10 @@ impl SolverConfig {
     }
     /// F-bar: per background cell, the particles' volume change is the cell
     /// average (default false). See `fbar`.
+    pub fn transfer(&self) -> Transfer {
+        self.transfer.unwrap_or(Transfer::Auto)
+    }
+
     pub fn fbar(&self) -> bool {
         self.fbar.unwrap_or(false)
     }

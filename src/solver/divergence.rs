@@ -1,6 +1,7 @@
 //! A run that stops early says what happened where: the step, the time and,
 //! where there is one, the particle.
 
+use crate::dim::{Mat3, Vector};
 use crate::model::Model;
 use crate::parallel::MIN_PARALLEL_LEN;
 use rayon::prelude::*;
@@ -38,60 +39,77 @@ pub fn check_state<const D: usize>(m: &Model<D>, step: usize, time: f64) -> Resu
         .into_par_iter()
         .with_min_len(MIN_PARALLEL_LEN)
         .find_first(|&q| {
-            !(p.x[q].iter().all(|v| v.is_finite())
-                && p.v[q].iter().all(|v| v.is_finite())
-                && p.stress[q].iter().all(|v| v.is_finite())
-                && p.f[q].determinant() > 0.0
-                && (m.grid.contains(&p.x[q]) || m.remove_outside)
-                && (!m.axisymmetric || p.x[q][0] > 0.0))
+            let inside = m.grid.contains(&p.x[q]) || m.remove_outside;
+            let off_axis = !m.axisymmetric || p.x[q][0] > 0.0;
+            !sound(&p.x[q], &p.v[q], &p.stress[q], &p.f[q], inside && off_axis)
         });
     match bad {
         None => Ok(()),
-        Some(q) => {
-            let finite = p.x[q]
-                .iter()
-                .chain(p.v[q].iter())
-                .chain(p.stress[q].iter())
-                .all(|v| v.is_finite());
-            let det = p.f[q].determinant();
-            let message = if finite && m.axisymmetric && p.x[q][0] <= 0.0 {
-                format!(
-                    "(body {}) reached the axis: r = {:e} (axisymmetric mode)",
-                    p.body[q], p.x[q][0]
-                )
-            } else if finite && (det.is_nan() || det <= 0.0) {
-                format!(
-                    "(body {}) is inverted or collapsed: det F = {det:e}",
-                    p.body[q]
-                )
-            } else if finite {
-                format!(
-                    "(body {}) left the grid: x = {:?}",
-                    p.body[q],
-                    p.x[q].as_slice()
-                )
-            } else {
-                format!(
-                    "(body {}) has a non-finite state: x = {:?}, v = {:?}",
-                    p.body[q],
-                    p.x[q].as_slice(),
-                    p.v[q].as_slice()
-                )
-            };
-            Err(Divergence {
-                step,
-                time,
-                particle: Some(q),
-                message,
-            })
-        }
+        Some(q) => Err(unsound(m, q, step, time)),
+    }
+}
+
+/// A particle state a run can go on from: finite, det F > 0, and `placed`
+/// (in the grid, off the axis, as the mode requires).
+#[inline(always)]
+pub fn sound<const D: usize>(
+    x: &Vector<D>,
+    v: &Vector<D>,
+    stress: &Mat3,
+    f: &Mat3,
+    placed: bool,
+) -> bool {
+    x.iter().all(|v| v.is_finite())
+        && v.iter().all(|v| v.is_finite())
+        && stress.iter().all(|v| v.is_finite())
+        && f.determinant() > 0.0
+        && placed
+}
+
+/// What went wrong with particle q, which is not `sound`.
+pub fn unsound<const D: usize>(m: &Model<D>, q: usize, step: usize, time: f64) -> Divergence {
+    let p = &m.particles;
+    let finite = p.x[q]
+        .iter()
+        .chain(p.v[q].iter())
+        .chain(p.stress[q].iter())
+        .all(|v| v.is_finite());
+    let det = p.f[q].determinant();
+    let message = if finite && m.axisymmetric && p.x[q][0] <= 0.0 {
+        format!(
+            "(body {}) reached the axis: r = {:e} (axisymmetric mode)",
+            p.body[q], p.x[q][0]
+        )
+    } else if finite && (det.is_nan() || det <= 0.0) {
+        format!(
+            "(body {}) is inverted or collapsed: det F = {det:e}",
+            p.body[q]
+        )
+    } else if finite {
+        format!(
+            "(body {}) left the grid: x = {:?}",
+            p.body[q],
+            p.x[q].as_slice()
+        )
+    } else {
+        format!(
+            "(body {}) has a non-finite state: x = {:?}, v = {:?}",
+            p.body[q],
+            p.x[q].as_slice(),
+            p.v[q].as_slice()
+        )
+    };
+    Divergence {
+        step,
+        time,
+        particle: Some(q),
+        message,
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dim::Mat3;
     use crate::scene::Scene;
 
     const BLOCK: &str = r#"dimension = 2

@@ -14,12 +14,14 @@ use crate::physics::bulk_viscosity::BulkViscosity;
 use crate::physics::contact::{Contact, PairTotal};
 use crate::physics::deformation::Trial;
 use crate::physics::mirror::Mirror;
+use crate::physics::scatter::NodeBox;
 use crate::physics::shape::{ShapeFunction, Stencils};
 use crate::physics::transfer::{
     applied_force, interpolate_two, mass_average, mass_momentum, nodal_force, NodeMap,
 };
-use crate::scene::{Scheme, SolverConfig};
+use crate::scene::{Scheme, SolverConfig, Transfer};
 use crate::solver::divergence::{check_state, Divergence};
+use crate::solver::explicit_scatter::{ScatterStep, Settings};
 use crate::solver::report::SolverReport;
 use crate::solver::stepper::Stepper;
 use rayon::prelude::*;
@@ -48,6 +50,10 @@ pub struct Explicit<const D: usize> {
     contact: Option<Contact<D>>,
     /// Artificial bulk viscosity (`crate::physics::bulk_viscosity`), if asked for.
     pub viscosity: Option<BulkViscosity>,
+    /// `solver.transfer`: `Auto` takes the scatter path where it serves.
+    pub transfer: Transfer,
+    /// The scatter path's buffers (`solver::explicit_scatter`), once it has run.
+    scatter: Option<ScatterStep<D>>,
 }
 
 impl<const D: usize> Explicit<D> {
@@ -68,7 +74,35 @@ impl<const D: usize> Explicit<D> {
             viscosity: s
                 .bulk_viscosity()
                 .map(|(quadratic, linear)| BulkViscosity { quadratic, linear }),
+            transfer: s.transfer(),
+            scatter: None,
         }
+    }
+
+    /// Can this step run on the scatter path (`solver::explicit_scatter`)? Not
+    /// with what needs the node map or per-entry values: CPDI, contact, F-bar,
+    /// bulk viscosity, absorbing faces, axisymmetry, removed particles, the
+    /// mirror of cubic and domain B-splines at faces with prescribed velocity;
+    /// nor USF with the families that read F (cpGIMP, domain B-splines), whose
+    /// second scatter would see the updated F.
+    pub fn scatter_serves(&self, m: &Model<D>) -> bool {
+        let prescribed = m.faces.iter().any(|fc| fc.constraint.fixed.contains(&true));
+        let mirror =
+            self.shape != ShapeFunction::Bspline2 && (2..=3).contains(&m.grid.degree) && prescribed;
+        let reads_f = matches!(
+            self.shape,
+            ShapeFunction::Cpgimp | ShapeFunction::Cpbspline2
+        );
+        self.transfer == Transfer::Auto
+            && NodeBox::<D>::serves(self.shape)
+            && m.contact.is_none()
+            && !self.fbar
+            && self.viscosity.is_none()
+            && m.absorbing.faces.is_empty()
+            && !m.axisymmetric
+            && !m.removes_particles()
+            && !mirror
+            && !(self.scheme == Scheme::Usf && reads_f)
     }
 
     /// Critical time step min_p h / (c_p + |v_p|) (2-45).
@@ -121,6 +155,18 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
     /// Advance the model from t to t + dt. Returns the work done by gravity and
     /// applied loads over the step.
     fn step(&mut self, m: &mut Model<D>, t: f64, dt: f64, step: usize) -> Result<f64, Divergence> {
+        if self.scatter_serves(m) {
+            let settings = Settings {
+                shape: self.shape,
+                scheme: self.scheme,
+                flip: self.flip,
+                damping: self.damping,
+                gravity: m.gravity * self.gravity_ramp.factor(t),
+            };
+            let scatter = self.scatter.get_or_insert_with(ScatterStep::default);
+            return scatter.step(&settings, m, t, dt, step);
+        }
+        self.scatter = None;
         if let (None, Some(plan)) = (&self.contact, &m.contact) {
             self.contact = Some(Contact::new(plan.clone(), m));
         }
@@ -284,7 +330,10 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
     }
 
     fn active_nodes(&self) -> usize {
-        self.map.len()
+        match &self.scatter {
+            Some(s) => s.active,
+            None => self.map.len(),
+        }
     }
 
     fn report(&self) -> SolverReport {
@@ -300,7 +349,7 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
 
 /// Local (non-viscous) damping of a nodal force: f − α |f| sign(v), component by
 /// component, with sign(0) = 0.
-fn local_damping<const D: usize>(f: &Vector<D>, v: &Vector<D>, alpha: f64) -> Vector<D> {
+pub(crate) fn local_damping<const D: usize>(f: &Vector<D>, v: &Vector<D>, alpha: f64) -> Vector<D> {
     let sign = |x: f64| {
         if x > 0.0 {
             1.0

@@ -4,6 +4,7 @@
 
 pub mod divergence;
 pub mod explicit;
+pub mod explicit_scatter;
 pub mod implicit;
 pub mod linear;
 pub mod report;

@@ -7,7 +7,8 @@
 //! abscissae (`grid.node_position`), up to the faces included.
 
 use super::linear::{
-    cell_coordinate, cell_index, moment_product, tensor_product, AxisFactors, MAX_PER_AXIS,
+    cell_coordinate, cell_index, moment_product, per_axis, tensor_product, AxisFactors,
+    MAX_PER_AXIS,
 };
 use crate::dim::{Tensor, Vector};
 use crate::model::grid::Grid;
@@ -29,6 +30,7 @@ fn ratio(num: f64, den: f64) -> f64 {
 /// The p + 1 basis functions that are nonzero on the knot span of `xi` (cell units),
 /// with their derivatives per cell; a point on the max face uses the last span.
 /// Spans whose functions see only unrepeated knots take the uniform polynomials.
+#[inline(always)]
 fn basis(xi: f64, p: usize, cells: usize) -> AxisFactors {
     let first = cell_index(xi, cells);
     if p >= 2 && first >= p && first + p < cells {
@@ -41,6 +43,7 @@ fn basis(xi: f64, p: usize, cells: usize) -> AxisFactors {
 /// The uniform (cardinal) B-splines of degree 2 or 3 that are nonzero on a span
 /// at local coordinate t ∈ [0, 1], and their derivatives per cell (the pieces of
 /// Cox–de Boor on equally spaced knots; e.g. Piegl & Tiller, ex. 2.2 for p = 2).
+#[inline(always)]
 fn uniform_basis(t: f64, first: usize, p: usize) -> AxisFactors {
     let s = 1.0 - t;
     let (weight, slope) = match p {
@@ -77,6 +80,7 @@ fn uniform_basis(t: f64, first: usize, p: usize) -> AxisFactors {
 
 /// The p + 1 basis functions of knot span `first` (cell `first`) at `xi`, which
 /// lies in that span or on its ends (the polynomial pieces agree there).
+#[inline(never)]
 fn basis_in_span(xi: f64, first: usize, p: usize, cells: usize) -> AxisFactors {
     let u = |k: usize| knot(k, p, cells);
     // At degree q, value[r] = N_{first+p−q+r, q}(xi), r = 0..=q (Cox–de Boor, NURBS Book 2.5).
@@ -287,7 +291,7 @@ pub(super) fn domain_axes<const D: usize>(
         grid.degree, degree,
         "the grid must be laid out for this degree"
     );
-    std::array::from_fn(|d| {
+    per_axis(|d| {
         let xi = cell_coordinate(grid, x, d);
         let mut f = domain_basis(xi, half[d] / grid.h[d], degree, grid.cells[d]);
         f.slope.iter_mut().for_each(|s| *s /= grid.h[d]);
@@ -318,6 +322,7 @@ pub fn evaluate<const D: usize>(
 
 /// The B-splines of a particle at `x`, axis by axis, derivatives per physical
 /// length.
+#[inline(always)]
 pub(super) fn axes<const D: usize>(
     grid: &Grid<D>,
     x: &Vector<D>,
@@ -331,12 +336,16 @@ pub(super) fn axes<const D: usize>(
         grid.degree, degree,
         "the grid must be laid out for this degree"
     );
-    std::array::from_fn(|d| {
-        let mut f = basis(cell_coordinate(grid, x, d), degree, grid.cells[d]);
+    // A loop, not `std::array::from_fn`, which the compiler left as a call per
+    // axis in the explicit particle loops (a quarter of the step).
+    let mut axes = [AxisFactors::NONE; D];
+    for (d, f) in axes.iter_mut().enumerate() {
+        *f = basis(cell_coordinate(grid, x, d), degree, grid.cells[d]);
         // Derivatives from cell units to physical units.
-        f.slope[..=degree].iter_mut().for_each(|s| *s /= grid.h[d]);
-        f
-    })
+        let per_length = 1.0 / grid.h[d];
+        f.slope[..=degree].iter_mut().for_each(|s| *s *= per_length);
+    }
+    axes
 }
 
 #[cfg(test)]

@@ -12,8 +12,8 @@
 //! gradient is the clipped-domain average of ∇N_I, not ∂S_I/∂x_p.
 
 use super::linear::{
-    cell_coordinate, cell_index, moment_product, tensor_product, AxisFactors, MomentFactors,
-    MAX_PER_AXIS,
+    cell_coordinate, cell_index, moment_product, per_axis, tensor_product, AxisFactors,
+    MomentFactors, MAX_PER_AXIS,
 };
 use crate::dim::{Tensor, Vector};
 use crate::model::grid::Grid;
@@ -104,7 +104,7 @@ pub(super) fn axes<const D: usize>(
     half: &Vector<D>,
 ) -> [AxisFactors; D] {
     debug_assert_eq!(grid.degree, 1, "GIMP lives on a degree-1 grid");
-    std::array::from_fn(|d| domain_factors(grid, x, half, d))
+    per_axis(|d| domain_factors(grid, x, half, d))
 }
 
 /// Ψ(t) = ∫_{−∞}^t s φ(s) ds, the first moment of the unit hat (piecewise cubic).

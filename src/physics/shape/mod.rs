@@ -10,6 +10,8 @@ pub mod cpdi;
 pub mod gimp;
 pub mod linear;
 
+pub use linear::{AxisFactors, MAX_PER_AXIS};
+
 use crate::dim::{restrict, Mat3, Tensor, Vector};
 use crate::model::grid::Grid;
 pub use crate::scene::ShapeFunction;
@@ -137,7 +139,8 @@ fn slots<const D: usize>(p: usize, per_axis: usize, code: u8) -> [usize; D] {
 
 /// The per-axis factors of a particle for the separable families (all but
 /// CPDI), as `evaluate` forms its tensor product from them.
-fn separable_axes<const D: usize>(
+#[inline(always)]
+pub fn separable_axes<const D: usize>(
     shape: ShapeFunction,
     grid: &Grid<D>,
     x: &Vector<D>,

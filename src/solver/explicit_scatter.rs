@@ -1,0 +1,477 @@
+//! The explicit step with particle-side transfers on a box of nodes
+//! (`physics::scatter`): the step of `solver::explicit` (USF, USL, MUSL; the
+//! PIC/FLIP blend, local damping, face conditions, friction faces, gravity and
+//! loads) without a node map or stored stencils. Each particle pass evaluates
+//! the particle's 1D factors again, which costs less than storing the tensor
+//! product and reading it back through a map.
+//!
+//! USL takes one scatter (mass, momentum, force), one pass over the nodes and
+//! one over the particles (G2P, ΔF = I + Δt L, the stress). USF and MUSL add a
+//! scatter and a particle pass each. `Explicit` chooses this path for the
+//! scenes it serves (`Explicit::scatter_serves`).
+
+use crate::dim::{embed_deformation, Mat3, Tensor, Vector};
+use crate::model::conditions::Constraint;
+use crate::model::particles::Particles;
+use crate::model::{load_factor, Model};
+use crate::physics::boundary::{friction_contact, node_constraint, node_friction};
+use crate::physics::deformation::{update_particle, ParticleState};
+use crate::physics::scatter::NodeBox;
+use crate::physics::shape::ShapeFunction;
+use crate::scene::Scheme;
+use crate::solver::divergence::{sound, unsound, Divergence};
+use crate::solver::explicit::{local_damping, TINY_MASS_FRACTION};
+use rayon::prelude::*;
+
+/// Particles per task of a particle pass: the chunking of
+/// `parallel::deterministic_sum`, so the work of the loads sums the same on
+/// any number of threads.
+const CHUNK: usize = 4096;
+
+/// What a box node gathers. After the node pass: `momentum` holds the updated
+/// velocity and `force` the acceleration.
+#[derive(Clone, Copy, Debug)]
+struct Node<const D: usize> {
+    mass: f64,
+    momentum: Vector<D>,
+    force: Vector<D>,
+}
+
+impl<const D: usize> Node<D> {
+    fn zero() -> Self {
+        Node {
+            mass: 0.0,
+            momentum: Vector::<D>::zeros(),
+            force: Vector::<D>::zeros(),
+        }
+    }
+}
+
+/// The settings of the step that the passes read.
+#[derive(Clone, Copy)]
+pub struct Settings<D> {
+    pub shape: ShapeFunction,
+    pub scheme: Scheme,
+    pub flip: f64,
+    pub damping: f64,
+    pub gravity: D,
+}
+
+/// The buffers of the scatter path, kept between steps.
+#[derive(Clone, Debug, Default)]
+pub struct ScatterStep<const D: usize> {
+    nb: NodeBox<D>,
+    nodes: Vec<Node<D>>,
+    /// USF: the step-start nodal velocity with the conditions applied. MUSL:
+    /// the remapped momentum, then velocity.
+    second: Vec<Vector<D>>,
+    /// Nodes with mass in the last step.
+    pub active: usize,
+}
+
+/// A face node's conditions: its constraint and the friction faces it lies on.
+struct Conditions<const D: usize> {
+    constraint: Constraint<D>,
+    friction: Vec<u8>,
+}
+
+impl<const D: usize> ScatterStep<D> {
+    /// Advance the model from t to t + dt (`Stepper::step`); returns the work
+    /// of gravity and applied loads over the step.
+    pub fn step(
+        &mut self,
+        s: &Settings<Vector<D>>,
+        m: &mut Model<D>,
+        t: f64,
+        dt: f64,
+        step: usize,
+    ) -> Result<f64, Divergence> {
+        let p = &m.particles;
+        self.nb.locate(s.shape, &m.grid, &p.x);
+        self.nodes.clear();
+        self.nodes.resize(self.nb.nodes(), Node::zero());
+        let scales = m.load_scales(t);
+        let tiny = TINY_MASS_FRACTION * p.mass.iter().cloned().fold(f64::INFINITY, f64::min);
+        // P2G: mass (2-24), momentum (2-25) and, but in USF, the force (2-51, 2-52).
+        match s.scheme {
+            Scheme::Usf => self.scatter::<true, false>(s, m, &scales),
+            _ => self.scatter::<true, true>(s, m, &scales),
+        }
+        let work = match s.scheme {
+            Scheme::Usl => {
+                self.node_pass(m, false, s.damping, tiny, dt);
+                self.particle_pass(s, m, t, dt, step, Pass::Full, &scales)?
+            }
+            Scheme::Usf => {
+                self.start_velocity(m);
+                self.particle_pass(s, m, t, dt, step, Pass::Stress, &scales)?;
+                self.scatter::<false, true>(s, m, &scales);
+                self.node_pass(m, true, s.damping, tiny, dt);
+                self.particle_pass(s, m, t, dt, step, Pass::Motion, &scales)?
+            }
+            Scheme::Musl => {
+                self.node_pass(m, false, s.damping, tiny, dt);
+                let work = self.particle_pass(s, m, t, dt, step, Pass::Velocity, &scales)?;
+                // Map the updated particle momentum back and use that velocity.
+                let p = &m.particles;
+                self.second.clear();
+                self.second.resize(self.nodes.len(), Vector::<D>::zeros());
+                let source = |q: usize| p.v[q] * p.mass[q];
+                let add = |n: &mut Vector<D>, s: &Vector<D>, w: f64, _: &Vector<D>| *n += s * w;
+                self.nb
+                    .scatter(s.shape, &m.grid, p, &mut self.second, source, add);
+                self.remapped_velocity(m);
+                self.particle_pass(s, m, t, dt, step, Pass::Remapped, &scales)?;
+                work
+            }
+        };
+        Ok(work)
+    }
+
+    /// P2G into the nodes: mass and momentum (`MOTION`), the force
+    /// f_ext − f_int = Σ S_I (m g + s f) − V σ ∇S_I (`FORCE`).
+    fn scatter<const MOTION: bool, const FORCE: bool>(
+        &mut self,
+        s: &Settings<Vector<D>>,
+        m: &Model<D>,
+        scales: &[f64],
+    ) {
+        let p = &m.particles;
+        let source = |q: usize| {
+            let applied = match FORCE {
+                true => s.gravity * p.mass[q] + p.load[q] * load_factor(&m.load_ramp_of, q, scales),
+                false => Vector::<D>::zeros(),
+            };
+            let stress = crate::dim::restrict::<D>(&p.stress[q]) * p.volume[q];
+            (p.mass[q], p.v[q] * p.mass[q], applied, stress)
+        };
+        let add =
+            |n: &mut Node<D>, s: &(f64, Vector<D>, Vector<D>, Tensor<D>), w: f64, g: &Vector<D>| {
+                if MOTION {
+                    n.mass += s.0 * w;
+                    n.momentum += s.1 * w;
+                }
+                if FORCE {
+                    n.force += s.2 * w - s.3 * g;
+                }
+            };
+        self.nb
+            .scatter(s.shape, &m.grid, p, &mut self.nodes, source, add);
+    }
+
+    /// The conditions of box node b at grid multi-index `ijk`, `None` for a
+    /// node on no grid face (most nodes).
+    fn conditions(m: &Model<D>, ijk: [usize; D]) -> Option<Conditions<D>> {
+        let grid = &m.grid;
+        if !(0..D).any(|d| ijk[d] == 0 || ijk[d] + 1 == grid.nodes[d]) {
+            return None;
+        }
+        let g = grid.node_index(ijk);
+        Some(Conditions {
+            constraint: node_constraint(grid, &m.faces, g),
+            friction: node_friction(grid, &m.friction, g),
+        })
+    }
+
+    /// v = p/m on a node with mass (2-25), with its conditions applied.
+    fn velocity(m: &Model<D>, raw: &Vector<D>, c: &Option<Conditions<D>>) -> Vector<D> {
+        let mut v = *raw;
+        if let Some(c) = c {
+            c.constraint.apply_velocity(&mut v);
+            if !c.friction.is_empty() {
+                v = friction_contact(&m.friction, &c.friction, &c.constraint, &v);
+            }
+        }
+        v
+    }
+
+    /// Calls `f(node, second, grid multi-index)` for every box node, in
+    /// parallel over the box's x-rows; sets `active` to the nodes with mass.
+    fn for_nodes(&mut self, f: impl Fn(&mut Node<D>, &mut Vector<D>, [usize; D]) + Sync) {
+        let (nb, row) = (&self.nb, self.nb.row_len().max(1));
+        self.second.resize(self.nodes.len(), Vector::<D>::zeros());
+        self.active = (self.nodes.par_chunks_mut(row))
+            .zip(self.second.par_chunks_mut(row))
+            .enumerate()
+            .map(|(r, (nodes, second))| {
+                let mut ijk = nb.grid_ijk(r * row);
+                let mut with_mass = 0;
+                for (n, s) in nodes.iter_mut().zip(second) {
+                    f(n, s, ijk);
+                    with_mass += (n.mass > 0.0) as usize;
+                    ijk[0] += 1;
+                }
+                with_mass
+            })
+            .sum();
+    }
+
+    /// The grid update (2-23, 2-29): acceleration from the force with local
+    /// damping (no acceleration on nodes lighter than `tiny`), prescribed
+    /// components landing on their value, friction faces on the updated
+    /// velocity. Leaves the updated velocity in `momentum` and the
+    /// acceleration in `force`. USF (`usf`): `momentum` already holds p/m and
+    /// `second` the constrained velocity.
+    fn node_pass(&mut self, m: &Model<D>, usf: bool, damping: f64, tiny: f64, dt: f64) {
+        self.for_nodes(|n, second, ijk| {
+            let c = Self::conditions(m, ijk);
+            let (raw, v) = match usf {
+                true => (n.momentum, *second),
+                false => {
+                    let raw = mass_average(n.mass, &n.momentum);
+                    (raw, Self::velocity(m, &raw, &c))
+                }
+            };
+            let mut acc = match n.mass > tiny {
+                true => local_damping(&n.force, &v, damping) / n.mass,
+                false => Vector::<D>::zeros(),
+            };
+            if let Some(c) = &c {
+                for d in (0..D).filter(|&d| c.constraint.fixed[d]) {
+                    acc[d] = (c.constraint.value[d] - raw[d]) / dt;
+                }
+            }
+            let mut v_new = raw + acc * dt;
+            if let Some(c) = c.as_ref().filter(|c| !c.friction.is_empty()) {
+                v_new = friction_contact(&m.friction, &c.friction, &c.constraint, &v_new);
+                acc = (v_new - raw) / dt;
+            }
+            (n.momentum, n.force) = (v_new, acc);
+        });
+    }
+
+    /// USF: p/m into `momentum`, and the velocity with the conditions into `second`.
+    fn start_velocity(&mut self, m: &Model<D>) {
+        self.for_nodes(|n, second, ijk| {
+            n.momentum = mass_average(n.mass, &n.momentum);
+            *second = Self::velocity(m, &n.momentum, &Self::conditions(m, ijk));
+        });
+    }
+
+    /// MUSL: the remapped momentum in `second` becomes the velocity with the
+    /// conditions.
+    fn remapped_velocity(&mut self, m: &Model<D>) {
+        self.for_nodes(|n, second, ijk| {
+            let raw = mass_average(n.mass, second);
+            *second = Self::velocity(m, &raw, &Self::conditions(m, ijk));
+        });
+    }
+
+    /// One pass over the particles (`Pass`), in fixed chunks; returns the work
+    /// of the applied forces over the step (passes that move the particles).
+    #[allow(clippy::too_many_arguments)]
+    fn particle_pass(
+        &self,
+        s: &Settings<Vector<D>>,
+        m: &mut Model<D>,
+        t: f64,
+        dt: f64,
+        step: usize,
+        pass: Pass,
+        scales: &[f64],
+    ) -> Result<f64, Divergence> {
+        let (nb, nodes, second) = (&self.nb, &self.nodes[..], &self.second[..]);
+        let (grid, materials, ramp_of) = (&m.grid, &m.materials, &m.load_ramp_of);
+        let Particles {
+            x,
+            v,
+            f,
+            stress,
+            volume,
+            history,
+            mass,
+            volume0,
+            half_length0,
+            load,
+            material,
+            ..
+        } = &mut m.particles;
+        let (mass, volume0, half_length0, load, material) =
+            (&*mass, &*volume0, &*half_length0, &*load, &*material);
+        let applied = |q: usize| s.gravity * mass[q] + load[q] * load_factor(ramp_of, q, scales);
+        // The last pass checks the state, as `check_state` does after a step.
+        let checks = matches!(pass, Pass::Full | Pass::Motion | Pass::Remapped);
+        let body = |q: usize, state: Moving<D>| -> (f64, bool, bool) {
+            let sc = nb.stencil(s.shape, grid, state.x, &half_length0[q], state.f);
+            let (vp, a, l) = match (pass, sc) {
+                (_, None) => (
+                    Vector::<D>::zeros(),
+                    Vector::<D>::zeros(),
+                    Tensor::<D>::zeros(),
+                ),
+                (Pass::Full, Some(sc)) => gather::<D, true, 1>(&sc, nb, nodes, second),
+                (Pass::Stress, Some(sc)) => gather::<D, false, 2>(&sc, nb, nodes, second),
+                (Pass::Motion | Pass::Velocity, Some(sc)) => {
+                    gather::<D, true, 0>(&sc, nb, nodes, second)
+                }
+                (Pass::Remapped, Some(sc)) => gather::<D, true, 2>(&sc, nb, nodes, second),
+            };
+            let mut work = 0.0;
+            if matches!(pass, Pass::Full | Pass::Motion | Pass::Velocity) {
+                // PIC/FLIP blend (2-27); the applied forces' work over the step.
+                let v_old = *state.v;
+                *state.v = (v_old + a * dt) * s.flip + vp * (1.0 - s.flip);
+                work = applied(q).dot(&(v_old + *state.v)) * 0.5;
+            }
+            if matches!(pass, Pass::Full | Pass::Motion | Pass::Remapped) {
+                // x ← x + Δt v_PIC (2-26).
+                *state.x += vp * dt;
+            }
+            let mut inverted = false;
+            if matches!(pass, Pass::Full | Pass::Stress | Pass::Remapped) {
+                // ΔF = I + Δt L (2-31).
+                let df = embed_deformation::<D>(&(Tensor::<D>::identity() + l * dt));
+                let particle = ParticleState {
+                    f: &mut *state.f,
+                    stress: &mut *state.stress,
+                    volume: &mut *state.volume,
+                    history: &mut *state.history,
+                };
+                let law = materials[material[q] as usize].as_ref();
+                inverted = update_particle(law, &df, dt, volume0[q], particle);
+            }
+            let bad = checks
+                && !sound(
+                    state.x,
+                    state.v,
+                    state.stress,
+                    state.f,
+                    grid.contains(state.x),
+                );
+            (work, inverted, bad)
+        };
+        let chunk = |c: usize,
+                     xs: &mut [Vector<D>],
+                     vs: &mut [Vector<D>],
+                     fs: &mut [Mat3],
+                     ss: &mut [Mat3],
+                     vols: &mut [f64],
+                     mut hs: Option<&mut [&mut [f64]]>| {
+            let (mut work, mut inverted, mut bad) = (0.0, usize::MAX, usize::MAX);
+            for i in 0..xs.len() {
+                let history: &mut [f64] = match &mut hs {
+                    Some(hs) => hs[i],
+                    None => &mut [],
+                };
+                let state = Moving {
+                    x: &mut xs[i],
+                    v: &mut vs[i],
+                    f: &mut fs[i],
+                    stress: &mut ss[i],
+                    volume: &mut vols[i],
+                    history,
+                };
+                let q = c * CHUNK + i;
+                let (w, inverts, unsound) = body(q, state);
+                work += w;
+                if inverts {
+                    inverted = inverted.min(q);
+                }
+                if unsound {
+                    bad = bad.min(q);
+                }
+            }
+            (work, inverted, bad)
+        };
+        let chunks = (x.par_chunks_mut(CHUNK))
+            .zip(v.par_chunks_mut(CHUNK))
+            .zip(f.par_chunks_mut(CHUNK))
+            .zip(stress.par_chunks_mut(CHUNK))
+            .zip(volume.par_chunks_mut(CHUNK))
+            .enumerate();
+        let per_chunk: Vec<(f64, usize, usize)> = match history.data.is_empty() {
+            true => chunks
+                .map(|(c, ((((xs, vs), fs), ss), vols))| chunk(c, xs, vs, fs, ss, vols, None))
+                .collect(),
+            false => {
+                let mut slots = history.own_slots_mut();
+                chunks
+                    .zip(slots.par_chunks_mut(CHUNK))
+                    .map(|((c, ((((xs, vs), fs), ss), vols)), hs)| {
+                        chunk(c, xs, vs, fs, ss, vols, Some(hs))
+                    })
+                    .collect()
+            }
+        };
+        let work: f64 = per_chunk.iter().map(|c| c.0).sum();
+        let first = |k: fn(&(f64, usize, usize)) -> usize| per_chunk.iter().map(k).min();
+        if let Some(q) = first(|c| c.1).filter(|&q| q != usize::MAX) {
+            return Err(Divergence {
+                step: step + 1,
+                time: t + dt,
+                particle: Some(q),
+                message: format!(
+                    "inverted: det F = {:.3e} ≤ 0",
+                    m.particles.f[q].determinant()
+                ),
+            });
+        }
+        if let Some(q) = first(|c| c.2).filter(|&q| q != usize::MAX) {
+            return Err(unsound(m, q, step + 1, t + dt));
+        }
+        Ok(work * dt)
+    }
+}
+
+/// What one particle pass does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Pass {
+    /// USL: G2P (velocity and position) and the stress from the updated velocity.
+    Full,
+    /// USF: the stress from the step-start velocity (`second`).
+    Stress,
+    /// USF: G2P.
+    Motion,
+    /// MUSL: the particle velocity only (positions move in `Remapped`).
+    Velocity,
+    /// MUSL: the position, and the stress from the remapped velocity (`second`).
+    Remapped,
+}
+
+/// The state of one particle that a pass changes.
+struct Moving<'a, const D: usize> {
+    x: &'a mut Vector<D>,
+    v: &'a mut Vector<D>,
+    f: &'a mut Mat3,
+    stress: &'a mut Mat3,
+    volume: &'a mut f64,
+    history: &'a mut [f64],
+}
+
+/// A particle's Σ S_I v_I and Σ S_I a_I from the updated nodes (`MOTION`), and
+/// L = Σ v_I ⊗ ∇S_I from the updated velocity (`GRAD` = 1) or from `second`
+/// (`GRAD` = 2).
+#[inline(always)]
+fn gather<const D: usize, const MOTION: bool, const GRAD: u8>(
+    sc: &crate::physics::scatter::Stencil<D>,
+    nb: &NodeBox<D>,
+    nodes: &[Node<D>],
+    second: &[Vector<D>],
+) -> (Vector<D>, Vector<D>, Tensor<D>) {
+    let (mut vp, mut a, mut l) = (
+        Vector::<D>::zeros(),
+        Vector::<D>::zeros(),
+        Tensor::<D>::zeros(),
+    );
+    sc.for_each(&nb.stride, |b, w, g| {
+        let n = &nodes[b];
+        if MOTION {
+            vp += n.momentum * w;
+            a += n.force * w;
+        }
+        match GRAD {
+            1 => l += n.momentum * g.transpose(),
+            2 => l += second[b] * g.transpose(),
+            _ => {}
+        }
+    });
+    (vp, a, l)
+}
+
+/// p/m on a node with mass, else zero (2-25).
+fn mass_average<const D: usize>(mass: f64, momentum: &Vector<D>) -> Vector<D> {
+    match mass > 0.0 {
+        true => momentum / mass,
+        false => Vector::<D>::zeros(),
+    }
+}
