@@ -11,6 +11,7 @@ pub mod deformation;
 pub mod fbar;
 pub mod field_split;
 pub mod geostatic;
+pub mod grid_update;
 pub mod mirror;
 pub mod rigid_body;
 pub mod rigid_penalty;

@@ -13,6 +13,7 @@ use crate::physics::boundary::{friction_contact, node_constraint, node_friction}
 use crate::physics::bulk_viscosity::BulkViscosity;
 use crate::physics::contact::{Contact, PairTotal};
 use crate::physics::deformation::Trial;
+use crate::physics::grid_update::{local_damping, TINY_MASS_FRACTION};
 use crate::physics::mirror::Mirror;
 use crate::physics::scatter::NodeBox;
 use crate::physics::shape::{ShapeFunction, Stencils};
@@ -25,11 +26,6 @@ use crate::solver::explicit_scatter::{ScatterStep, Settings};
 use crate::solver::report::SolverReport;
 use crate::solver::stepper::Stepper;
 use rayon::prelude::*;
-
-/// Nodes lighter than this fraction of the lightest particle get no acceleration:
-/// f_I/m_I is ill-conditioned there (f_I need not vanish with m_I), while the
-/// velocity p_I/m_I, a mass-weighted average of particle velocities, is always kept.
-pub const TINY_MASS_FRACTION: f64 = 1e-9;
 
 pub struct Explicit<const D: usize> {
     pub shape: ShapeFunction,
@@ -345,21 +341,6 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
             .as_mut()
             .map_or_else(Vec::new, |c| c.take_totals())
     }
-}
-
-/// Local (non-viscous) damping of a nodal force: f − α |f| sign(v), component by
-/// component, with sign(0) = 0.
-pub(crate) fn local_damping<const D: usize>(f: &Vector<D>, v: &Vector<D>, alpha: f64) -> Vector<D> {
-    let sign = |x: f64| {
-        if x > 0.0 {
-            1.0
-        } else if x < 0.0 {
-            -1.0
-        } else {
-            0.0
-        }
-    };
-    Vector::<D>::from_fn(|d, _| f[d] - alpha * f[d].abs() * sign(v[d]))
 }
 
 /// Nodal velocities with the prescribed components imposed.

@@ -16,11 +16,11 @@ use crate::model::particles::Particles;
 use crate::model::{load_factor, Model};
 use crate::physics::boundary::{friction_contact, node_constraint, node_friction};
 use crate::physics::deformation::{update_particle, ParticleState};
+use crate::physics::grid_update::{local_damping, TINY_MASS_FRACTION};
 use crate::physics::scatter::NodeBox;
 use crate::physics::shape::ShapeFunction;
 use crate::scene::Scheme;
 use crate::solver::divergence::{sound, unsound, Divergence};
-use crate::solver::explicit::{local_damping, TINY_MASS_FRACTION};
 use rayon::prelude::*;
 
 /// Particles per task of a particle pass: the chunking of
