@@ -330,5 +330,5 @@ pub fn update_particle(
     let new = advance(material, &inc, volume0, hist);
     (*state.stress, *state.f, *state.volume) = (new.stress, new.f, new.volume);
     // NaN counts as inverted, as in `Advanced::inverted_at`.
-    !(new.det > 0.0)
+    new.inverted_at(0) == 0
 }

@@ -23,7 +23,7 @@ use crate::physics::transfer::{
 use crate::scene::{Scheme, SolverConfig, Transfer};
 use crate::solver::divergence::{check_state, Divergence};
 use crate::solver::explicit_scatter::{ScatterStep, Settings};
-use crate::solver::report::SolverReport;
+use crate::solver::report::{SolverReport, TransferPath};
 use crate::solver::stepper::Stepper;
 use rayon::prelude::*;
 
@@ -333,7 +333,11 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
     }
 
     fn report(&self) -> SolverReport {
-        SolverReport::explicit(self.scheme)
+        let transfer = match self.scatter {
+            Some(_) => TransferPath::Scatter,
+            None => TransferPath::Gather,
+        };
+        SolverReport::explicit(self.scheme, transfer)
     }
 
     fn take_contact(&mut self) -> Vec<PairTotal<D>> {

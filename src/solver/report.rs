@@ -38,6 +38,9 @@ pub struct SolverReport {
     pub solver: SolverKind,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scheme: Option<Scheme>,
+    /// How the last explicit step moved values between particles and nodes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub transfer: Option<TransferPath>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub integrator: Option<Integrator>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -86,12 +89,23 @@ pub struct MultigridCounts {
     pub largest_coarse_unknowns: usize,
 }
 
+/// The transfers an explicit step took (`solver.transfer`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TransferPath {
+    /// Particle-side scatter on a box of nodes (`solver::explicit_scatter`).
+    Scatter,
+    /// Node-side gathers through the node map.
+    Gather,
+}
+
 impl SolverReport {
     /// An explicit stage.
-    pub fn explicit(scheme: Scheme) -> SolverReport {
+    pub fn explicit(scheme: Scheme, transfer: TransferPath) -> SolverReport {
         SolverReport {
             solver: SolverKind::Explicit,
             scheme: Some(scheme),
+            transfer: Some(transfer),
             integrator: None,
             newton_iterations: None,
             cutbacks: None,

@@ -16,3 +16,4 @@ mod restart;
 mod signals;
 mod stability;
 mod threads;
+mod transfers;

@@ -223,6 +223,7 @@ impl<const D: usize> Stepper<D> for Implicit<D> {
         SolverReport {
             solver: SolverKind::Implicit,
             scheme: None,
+            transfer: None,
             integrator: Some(self.settings.integrator),
             newton_iterations: Some(self.newton.iterations),
             cutbacks: Some(self.cutbacks),
