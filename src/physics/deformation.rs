@@ -264,9 +264,10 @@ fn update_in_place<const D: usize>(
             volume,
             history: hist,
         };
-        match update_particle(material, &df, dt, volume0[q], state) {
-            true => q,
-            false => usize::MAX,
+        // NaN counts as inverted, as in `Advanced::inverted_at`.
+        match update_particle(material, &df, dt, volume0[q], state) > 0.0 {
+            true => usize::MAX,
+            false => q,
         }
     };
     let states = f
@@ -298,19 +299,20 @@ pub struct ParticleState<'a> {
 
 /// One particle's deformation and stress update under ΔF, in place: the
 /// material's stress from the step-start state, F = ΔF F_old, V = det F V0
-/// (2-31, 2-32). True if the deformation inverted (det F ≤ 0, or NaN).
+/// (2-31, 2-32). Returns det F (the deformation inverted unless det F > 0).
 pub fn update_particle(
     material: &dyn Material,
     df: &Mat3,
     dt: f64,
     volume0: f64,
     state: ParticleState,
-) -> bool {
+) -> f64 {
     // The material reads the step-start history and writes the new one.
     let hist = state.history;
     let mut kept = [0.0; 8];
     let old: Vec<f64>;
     let history_old: &[f64] = match hist.len() <= kept.len() {
+        _ if hist.is_empty() => &[],
         true => {
             kept[..hist.len()].copy_from_slice(hist);
             &kept[..hist.len()]
@@ -329,6 +331,5 @@ pub fn update_particle(
     };
     let new = advance(material, &inc, volume0, hist);
     (*state.stress, *state.f, *state.volume) = (new.stress, new.f, new.volume);
-    // NaN counts as inverted, as in `Advanced::inverted_at`.
-    new.inverted_at(0) == 0
+    new.det
 }

@@ -41,7 +41,13 @@ pub fn check_state<const D: usize>(m: &Model<D>, step: usize, time: f64) -> Resu
         .find_first(|&q| {
             let inside = m.grid.contains(&p.x[q]) || m.remove_outside;
             let off_axis = !m.axisymmetric || p.x[q][0] > 0.0;
-            !sound(&p.x[q], &p.v[q], &p.stress[q], &p.f[q], inside && off_axis)
+            !sound(
+                &p.x[q],
+                &p.v[q],
+                &p.stress[q],
+                p.f[q].determinant(),
+                inside && off_axis,
+            )
         });
     match bad {
         None => Ok(()),
@@ -56,13 +62,13 @@ pub fn sound<const D: usize>(
     x: &Vector<D>,
     v: &Vector<D>,
     stress: &Mat3,
-    f: &Mat3,
+    det_f: f64,
     placed: bool,
 ) -> bool {
     x.iter().all(|v| v.is_finite())
         && v.iter().all(|v| v.is_finite())
         && stress.iter().all(|v| v.is_finite())
-        && f.determinant() > 0.0
+        && det_f > 0.0
         && placed
 }
 

@@ -317,27 +317,26 @@ impl<const D: usize> ScatterStep<D> {
                 // x ← x + Δt v_PIC (2-26).
                 *state.x += vp * dt;
             }
-            let mut inverted = false;
-            if matches!(pass, Pass::Full | Pass::Stress | Pass::Remapped) {
-                // ΔF = I + Δt L (2-31).
-                let df = embed_deformation::<D>(&(Tensor::<D>::identity() + l * dt));
-                let particle = ParticleState {
-                    f: &mut *state.f,
-                    stress: &mut *state.stress,
-                    volume: &mut *state.volume,
-                    history: &mut *state.history,
-                };
-                let law = materials[material[q] as usize].as_ref();
-                inverted = update_particle(law, &df, dt, volume0[q], particle);
-            }
-            let bad = checks
-                && !sound(
-                    state.x,
-                    state.v,
-                    state.stress,
-                    state.f,
-                    grid.contains(state.x),
-                );
+            // det F of the updated state: from the stress update, or formed.
+            let det = match matches!(pass, Pass::Full | Pass::Stress | Pass::Remapped) {
+                true => {
+                    // ΔF = I + Δt L (2-31).
+                    let df = embed_deformation::<D>(&(Tensor::<D>::identity() + l * dt));
+                    let particle = ParticleState {
+                        f: &mut *state.f,
+                        stress: &mut *state.stress,
+                        volume: &mut *state.volume,
+                        history: &mut *state.history,
+                    };
+                    let law = materials[material[q] as usize].as_ref();
+                    update_particle(law, &df, dt, volume0[q], particle)
+                }
+                false if checks => state.f.determinant(),
+                false => 1.0,
+            };
+            // NaN counts as inverted, as in `check_state`.
+            let inverted = !(det > 0.0);
+            let bad = checks && !sound(state.x, state.v, state.stress, det, grid.contains(state.x));
             (work, inverted, bad)
         };
         let chunk = |c: usize,
