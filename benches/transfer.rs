@@ -4,11 +4,16 @@
 //! P2G = shape-function evaluation + active-node map + nodal mass, momentum and
 //! force. G2P = interpolation of nodal velocity and acceleration to particles and
 //! the velocity gradient (what the explicit step does per particle).
+//! `scatter_p2g` and `scatter_g2p` are the same work on the explicit step's box
+//! of nodes (`physics::scatter`, the families it serves): the box and the tile
+//! order, the coloured scatter of mass, momentum and force; the 1D factors
+//! evaluated again per particle and the same three sums.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use mpm::dim::{Mat3, Tensor, Vector};
+use mpm::dim::{restrict, Mat3, Tensor, Vector};
 use mpm::model::grid::Grid;
 use mpm::model::particles::Particles;
+use mpm::physics::scatter::NodeBox;
 use mpm::physics::shape::{ShapeFunction, Stencils};
 use mpm::physics::transfer::{gradient, interpolate, mass_momentum, nodal_force, NodeMap};
 use rayon::prelude::*;
@@ -103,8 +108,77 @@ fn bench_dim<const D: usize>(c: &mut Criterion, n: usize) {
                     .sum::<f64>()
             })
         });
+        if NodeBox::<D>::serves(shape) {
+            scatter_benches(&mut group, shape, &grid, &p);
+        }
     }
     group.finish();
+}
+
+/// `scatter_p2g` and `scatter_g2p` of one family (module doc).
+fn scatter_benches<const D: usize>(
+    group: &mut criterion::BenchmarkGroup<criterion::measurement::WallTime>,
+    shape: ShapeFunction,
+    grid: &Grid<D>,
+    p: &Particles<D>,
+) {
+    let mut nb = NodeBox::<D>::default();
+    let mut nodes: Vec<(f64, Vector<D>, Vector<D>)> = Vec::new();
+    let gravity = Vector::<D>::zeros();
+    group.bench_with_input(
+        BenchmarkId::new("scatter_p2g", shape.name()),
+        &shape,
+        |b, &shape| {
+            b.iter(|| {
+                nb.locate(shape, grid, &p.x);
+                nodes.clear();
+                nodes.resize(
+                    nb.nodes(),
+                    (0.0, Vector::<D>::zeros(), Vector::<D>::zeros()),
+                );
+                let source = |q: usize| {
+                    let stress: Tensor<D> = restrict::<D>(&p.stress[q]) * p.volume[q];
+                    (p.mass[q], p.v[q] * p.mass[q], gravity * p.mass[q], stress)
+                };
+                nb.scatter(shape, grid, p, &mut nodes, source, |n, s, w, g| {
+                    n.0 += s.0 * w;
+                    n.1 += s.1 * w;
+                    n.2 += s.2 * w - s.3 * g;
+                });
+                nodes.len()
+            })
+        },
+    );
+    nb.locate(shape, grid, &p.x);
+    let nodal: Vec<Vector<D>> = (0..nb.nodes())
+        .map(|b| Vector::<D>::repeat(b as f64 * 1e-3))
+        .collect();
+    group.bench_with_input(
+        BenchmarkId::new("scatter_g2p", shape.name()),
+        &shape,
+        |b, &shape| {
+            b.iter(|| {
+                (0..p.len())
+                    .into_par_iter()
+                    .map(|q| {
+                        let st = nb.stencil(shape, grid, &p.x[q], &p.half_length0[q], &p.f[q]);
+                        let (mut v, mut a, mut l) = (
+                            Vector::<D>::zeros(),
+                            Vector::<D>::zeros(),
+                            Tensor::<D>::zeros(),
+                        );
+                        st.expect("inside the grid")
+                            .for_each(&nb.stride, |b, w, g| {
+                                v += nodal[b] * w;
+                                a += nodal[b] * w;
+                                l += nodal[b] * g.transpose();
+                            });
+                        v.sum() + a.sum() + l.trace()
+                    })
+                    .sum::<f64>()
+            })
+        },
+    );
 }
 
 /// P2G split into its parts (2D, linear and CPDI): shape-function evaluation, the

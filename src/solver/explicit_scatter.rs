@@ -335,7 +335,8 @@ impl<const D: usize> ScatterStep<D> {
                 false => 1.0,
             };
             // NaN counts as inverted, as in `check_state`.
-            let inverted = !(det > 0.0);
+            let intact = det > 0.0;
+            let inverted = !intact;
             let bad = checks && !sound(state.x, state.v, state.stress, det, grid.contains(state.x));
             (work, inverted, bad)
         };

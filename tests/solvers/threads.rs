@@ -79,7 +79,7 @@ fn scatter_runs_give_identical_results_on_one_and_two_threads() {
         let run = |threads: usize| {
             let overrides = [
                 format!("solver.scheme=\"{scheme}\""),
-                "solver.end_time=0.02".to_string(),
+                "solver.end_time=0.004".to_string(),
                 "grid.cells=[320,100]".to_string(),
                 "output.frames=0".to_string(),
             ];
