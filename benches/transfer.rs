@@ -13,7 +13,7 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Through
 use mpm::dim::{restrict, Mat3, Tensor, Vector};
 use mpm::model::grid::Grid;
 use mpm::model::particles::Particles;
-use mpm::physics::scatter::NodeBox;
+use mpm::physics::scatter::{NodeBox, Points};
 use mpm::physics::shape::{ShapeFunction, Stencils};
 use mpm::physics::transfer::{gradient, interpolate, mass_momentum, nodal_force, NodeMap};
 use rayon::prelude::*;
@@ -140,11 +140,18 @@ fn scatter_benches<const D: usize>(
                     let stress: Tensor<D> = restrict::<D>(&p.stress[q]) * p.volume[q];
                     (p.mass[q], p.v[q] * p.mass[q], gravity * p.mass[q], stress)
                 };
-                nb.scatter(shape, grid, p, &mut nodes, source, |n, s, w, g| {
-                    n.0 += s.0 * w;
-                    n.1 += s.1 * w;
-                    n.2 += s.2 * w - s.3 * g;
-                });
+                nb.scatter(
+                    shape,
+                    grid,
+                    Points::of(p),
+                    &mut nodes,
+                    source,
+                    |n, s, w, g| {
+                        n.0 += s.0 * w;
+                        n.1 += s.1 * w;
+                        n.2 += s.2 * w - s.3 * g;
+                    },
+                );
                 nodes.len()
             })
         },

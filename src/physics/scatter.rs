@@ -94,6 +94,25 @@ impl<const D: usize> Stencil<D> {
     }
 }
 
+/// What the shape functions read of the particles: the positions and, for
+/// GIMP and the domain B-splines, the domains' reference half-lengths and F.
+#[derive(Clone, Copy)]
+pub struct Points<'a, const D: usize> {
+    pub x: &'a [Vector<D>],
+    pub half_length0: &'a [Vector<D>],
+    pub f: &'a [Mat3],
+}
+
+impl<'a, const D: usize> Points<'a, D> {
+    pub fn of(p: &'a Particles<D>) -> Self {
+        Points {
+            x: &p.x,
+            half_length0: &p.half_length0,
+            f: &p.f,
+        }
+    }
+}
+
 /// The box of nodes of one step and the particles sorted by tile.
 #[derive(Clone, Debug)]
 pub struct NodeBox<const D: usize> {
@@ -268,16 +287,17 @@ impl<const D: usize> NodeBox<D> {
         )
     }
 
-    /// P2G by colours: for every particle q in the grid, `add(node, &source(q),
-    /// S_Iq, ∇S_Iq)` at each of its nodes, `nodes` one value per box node.
-    /// `source` is called once per particle, `add` once per entry.
+    /// P2G by colours: for every particle q in the grid, `add(node, &source(q,
+    /// stencil), S_Iq, ∇S_Iq)` at each of its nodes, `nodes` one value per box
+    /// node. `source` is called once per particle (in its tile's task, so it may
+    /// also update particle q alone), `add` once per entry.
     pub fn scatter<N: Send, S>(
         &self,
         shape: ShapeFunction,
         grid: &Grid<D>,
-        p: &Particles<D>,
+        points: Points<D>,
         nodes: &mut [N],
-        source: impl Fn(usize) -> S + Sync,
+        source: impl Fn(usize, &Stencil<D>) -> S + Sync,
         add: impl Fn(&mut N, &S, f64, &Vector<D>) + Sync,
     ) {
         assert_eq!(nodes.len(), self.nodes(), "one value per box node");
@@ -295,15 +315,15 @@ impl<const D: usize> NodeBox<D> {
                 let (first, end) = self.tile_nodes(t, reach);
                 for &q in &self.order[self.start[t] as usize..self.start[t + 1] as usize] {
                     let q = q as usize;
-                    let Some(st) = self.stencil(shape, grid, &p.x[q], &p.half_length0[q], &p.f[q])
-                    else {
+                    let (x, half, f) = (&points.x[q], &points.half_length0[q], &points.f[q]);
+                    let Some(st) = self.stencil(shape, grid, x, half, f) else {
                         continue;
                     };
                     assert!(
                         (0..D).all(|d| st.first[d] >= first[d] && st.first[d] + st.count[d] <= end[d]),
                         "{shape:?} reaches beyond its tile's nodes: the colouring would not hold"
                     );
-                    let s = source(q);
+                    let s = source(q, &st);
                     st.for_each(&self.stride, |b, w, g| {
                         // SAFETY: tiles of one colour touch disjoint nodes (module doc),
                         // and this tile's particles are visited by this task alone.
@@ -374,9 +394,9 @@ mod tests {
                     nb.scatter(
                         shape,
                         &grid,
-                        &p,
+                        Points::of(&p),
                         &mut nodes,
-                        |q| (p.mass[q], p.v[q] * p.mass[q]),
+                        |q, _| (p.mass[q], p.v[q] * p.mass[q]),
                         |n, s, w, _| {
                             n.0 += s.0 * w;
                             n.1 += s.1 * w;

@@ -14,10 +14,11 @@ use crate::dim::{embed_deformation, Mat3, Tensor, Vector};
 use crate::model::conditions::Constraint;
 use crate::model::particles::Particles;
 use crate::model::{load_factor, Model};
+use crate::parallel::DisjointSlice;
 use crate::physics::boundary::{friction_contact, node_constraint, node_friction};
 use crate::physics::deformation::{update_particle, ParticleState};
 use crate::physics::grid_update::{local_damping, TINY_MASS_FRACTION};
-use crate::physics::scatter::NodeBox;
+use crate::physics::scatter::{NodeBox, Points, Stencil};
 use crate::physics::shape::ShapeFunction;
 use crate::scene::Scheme;
 use crate::solver::divergence::{sound, unsound, Divergence};
@@ -65,6 +66,8 @@ pub struct ScatterStep<const D: usize> {
     /// USF: the step-start nodal velocity with the conditions applied. MUSL:
     /// the remapped momentum, then velocity.
     second: Vec<Vector<D>>,
+    /// MUSL: the work of the loads per particle over the step.
+    work: Vec<f64>,
     /// Nodes with mass in the last step.
     pub active: usize,
 }
@@ -111,15 +114,7 @@ impl<const D: usize> ScatterStep<D> {
             }
             Scheme::Musl => {
                 self.node_pass(m, false, s.damping, tiny, dt);
-                let work = self.particle_pass(s, m, t, dt, step, Pass::Velocity, &scales)?;
-                // Map the updated particle momentum back and use that velocity.
-                let p = &m.particles;
-                self.second.clear();
-                self.second.resize(self.nodes.len(), Vector::<D>::zeros());
-                let source = |q: usize| p.v[q] * p.mass[q];
-                let add = |n: &mut Vector<D>, s: &Vector<D>, w: f64, _: &Vector<D>| *n += s * w;
-                self.nb
-                    .scatter(s.shape, &m.grid, p, &mut self.second, source, add);
+                let work = self.velocity_and_remap(s, m, dt, &scales);
                 self.remapped_velocity(m);
                 self.particle_pass(s, m, t, dt, step, Pass::Remapped, &scales)?;
                 work
@@ -137,7 +132,7 @@ impl<const D: usize> ScatterStep<D> {
         scales: &[f64],
     ) {
         let p = &m.particles;
-        let source = |q: usize| {
+        let source = |q: usize, _: &Stencil<D>| {
             let applied = match FORCE {
                 true => s.gravity * p.mass[q] + p.load[q] * load_factor(&m.load_ramp_of, q, scales),
                 false => Vector::<D>::zeros(),
@@ -155,8 +150,64 @@ impl<const D: usize> ScatterStep<D> {
                     n.force += s.2 * w - s.3 * g;
                 }
             };
-        self.nb
-            .scatter(s.shape, &m.grid, p, &mut self.nodes, source, add);
+        self.nb.scatter(
+            s.shape,
+            &m.grid,
+            Points::of(p),
+            &mut self.nodes,
+            source,
+            add,
+        );
+    }
+
+    /// MUSL: the particles' velocity from the updated nodes (G2P, 2-27) and its
+    /// momentum mapped back into `second`, in one coloured pass (the scatter's
+    /// tile task owns its particles, so it may update them). Positions move in
+    /// the last pass. Returns the work of the loads over the step, summed in the
+    /// chunks of `deterministic_sum` from the per-particle terms.
+    fn velocity_and_remap(
+        &mut self,
+        s: &Settings<Vector<D>>,
+        m: &mut Model<D>,
+        dt: f64,
+        scales: &[f64],
+    ) -> f64 {
+        let (nb, nodes) = (&self.nb, &self.nodes[..]);
+        self.second.clear();
+        self.second.resize(self.nodes.len(), Vector::<D>::zeros());
+        let n = m.particles.len();
+        self.work.clear();
+        self.work.resize(n, 0.0);
+        let (grid, ramp_of) = (&m.grid, &m.load_ramp_of);
+        let Particles {
+            x,
+            v,
+            f,
+            half_length0,
+            mass,
+            load,
+            ..
+        } = &mut m.particles;
+        let points = Points { x, half_length0, f };
+        let (velocity, work) = (DisjointSlice::new(v), DisjointSlice::new(&mut self.work));
+        let source = |q: usize, st: &Stencil<D>| {
+            let (vp, a, _) = gather::<D, true, 0>(st, nb, nodes, &[]);
+            // SAFETY: particle q belongs to this tile's task alone.
+            let (v, w) = unsafe { (velocity.at(q), work.at(q)) };
+            let v_old = *v;
+            *v = (v_old + a * dt) * s.flip + vp * (1.0 - s.flip);
+            let applied = s.gravity * mass[q] + load[q] * load_factor(ramp_of, q, scales);
+            *w = applied.dot(&(v_old + *v)) * 0.5;
+            *v * mass[q]
+        };
+        let add = |n: &mut Vector<D>, s: &Vector<D>, w: f64, _: &Vector<D>| *n += s * w;
+        nb.scatter(s.shape, grid, points, &mut self.second, source, add);
+        let sums: Vec<f64> = self
+            .work
+            .par_chunks(CHUNK)
+            .map(|c| c.iter().sum())
+            .collect();
+        sums.iter().sum::<f64>() * dt
     }
 
     /// The conditions of box node b at grid multi-index `ijk`, `None` for a
@@ -301,13 +352,11 @@ impl<const D: usize> ScatterStep<D> {
                 ),
                 (Pass::Full, Some(sc)) => gather::<D, true, 1>(&sc, nb, nodes, second),
                 (Pass::Stress, Some(sc)) => gather::<D, false, 2>(&sc, nb, nodes, second),
-                (Pass::Motion | Pass::Velocity, Some(sc)) => {
-                    gather::<D, true, 0>(&sc, nb, nodes, second)
-                }
+                (Pass::Motion, Some(sc)) => gather::<D, true, 0>(&sc, nb, nodes, second),
                 (Pass::Remapped, Some(sc)) => gather::<D, true, 2>(&sc, nb, nodes, second),
             };
             let mut work = 0.0;
-            if matches!(pass, Pass::Full | Pass::Motion | Pass::Velocity) {
+            if matches!(pass, Pass::Full | Pass::Motion) {
                 // PIC/FLIP blend (2-27); the applied forces' work over the step.
                 let v_old = *state.v;
                 *state.v = (v_old + a * dt) * s.flip + vp * (1.0 - s.flip);
@@ -422,8 +471,6 @@ enum Pass {
     Stress,
     /// USF: G2P.
     Motion,
-    /// MUSL: the particle velocity only (positions move in `Remapped`).
-    Velocity,
     /// MUSL: the position, and the stress from the remapped velocity (`second`).
     Remapped,
 }
