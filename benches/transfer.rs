@@ -13,7 +13,7 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Through
 use mpm::dim::{restrict, Mat3, Tensor, Vector};
 use mpm::model::grid::Grid;
 use mpm::model::particles::Particles;
-use mpm::physics::scatter::{NodeBox, Points};
+use mpm::physics::scatter::{NodeBox, Points, Stencil};
 use mpm::physics::shape::{ShapeFunction, Stencils};
 use mpm::physics::transfer::{gradient, interpolate, mass_momentum, nodal_force, NodeMap};
 use rayon::prelude::*;
@@ -136,7 +136,7 @@ fn scatter_benches<const D: usize>(
                     nb.nodes(),
                     (0.0, Vector::<D>::zeros(), Vector::<D>::zeros()),
                 );
-                let source = |q: usize| {
+                let source = |q: usize, _: &Stencil<D>| {
                     let stress: Tensor<D> = restrict::<D>(&p.stress[q]) * p.volume[q];
                     (p.mass[q], p.v[q] * p.mass[q], gravity * p.mass[q], stress)
                 };
