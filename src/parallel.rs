@@ -1,9 +1,11 @@
 //! Parallel loops whose results do not depend on the number of threads.
 //!
 //! Particle-to-grid transfers are gathers (each node sums its particles in
-//! increasing order, `physics::transfer::NodeMap::gather`); sums over particles
-//! use a fixed chunking (`deterministic_sum`). Loops over fewer items than
-//! `MIN_PARALLEL_LEN` run serially.
+//! increasing order, `physics::transfer::NodeMap::gather`) or, in the explicit
+//! step on a box of nodes, scatters coloured so that every node sums in one
+//! fixed order (`physics::scatter`); sorts are stable (`bucket_sort`); sums over
+//! particles use a fixed chunking (`deterministic_sum`). Loops over fewer items
+//! than `MIN_PARALLEL_LEN` run serially.
 
 use rayon::prelude::*;
 

@@ -5,7 +5,8 @@
 //! Only nodes touched by a particle are active. P2G is a gather: every active node
 //! sums its particle contributions in increasing particle order, so the result is
 //! bit-identical for any number of threads. G2P loops over particles, each reading
-//! its own stencil.
+//! its own stencil. (The explicit step of scenes that need no node map takes the
+//! particle-side scatter of `physics::scatter` instead.)
 
 use crate::dim::{restrict, Mat3, Tensor, Vector};
 use crate::model::particles::Particles;

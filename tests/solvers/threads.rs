@@ -40,6 +40,27 @@ fn one_and_two_threads_give_identical_results() {
     }
 }
 
+/// `problems/NAME` with the overrides on 1 and on 2 threads: particles_final.csv
+/// and history.csv must be byte-identical (`what` names the case in the message).
+fn same_on_one_and_two_threads(name: &str, overrides: &[String], what: &str) {
+    let run = |threads: usize| {
+        let dir = run_cli(name, threads, overrides);
+        (
+            read_output(&dir, "particles_final.csv"),
+            read_output(&dir, "history.csv"),
+        )
+    };
+    let ((p1, h1), (p2, h2)) = (run(1), run(2));
+    assert!(
+        p1 == p2,
+        "{what}: particles_final.csv differs between 1 and 2 threads"
+    );
+    assert!(
+        h1 == h2,
+        "{what}: history.csv differs between 1 and 2 threads"
+    );
+}
+
 /// Axisymmetric (hoop terms in the stencils, the stress update and the nodal
 /// force): the thick cylinder, explicit, with about 4000 particles so that the
 /// parallel loops split, and implicit with a Krylov solver.
@@ -49,23 +70,13 @@ fn axisymmetric_runs_give_identical_results_on_one_and_two_threads() {
         "solver={kind=\"explicit\",scheme=\"musl\",end_time=0.02,damping=0.5}",
         "solver={kind=\"implicit\",integrator=\"quasi_static\",end_time=1.0,load_steps=2,linear_solver=\"gmres\",preconditioner=\"multigrid\"}",
     ] {
-        let run = |threads: usize| {
-            let overrides = [
-                solver.to_string(),
-                "grid.cells=[160,4]".to_string(),
-                "load.0.region_max=[1.0078125,0.25]".to_string(),
-                "output.frames=0".to_string(),
-            ];
-            let dir = run_cli("axisymmetric_cylinder.toml", threads, &overrides);
-            (
-                read_output(&dir, "particles_final.csv"),
-                read_output(&dir, "history.csv"),
-            )
-        };
-        let (p1, h1) = run(1);
-        let (p2, h2) = run(2);
-        assert!(p1 == p2, "{solver}: particles_final.csv differs between 1 and 2 threads");
-        assert!(h1 == h2, "{solver}: history.csv differs between 1 and 2 threads");
+        let overrides = [
+            solver.to_string(),
+            "grid.cells=[160,4]".to_string(),
+            "load.0.region_max=[1.0078125,0.25]".to_string(),
+            "output.frames=0".to_string(),
+        ];
+        same_on_one_and_two_threads("axisymmetric_cylinder.toml", &overrides, solver);
     }
 }
 
@@ -76,28 +87,12 @@ fn axisymmetric_runs_give_identical_results_on_one_and_two_threads() {
 #[test]
 fn scatter_runs_give_identical_results_on_one_and_two_threads() {
     for scheme in ["usl", "usf", "musl"] {
-        let run = |threads: usize| {
-            let overrides = [
-                format!("solver.scheme=\"{scheme}\""),
-                "solver.end_time=0.004".to_string(),
-                "grid.cells=[320,100]".to_string(),
-                "output.frames=0".to_string(),
-            ];
-            let dir = run_cli("collapse.toml", threads, &overrides);
-            (
-                read_output(&dir, "particles_final.csv"),
-                read_output(&dir, "history.csv"),
-            )
-        };
-        let (p1, h1) = run(1);
-        let (p2, h2) = run(2);
-        assert!(
-            p1 == p2,
-            "{scheme}: particles_final.csv differs between 1 and 2 threads"
-        );
-        assert!(
-            h1 == h2,
-            "{scheme}: history.csv differs between 1 and 2 threads"
-        );
+        let overrides = [
+            format!("solver.scheme=\"{scheme}\""),
+            "solver.end_time=0.004".to_string(),
+            "grid.cells=[320,100]".to_string(),
+            "output.frames=0".to_string(),
+        ];
+        same_on_one_and_two_threads("collapse.toml", &overrides, scheme);
     }
 }
