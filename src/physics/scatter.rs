@@ -311,7 +311,11 @@ impl<const D: usize> NodeBox<D> {
                     (0..D).all(|d| (t / tile_stride[d] % self.tiles[d]) & 1 == colour >> d & 1)
                 })
                 .collect();
-            of_colour.par_iter().for_each(|&t| {
+            // Tasks of at least MIN_PARALLEL_LEN particles on average: a small
+            // scene scatters in one task (the sums are the same either way).
+            let per_tile = self.order.len() / n_tiles.max(1) + 1;
+            let tiles_per_task = MIN_PARALLEL_LEN.div_ceil(per_tile);
+            of_colour.par_iter().with_min_len(tiles_per_task).for_each(|&t| {
                 let (first, end) = self.tile_nodes(t, reach);
                 for &q in &self.order[self.start[t] as usize..self.start[t + 1] as usize] {
                     let q = q as usize;

@@ -14,7 +14,7 @@ use crate::dim::{embed_deformation, Mat3, Tensor, Vector};
 use crate::model::conditions::Constraint;
 use crate::model::particles::Particles;
 use crate::model::{load_factor, Model};
-use crate::parallel::DisjointSlice;
+use crate::parallel::{DisjointSlice, MIN_PARALLEL_LEN};
 use crate::physics::boundary::{friction_contact, node_constraint, node_friction};
 use crate::physics::deformation::{update_particle, ParticleState};
 use crate::physics::grid_update::{local_damping, TINY_MASS_FRACTION};
@@ -244,6 +244,7 @@ impl<const D: usize> ScatterStep<D> {
         self.active = (self.nodes.par_chunks_mut(row))
             .zip(self.second.par_chunks_mut(row))
             .enumerate()
+            .with_min_len(MIN_PARALLEL_LEN.div_ceil(row))
             .map(|(r, (nodes, second))| {
                 let mut ijk = nb.grid_ijk(r * row);
                 let mut with_mass = 0;
