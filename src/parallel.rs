@@ -13,13 +13,15 @@ use rayon::prelude::*;
 /// cost of waking threads exceeds the work (small scenes run serially).
 pub const MIN_PARALLEL_LEN: usize = 512;
 
+/// Items per chunk of `deterministic_sum` (and of loops that sum as it does).
+pub const SUM_CHUNK: usize = 4096;
+
 /// Sum of `f(i)` for i in 0..n, in parallel but with a fixed chunking so that the
 /// floating-point result does not depend on the number of threads.
 pub fn deterministic_sum(n: usize, f: impl Fn(usize) -> f64 + Sync) -> f64 {
-    const CHUNK: usize = 4096;
-    let partial: Vec<f64> = (0..n.div_ceil(CHUNK))
+    let partial: Vec<f64> = (0..n.div_ceil(SUM_CHUNK))
         .into_par_iter()
-        .map(|c| (c * CHUNK..((c + 1) * CHUNK).min(n)).map(&f).sum())
+        .map(|c| (c * SUM_CHUNK..((c + 1) * SUM_CHUNK).min(n)).map(&f).sum())
         .collect();
     partial.iter().sum()
 }

@@ -258,14 +258,14 @@ fn update_in_place<const D: usize>(
     let update = |q: usize, f: &mut Mat3, stress: &mut Mat3, volume: &mut f64, hist: &mut [f64]| {
         let material = materials[material[q] as usize].as_ref();
         let df = increment(st, map, q, u, axisymmetric);
-        let state = ParticleState {
+        let mut state = ParticleState {
             f,
             stress,
             volume,
             history: hist,
         };
         // NaN counts as inverted, as in `Advanced::inverted_at`.
-        match update_particle(material, &df, dt, volume0[q], state) > 0.0 {
+        match update_particle(material, &df, dt, volume0[q], &mut state) > 0.0 {
             true => usize::MAX,
             false => q,
         }
@@ -305,10 +305,10 @@ pub fn update_particle(
     df: &Mat3,
     dt: f64,
     volume0: f64,
-    state: ParticleState,
+    state: &mut ParticleState,
 ) -> f64 {
     // The material reads the step-start history and writes the new one.
-    let hist = state.history;
+    let hist = &mut *state.history;
     let mut kept = [0.0; 8];
     let old: Vec<f64>;
     let history_old: &[f64] = match hist.len() <= kept.len() {

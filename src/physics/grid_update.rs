@@ -3,6 +3,7 @@
 //! force, and no acceleration on nodes too light to carry one.
 
 use crate::dim::Vector;
+use crate::model::conditions::Constraint;
 
 /// Nodes lighter than this fraction of the lightest particle get no acceleration:
 /// f_I/m_I is ill-conditioned there (f_I need not vanish with m_I), while the
@@ -22,4 +23,30 @@ pub fn local_damping<const D: usize>(f: &Vector<D>, v: &Vector<D>, alpha: f64) -
         }
     };
     Vector::<D>::from_fn(|d, _| f[d] - alpha * f[d].abs() * sign(v[d]))
+}
+
+/// A node's acceleration (2-23, 2-29): the force with local damping `alpha`
+/// (the sign of the velocity `v`) over the mass, none on a node not heavier
+/// than `tiny`; a prescribed component takes the acceleration that lands the
+/// velocity `raw` = p/m on its value after `dt`.
+#[allow(clippy::too_many_arguments)]
+pub fn acceleration<const D: usize>(
+    mass: f64,
+    force: &Vector<D>,
+    v: &Vector<D>,
+    raw: &Vector<D>,
+    constraint: &Constraint<D>,
+    alpha: f64,
+    tiny: f64,
+    dt: f64,
+) -> Vector<D> {
+    let mut acc = if mass > tiny {
+        local_damping(force, v, alpha) / mass
+    } else {
+        Vector::<D>::zeros()
+    };
+    for d in (0..D).filter(|&d| constraint.fixed[d]) {
+        acc[d] = (constraint.value[d] - raw[d]) / dt;
+    }
+    acc
 }

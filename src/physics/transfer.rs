@@ -266,14 +266,17 @@ pub fn mass_weighted<const D: usize>(
 /// v_I = p_I / m_I (2-25); zero on a node whose mass is exactly zero.
 pub fn mass_average<const D: usize>(mass: &[f64], momentum: &[Vector<D>]) -> Vec<Vector<D>> {
     (0..mass.len())
-        .map(|a| {
-            if mass[a] > 0.0 {
-                momentum[a] / mass[a]
-            } else {
-                Vector::<D>::zeros()
-            }
-        })
+        .map(|a| nodal_velocity(mass[a], &momentum[a]))
         .collect()
+}
+
+/// v_I = p_I / m_I of one node (2-25); zero when its mass is exactly zero.
+pub fn nodal_velocity<const D: usize>(mass: f64, momentum: &Vector<D>) -> Vector<D> {
+    if mass > 0.0 {
+        momentum / mass
+    } else {
+        Vector::<D>::zeros()
+    }
 }
 
 /// scale · Σ_J M_IJ w_J with the consistent mass matrix M_IJ = Σ_p m_p S_Ip S_Jp
@@ -402,7 +405,18 @@ pub fn applied_force<const D: usize>(
     gravity: &Vector<D>,
     load_factor: &impl Fn(usize) -> f64,
 ) -> Vector<D> {
-    gravity * p.mass[q] + p.load[q] * load_factor(q)
+    applied(gravity, p.mass[q], &p.load[q], load_factor(q))
+}
+
+/// m g + s f: gravity on a mass m and a load f at load factor s.
+#[inline(always)]
+pub fn applied<const D: usize>(
+    gravity: &Vector<D>,
+    mass: f64,
+    load: &Vector<D>,
+    s: f64,
+) -> Vector<D> {
+    gravity * mass + load * s
 }
 
 /// Σ_I S_Ip u_I for particle p (interpolation of a nodal vector field).

@@ -55,6 +55,16 @@ pub fn check_state<const D: usize>(m: &Model<D>, step: usize, time: f64) -> Resu
     }
 }
 
+/// Particle q's deformation inverted in the stress update (det F ≤ 0).
+pub fn inverted(q: usize, det: f64, step: usize, time: f64) -> Divergence {
+    Divergence {
+        step,
+        time,
+        particle: Some(q),
+        message: format!("inverted: det F = {det:.3e} ≤ 0"),
+    }
+}
+
 /// A particle state a run can go on from: finite, det F > 0, and `placed`
 /// (in the grid, off the axis, as the mode requires).
 #[inline(always)]

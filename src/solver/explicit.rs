@@ -13,7 +13,7 @@ use crate::physics::boundary::{friction_contact, node_constraint, node_friction}
 use crate::physics::bulk_viscosity::BulkViscosity;
 use crate::physics::contact::{Contact, PairTotal};
 use crate::physics::deformation::Trial;
-use crate::physics::grid_update::{local_damping, TINY_MASS_FRACTION};
+use crate::physics::grid_update::{acceleration, local_damping, TINY_MASS_FRACTION};
 use crate::physics::mirror::Mirror;
 use crate::physics::scatter::NodeBox;
 use crate::physics::shape::{ShapeFunction, Stencils};
@@ -21,7 +21,7 @@ use crate::physics::transfer::{
     applied_force, interpolate_two, mass_average, mass_momentum, nodal_force, NodeMap,
 };
 use crate::scene::{Scheme, SolverConfig, Transfer};
-use crate::solver::divergence::{check_state, Divergence};
+use crate::solver::divergence::{check_state, inverted, Divergence};
 use crate::solver::explicit_scatter::{ScatterStep, Settings};
 use crate::solver::report::{SolverReport, TransferPath};
 use crate::solver::stepper::Stepper;
@@ -229,16 +229,16 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
             .into_par_iter()
             .with_min_len(MIN_PARALLEL_LEN)
             .map(|a| {
-                let mut acc = if mass[a] > tiny {
-                    local_damping(&force[a], &velocity[a], self.damping) / mass[a]
-                } else {
-                    Vector::<D>::zeros()
-                };
-                // Prescribed components: the acceleration that lands on the value.
-                for d in (0..D).filter(|&d| constraint[a].fixed[d]) {
-                    acc[d] = (constraint[a].value[d] - raw_velocity[a][d]) / dt;
-                }
-                acc
+                acceleration(
+                    mass[a],
+                    &force[a],
+                    &velocity[a],
+                    &raw_velocity[a],
+                    &constraint[a],
+                    self.damping,
+                    tiny,
+                    dt,
+                )
             })
             .collect();
         let damped = |f: f64, v: f64| {
@@ -398,10 +398,5 @@ fn update_stress<const D: usize>(
     let u: Vec<Vector<D>> = velocity.iter().map(|v| v * dt).collect();
     trial
         .advance(&mut m.particles, &m.materials, st, map, &u, dt)
-        .map_err(|(q, det)| Divergence {
-            step: step + 1,
-            time: t + dt,
-            particle: Some(q),
-            message: format!("inverted: det F = {det:.3e} ≤ 0"),
-        })
+        .map_err(|(q, det)| inverted(q, det, step + 1, t + dt))
 }

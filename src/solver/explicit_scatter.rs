@@ -14,20 +14,21 @@ use crate::dim::{embed_deformation, Mat3, Tensor, Vector};
 use crate::model::conditions::Constraint;
 use crate::model::particles::Particles;
 use crate::model::{load_factor, Model};
-use crate::parallel::{DisjointSlice, MIN_PARALLEL_LEN};
+use crate::parallel::{deterministic_sum, DisjointSlice, MIN_PARALLEL_LEN, SUM_CHUNK};
 use crate::physics::boundary::{friction_contact, node_constraint, node_friction};
 use crate::physics::deformation::{update_particle, ParticleState};
-use crate::physics::grid_update::{local_damping, TINY_MASS_FRACTION};
+use crate::physics::grid_update::{acceleration, TINY_MASS_FRACTION};
 use crate::physics::scatter::{NodeBox, Points, Stencil};
 use crate::physics::shape::ShapeFunction;
+use crate::physics::transfer::{applied, applied_force, nodal_velocity};
 use crate::scene::Scheme;
-use crate::solver::divergence::{sound, unsound, Divergence};
+use crate::solver::divergence::{inverted, sound, unsound, Divergence};
 use rayon::prelude::*;
 
 /// Particles per task of a particle pass: the chunking of
 /// `parallel::deterministic_sum`, so the work of the loads sums the same on
 /// any number of threads.
-const CHUNK: usize = 4096;
+const CHUNK: usize = SUM_CHUNK;
 
 /// What a box node gathers. After the node pass: `momentum` holds the updated
 /// velocity and `force` the acceleration.
@@ -50,12 +51,12 @@ impl<const D: usize> Node<D> {
 
 /// The settings of the step that the passes read.
 #[derive(Clone, Copy)]
-pub struct Settings<D> {
+pub struct Settings<const D: usize> {
     pub shape: ShapeFunction,
     pub scheme: Scheme,
     pub flip: f64,
     pub damping: f64,
-    pub gravity: D,
+    pub gravity: Vector<D>,
 }
 
 /// The buffers of the scatter path, kept between steps.
@@ -83,7 +84,7 @@ impl<const D: usize> ScatterStep<D> {
     /// of gravity and applied loads over the step.
     pub fn step(
         &mut self,
-        s: &Settings<Vector<D>>,
+        s: &Settings<D>,
         m: &mut Model<D>,
         t: f64,
         dt: f64,
@@ -127,14 +128,16 @@ impl<const D: usize> ScatterStep<D> {
     /// f_ext − f_int = Σ S_I (m g + s f) − V σ ∇S_I (`FORCE`).
     fn scatter<const MOTION: bool, const FORCE: bool>(
         &mut self,
-        s: &Settings<Vector<D>>,
+        s: &Settings<D>,
         m: &Model<D>,
         scales: &[f64],
     ) {
         let p = &m.particles;
         let source = |q: usize, _: &Stencil<D>| {
             let applied = match FORCE {
-                true => s.gravity * p.mass[q] + p.load[q] * load_factor(&m.load_ramp_of, q, scales),
+                true => applied_force(p, q, &s.gravity, &|q| {
+                    load_factor(&m.load_ramp_of, q, scales)
+                }),
                 false => Vector::<D>::zeros(),
             };
             let stress = crate::dim::restrict::<D>(&p.stress[q]) * p.volume[q];
@@ -167,7 +170,7 @@ impl<const D: usize> ScatterStep<D> {
     /// chunks of `deterministic_sum` from the per-particle terms.
     fn velocity_and_remap(
         &mut self,
-        s: &Settings<Vector<D>>,
+        s: &Settings<D>,
         m: &mut Model<D>,
         dt: f64,
         scales: &[f64],
@@ -196,18 +199,18 @@ impl<const D: usize> ScatterStep<D> {
             let (v, w) = unsafe { (velocity.at(q), work.at(q)) };
             let v_old = *v;
             *v = (v_old + a * dt) * s.flip + vp * (1.0 - s.flip);
-            let applied = s.gravity * mass[q] + load[q] * load_factor(ramp_of, q, scales);
+            let applied = applied(
+                &s.gravity,
+                mass[q],
+                &load[q],
+                load_factor(ramp_of, q, scales),
+            );
             *w = applied.dot(&(v_old + *v)) * 0.5;
             *v * mass[q]
         };
         let add = |n: &mut Vector<D>, s: &Vector<D>, w: f64, _: &Vector<D>| *n += s * w;
         nb.scatter(s.shape, grid, points, &mut self.second, source, add);
-        let sums: Vec<f64> = self
-            .work
-            .par_chunks(CHUNK)
-            .map(|c| c.iter().sum())
-            .collect();
-        sums.iter().sum::<f64>() * dt
+        deterministic_sum(n, |q| self.work[q]) * dt
     }
 
     /// The conditions of box node b at grid multi-index `ijk`, `None` for a
@@ -270,19 +273,13 @@ impl<const D: usize> ScatterStep<D> {
             let (raw, v) = match usf {
                 true => (n.momentum, *second),
                 false => {
-                    let raw = mass_average(n.mass, &n.momentum);
+                    let raw = nodal_velocity(n.mass, &n.momentum);
                     (raw, Self::velocity(m, &raw, &c))
                 }
             };
-            let mut acc = match n.mass > tiny {
-                true => local_damping(&n.force, &v, damping) / n.mass,
-                false => Vector::<D>::zeros(),
-            };
-            if let Some(c) = &c {
-                for d in (0..D).filter(|&d| c.constraint.fixed[d]) {
-                    acc[d] = (c.constraint.value[d] - raw[d]) / dt;
-                }
-            }
+            let free = Constraint::free();
+            let constraint = c.as_ref().map_or(&free, |c| &c.constraint);
+            let mut acc = acceleration(n.mass, &n.force, &v, &raw, constraint, damping, tiny, dt);
             let mut v_new = raw + acc * dt;
             if let Some(c) = c.as_ref().filter(|c| !c.friction.is_empty()) {
                 v_new = friction_contact(&m.friction, &c.friction, &c.constraint, &v_new);
@@ -295,7 +292,7 @@ impl<const D: usize> ScatterStep<D> {
     /// USF: p/m into `momentum`, and the velocity with the conditions into `second`.
     fn start_velocity(&mut self, m: &Model<D>) {
         self.for_nodes(|n, second, ijk| {
-            n.momentum = mass_average(n.mass, &n.momentum);
+            n.momentum = nodal_velocity(n.mass, &n.momentum);
             *second = Self::velocity(m, &n.momentum, &Self::conditions(m, ijk));
         });
     }
@@ -304,7 +301,7 @@ impl<const D: usize> ScatterStep<D> {
     /// conditions.
     fn remapped_velocity(&mut self, m: &Model<D>) {
         self.for_nodes(|n, second, ijk| {
-            let raw = mass_average(n.mass, second);
+            let raw = nodal_velocity(n.mass, second);
             *second = Self::velocity(m, &raw, &Self::conditions(m, ijk));
         });
     }
@@ -314,7 +311,7 @@ impl<const D: usize> ScatterStep<D> {
     #[allow(clippy::too_many_arguments)]
     fn particle_pass(
         &self,
-        s: &Settings<Vector<D>>,
+        s: &Settings<D>,
         m: &mut Model<D>,
         t: f64,
         dt: f64,
@@ -340,11 +337,24 @@ impl<const D: usize> ScatterStep<D> {
         } = &mut m.particles;
         let (mass, volume0, half_length0, load, material) =
             (&*mass, &*volume0, &*half_length0, &*load, &*material);
-        let applied = |q: usize| s.gravity * mass[q] + load[q] * load_factor(ramp_of, q, scales);
+        let applied = |q: usize| {
+            applied(
+                &s.gravity,
+                mass[q],
+                &load[q],
+                load_factor(ramp_of, q, scales),
+            )
+        };
         // The last pass checks the state, as `check_state` does after a step.
         let checks = matches!(pass, Pass::Full | Pass::Motion | Pass::Remapped);
-        let body = |q: usize, state: Moving<D>| -> (f64, bool, bool) {
-            let sc = nb.stencil(s.shape, grid, state.x, &half_length0[q], state.f);
+        let body = |q: usize, mut state: Moving<D>| -> (f64, bool, bool) {
+            let sc = nb.stencil(
+                s.shape,
+                grid,
+                state.x,
+                &half_length0[q],
+                state.deformation.f,
+            );
             let (vp, a, l) = match (pass, sc) {
                 (_, None) => (
                     Vector::<D>::zeros(),
@@ -372,23 +382,17 @@ impl<const D: usize> ScatterStep<D> {
                 true => {
                     // ΔF = I + Δt L (2-31).
                     let df = embed_deformation::<D>(&(Tensor::<D>::identity() + l * dt));
-                    let particle = ParticleState {
-                        f: &mut *state.f,
-                        stress: &mut *state.stress,
-                        volume: &mut *state.volume,
-                        history: &mut *state.history,
-                    };
                     let law = materials[material[q] as usize].as_ref();
-                    update_particle(law, &df, dt, volume0[q], particle)
+                    update_particle(law, &df, dt, volume0[q], &mut state.deformation)
                 }
-                false if checks => state.f.determinant(),
+                false if checks => state.deformation.f.determinant(),
                 false => 1.0,
             };
             // NaN counts as inverted, as in `check_state`.
             let intact = det > 0.0;
-            let inverted = !intact;
-            let bad = checks && !sound(state.x, state.v, state.stress, det, grid.contains(state.x));
-            (work, inverted, bad)
+            let stress = &*state.deformation.stress;
+            let bad = checks && !sound(state.x, state.v, stress, det, grid.contains(state.x));
+            (work, !intact, bad)
         };
         let chunk = |c: usize,
                      xs: &mut [Vector<D>],
@@ -397,7 +401,7 @@ impl<const D: usize> ScatterStep<D> {
                      ss: &mut [Mat3],
                      vols: &mut [f64],
                      mut hs: Option<&mut [&mut [f64]]>| {
-            let (mut work, mut inverted, mut bad) = (0.0, usize::MAX, usize::MAX);
+            let (mut work, mut first_inverted, mut bad) = (0.0, usize::MAX, usize::MAX);
             for i in 0..xs.len() {
                 let history: &mut [f64] = match &mut hs {
                     Some(hs) => hs[i],
@@ -406,22 +410,24 @@ impl<const D: usize> ScatterStep<D> {
                 let state = Moving {
                     x: &mut xs[i],
                     v: &mut vs[i],
-                    f: &mut fs[i],
-                    stress: &mut ss[i],
-                    volume: &mut vols[i],
-                    history,
+                    deformation: ParticleState {
+                        f: &mut fs[i],
+                        stress: &mut ss[i],
+                        volume: &mut vols[i],
+                        history,
+                    },
                 };
                 let q = c * CHUNK + i;
                 let (w, inverts, unsound) = body(q, state);
                 work += w;
                 if inverts {
-                    inverted = inverted.min(q);
+                    first_inverted = first_inverted.min(q);
                 }
                 if unsound {
                     bad = bad.min(q);
                 }
             }
-            (work, inverted, bad)
+            (work, first_inverted, bad)
         };
         let chunks = (x.par_chunks_mut(CHUNK))
             .zip(v.par_chunks_mut(CHUNK))
@@ -446,15 +452,12 @@ impl<const D: usize> ScatterStep<D> {
         let work: f64 = per_chunk.iter().map(|c| c.0).sum();
         let first = |k: fn(&(f64, usize, usize)) -> usize| per_chunk.iter().map(k).min();
         if let Some(q) = first(|c| c.1).filter(|&q| q != usize::MAX) {
-            return Err(Divergence {
-                step: step + 1,
-                time: t + dt,
-                particle: Some(q),
-                message: format!(
-                    "inverted: det F = {:.3e} ≤ 0",
-                    m.particles.f[q].determinant()
-                ),
-            });
+            return Err(inverted(
+                q,
+                m.particles.f[q].determinant(),
+                step + 1,
+                t + dt,
+            ));
         }
         if let Some(q) = first(|c| c.2).filter(|&q| q != usize::MAX) {
             return Err(unsound(m, q, step + 1, t + dt));
@@ -476,14 +479,12 @@ enum Pass {
     Remapped,
 }
 
-/// The state of one particle that a pass changes.
+/// The state of one particle that a pass changes: its motion and what the
+/// stress update changes.
 struct Moving<'a, const D: usize> {
     x: &'a mut Vector<D>,
     v: &'a mut Vector<D>,
-    f: &'a mut Mat3,
-    stress: &'a mut Mat3,
-    volume: &'a mut f64,
-    history: &'a mut [f64],
+    deformation: ParticleState<'a>,
 }
 
 /// A particle's Σ S_I v_I and Σ S_I a_I from the updated nodes (`MOTION`), and
@@ -514,12 +515,4 @@ fn gather<const D: usize, const MOTION: bool, const GRAD: u8>(
         }
     });
     (vp, a, l)
-}
-
-/// p/m on a node with mass, else zero (2-25).
-fn mass_average<const D: usize>(mass: f64, momentum: &Vector<D>) -> Vector<D> {
-    match mass > 0.0 {
-        true => momentum / mass,
-        false => Vector::<D>::zeros(),
-    }
 }
