@@ -49,7 +49,13 @@ use super::return_mapping::{
     Elasticity, Frictional, Principal, PrincipalTangent, Return, ReturnMapping,
 };
 use super::{reduced_angle, Strength};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{SMatrix, SVector};
+
+/// The local Newton system has at most three surfaces and κ; smaller sets are
+/// padded with identity rows, which partial-pivoting LU leaves untouched.
+const MAX_UNKNOWNS: usize = 4;
+type LocalMatrix = SMatrix<f64, MAX_UNKNOWNS, MAX_UNKNOWNS>;
+type LocalVector = SVector<f64, MAX_UNKNOWNS>;
 
 /// Linear strain softening from the peak to the residual strength parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -116,6 +122,7 @@ const CUT_OFF_SETS: [&[Surface]; 7] = [
 ];
 
 /// f = a·τ − k with flow direction n, and their derivatives with respect to κ.
+#[derive(Clone, Copy)]
 struct Linear {
     a: Principal,
     da: Principal,
@@ -154,7 +161,8 @@ struct Solution {
     tau: Principal,
     tangent: PrincipalTangent,
     kappa: f64,
-    multipliers: Vec<f64>,
+    /// Δγ per active surface; zero beyond the active set.
+    multipliers: [f64; 3],
 }
 
 impl MohrCoulomb {
@@ -255,6 +263,13 @@ impl MohrCoulomb {
         }
     }
 
+    /// The surfaces of `set` linearized at κ, in `out`.
+    fn linearize(&self, set: &[Surface], piece: Piece, kappa: f64, out: &mut [Linear; 3]) {
+        for (o, &surface) in out.iter_mut().zip(set) {
+            *o = self.linear(surface, piece, kappa);
+        }
+    }
+
     /// Newton's method on (Δγ, κ) for the active set (module documentation).
     fn solve(
         &self,
@@ -264,19 +279,29 @@ impl MohrCoulomb {
         tau_trial: &Principal,
         kappa_old: f64,
         stress_tolerance: f64,
+        with_tangent: bool,
     ) -> Option<Solution> {
         let m = set.len();
         let de = el.stiffness();
-        let mut dg = vec![0.0; m];
+        let mut dg = [0.0; 3];
         let mut kappa = kappa_old;
-        for _ in 0..40 {
-            let surfaces: Vec<Linear> = set.iter().map(|&s| self.linear(s, piece, kappa)).collect();
-            let plastic: Principal = surfaces.iter().zip(&dg).map(|(s, g)| s.n * *g).sum();
-            let plastic_dkappa: Principal = surfaces.iter().zip(&dg).map(|(s, g)| s.dn * *g).sum();
+        let mut linearized = [self.linear(set[0], piece, kappa); 3];
+        self.linearize(set, piece, kappa, &mut linearized);
+        // Without softening the surfaces do not move with κ.
+        let moving = self.softening.is_some();
+        for iteration in 0..40 {
+            if moving && iteration > 0 {
+                self.linearize(set, piece, kappa, &mut linearized);
+            }
+            let surfaces = &linearized[..m];
+            let dg_active = &dg[..m];
+            let plastic: Principal = surfaces.iter().zip(dg_active).map(|(s, g)| s.n * *g).sum();
+            let plastic_dkappa: Principal =
+                surfaces.iter().zip(dg_active).map(|(s, g)| s.dn * *g).sum();
             let tau = tau_trial - de * plastic;
             let (h, dh) = equivalent_strain(&plastic);
-            let mut r = DVector::zeros(m + 1);
-            let mut jac = DMatrix::zeros(m + 1, m + 1);
+            let mut r = LocalVector::zeros();
+            let mut jac = LocalMatrix::identity();
             for (i, si) in surfaces.iter().enumerate() {
                 r[i] = si.a.dot(&tau) - si.k;
                 for (j, sj) in surfaces.iter().enumerate() {
@@ -291,10 +316,18 @@ impl MohrCoulomb {
             jac[(m, m)] = 1.0 - dh.dot(&plastic_dkappa);
             let converged = (0..m).all(|i| r[i].abs() <= stress_tolerance)
                 && r[m].abs() <= 1e-14 * (1.0 + kappa.abs());
-            let lu = jac.clone().lu();
+            if converged && !with_tangent {
+                return Some(Solution {
+                    tau,
+                    tangent: PrincipalTangent::zeros(),
+                    kappa,
+                    multipliers: dg,
+                });
+            }
+            let lu = jac.lu();
             if converged {
                 // ∂r/∂ε^tr: rows a_iᵀ D^e for the surfaces, zero for κ.
-                let mut b = DMatrix::zeros(m + 1, 3);
+                let mut b = SMatrix::<f64, MAX_UNKNOWNS, 3>::zeros();
                 for (i, si) in surfaces.iter().enumerate() {
                     let row = (de * si.a).transpose();
                     for c in 0..3 {
@@ -319,7 +352,7 @@ impl MohrCoulomb {
                 });
             }
             let step = lu.solve(&(-r))?;
-            for (j, g) in dg.iter_mut().enumerate() {
+            for (j, g) in dg[..m].iter_mut().enumerate() {
                 *g += step[j];
             }
             kappa += step[m];
@@ -355,12 +388,13 @@ impl MohrCoulomb {
             tau: Principal::repeat(p),
             tangent: Principal::repeat(1.0) * (dh * dp).transpose(),
             kappa,
-            multipliers: Vec::new(),
+            multipliers: [0.0; 3],
         }
     }
 
-    /// Return mapping in ordered principal space.
-    fn ordered_return(&self, eps: &Principal, kappa_old: f64) -> Solution {
+    /// Return mapping in ordered principal space; the tangent is zero unless
+    /// `with_tangent`.
+    fn ordered_return(&self, eps: &Principal, kappa_old: f64, with_tangent: bool) -> Solution {
         let el = self.elastic();
         let tau_trial = el.stress(eps);
         let scale = tau_trial.amax()
@@ -377,7 +411,7 @@ impl MohrCoulomb {
                 tau: tau_trial,
                 tangent: el.stiffness(),
                 kappa: kappa_old,
-                multipliers: Vec::new(),
+                multipliers: [0.0; 3],
             };
         }
         let cut_off_sets: &[&[Surface]] = if self.tensile_strength.is_some() {
@@ -400,7 +434,15 @@ impl MohrCoulomb {
             .chain(cut_off_sets)
             .flat_map(|set| pieces.clone().map(move |&piece| (set, piece)))
             .filter_map(|(set, piece)| {
-                let s = self.solve(&el, set, piece, &tau_trial, kappa_old, stress_tolerance)?;
+                let s = self.solve(
+                    &el,
+                    set,
+                    piece,
+                    &tau_trial,
+                    kappa_old,
+                    stress_tolerance,
+                    with_tangent,
+                )?;
                 let kappa_tolerance = 1e-12 * (1.0 + s.kappa.abs());
                 self.in_piece(piece, s.kappa, kappa_tolerance).then_some(s)
             })
@@ -421,7 +463,7 @@ impl MohrCoulomb {
             tau: tau_trial,
             tangent: el.stiffness(),
             kappa: kappa_old,
-            multipliers: Vec::new(),
+            multipliers: [0.0; 3],
         }
     }
 }
@@ -432,11 +474,28 @@ impl ReturnMapping for MohrCoulomb {
     }
 
     fn return_map(&self, eps: &Principal, h_old: &[f64], h_new: &mut [f64]) -> Return {
+        self.unordered_return(eps, h_old, h_new, true)
+    }
+
+    fn return_stress(&self, eps: &Principal, h_old: &[f64], h_new: &mut [f64]) -> Principal {
+        self.unordered_return(eps, h_old, h_new, false).tau
+    }
+}
+
+impl MohrCoulomb {
+    /// [`MohrCoulomb::ordered_return`] for principal strains in any order.
+    fn unordered_return(
+        &self,
+        eps: &Principal,
+        h_old: &[f64],
+        h_new: &mut [f64],
+        with_tangent: bool,
+    ) -> Return {
         // Order the principal strains (the trial stresses have the same order).
         let mut order = [0usize, 1, 2];
         order.sort_by(|&a, &b| eps[b].total_cmp(&eps[a]));
         let sorted = Principal::from_fn(|i, _| eps[order[i]]);
-        let s = self.ordered_return(&sorted, h_old[0]);
+        let s = self.ordered_return(&sorted, h_old[0], with_tangent);
         h_new[0] = s.kappa;
         let mut tau = Principal::zeros();
         let mut tangent = PrincipalTangent::zeros();
@@ -823,7 +882,7 @@ mod tests {
     /// inside the pyramid and below the cut-off, in the principal order of the
     /// trial.
     #[test]
-    fn every_return_is_admissible() {
+    fn every_return_is_admissible_and_the_same_without_tangent() {
         let mut seed: u64 = 0x2545_f491_4f6c_dd1d;
         let mut uniform = move || {
             seed ^= seed << 13;
@@ -852,6 +911,12 @@ mod tests {
                 let kappa = 0.03 * (uniform() + 1.0);
                 let mut h = [0.0];
                 let ret = m.return_map(&eps, &[kappa], &mut h);
+                let mut h_stress_only = [0.0];
+                let tau = m.return_stress(&eps, &[kappa], &mut h_stress_only);
+                assert!(
+                    tau == ret.tau && h_stress_only == h,
+                    "the stress-only return is the same return"
+                );
                 let mut order = [0, 1, 2];
                 order.sort_by(|&a, &b| eps[b].total_cmp(&eps[a]));
                 let t = Vector3::from_fn(|i, _| ret.tau[order[i]]);

@@ -103,6 +103,17 @@ pub trait ReturnMapping {
         history_old: &[f64],
         history_new: &mut [f64],
     ) -> Return;
+
+    /// The principal stresses of [`ReturnMapping::return_map`] alone, for
+    /// callers that do not need the tangent (explicit steps).
+    fn return_stress(
+        &self,
+        eps_trial: &Principal,
+        history_old: &[f64],
+        history_new: &mut [f64],
+    ) -> Principal {
+        self.return_map(eps_trial, history_old, history_new).tau
+    }
 }
 
 /// The trial elastic state of an increment.
@@ -147,8 +158,8 @@ impl Trial {
 /// Cauchy stress at the end of the increment; writes the new history.
 pub fn update<R: ReturnMapping + ?Sized>(r: &R, inc: &Increment, history_new: &mut [f64]) -> Mat3 {
     let trial = Trial::of(&r.elasticity(), inc);
-    let ret = r.return_map(&trial.eps, inc.history_old, history_new);
-    trial.rotate(&ret.tau) / trial.j
+    let tau = r.return_stress(&trial.eps, inc.history_old, history_new);
+    trial.rotate(&tau) / trial.j
 }
 
 /// Below this difference of principal strains the quotient (τ_a − τ_b)/(ε_a − ε_b)
