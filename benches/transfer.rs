@@ -58,13 +58,11 @@ fn setup<const D: usize>(n: usize, shape: ShapeFunction) -> (Grid<D>, Particles<
             0,
         );
     }
-    for f in p.f.iter_mut() {
-        *f = Mat3::identity();
-        f[(0, 1)] = 0.1;
-    }
-    for s in p.stress.iter_mut() {
-        *s = Mat3::new(1.0, 0.2, 0.0, 0.2, -1.0, 0.0, 0.0, 0.0, 0.5);
-    }
+    let mut f = Mat3::identity();
+    f[(0, 1)] = 0.1;
+    p.f.iter_mut().for_each(|mut slot| slot.set(&f));
+    let s = Mat3::new(1.0, 0.2, 0.0, 0.2, -1.0, 0.0, 0.0, 0.0, 0.5);
+    p.stress.iter_mut().for_each(|mut slot| slot.set(&s));
     (grid, p)
 }
 
@@ -137,7 +135,7 @@ fn scatter_benches<const D: usize>(
                     (0.0, Vector::<D>::zeros(), Vector::<D>::zeros()),
                 );
                 let source = |q: usize, _: &Stencil<D>| {
-                    let stress: Tensor<D> = restrict::<D>(&p.stress[q]) * p.volume[q];
+                    let stress: Tensor<D> = restrict::<D>(&p.stress.get(q)) * p.volume[q];
                     (p.mass[q], p.v[q] * p.mass[q], gravity * p.mass[q], stress)
                 };
                 nb.scatter(
@@ -168,7 +166,7 @@ fn scatter_benches<const D: usize>(
                 (0..p.len())
                     .into_par_iter()
                     .map(|q| {
-                        let st = nb.stencil(shape, grid, &p.x[q], &p.half_length0[q], &p.f[q]);
+                        let st = nb.stencil(shape, grid, &p.x[q], &p.half_length0[q], &p.f.get(q));
                         let (mut v, mut a, mut l) = (
                             Vector::<D>::zeros(),
                             Vector::<D>::zeros(),

@@ -271,6 +271,7 @@ impl MohrCoulomb {
     }
 
     /// Newton's method on (Δγ, κ) for the active set (module documentation).
+    #[allow(clippy::too_many_arguments)]
     fn solve(
         &self,
         el: &Elasticity,

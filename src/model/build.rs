@@ -201,6 +201,7 @@ fn fill_body<const D: usize>(
         .velocity
         .as_deref()
         .map_or(Vector::<D>::zeros(), |v| Vector::<D>::from_fn(|d, _| v[d]));
+    particles.reserve(points.len());
     let mut added = 0;
     for (x, volume, half) in points {
         let mut v = uniform;

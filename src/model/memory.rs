@@ -21,6 +21,7 @@
 //! take `--memory-limit GIB` to set another.
 
 use crate::scene::{LinearSolver, PreconditionerKind, SceneConfig, SolverKind};
+use crate::model::tensors::Layout;
 
 /// The estimate's parts, in bytes, and the counts they come from.
 #[derive(Clone, Debug, PartialEq)]
@@ -64,10 +65,15 @@ impl Estimate {
             })
             .collect();
         let particles: f64 = lattice_points.iter().sum();
-        // x, x0, v, half-lengths, load; mass and volumes; F and σ; ids; history;
-        // the stencil (weight, gradient, node).
-        let per_particle =
-            5.0 * 8.0 * d + 3.0 * 8.0 + 2.0 * 72.0 + 8.0 + 80.0 + support * (8.0 + 8.0 * d + 8.0);
+        // x, x0, v, half-lengths, load; mass and volumes; F and σ (packed); ids;
+        // history; the stencil (weight, gradient, node).
+        let tensors = 8 * (Layout::gradient(dim).components() + Layout::stress(dim).components());
+        let per_particle = 5.0 * 8.0 * d
+            + 3.0 * 8.0
+            + tensors as f64
+            + 8.0
+            + 80.0
+            + support * (8.0 + 8.0 * d + 8.0);
         // Mass and momentum, force, velocity, acceleration; implicit unknowns.
         let per_node = 8.0 * (1.0 + 8.0 * d);
         let implicit_stages = || {

@@ -10,6 +10,7 @@ pub mod grid;
 pub mod loads;
 pub mod memory;
 pub mod particles;
+pub mod tensors;
 
 pub use loads::{load_factor, LoadTime};
 
@@ -87,7 +88,7 @@ impl<const D: usize> Model<D> {
         let mass = eroded.iter().fold(0.0, |sum, &q| sum + p.mass[q]);
         let energy = eroded.iter().fold(0.0, |sum, &q| {
             let mat = &self.materials[p.material[q] as usize];
-            let stored = mat.strain_energy_density(&p.f[q], &p.stress[q], p.history.get(q));
+            let stored = mat.strain_energy_density(&p.f.get(q), &p.stress.get(q), p.history.get(q));
             sum + 0.5 * p.mass[q] * p.v[q].norm_squared() + p.volume[q] * stored
         });
         (mass, energy)

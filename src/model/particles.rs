@@ -5,8 +5,9 @@
 //! empty buffer.
 
 use crate::dim::{Mat3, Vector};
+use crate::model::tensors::{Layout, Tensors};
 
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct Particles<const D: usize> {
     /// Current position x.
     pub x: Vec<Vector<D>>,
@@ -16,10 +17,11 @@ pub struct Particles<const D: usize> {
     pub mass: Vec<f64>,
     pub volume: Vec<f64>,
     pub volume0: Vec<f64>,
-    /// Deformation gradient (3×3; plane strain keeps F_zz = 1).
-    pub f: Vec<Mat3>,
-    /// Cauchy stress (3×3; plane strain carries σ_zz).
-    pub stress: Vec<Mat3>,
+    /// Deformation gradient (plane strain keeps F_zz = 1), packed by
+    /// `Layout::gradient(D)`.
+    pub f: Tensors,
+    /// Cauchy stress (plane strain carries σ_zz), packed by `Layout::stress(D)`.
+    pub stress: Tensors,
     /// Half-lengths of the particle domain in the reference configuration: the CPDI
     /// domain vectors at t = 0 are r_i⁰ = lp0_i e_i, and now r_i = F r_i⁰; GIMP uses
     /// them as the half-widths of the characteristic function.
@@ -98,6 +100,26 @@ fn split_slots<'a>(len: &[u16], data: &'a mut [f64]) -> Vec<&'a mut [f64]> {
     out
 }
 
+impl<const D: usize> Default for Particles<D> {
+    fn default() -> Self {
+        Particles {
+            x: Vec::new(),
+            x0: Vec::new(),
+            v: Vec::new(),
+            mass: Vec::new(),
+            volume: Vec::new(),
+            volume0: Vec::new(),
+            f: Tensors::new(Layout::gradient(D)),
+            stress: Tensors::new(Layout::stress(D)),
+            half_length0: Vec::new(),
+            body: Vec::new(),
+            material: Vec::new(),
+            load: Vec::new(),
+            history: History::default(),
+        }
+    }
+}
+
 impl<const D: usize> Particles<D> {
     pub fn len(&self) -> usize {
         self.x.len()
@@ -105,6 +127,23 @@ impl<const D: usize> Particles<D> {
 
     pub fn is_empty(&self) -> bool {
         self.x.is_empty()
+    }
+
+    /// Room for `additional` more particles (a fill knows its count: no regrowth).
+    pub fn reserve(&mut self, additional: usize) {
+        let n = additional;
+        self.x.reserve_exact(n);
+        self.x0.reserve_exact(n);
+        self.v.reserve_exact(n);
+        self.mass.reserve_exact(n);
+        self.volume.reserve_exact(n);
+        self.volume0.reserve_exact(n);
+        self.f.reserve(n);
+        self.stress.reserve(n);
+        self.half_length0.reserve_exact(n);
+        self.body.reserve_exact(n);
+        self.material.reserve_exact(n);
+        self.load.reserve_exact(n);
     }
 
     /// Add one particle at rest, undeformed and unstressed.
@@ -126,8 +165,8 @@ impl<const D: usize> Particles<D> {
         self.mass.push(mass);
         self.volume.push(volume);
         self.volume0.push(volume);
-        self.f.push(Mat3::identity());
-        self.stress.push(Mat3::zeros());
+        self.f.push(&Mat3::identity());
+        self.stress.push(&Mat3::zeros());
         self.half_length0.push(half_length0);
         self.body.push(body);
         self.material.push(material);

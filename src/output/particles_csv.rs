@@ -68,7 +68,7 @@ pub fn write_particles_csv_with<const D: usize>(
         for i in 0..p.len() {
             let ids = [Field::from(i), Field::from(p.body[i])];
             let kinematics = p.x0[i].iter().chain(p.x[i].iter()).chain(p.v[i].iter());
-            let sigma = stress.iter().map(|&(_, r, c)| p.stress[i][(r, c)]);
+            let sigma = stress.iter().map(|&(_, r, c)| p.stress.get(i)[(r, c)]);
             let sizes = [p.volume0[i], p.volume[i], p.mass[i]];
             let more = extra.iter().map(|(_, values)| values[i]);
             let numbers = kinematics.copied().chain(sigma).chain(sizes).chain(more);
@@ -133,7 +133,7 @@ mod tests {
             0,
         );
         p.x[1] = Vector::<2>::new(1.5, 2.0 / 3.0);
-        p.stress[1] = stressed();
+        p.stress.set(1, &stressed());
         p.volume[1] = 0.625;
 
         let dir = tempfile::tempdir().unwrap();
@@ -185,7 +185,7 @@ mod tests {
             0,
         );
         p.x[0] = Vector::<3>::new(1.1, 2.2, 3.3);
-        p.stress[0] = stressed();
+        p.stress.set(0, &stressed());
 
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("particles_final.csv");

@@ -59,6 +59,7 @@ mod tests {
     use super::*;
     use crate::dim::Mat3;
     use crate::model::grid::Grid;
+    use crate::model::tensors::{Layout, Tensors};
     use crate::physics::shape::ShapeFunction;
     use strum::IntoEnumIterator;
 
@@ -78,7 +79,7 @@ mod tests {
                 .map(|k| Vector::<2>::new(0.0625 + 0.125 * k as f64, 0.3))
                 .collect();
             let half = vec![Vector::<2>::new(0.0625, 0.125); x.len()];
-            let f = vec![Mat3::identity(); x.len()];
+            let f = Tensors::filled(Layout::gradient(2), x.len(), &Mat3::identity());
             let mut st = Stencils::<2>::default();
             st.compute(shape, &grid, &x, &half, &f);
             hoop_gradients(&mut st, &x);

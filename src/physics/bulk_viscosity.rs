@@ -90,7 +90,7 @@ impl BulkViscosity {
             .map(|q| {
                 let mat = &materials[p.material[q] as usize];
                 let rho = p.mass[q] / p.volume[q];
-                let c = mat.wave_speed(p.f[q].determinant(), p.history.get(q));
+                let c = mat.wave_speed(p.f.get(q).determinant(), p.history.get(q));
                 self.pressure(rho, c, l, rates[q]) * p.volume[q]
             })
             .collect();

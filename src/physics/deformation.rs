@@ -11,6 +11,7 @@ use crate::dim::{embed_deformation, Mat3, Tensor, Vector};
 use crate::material::{Increment, Material};
 use crate::model::grid::Grid;
 use crate::model::particles::Particles;
+use crate::model::tensors::{Layout, TensorMut, Tensors};
 use crate::parallel::MIN_PARALLEL_LEN;
 use crate::physics::axisymmetry::hoop_stretch;
 use crate::physics::fbar::{scale_factor, scaled, Cells, FBarState};
@@ -24,16 +25,29 @@ use rayon::prelude::*;
 /// displacements (with F-bar, from the plain ΔF_p and the cells' mean
 /// dilatation), with the arithmetic of `evaluate`, so every reader sees the
 /// same bits (72 bytes per particle less in every implicit step).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct Trial<const D: usize> {
     /// The nodal displacements u of the increment (one per active node).
     u: Vec<Vector<D>>,
-    pub stress: Vec<Mat3>,
+    /// Packed as the particles' stresses.
+    pub stress: Tensors,
     pub volume: Vec<f64>,
     /// History variables, laid out like `Particles::history.data`.
     pub history: Vec<f64>,
     /// F-bar (None: off): the cells of this step, set by `use_fbar`.
     pub fbar: Option<FBarState>,
+}
+
+impl<const D: usize> Default for Trial<D> {
+    fn default() -> Self {
+        Trial {
+            u: Vec::new(),
+            stress: Tensors::new(Layout::stress(D)),
+            volume: Vec::new(),
+            history: Vec::new(),
+            fbar: None,
+        }
+    }
 }
 
 impl<const D: usize> Trial<D> {
@@ -58,7 +72,7 @@ impl<const D: usize> Trial<D> {
         let n = p.len();
         self.u.clear();
         self.u.extend_from_slice(u);
-        self.stress.resize(n, Mat3::zeros());
+        self.stress.resize(n, &Mat3::zeros());
         self.volume.resize(n, 0.0);
         self.history.clone_from(&p.history.data);
         let axisymmetric = !st.hoop.is_empty();
@@ -85,17 +99,18 @@ impl<const D: usize> Trial<D> {
             .zip(history.par_iter_mut())
             .enumerate()
             .with_min_len(MIN_PARALLEL_LEN)
-            .map(|(q, ((stress, volume), hist))| {
+            .map(|(q, ((mut stress, volume), hist))| {
                 let material = materials[p.material[q] as usize].as_ref();
                 let inc = Increment {
-                    f_old: p.f[q],
+                    f_old: p.f.get(q),
                     df: df_of(u, fbar, st, map, q),
                     dt,
-                    stress_old: p.stress[q],
+                    stress_old: p.stress.get(q),
                     history_old: history_old[q],
                 };
                 let new = advance(material, &inc, p.volume0[q], hist);
-                (*stress, *volume) = (new.stress, new.volume);
+                stress.set(&new.stress);
+                *volume = new.volume;
                 new.inverted_at(q)
             })
             .min()
@@ -124,7 +139,7 @@ impl<const D: usize> Trial<D> {
     ) -> Result<(), (usize, f64)> {
         if self.fbar.is_none() {
             return match update_in_place(p, materials, st, map, u, dt) {
-                Some(q) => Err((q, p.f[q].determinant())),
+                Some(q) => Err((q, p.f.get(q).determinant())),
                 None => Ok(()),
             };
         }
@@ -138,7 +153,7 @@ impl<const D: usize> Trial<D> {
     /// The trial deformation gradient of particle q, F = ΔF F_old (2-31); not
     /// stored: only a commit and an inversion's report need it.
     pub fn f(&self, p: &Particles<D>, st: &Stencils<D>, map: &NodeMap, q: usize) -> Mat3 {
-        self.df(st, map, q) * p.f[q]
+        self.df(st, map, q) * p.f.get(q)
     }
 
     /// Make the trial state the particles' state: F = ΔF F_old formed in place,
@@ -148,7 +163,7 @@ impl<const D: usize> Trial<D> {
         (p.f.par_iter_mut())
             .enumerate()
             .with_min_len(MIN_PARALLEL_LEN)
-            .for_each(|(q, f)| *f = self.df(st, map, q) * *f);
+            .for_each(|(q, mut f)| f.set(&(self.df(st, map, q) * f.get())));
         std::mem::swap(&mut p.stress, &mut self.stress);
         std::mem::swap(&mut p.volume, &mut self.volume);
         std::mem::swap(&mut p.history.data, &mut self.history);
@@ -255,7 +270,7 @@ fn update_in_place<const D: usize>(
         history,
         ..
     } = p;
-    let update = |q: usize, f: &mut Mat3, stress: &mut Mat3, volume: &mut f64, hist: &mut [f64]| {
+    let update = |q: usize, f: TensorMut, stress: TensorMut, volume: &mut f64, hist: &mut [f64]| {
         let material = materials[material[q] as usize].as_ref();
         let df = increment(st, map, q, u, axisymmetric);
         let mut state = ParticleState {
@@ -291,8 +306,8 @@ fn update_in_place<const D: usize>(
 
 /// The mutable state of one particle that a stress update changes.
 pub struct ParticleState<'a> {
-    pub f: &'a mut Mat3,
-    pub stress: &'a mut Mat3,
+    pub f: TensorMut<'a>,
+    pub stress: TensorMut<'a>,
     pub volume: &'a mut f64,
     pub history: &'a mut [f64],
 }
@@ -323,13 +338,15 @@ pub fn update_particle(
         }
     };
     let inc = Increment {
-        f_old: *state.f,
+        f_old: state.f.get(),
         df: *df,
         dt,
-        stress_old: *state.stress,
+        stress_old: state.stress.get(),
         history_old,
     };
     let new = advance(material, &inc, volume0, hist);
-    (*state.stress, *state.f, *state.volume) = (new.stress, new.f, new.volume);
+    state.stress.set(&new.stress);
+    state.f.set(&new.f);
+    *state.volume = new.volume;
     new.det
 }

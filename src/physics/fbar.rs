@@ -175,7 +175,7 @@ load_steps = 1
         fn of(t: Trial<2>, st: &Stencils<2>, map: &NodeMap) -> Evaluated {
             Evaluated {
                 df: (0..t.stress.len()).map(|q| t.df(st, map, q)).collect(),
-                stress: t.stress,
+                stress: t.stress.iter().collect(),
                 volume: t.volume,
                 fbar: t.fbar,
             }

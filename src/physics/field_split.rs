@@ -239,7 +239,7 @@ impl FieldSplit {
         let extent = |a: usize, x_node: &Vector<D>, n: &Vector<D>, local: bool| -> f64 {
             // A particle's reach along a unit direction u: Σ_d l_d |u · F e_d|.
             let reach = |q: usize, u: &Vector<D>| -> f64 {
-                let f = &p.f[q];
+                let f = &p.f.get(q);
                 (0..D)
                     .map(|d| {
                         let column = Vector::<D>::from_fn(|i, _| f[(i, d)]);

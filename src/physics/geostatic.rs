@@ -49,6 +49,6 @@ pub fn initialise<const D: usize>(model: &mut Model<D>, g: &GeostaticConfig) {
         let sigma_v = -model.materials[m].density() * g_mag * depth;
         let mut s = Mat3::from_diagonal_element(k0 * sigma_v);
         s[(v, v)] = sigma_v;
-        p.stress[q] = s;
+        p.stress.set(q, &s);
     }
 }

@@ -22,6 +22,7 @@
 use crate::dim::{Mat3, Vector};
 use crate::model::grid::Grid;
 use crate::model::particles::Particles;
+use crate::model::tensors::Tensors;
 use crate::parallel::{bucket_sort, DisjointSlice, MIN_PARALLEL_LEN, NO_BUCKET};
 use crate::physics::shape::linear::{cell_coordinate, cell_index};
 use crate::physics::shape::{separable_axes, ShapeFunction, MAX_PER_AXIS};
@@ -100,7 +101,7 @@ impl<const D: usize> Stencil<D> {
 pub struct Points<'a, const D: usize> {
     pub x: &'a [Vector<D>],
     pub half_length0: &'a [Vector<D>],
-    pub f: &'a [Mat3],
+    pub f: &'a Tensors,
 }
 
 impl<'a, const D: usize> Points<'a, D> {
@@ -319,7 +320,7 @@ impl<const D: usize> NodeBox<D> {
                 let (first, end) = self.tile_nodes(t, reach);
                 for &q in &self.order[self.start[t] as usize..self.start[t + 1] as usize] {
                     let q = q as usize;
-                    let (x, half, f) = (&points.x[q], &points.half_length0[q], &points.f[q]);
+                    let (x, half, f) = (&points.x[q], &points.half_length0[q], &points.f.get(q));
                     let Some(st) = self.stencil(shape, grid, x, half, f) else {
                         continue;
                     };

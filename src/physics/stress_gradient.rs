@@ -39,7 +39,7 @@ impl<const D: usize> LinearStress<D> {
     /// admits `cpgimp` and `cpbspline2` only).
     pub fn new(shape: ShapeFunction, grid: &Grid<D>, p: &Particles<D>, st: &Stencils<D>) -> Self {
         let half: Vec<Vector<D>> = (0..p.len())
-            .map(|q| contiguous_half_length(grid, &p.half_length0[q], &p.f[q]))
+            .map(|q| contiguous_half_length(grid, &p.half_length0[q], &p.f.get(q)))
             .collect();
         let active: Vec<bool> = st.count.iter().map(|c| *c > 0).collect();
         let mut moments = vec![Tensor::<D>::zeros(); st.node.len()];
@@ -48,7 +48,8 @@ impl<const D: usize> LinearStress<D> {
             .enumerate()
             .filter(|(q, _)| active[*q])
             .for_each(|(q, out)| {
-                let n = gradient_moments(shape, grid, &p.x[q], &p.half_length0[q], &p.f[q], out);
+                let n =
+                    gradient_moments(shape, grid, &p.x[q], &p.half_length0[q], &p.f.get(q), out);
                 assert_eq!(n, Some(st.count[q] as usize), "domain moments of {shape:?}");
             });
         LinearStress {

@@ -381,8 +381,8 @@ pub fn nodal_force<const D: usize>(
         .with_min_len(MIN_PARALLEL_LEN)
         .map(|q| ForceSource {
             applied: applied_force(p, q, gravity, load_factor),
-            stress: restrict::<D>(&p.stress[q]),
-            hoop_stress: p.stress[q][(2, 2)],
+            stress: restrict::<D>(&p.stress.get(q)),
+            hoop_stress: p.stress.get(q)[(2, 2)],
             volume: p.volume[q],
         })
         .collect();
@@ -465,6 +465,7 @@ pub fn gradient<const D: usize>(
 mod tests {
     use super::*;
     use crate::model::grid::Grid;
+    use crate::model::tensors::{Layout, Tensors};
     use crate::physics::shape::tests::sample_points;
 
     /// The map by the definition: nodes in ascending order, each with its
@@ -501,14 +502,14 @@ mod tests {
         );
         let x = sample_points(&grid, 5000);
         let half = vec![Vector::<2>::repeat(0.025); x.len()];
-        let f = vec![Mat3::identity(); x.len()];
+        let f = Tensors::filled(Layout::gradient(2), x.len(), &Mat3::identity());
         let mut st = Stencils::<2>::default();
         st.compute(
             ShapeFunction::Bspline2,
             &grid,
             &x[..3000],
             &half[..3000],
-            &f[..3000],
+            &f,
         );
         let mut earlier = NodeMap::default();
         earlier.build(&st, grid.node_count());

@@ -25,6 +25,7 @@
 
 use crate::dim::{Mat3, Vector};
 use crate::model::particles::{History, Particles};
+use crate::model::tensors::{Layout, Tensors};
 use crate::output::atomic::write_atomically;
 use crate::run::recorders::RecorderState;
 use crate::run::summary::StageSummary;
@@ -109,8 +110,11 @@ fn flat_vectors<const D: usize>(v: &[Vector<D>]) -> Vec<f64> {
     v.iter().flat_map(|a| a.iter().copied()).collect()
 }
 
-fn flat_matrices(m: &[Mat3]) -> Vec<f64> {
-    m.iter().flat_map(|a| a.iter().copied()).collect()
+/// Nine values per tensor (column-major), whatever the particles' packing.
+fn flat_matrices(m: &Tensors) -> Vec<f64> {
+    m.iter()
+        .flat_map(|a| a.iter().copied().collect::<Vec<_>>())
+        .collect()
 }
 
 fn vectors<const D: usize>(v: &[f64]) -> Vec<Vector<D>> {
@@ -119,8 +123,8 @@ fn vectors<const D: usize>(v: &[f64]) -> Vec<Vector<D>> {
         .collect()
 }
 
-fn matrices(v: &[f64]) -> Vec<Mat3> {
-    v.chunks_exact(9).map(Mat3::from_column_slice).collect()
+fn matrices(v: &[f64], layout: Layout) -> Tensors {
+    Tensors::from_matrices(layout, v.chunks_exact(9).map(Mat3::from_column_slice))
 }
 
 impl ParticleState {
@@ -178,8 +182,8 @@ impl ParticleState {
             mass: self.mass.clone(),
             volume: self.volume.clone(),
             volume0: self.volume0.clone(),
-            f: matrices(&self.f),
-            stress: matrices(&self.stress),
+            f: matrices(&self.f, Layout::gradient(D)),
+            stress: matrices(&self.stress, Layout::stress(D)),
             half_length0: vectors(&self.half_length0),
             body: self.body.clone(),
             material: self.material.clone(),

@@ -14,6 +14,6 @@ pub fn strain_energy<const D: usize>(m: &Model<D>) -> f64 {
     let p = &m.particles;
     deterministic_sum(p.len(), |q| {
         let mat = &m.materials[p.material[q] as usize];
-        p.volume[q] * mat.strain_energy_density(&p.f[q], &p.stress[q], p.history.get(q))
+        p.volume[q] * mat.strain_energy_density(&p.f.get(q), &p.stress.get(q), p.history.get(q))
     })
 }

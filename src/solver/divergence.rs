@@ -44,8 +44,8 @@ pub fn check_state<const D: usize>(m: &Model<D>, step: usize, time: f64) -> Resu
             !sound(
                 &p.x[q],
                 &p.v[q],
-                &p.stress[q],
-                p.f[q].determinant(),
+                &p.stress.get(q),
+                p.f.get(q).determinant(),
                 inside && off_axis,
             )
         });
@@ -88,9 +88,9 @@ pub fn unsound<const D: usize>(m: &Model<D>, q: usize, step: usize, time: f64) -
     let finite = p.x[q]
         .iter()
         .chain(p.v[q].iter())
-        .chain(p.stress[q].iter())
+        .chain(p.stress.get(q).iter())
         .all(|v| v.is_finite());
-    let det = p.f[q].determinant();
+    let det = p.f.get(q).determinant();
     let message = if finite && m.axisymmetric && p.x[q][0] <= 0.0 {
         format!(
             "(body {}) reached the axis: r = {:e} (axisymmetric mode)",
@@ -158,7 +158,7 @@ end_time = 1.0
             Mat3::new(1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0),
             -Mat3::identity(),
         ] {
-            m.particles.f[2] = f;
+            m.particles.f.set(2, &f);
             let d = check_state(&m, 5, 0.5).unwrap_err();
             assert_eq!((d.step, d.particle), (5, Some(2)));
             assert!(d.message.contains("inverted or collapsed"), "{d}");

@@ -131,7 +131,7 @@ impl<const D: usize> Explicit<D> {
             .filter(|&q| counts(q))
             .map(|q| {
                 let c = m.materials[p.material[q] as usize]
-                    .wave_speed(p.f[q].determinant(), p.history.get(q));
+                    .wave_speed(p.f.get(q).determinant(), p.history.get(q));
                 let dt = h / (c + p.v[q].norm());
                 viscosity.map_or(dt, |v| dt.min(v.stable_dt(c, h, 0.0)))
             })

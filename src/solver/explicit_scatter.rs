@@ -10,9 +10,10 @@
 //! scatter and a particle pass each. `Explicit` chooses this path for the
 //! scenes it serves (`Explicit::scatter_serves`).
 
-use crate::dim::{embed_deformation, Mat3, Tensor, Vector};
+use crate::dim::{embed_deformation, Tensor, Vector};
 use crate::model::conditions::Constraint;
 use crate::model::particles::Particles;
+use crate::model::tensors::TensorsMut;
 use crate::model::{load_factor, Model};
 use crate::parallel::{deterministic_sum, DisjointSlice, MIN_PARALLEL_LEN, SUM_CHUNK};
 use crate::physics::boundary::{friction_contact, node_constraint, node_friction};
@@ -140,7 +141,7 @@ impl<const D: usize> ScatterStep<D> {
                 }),
                 false => Vector::<D>::zeros(),
             };
-            let stress = crate::dim::restrict::<D>(&p.stress[q]) * p.volume[q];
+            let stress = crate::dim::restrict::<D>(&p.stress.get(q)) * p.volume[q];
             (p.mass[q], p.v[q] * p.mass[q], applied, stress)
         };
         let add =
@@ -353,7 +354,7 @@ impl<const D: usize> ScatterStep<D> {
                 grid,
                 state.x,
                 &half_length0[q],
-                state.deformation.f,
+                &state.deformation.f.get(),
             );
             let (vp, a, l) = match (pass, sc) {
                 (_, None) => (
@@ -385,20 +386,20 @@ impl<const D: usize> ScatterStep<D> {
                     let law = materials[material[q] as usize].as_ref();
                     update_particle(law, &df, dt, volume0[q], &mut state.deformation)
                 }
-                false if checks => state.deformation.f.determinant(),
+                false if checks => state.deformation.f.get().determinant(),
                 false => 1.0,
             };
             // NaN counts as inverted, as in `check_state`.
             let intact = det > 0.0;
-            let stress = &*state.deformation.stress;
-            let bad = checks && !sound(state.x, state.v, stress, det, grid.contains(state.x));
+            let stress = state.deformation.stress.get();
+            let bad = checks && !sound(state.x, state.v, &stress, det, grid.contains(state.x));
             (work, !intact, bad)
         };
         let chunk = |c: usize,
                      xs: &mut [Vector<D>],
                      vs: &mut [Vector<D>],
-                     fs: &mut [Mat3],
-                     ss: &mut [Mat3],
+                     mut fs: TensorsMut,
+                     mut ss: TensorsMut,
                      vols: &mut [f64],
                      mut hs: Option<&mut [&mut [f64]]>| {
             let (mut work, mut first_inverted, mut bad) = (0.0, usize::MAX, usize::MAX);
@@ -411,8 +412,8 @@ impl<const D: usize> ScatterStep<D> {
                     x: &mut xs[i],
                     v: &mut vs[i],
                     deformation: ParticleState {
-                        f: &mut fs[i],
-                        stress: &mut ss[i],
+                        f: fs.at(i),
+                        stress: ss.at(i),
                         volume: &mut vols[i],
                         history,
                     },
@@ -454,7 +455,7 @@ impl<const D: usize> ScatterStep<D> {
         if let Some(q) = first(|c| c.1).filter(|&q| q != usize::MAX) {
             return Err(inverted(
                 q,
-                m.particles.f[q].determinant(),
+                m.particles.f.get(q).determinant(),
                 step + 1,
                 t + dt,
             ));

@@ -130,7 +130,7 @@ fn k0_depth_is_measured_below_the_slope_face() {
         // Slope face y = (35 − x)/2 for 15 ≤ x ≤ 35, crest level 10 behind it.
         let surface = if x <= 15.0 { 10.0 } else { (35.0 - x) / 2.0 };
         let sv = -20.0 * (surface - y);
-        let s = p.stress[q];
+        let s = p.stress.get(q);
         assert!((s[(1, 1)] - sv).abs() < 1e-9, "σ_v at ({x}, {y})");
         assert!((s[(0, 0)] - k0 * sv).abs() < 1e-9 && (s[(2, 2)] - k0 * sv).abs() < 1e-9);
         assert_eq!(s[(0, 1)], 0.0);

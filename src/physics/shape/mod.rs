@@ -14,6 +14,7 @@ pub use linear::{AxisFactors, MAX_PER_AXIS};
 
 use crate::dim::{restrict, Mat3, Tensor, Vector};
 use crate::model::grid::Grid;
+use crate::model::tensors::Tensors;
 pub use crate::scene::ShapeFunction;
 use rayon::prelude::*;
 
@@ -217,7 +218,7 @@ impl<const D: usize> Stencils<D> {
         grid: &Grid<D>,
         x: &[Vector<D>],
         half_length0: &[Vector<D>],
-        f: &[Mat3],
+        f: &Tensors,
     ) {
         let n = x.len();
         let stride = shape.max_support(D);
@@ -239,7 +240,7 @@ impl<const D: usize> Stencils<D> {
         grid: &Grid<D>,
         x: &[Vector<D>],
         half_length0: &[Vector<D>],
-        f: &[Mat3],
+        f: &Tensors,
     ) {
         let (n, stride) = (x.len(), self.stride);
         if !matches!(self.values, Values::Entries { .. }) {
@@ -260,7 +261,9 @@ impl<const D: usize> Stencils<D> {
             .for_each(|(p, (((c, nd), w), g))| {
                 // A particle outside the grid (removed, `Model::removed`) has no nodes.
                 *c = match grid.contains(&x[p]) {
-                    true => evaluate(shape, grid, &x[p], &half_length0[p], &f[p], nd, w, g) as u32,
+                    true => {
+                        evaluate(shape, grid, &x[p], &half_length0[p], &f.get(p), nd, w, g) as u32
+                    }
                     false => 0,
                 };
             });
@@ -275,7 +278,7 @@ impl<const D: usize> Stencils<D> {
         grid: &Grid<D>,
         x: &[Vector<D>],
         half_length0: &[Vector<D>],
-        f: &[Mat3],
+        f: &Tensors,
     ) {
         let (n, stride) = (x.len(), self.stride);
         // The buffers of the last step are reused.
@@ -305,7 +308,7 @@ impl<const D: usize> Stencils<D> {
                     *c = 0;
                     return;
                 }
-                let axes = separable_axes(shape, grid, &x[p], &half_length0[p], &f[p]);
+                let axes = separable_axes(shape, grid, &x[p], &half_length0[p], &f.get(p));
                 for (d, a) in axes.iter().enumerate() {
                     w[d * per_axis..(d + 1) * per_axis].copy_from_slice(&a.weight[..per_axis]);
                     s[d * per_axis..(d + 1) * per_axis].copy_from_slice(&a.slope[..per_axis]);
@@ -431,6 +434,7 @@ pub(crate) mod tests {
     //! families through the `ShapeFunction` dispatch.
 
     use super::*;
+    use crate::model::tensors::Layout;
     use strum::IntoEnumIterator;
 
     /// Small deterministic generator (SplitMix64), so tests need no extra crate.
@@ -789,7 +793,8 @@ pub(crate) mod tests {
                 .collect();
             let half0 = vec![g.h / 4.0; x.len()];
             let mut st = Stencils::<D>::default();
-            st.compute(shape, &g, &x, &half0, &f);
+            let packed = Tensors::from_matrices(Layout::gradient(D), f.iter().copied());
+            st.compute(shape, &g, &x, &half0, &packed);
             let cap = shape.max_support(D);
             for (p, xp) in x.iter().enumerate() {
                 let (mut node, mut w, mut grad) = (

@@ -49,7 +49,7 @@ pub fn residual<const D: usize>(
     let pk1: Vec<_> = (0..p.len())
         .into_par_iter()
         .with_min_len(MIN_PARALLEL_LEN)
-        .map(|q| relative_pk1(&sys.trial.df(st, map, q), &sys.trial.stress[q]))
+        .map(|q| relative_pk1(&sys.trial.df(st, map, q), &sys.trial.stress.get(q)))
         .collect();
     let mut f_int = internal_force(map, st, &p.volume, &pk1);
     // A stress linear within each particle domain (`physics::stress_gradient`).

@@ -274,8 +274,15 @@ impl StepSettings {
                 true => {
                     let value = |n: u32| u[map.local[n as usize] as usize];
                     let shape = self.shape;
-                    domain_corner_mean(shape, &m.grid, &p.x[q], &p.half_length0[q], &p.f[q], value)
-                        .expect("a linear domain stress on a box domain")
+                    domain_corner_mean(
+                        shape,
+                        &m.grid,
+                        &p.x[q],
+                        &p.half_length0[q],
+                        &p.f.get(q),
+                        value,
+                    )
+                    .expect("a linear domain stress on a box domain")
                 }
             })
             .collect()

@@ -148,10 +148,10 @@ pub fn particle_tangents<const D: usize>(
         .filter_map(|(q, (a_q, hoop_q))| {
             let df = trial.df(st, map, q);
             let inc = Increment {
-                f_old: p.f[q],
+                f_old: p.f.get(q),
                 df,
                 dt: 0.0,
-                stress_old: p.stress[q],
+                stress_old: p.stress.get(q),
                 history_old: history_old[q],
             };
             let mat = m.materials[p.material[q] as usize].as_ref();
@@ -160,7 +160,7 @@ pub fn particle_tangents<const D: usize>(
                     numerical.then(|| numerical_stress_derivative(mat, &inc, NUMERICAL_STEP))
                 })
                 .map(|ds| {
-                    let full = pk1_derivative::<D>(&df, &trial.stress[q], &ds, hoop);
+                    let full = pk1_derivative::<D>(&df, &trial.stress.get(q), &ds, hoop);
                     compact::<D>(&full, a_q);
                     if hoop {
                         compact_hoop::<D>(&full, hoop_q);
