@@ -20,8 +20,8 @@
 //! available memory (`MemAvailable` of /proc/meminfo); `mpm run` and `mpm check`
 //! take `--memory-limit GIB` to set another.
 
-use crate::scene::{LinearSolver, PreconditionerKind, SceneConfig, SolverKind};
 use crate::model::tensors::Layout;
+use crate::scene::{LinearSolver, PreconditionerKind, SceneConfig, SolverKind};
 
 /// The estimate's parts, in bytes, and the counts they come from.
 #[derive(Clone, Debug, PartialEq)]

@@ -52,6 +52,7 @@ impl Layout {
         }
     }
 
+    #[inline]
     fn unpack(self, c: &[f64]) -> Mat3 {
         match self {
             Layout::Full => Mat3::from_row_slice(&c[..9]),
@@ -61,6 +62,7 @@ impl Layout {
         }
     }
 
+    #[inline]
     fn pack(self, m: &Mat3, c: &mut [f64]) {
         match self {
             Layout::Full => {
@@ -124,11 +126,13 @@ impl Tensors {
     }
 
     /// Tensor q, unpacked.
+    #[inline]
     pub fn get(&self, q: usize) -> Mat3 {
         let n = self.layout.components();
         self.layout.unpack(&self.data[q * n..(q + 1) * n])
     }
 
+    #[inline]
     pub fn set(&mut self, q: usize, value: &Mat3) {
         let n = self.layout.components();
         self.layout.pack(value, &mut self.data[q * n..(q + 1) * n]);
@@ -191,10 +195,12 @@ pub struct TensorMut<'a> {
 }
 
 impl TensorMut<'_> {
+    #[inline]
     pub fn get(&self) -> Mat3 {
         self.layout.unpack(self.data)
     }
 
+    #[inline]
     pub fn set(&mut self, value: &Mat3) {
         self.layout.pack(value, self.data);
     }
@@ -208,6 +214,7 @@ pub struct TensorsMut<'a> {
 
 impl TensorsMut<'_> {
     /// Tensor i of the run.
+    #[inline]
     pub fn at(&mut self, i: usize) -> TensorMut<'_> {
         let n = self.layout.components();
         TensorMut {
