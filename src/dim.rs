@@ -13,6 +13,18 @@ pub fn restrict<const D: usize>(m: &Mat3) -> Tensor<D> {
     Tensor::<D>::from_fn(|i, j| m[(i, j)])
 }
 
+/// The six components of a symmetric tensor in Voigt order: xx, yy, zz, xy, yz, xz.
+pub fn voigt(m: &Mat3) -> [f64; 6] {
+    [
+        m[(0, 0)],
+        m[(1, 1)],
+        m[(2, 2)],
+        m[(0, 1)],
+        m[(1, 2)],
+        m[(0, 2)],
+    ]
+}
+
 /// Embed a D×D increment of a deformation gradient: identity in the missing directions.
 pub fn embed_deformation<const D: usize>(a: &Tensor<D>) -> Mat3 {
     let mut m = Mat3::identity();

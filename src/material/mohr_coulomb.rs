@@ -132,6 +132,18 @@ struct Linear {
     dn: Principal,
 }
 
+impl Linear {
+    /// A placeholder for the slots beyond an active set.
+    const UNSET: Linear = Linear {
+        a: Principal::new(0.0, 0.0, 0.0),
+        da: Principal::new(0.0, 0.0, 0.0),
+        k: 0.0,
+        dk: 0.0,
+        n: Principal::new(0.0, 0.0, 0.0),
+        dn: Principal::new(0.0, 0.0, 0.0),
+    };
+}
+
 fn unit(i: usize) -> Principal {
     Principal::ith(i, 1.0)
 }
@@ -286,12 +298,11 @@ impl MohrCoulomb {
         let de = el.stiffness();
         let mut dg = [0.0; 3];
         let mut kappa = kappa_old;
-        let mut linearized = [self.linear(set[0], piece, kappa); 3];
-        self.linearize(set, piece, kappa, &mut linearized);
+        let mut linearized = [Linear::UNSET; 3];
         // Without softening the surfaces do not move with κ.
         let moving = self.softening.is_some();
         for iteration in 0..40 {
-            if moving && iteration > 0 {
+            if iteration == 0 || moving {
                 self.linearize(set, piece, kappa, &mut linearized);
             }
             let surfaces = &linearized[..m];
@@ -467,23 +478,7 @@ impl MohrCoulomb {
             multipliers: [0.0; 3],
         }
     }
-}
 
-impl ReturnMapping for MohrCoulomb {
-    fn elasticity(&self) -> Elasticity {
-        self.elastic()
-    }
-
-    fn return_map(&self, eps: &Principal, h_old: &[f64], h_new: &mut [f64]) -> Return {
-        self.unordered_return(eps, h_old, h_new, true)
-    }
-
-    fn return_stress(&self, eps: &Principal, h_old: &[f64], h_new: &mut [f64]) -> Principal {
-        self.unordered_return(eps, h_old, h_new, false).tau
-    }
-}
-
-impl MohrCoulomb {
     /// [`MohrCoulomb::ordered_return`] for principal strains in any order.
     fn unordered_return(
         &self,
@@ -507,6 +502,20 @@ impl MohrCoulomb {
             }
         }
         Return { tau, tangent }
+    }
+}
+
+impl ReturnMapping for MohrCoulomb {
+    fn elasticity(&self) -> Elasticity {
+        self.elastic()
+    }
+
+    fn return_map(&self, eps: &Principal, h_old: &[f64], h_new: &mut [f64]) -> Return {
+        self.unordered_return(eps, h_old, h_new, true)
+    }
+
+    fn return_stress(&self, eps: &Principal, h_old: &[f64], h_new: &mut [f64]) -> Principal {
+        self.unordered_return(eps, h_old, h_new, false).tau
     }
 }
 

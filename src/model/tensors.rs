@@ -9,7 +9,7 @@
 //! `Mat3`, writing packs (an out-of-plane shear of F, or the skew part of σ, is
 //! dropped: the materials produce none beyond round-off).
 
-use crate::dim::Mat3;
+use crate::dim::{voigt, Mat3};
 use rayon::prelude::*;
 
 /// Which components a [`Tensors`] keeps.
@@ -19,7 +19,7 @@ pub enum Layout {
     Full,
     /// xx, xy, yx, yy, zz (a 2D deformation gradient).
     Plane,
-    /// xx, yy, zz, xy, yz, xz of a symmetric tensor (a 3D stress).
+    /// The Voigt components of a symmetric tensor (`dim::voigt`; a 3D stress).
     Symmetric,
     /// xx, yy, xy, zz of a symmetric tensor without out-of-plane shear (a 2D stress).
     PlaneSymmetric,
@@ -73,14 +73,7 @@ impl Layout {
             Layout::Plane => {
                 c[..5].copy_from_slice(&[m[(0, 0)], m[(0, 1)], m[(1, 0)], m[(1, 1)], m[(2, 2)]])
             }
-            Layout::Symmetric => c[..6].copy_from_slice(&[
-                m[(0, 0)],
-                m[(1, 1)],
-                m[(2, 2)],
-                m[(0, 1)],
-                m[(1, 2)],
-                m[(0, 2)],
-            ]),
+            Layout::Symmetric => c[..6].copy_from_slice(&voigt(m)),
             Layout::PlaneSymmetric => {
                 c[..4].copy_from_slice(&[m[(0, 0)], m[(1, 1)], m[(0, 1)], m[(2, 2)]])
             }

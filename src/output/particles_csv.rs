@@ -68,7 +68,8 @@ pub fn write_particles_csv_with<const D: usize>(
         for i in 0..p.len() {
             let ids = [Field::from(i), Field::from(p.body[i])];
             let kinematics = p.x0[i].iter().chain(p.x[i].iter()).chain(p.v[i].iter());
-            let sigma = stress.iter().map(|&(_, r, c)| p.stress.get(i)[(r, c)]);
+            let s = p.stress.get(i);
+            let sigma = stress.iter().map(|&(_, r, c)| s[(r, c)]);
             let sizes = [p.volume0[i], p.volume[i], p.mass[i]];
             let more = extra.iter().map(|(_, values)| values[i]);
             let numbers = kinematics.copied().chain(sigma).chain(sizes).chain(more);

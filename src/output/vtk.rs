@@ -17,6 +17,7 @@ use vtkio::model::{
 };
 
 use super::text::f64_string;
+use crate::dim::voigt;
 use crate::model::particles::Particles;
 
 /// Writer of ParaView frames `{prefix}_{NNNNN}.vtu` and the collection `{prefix}.pvd`.
@@ -144,15 +145,7 @@ fn frame_model<const D: usize>(p: &Particles<D>, extra: &[(&str, &[f64])]) -> Vt
         points.extend(pad3(&|k| p.x[i][k]));
         velocity.extend(pad3(&|k| p.v[i][k]));
         displacement.extend(pad3(&|k| p.x[i][k] - p.x0[i][k]));
-        let s = &p.stress.get(i);
-        stress.extend([
-            s[(0, 0)],
-            s[(1, 1)],
-            s[(2, 2)],
-            s[(0, 1)],
-            s[(1, 2)],
-            s[(0, 2)],
-        ]);
+        stress.extend(voigt(&p.stress.get(i)));
         jac.push(p.f.get(i).determinant());
     }
 

@@ -25,7 +25,7 @@ use crate::model::particles::Particles;
 use crate::model::tensors::Tensors;
 use crate::parallel::{bucket_sort, DisjointSlice, MIN_PARALLEL_LEN, NO_BUCKET};
 use crate::physics::shape::linear::{cell_coordinate, cell_index};
-use crate::physics::shape::{separable_axes, ShapeFunction, MAX_PER_AXIS};
+use crate::physics::shape::{deformation_for, separable_axes, ShapeFunction, MAX_PER_AXIS};
 use rayon::prelude::*;
 
 /// Cells per axis of a tile. Must be at least the family's reach − 1
@@ -320,8 +320,9 @@ impl<const D: usize> NodeBox<D> {
                 let (first, end) = self.tile_nodes(t, reach);
                 for &q in &self.order[self.start[t] as usize..self.start[t + 1] as usize] {
                     let q = q as usize;
-                    let (x, half, f) = (&points.x[q], &points.half_length0[q], &points.f.get(q));
-                    let Some(st) = self.stencil(shape, grid, x, half, f) else {
+                    let f = deformation_for(shape, || points.f.get(q));
+                    let (x, half) = (&points.x[q], &points.half_length0[q]);
+                    let Some(st) = self.stencil(shape, grid, x, half, &f) else {
                         continue;
                     };
                     assert!(

@@ -113,7 +113,7 @@ fn flat_vectors<const D: usize>(v: &[Vector<D>]) -> Vec<f64> {
 /// Nine values per tensor (column-major), whatever the particles' packing.
 fn flat_matrices(m: &Tensors) -> Vec<f64> {
     m.iter()
-        .flat_map(|a| a.iter().copied().collect::<Vec<_>>())
+        .flat_map(|a| a.data.0.into_iter().flatten())
         .collect()
 }
 

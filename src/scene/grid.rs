@@ -81,6 +81,15 @@ impl ShapeFunction {
         self.into()
     }
 
+    /// Whether the family follows the particle's deformation (reads F): cpGIMP,
+    /// the domain-averaged B-spline and CPDI.
+    pub fn reads_deformation(&self) -> bool {
+        matches!(
+            self,
+            ShapeFunction::Cpgimp | ShapeFunction::Cpbspline2 | ShapeFunction::Cpdi
+        )
+    }
+
     /// Polynomial degree of the underlying grid basis (sets the node layout).
     pub fn degree(&self) -> usize {
         match self {

@@ -85,10 +85,6 @@ impl<const D: usize> Explicit<D> {
         let prescribed = m.faces.iter().any(|fc| fc.constraint.fixed.contains(&true));
         let mirror =
             self.shape != ShapeFunction::Bspline2 && (2..=3).contains(&m.grid.degree) && prescribed;
-        let reads_f = matches!(
-            self.shape,
-            ShapeFunction::Cpgimp | ShapeFunction::Cpbspline2
-        );
         self.transfer == Transfer::Auto
             && NodeBox::<D>::serves(self.shape)
             && m.contact.is_none()
@@ -98,7 +94,7 @@ impl<const D: usize> Explicit<D> {
             && !m.axisymmetric
             && !m.removes_particles()
             && !mirror
-            && !(self.scheme == Scheme::Usf && reads_f)
+            && !(self.scheme == Scheme::Usf && self.shape.reads_deformation())
     }
 
     /// Critical time step min_p h / (c_p + |v_p|) (2-45).

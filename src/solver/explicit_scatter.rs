@@ -20,7 +20,7 @@ use crate::physics::boundary::{friction_contact, node_constraint, node_friction}
 use crate::physics::deformation::{update_particle, ParticleState};
 use crate::physics::grid_update::{acceleration, TINY_MASS_FRACTION};
 use crate::physics::scatter::{NodeBox, Points, Stencil};
-use crate::physics::shape::ShapeFunction;
+use crate::physics::shape::{deformation_for, ShapeFunction};
 use crate::physics::transfer::{applied, applied_force, nodal_velocity};
 use crate::scene::Scheme;
 use crate::solver::divergence::{inverted, sound, unsound, Divergence};
@@ -354,7 +354,7 @@ impl<const D: usize> ScatterStep<D> {
                 grid,
                 state.x,
                 &half_length0[q],
-                &state.deformation.f.get(),
+                &deformation_for(s.shape, || state.deformation.f.get()),
             );
             let (vp, a, l) = match (pass, sc) {
                 (_, None) => (

@@ -138,6 +138,16 @@ fn slots<const D: usize>(p: usize, per_axis: usize, code: u8) -> [usize; D] {
     std::array::from_fn(|d| base + d * per_axis + (code >> (2 * d) & 3) as usize)
 }
 
+/// The deformation gradient as `shape` reads it: the particle's (`f()`, which
+/// may unpack it) for the families that follow the deformation, else I (unread).
+#[inline(always)]
+pub fn deformation_for(shape: ShapeFunction, f: impl FnOnce() -> Mat3) -> Mat3 {
+    match shape.reads_deformation() {
+        true => f(),
+        false => Mat3::identity(),
+    }
+}
+
 /// The per-axis factors of a particle for the separable families (all but
 /// CPDI), as `evaluate` forms its tensor product from them.
 #[inline(always)]
@@ -261,9 +271,16 @@ impl<const D: usize> Stencils<D> {
             .for_each(|(p, (((c, nd), w), g))| {
                 // A particle outside the grid (removed, `Model::removed`) has no nodes.
                 *c = match grid.contains(&x[p]) {
-                    true => {
-                        evaluate(shape, grid, &x[p], &half_length0[p], &f.get(p), nd, w, g) as u32
-                    }
+                    true => evaluate(
+                        shape,
+                        grid,
+                        &x[p],
+                        &half_length0[p],
+                        &deformation_for(shape, || f.get(p)),
+                        nd,
+                        w,
+                        g,
+                    ) as u32,
                     false => 0,
                 };
             });
@@ -308,7 +325,8 @@ impl<const D: usize> Stencils<D> {
                     *c = 0;
                     return;
                 }
-                let axes = separable_axes(shape, grid, &x[p], &half_length0[p], &f.get(p));
+                let f = deformation_for(shape, || f.get(p));
+                let axes = separable_axes(shape, grid, &x[p], &half_length0[p], &f);
                 for (d, a) in axes.iter().enumerate() {
                     w[d * per_axis..(d + 1) * per_axis].copy_from_slice(&a.weight[..per_axis]);
                     s[d * per_axis..(d + 1) * per_axis].copy_from_slice(&a.slope[..per_axis]);
