@@ -52,7 +52,7 @@ impl Layout {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn unpack(self, c: &[f64]) -> Mat3 {
         match self {
             Layout::Full => Mat3::from_row_slice(&c[..9]),
@@ -62,7 +62,7 @@ impl Layout {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn pack(self, m: &Mat3, c: &mut [f64]) {
         match self {
             Layout::Full => {
@@ -119,13 +119,13 @@ impl Tensors {
     }
 
     /// Tensor q, unpacked.
-    #[inline]
+    #[inline(always)]
     pub fn get(&self, q: usize) -> Mat3 {
         let n = self.layout.components();
         self.layout.unpack(&self.data[q * n..(q + 1) * n])
     }
 
-    #[inline]
+    #[inline(always)]
     pub fn set(&mut self, q: usize, value: &Mat3) {
         let n = self.layout.components();
         self.layout.pack(value, &mut self.data[q * n..(q + 1) * n]);
@@ -188,12 +188,12 @@ pub struct TensorMut<'a> {
 }
 
 impl TensorMut<'_> {
-    #[inline]
+    #[inline(always)]
     pub fn get(&self) -> Mat3 {
         self.layout.unpack(self.data)
     }
 
-    #[inline]
+    #[inline(always)]
     pub fn set(&mut self, value: &Mat3) {
         self.layout.pack(value, self.data);
     }
@@ -207,7 +207,7 @@ pub struct TensorsMut<'a> {
 
 impl TensorsMut<'_> {
     /// Tensor i of the run.
-    #[inline]
+    #[inline(always)]
     pub fn at(&mut self, i: usize) -> TensorMut<'_> {
         let n = self.layout.components();
         TensorMut {
