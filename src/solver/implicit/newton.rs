@@ -7,7 +7,8 @@
 //! 3. solves the correction K δu = −r (2-38), with the assembled consistent
 //!    tangent (2-40) and the sparse direct solver, or matrix-free by GMRES or CG on
 //!    difference products of the residual (2-39, `krylov`);
-//! 4. with `line_search`, shortens δu until ‖r‖ decreases;
+//! 4. with `line_search`, halves δu until ‖r‖ decreases (or takes the length
+//!    that raised it least), keeping the residual it found for step 1;
 //! 5. updates u ← u + s δu; tied nodes follow their masters.
 //!
 //! A non-finite residual, an inverted particle, a failed linear solve or no
@@ -116,9 +117,14 @@ impl Newton {
             last_increment: f64::NAN,
         };
         let mut method = "none".to_string();
+        let mut known = None;
         for iteration in 0..=self.max_iterations {
-            // Residual at the current iterate, from the step-start state (2-37).
-            let r = residual(m, sys, &u)?;
+            // Residual at the current iterate, from the step-start state (2-37),
+            // unless the line search left it (and the trial state) there.
+            let r = match known.take() {
+                Some(r) => r,
+                None => residual(m, sys, &u)?,
+            };
             let r_free = sys.dofs.reduce(&r);
             let r_norm = norm(&r_free);
             let reaction = reactions(&sys.constraint, &r);
@@ -186,7 +192,9 @@ impl Newton {
             method = used;
             // Update u ← u + s δu, s from the line search (or 1).
             let step_length = if self.line_search {
-                line_search(m, sys, &u, &du, r_norm)
+                let (length, r) = line_search(m, sys, &u, &du, r_norm);
+                known = r;
+                length
             } else {
                 1.0
             };
@@ -321,24 +329,35 @@ fn linear_failure(e: SolveError) -> Failure {
 }
 
 /// Backtracking on ‖r‖: halve the step length until the residual decreases
-/// (at most 6 halvings; the last length is taken anyway).
+/// (at most 6 halvings; if none decreases it, the length with the smallest
+/// residual). Returns the length, and the residual there if it was the last
+/// evaluated (the trial state is then that of the new iterate).
 fn line_search<const D: usize>(
     m: &Model<D>,
     sys: &mut StepSystem<D>,
     u: &[Vector<D>],
     du: &[f64],
     r_norm: f64,
-) -> f64 {
+) -> (f64, Option<Vec<Vector<D>>>) {
     let mut length = 1.0;
-    for _ in 0..6 {
+    let mut best = (f64::INFINITY, length / 64.0);
+    let mut last = None;
+    for _ in 0..=6 {
         let mut trial_u = u.to_vec();
         sys.dofs.apply_correction(&mut trial_u, du, length);
-        if let Ok(r) = residual(m, sys, &trial_u) {
-            if norm(&sys.dofs.reduce(&r)) < r_norm {
-                return length;
+        last = residual(m, sys, &trial_u).ok();
+        if let Some(r) = &last {
+            let trial = norm(&sys.dofs.reduce(r));
+            if trial < r_norm {
+                return (length, last);
+            }
+            if trial < best.0 {
+                best = (trial, length);
             }
         }
         length *= 0.5;
     }
-    length
+    // No length lowered ‖r‖: the one that raised it least. Its residual is
+    // the last one evaluated only if it was the shortest.
+    (best.1, last.filter(|_| best.1 == length * 2.0))
 }
