@@ -1520,18 +1520,31 @@ fn implicit_slide(mu: f64, extra: &[&str]) -> (f64, f64, tempfile::TempDir) {
 
 #[test]
 fn implicit_block_slides_on_a_deformable_incline_as_the_closed_form() {
-    // Measured: −0.0008 %, +0.18 %, +1.21 % at t = 0.5 s (Newmark, Δt = 5 ms,
-    // cpGIMP, 20 cells over the block). The issue asks 1 %: μ = 0.5 misses it
+    // Measured: −0.0008 %, −0.15 %, +1.06 % at t = 0.5 s (Newmark, Δt = 5 ms,
+    // cpGIMP, 20 cells over the block; +0.18 % and +1.21 % with ε_t = ε_n and
+    // the old line search). The issue asks 1 %: μ = 0.5 misses it
     // (before the gap was taken at the node +1.12 %: +1.02 % at Δt = 2.5 ms,
     // +1.14 % on a grid twice as fine; the explicit run +0.64 %), so it is held
     // to 1.5 % here (docs/contact.md). One shared
     // velocity field would carry the block with the base: it would not move.
-    for (mu, tolerance) in [(0.0, 0.01), (0.3, 0.01), (0.5, 0.015)] {
-        let (t, x, _) = implicit_slide(mu, &[]);
+    //
+    // Newton's work, rows of newton.csv over the run (iterations and converged
+    // checks, cut-back attempts included): 836, 857 and 661. With the
+    // tangential penalty equal to the normal one and a line search that took
+    // its shortest step even when that raised ‖r‖, 836, 1,509 and 1,636
+    // (docs/contact.md); the bounds catch a return to those.
+    for (mu, tolerance, rows) in [(0.0, 0.01, 900), (0.3, 0.01, 1000), (0.5, 0.015, 800)] {
+        let (t, x, dir) = implicit_slide(mu, &[]);
         let exact = closed_form(45.0, mu, t);
         let err = (x / exact - 1.0).abs();
-        println!("mu {mu}: x = {x:.5} m, closed form {exact:.5} m, error {err:.2e}");
+        let newton = Table::read(&dir.path().join("newton.csv")).unwrap();
+        let iterations = newton.col("iteration").len();
+        println!(
+            "mu {mu}: x = {x:.5} m, closed form {exact:.5} m, error {err:.2e}, \
+             {iterations} rows of newton.csv"
+        );
         assert!(err < tolerance, "mu {mu}: x = {x}, exact {exact}");
+        assert!(iterations < rows, "mu {mu}: {iterations} Newton rows");
     }
 }
 

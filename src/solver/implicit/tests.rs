@@ -361,16 +361,20 @@ fn tangent_with_deformable_contact_matches_finite_differences_of_the_residual() 
         .replace("max = [4.0, 1.5]", "max = [4.0, 1.25]")
         .replace("min = [0.5, 1.5]", "min = [0.5, 1.25]");
     let on_node = STACK.to_string();
+    // μ = 0.03: a meeting slips once its tangential trial force ε_t |Δ| exceeds
+    // μ ε_n g; with ε_t = ε_n/10 (`contact::TANGENTIAL_PENALTY`) μ = 0.3 left
+    // every meeting sticking at this iterate, 0.03 leaves 1–2 sticking and 5–9
+    // slipping.
     let cases = [
         (&on_node, "linear", 0.0),
-        (&on_node, "linear", 0.3),
-        (&on_node, "bspline2", 0.3),
+        (&on_node, "linear", 0.03),
+        (&on_node, "bspline2", 0.03),
         (&on_node, "cpgimp", 0.0),
-        (&on_node, "cpgimp", 0.3),
-        (&on_node, "cpdi", 0.3),
+        (&on_node, "cpgimp", 0.03),
+        (&on_node, "cpdi", 0.03),
         (&mid_cell, "cpgimp", 0.0),
-        (&mid_cell, "cpgimp", 0.3),
-        (&mid_cell, "cpdi", 0.3),
+        (&mid_cell, "cpgimp", 0.03),
+        (&mid_cell, "cpdi", 0.03),
     ];
     for (text, shape, mu) in cases {
         let overrides = vec![
