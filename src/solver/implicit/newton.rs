@@ -339,10 +339,10 @@ fn line_search<const D: usize>(
     du: &[f64],
     r_norm: f64,
 ) -> (f64, Option<Vec<Vector<D>>>) {
-    let mut length = 1.0;
-    let mut best = (f64::INFINITY, length / 64.0);
+    const SHORTEST: f64 = 1.0 / 64.0;
+    let (mut length, mut best) = (1.0, (f64::INFINITY, SHORTEST));
     let mut last = None;
-    for _ in 0..=6 {
+    while length >= SHORTEST {
         let mut trial_u = u.to_vec();
         sys.dofs.apply_correction(&mut trial_u, du, length);
         last = residual(m, sys, &trial_u).ok();
@@ -357,7 +357,7 @@ fn line_search<const D: usize>(
         }
         length *= 0.5;
     }
-    // No length lowered ‖r‖: the one that raised it least. Its residual is
-    // the last one evaluated only if it was the shortest.
-    (best.1, last.filter(|_| best.1 == length * 2.0))
+    // No length lowered ‖r‖: the one that raised it least. Its residual (and
+    // the trial state) is the last evaluated only if it is the shortest.
+    (best.1, last.filter(|_| best.1 == SHORTEST))
 }
