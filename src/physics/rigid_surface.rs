@@ -32,6 +32,14 @@ use crate::physics::rigid_body::{from3, to3};
 use crate::scene::contact::ContactPlan;
 use nalgebra::Vector3;
 
+/// A particle whose reach falls short of a rigid surface by this fraction of
+/// the reach touches it (depth 0: no force, but the stiffness). Surfaces laid
+/// to coincide differ by round-off: a block's particles filled from y = 0.25
+/// with spacing 0.025 lie 0.012500000000000011 above it with a reach of
+/// 0.0125, and a block resting there started with no support at all (a
+/// singular first tangent).
+const TOUCH_TOLERANCE: f64 = 1e-9;
+
 /// One rigid velocity field: its particles and the geometries of its bodies.
 #[derive(Clone, Debug)]
 pub struct Surface {
@@ -210,7 +218,7 @@ impl Surface {
         half_lengths: &Vector<D>,
         on_boundary: &dyn Fn(usize, f64) -> bool,
     ) -> Option<Inside<D>> {
-        let reach = half_lengths.max();
+        let reach = half_lengths.max() * (1.0 + TOUCH_TOLERANCE);
         let xr = at.body_point(x);
         let outside = |d: usize| xr[d] < self.lower[d] - reach || xr[d] > self.upper[d] + reach;
         if (0..D).any(outside) {
@@ -241,14 +249,15 @@ impl Surface {
             .component_mul(half_lengths)
             .component_mul(&normal);
         let reach_n = l2n.dot(&normal).sqrt();
-        if distance > reach_n {
+        // Surfaces that coincide up to round-off touch (`TOUCH_TOLERANCE`).
+        if distance > reach_n * (1.0 + TOUCH_TOLERANCE) {
             return None;
         }
         Some(Inside {
             point: at.point_to_world(&s.point),
             normal,
             normal_derivative,
-            depth: reach_n - distance,
+            depth: (reach_n - distance).max(0.0),
             depth_gradient: normal_derivative * l2n / reach_n - normal,
         })
     }
@@ -352,6 +361,30 @@ mod tests {
         assert!((y - place([2.0, 1.2])).norm() < 1e-13);
         assert!((n - Vector::<2>::new(theta.cos(), theta.sin())).norm() < 1e-14);
         assert!(s.push_out(&at, &place([2.1, 1.2]), &none).is_none());
+    }
+
+    #[test]
+    fn a_particle_laid_on_a_face_touches_it_despite_round_off() {
+        // A base [-0.5, 3] × [0, 0.25] at rest; a particle of spacing 0.025
+        // laid on it sits at 0.25 + 0.0125, which rounds to 0.012500000000000011
+        // above the face against a reach of 0.0125.
+        let p = particles(&[[1.25, 0.125]], &[[1.25, 0.125]]);
+        let base = Geometry::Box {
+            min: vec![-0.5, 0.0],
+            max: vec![3.0, 0.25],
+        };
+        let s = Surface::new(0, vec![0], vec![base], &p, false);
+        let at = s.placement(&p);
+        let none = |_: usize, _: f64| false;
+        let ell = Vector::<2>::new(0.0125, 0.0125);
+        let x = Vector::<2>::new(0.5125, 0.25 + 0.0125);
+        assert!(x[1] - 0.25 > ell[1], "the round-off this test is about");
+        let touch = s.reached(&at, &x, &ell, &none).expect("touches");
+        assert_eq!(touch.depth, 0.0);
+        assert_eq!(touch.normal, Vector::<2>::new(0.0, 1.0));
+        // A particle a hair farther off (1e-6 of its reach) does not.
+        let off = Vector::<2>::new(0.5125, 0.25 + 0.0125 * (1.0 + 1e-6));
+        assert!(s.reached(&at, &off, &ell, &none).is_none());
     }
 
     #[test]

@@ -148,7 +148,8 @@ impl Newton {
                 krylov_iterations: 0,
                 forcing: f64::NAN,
             };
-            if test.converged(iteration, r_norm, reference) {
+            let floor = sys.contact.as_ref().map_or(0.0, |c| c.residual_floor());
+            if test.converged(iteration, r_norm, reference, floor) {
                 self.log.push(row);
                 return Ok(Converged { u, reaction });
             }
@@ -222,6 +223,11 @@ impl Newton {
     }
 }
 
+/// How far above the estimated round-off floor of the residual Newton stops
+/// (the estimate is a root sum of squares; the residuals it bounds scatter
+/// about it by a factor of up to 1.3).
+const ROUND_OFF_MARGIN: f64 = 4.0;
+
 /// The convergence test of one attempt: ‖r‖ small against a reference force, and
 /// the last correction small against u.
 struct Convergence {
@@ -251,8 +257,12 @@ impl Convergence {
     }
 
     /// Has iteration `iteration`, whose residual norm is `r_norm`, converged?
-    fn converged(&mut self, iteration: usize, r_norm: f64, reference: f64) -> bool {
-        let residual_ok = r_norm <= self.residual_tolerance * reference || r_norm == 0.0;
+    /// `floor` is the round-off the residual cannot go below (the penalty
+    /// contact's, `PenaltyContact::residual_floor`): within `ROUND_OFF_MARGIN`
+    /// of it the residual counts as converged.
+    fn converged(&mut self, iteration: usize, r_norm: f64, reference: f64, floor: f64) -> bool {
+        let tolerance = (self.residual_tolerance * reference).max(ROUND_OFF_MARGIN * floor);
+        let residual_ok = r_norm <= tolerance || r_norm == 0.0;
         // Near rest (e.g. settled on absorbing faces) ‖u‖ → 0 and ‖δu‖/‖u‖ stalls
         // at round-off: a converged residual that a correction no longer halves
         // is at the round-off floor and accepted.
