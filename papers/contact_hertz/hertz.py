@@ -13,8 +13,9 @@ measured P beside two measurements:
   cell to 1.6 b (the block is 8 b deep, so deeper points feel its base);
 - the top layer's sigma_yy(x), a quarter cell below the surface: the width b of
   p^2 = p0^2 (1 - x^2/b^2) fitted to its points with p > p_max/4, and its peak.
-  The contact acts at the top particles' centres, inside the top cell, so that
-  layer carries only part of the pressure (its peak is about half of p0).
+  The contact acts at the top particles' contact points, on the block's surface,
+  so that layer carries the pressure (its peak within 2 % of p0 from 3 cells
+  across 2b).
 
 usage: python3 hertz.py OUTDIR [R E NU H]
 """

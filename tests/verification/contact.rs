@@ -1037,12 +1037,13 @@ fn implicit_rigid_plate_compresses_a_block_to_the_hencky_stress() {
     // problems/contact_plate_implicit.toml: the plate of
     // `rigid_plate_compresses_a_block_to_the_hencky_stress` as a quasi-static
     // implicit run with penalty contact (25 load steps to λ = 0.75). Measured: the
-    // plate's force within 2.2 % of σ_yy(t) × 1 m at every step and 1.3 % at the
-    // end (the top layer is loaded at its centres, half a particle below the
-    // surface, and its reach is the undeformed half-width: O(h) offsets); the
-    // volume mean of σ_yy −0.50 %; every step in at most 5 Newton iterations,
-    // converging quadratically (order 1.86); the deepest penalty penetration
-    // 1.94e-4 m, the estimate σ h / (α M).
+    // plate's force within 0.11 % of σ_yy(t) × 1 m at every step and at the end;
+    // the volume mean of σ_yy −0.11 %; every step in at most 3 Newton
+    // iterations, converging quadratically (order 1.93); the deepest penalty
+    // penetration 1.92e-4 m, the estimate σ h / (α M). (With the contact at the
+    // particles' centres, half a particle below the surface, and the
+    // undeformed half-width as their reach, before the contact points: 2.2 %,
+    // 1.3 % at the end, −0.50 %, 5 iterations.)
     let (result, dir) = run_problem("contact_plate_implicit.toml", &["output.frames=0"]);
     let summary = result.unwrap();
     assert_eq!(summary.status, Status::Completed);
@@ -1066,14 +1067,14 @@ fn implicit_rigid_plate_compresses_a_block_to_the_hencky_stress() {
         "force within {worst:.4} of σ(t) A ({last:.4} at the end); mean σ_yy {mean:+.4}; \
          penetration {penetration:.2e} m; at most {most} Newton iterations a step, order {order:.2}"
     );
-    assert!(worst < 0.025 && last < 0.02, "force {worst}, {last}");
-    assert!(mean.abs() < 0.01, "mean σ_yy off by {mean}");
+    assert!(worst < 0.005 && last < 0.005, "force {worst}, {last}");
+    assert!(mean.abs() < 0.005, "mean σ_yy off by {mean}");
     // σ h / (α M) = 3.9e5 × 0.05 / (100 × 1e6) = 1.9e-4 m at the end.
     assert!(
         penetration > 1.7e-4 && penetration < 2.2e-4,
         "penetration {penetration}"
     );
-    assert!(most <= 5 && order > 1.8, "{most} iterations, order {order}");
+    assert!(most <= 4 && order > 1.8, "{most} iterations, order {order}");
 }
 
 #[test]
@@ -1137,10 +1138,11 @@ fn implicit_footing_with(overrides: &[&str]) -> (f64, f64, f64) {
 #[test]
 fn implicit_contact_footing_converges_to_prandtl_at_first_order() {
     // A rigid smooth footing pushed into weightless Tresca soil through implicit
-    // penalty contact (F-bar, cpGIMP). Measured: q/c_u = 5.857 (+13.9 %) at
-    // h = 0.25 m and 5.515 (+7.3 %) at h = 0.125 m, error ratio 1.92 (first
-    // order); 5.339 (+3.8 %) at h = 0.0625 m (the ignored test below); the
-    // explicit contact footing: +17, +12, +8.4 % on the same grids.
+    // penalty contact (F-bar, cpGIMP). Measured: q/c_u = 5.544 (+7.8 %) at
+    // h = 0.25 m and 5.364 (+4.3 %) at h = 0.125 m, error ratio 1.81 (first
+    // order); 5.269 (+2.5 %) at h = 0.0625 m (the ignored test below). With the
+    // contact at the particles' centres (before the contact points): +13.9,
+    // +7.3, +3.8 %; the explicit contact footing: +17, +12, +8.4 %.
     let (q1, e1, p1) = implicit_footing("grid.cells=[20,14]");
     let (q2, e2, p2) = implicit_footing("grid.cells=[40,28]");
     println!(
@@ -1150,12 +1152,12 @@ fn implicit_contact_footing_converges_to_prandtl_at_first_order() {
         100.0 * e2,
         e1 / e2
     );
-    assert!(e1 > 0.0 && e1 < 0.15 && e2 > 0.0 && e2 < 0.08, "{e1} {e2}");
+    assert!(e1 > 0.0 && e1 < 0.09 && e2 > 0.0 && e2 < 0.05, "{e1} {e2}");
     assert!(e1 / e2 > 1.7, "first order: ratio {}", e1 / e2);
     assert!(p1.abs() < 5e-3 && p2.abs() < 5e-3, "plateau {p1} {p2}");
     // Rough (μ = 10: the soil sticks under the footing): Newton converges through
-    // the stick–slip changes at the footing's edge; 5.921 (+15.2 %) at h = 0.25 m
-    // (5.552, +8.0 %, at h = 0.125 m).
+    // the stick–slip changes at the footing's edge; 5.625 (+9.4 %) at h = 0.25 m
+    // (before the contact points 5.921, +15.2 %).
     let (q, e, p) =
         implicit_footing_with(&["grid.cells=[20,14]", "contact.0.friction_coefficient=10"]);
     println!(
@@ -1163,7 +1165,7 @@ fn implicit_contact_footing_converges_to_prandtl_at_first_order() {
         100.0 * e
     );
     assert!(
-        e > e1 && e < 0.17 && p.abs() < 5e-3,
+        e > e1 && e < 0.11 && p.abs() < 5e-3,
         "rough {e}, plateau {p}"
     );
 }
@@ -1171,7 +1173,8 @@ fn implicit_contact_footing_converges_to_prandtl_at_first_order() {
 #[test]
 #[ignore = "about 8 to 12 minutes: the h = B/32 footings, smooth and rough"]
 fn implicit_contact_footing_is_within_5_percent_of_prandtl_at_h_b_over_32() {
-    // Measured: smooth 5.339 (+3.8 %), rough (μ = 10) 5.361 (+4.3 %).
+    // Measured: smooth 5.269 (+2.5 %), rough (μ = 10) 5.283 (+2.8 %) (before
+    // the contact points: +3.8 %, +4.3 %).
     for mu in ["0", "10"] {
         let friction = format!("contact.0.friction_coefficient={mu}");
         let (q, e, p) = implicit_footing_with(&["grid.cells=[80,56]", &friction]);
@@ -1347,17 +1350,18 @@ fn staged_block_is_loaded_implicitly_and_handed_to_an_explicit_stage() {
     // 1–2.4e-9 of the weight, above the tolerance, from the penalty's
     // round-off (ε_n × 2.2e-16 × |x|), until the round-off floor counted as
     // converged. Measured: 4 Newton rows a step (iterations 0–3, the last the
-    // converged check), the contact force the weight applied to 2.3e-10
+    // converged check), the contact force the weight applied to 9.6e-11
     // (rigid) and 2.7e-14 (elastic base); over the explicit stage the largest
-    // kinetic energy 1.6 % of the strain energy at the hand-over on the rigid
-    // base (mean σ_yy +0.87 % off ρ g H / 2 at the end) and 2.2e-4 on the
-    // elastic one (−1.4e-4): the explicit contact
-    // supports the block at the nodes where the implicit penalty against the
-    // rigid body supported the particles (docs/contact.md), while between two
-    // deformable bodies both act at the split nodes.
+    // kinetic energy 2.5e-5 of the strain energy at the hand-over on the rigid
+    // base (mean σ_yy −1.2e-4 off ρ g H / 2 at the end) and 2.2e-4 on the
+    // elastic one (−1.4e-4). On the rigid base the implicit penalty acts at
+    // the bottom particles' contact points, on the base's surface, where the
+    // explicit contact supports the block's nodes; when it acted at their
+    // centres (before the contact points) the kinetic energy reached 1.6 % of
+    // the strain energy and σ_yy swung about +0.9 %.
     let (rows, force, ke, stress) = staged_block("steel");
     println!("rigid base: {rows} Newton rows, contact force {force:.1e} off, KE/SE {ke:.2e}, σ_yy {stress:+.2e}");
-    assert!(rows <= 40 && force < 1e-7 && ke < 0.03 && stress.abs() < 0.02);
+    assert!(rows <= 40 && force < 1e-7 && ke < 1e-3 && stress.abs() < 1e-3);
     let (rows, force, ke, stress) = staged_block("elastic");
     println!("elastic base: {rows} Newton rows, contact force {force:.1e} off, KE/SE {ke:.2e}, σ_yy {stress:+.2e}");
     assert!(rows <= 40 && force < 1e-7 && ke < 1e-3 && stress.abs() < 1e-3);
@@ -1377,15 +1381,14 @@ fn fit_line(pts: &[(f64, f64)]) -> (f64, f64) {
 fn implicit_contact_reproduces_hertz_line_contact() {
     // problems/contact_hertz.toml (papers/contact_hertz): a rigid cylinder
     // R = 0.5 m pressed 0.01 m into an elastic block (E = 1 MPa, ν = 0.3), h =
-    // 0.02 m. Hertz for the measured force P: b = √(4PR/(πE*)) = 0.0614 m (6.1
+    // 0.02 m. Hertz for the measured force P: b = √(4PR/(πE*)) = 0.0607 m (6.1
     // cells across 2b), p0 = 2P/(πb). Below the contact's centre σ_z(z) =
     // −p0/√(1 + z²/b²): fitting 1/σ² = 1/p0² + z²/(p0² b²) to the axis column
-    // between one cell and 1.6 b deep gives b −7.6 %, p0 +7.5 % (the issue asks
-    // 10 % from 5 cells across 2b; h = 0.04 m: −15.8 %, +10.4 %; h = 0.01 m:
-    // +1.7 %, −0.3 %). The stresses of the top layers are not the pressure: the
-    // contact acts at the top particles' centres, inside the top cell, and the
-    // layers just below oscillate about Hertz's field by tens of per cent
-    // (printed, not asserted).
+    // between one cell and 1.6 b deep gives b +1.6 %, p0 −1.3 % (the issue asks
+    // 10 % from 5 cells across 2b; h = 0.04 m, 3.1 cells: +19 %, −13 %; h =
+    // 0.01 m: +0.5 %, −0.3 %). The top layer's σ_yy peaks at p0 −0.3 % (printed,
+    // not asserted). Before the contact points (the load at the top particles'
+    // centres): b −7.6 %, p0 +7.5 %, and a top-layer peak of 28–54 % of p0.
     let (result, dir) = run_problem("contact_hertz.toml", &[]);
     assert_eq!(result.unwrap().status, Status::Completed);
     let c = Table::read(&dir.path().join("contact.csv")).unwrap();
@@ -1433,7 +1436,7 @@ fn implicit_contact_reproduces_hertz_line_contact() {
         rel(peak, p0)
     );
     assert!(2.0 * b / 0.02 >= 5.0, "2b/h = {}", 2.0 * b / 0.02);
-    assert!(rel(b_axis, b).abs() < 0.1 && rel(p0_axis, p0).abs() < 0.1);
+    assert!(rel(b_axis, b).abs() < 0.03 && rel(p0_axis, p0).abs() < 0.03);
 }
 
 /// problems/contact_plate_implicit.toml as a cube (h = 0.2 m across, 0.1 m
@@ -1510,10 +1513,10 @@ frames = 0
 fn implicit_rigid_plate_compresses_a_hencky_cube_in_3d() {
     // The cube compressed 25 % by a rigid plate through implicit penalty contact
     // (issue 14: the Cauchy σ within 1 % with the penetration stated). Measured:
-    // the volume mean of σ_zz +0.25 % of E ln λ/λ (+0.79 % with 10 × 10 × 15
-    // cells); the plate's force within 4.4 % of σ(t) A along the way (3.6 % at
-    // the end: the O(h) offset of loading the top layer at its centres, h = 0.1 m
-    // along z here); penetration 6.7e-4 m.
+    // the volume mean of σ_zz −0.36 % of E ln λ/λ; the plate's force within
+    // 0.36 % of σ(t) A along the way; penetration 6.1e-4 m. (With the contact at
+    // the top layer's centres, before the contact points: +0.25 % and 4.4 %, an
+    // O(h) offset with h = 0.1 m along z.)
     let (result, dir) = run_text(PLATE_3D, &[]);
     let summary = result.unwrap();
     assert_eq!(summary.status, Status::Completed);
@@ -1532,7 +1535,7 @@ fn implicit_rigid_plate_compresses_a_hencky_cube_in_3d() {
     let penetration = summary.solver.contact_penetration.unwrap();
     println!("mean σ_zz {mean:+.4}; force within {worst:.4}; penetration {penetration:.2e} m");
     assert!(mean.abs() < 0.01, "mean σ_zz off by {mean}");
-    assert!(worst < 0.05, "force {worst}");
+    assert!(worst < 0.01, "force {worst}");
     assert!(
         penetration > 0.0 && penetration < 1e-3,
         "penetration {penetration}"
@@ -1544,9 +1547,9 @@ fn implicit_rigid_plate_compresses_a_hencky_cube_in_3d() {
 /// first step. The work of the plate on the block (the contact force of
 /// contact.csv times the plate's velocity, trapezoidal over the rows) is the
 /// block's strain energy plus the dissipation, to the energy stored in the
-/// penalty springs: measured W = 613.6 J, strain 344.2 J, dissipation 268.9 J,
-/// W − (strain + dissipation) = 0.46 J (7.5e-4 of W) with 20, 40, 80 and 160
-/// load steps alike (the dissipation per step is trapezoidal in the force).
+/// penalty springs: measured W = 587.1 J, strain 331.7 J, dissipation 254.9 J,
+/// W − (strain + dissipation) = 0.48 J (8.1e-4 of W; 7.7e-4 with 80 load
+/// steps; the dissipation per step is trapezoidal in the force).
 /// With the end-of-step force it was first order (2.1e-2 … 2.0e-3), and
 /// without dissipation the balance is off by 44 %.
 #[test]

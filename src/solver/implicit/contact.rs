@@ -12,6 +12,13 @@
 //!
 //!   r_I −= S_Ip f_p,   K_IJ −= S_Ip S_Jp ∂f_p/∂x_p.
 //!
+//! With a particle-domain basis (uGIMP, cpGIMP, CPDI, cpbspline2) the point
+//! that touches is the particle's contact point instead (`contact_points`):
+//! the point c of its domain that faces the nearest body at the step start,
+//! moved by the point basis N_I of the family, x_c(u) = c + Σ_I N_I(c) u_I,
+//! in contact when inside the body; S_Ip above becomes N_I(c). The load then
+//! enters at the body's surface, not half a particle inside it.
+//!
 //! The penalty of particle p is ε_n = ε_t = α M_p A_p / h (α the contact's
 //! `penalty_factor`, M_p its material's P-wave modulus, A_p = V⁰_p^{(D−1)/D} its
 //! face, h the smallest cell size): a particle pressed by a traction t sinks
@@ -61,8 +68,8 @@ use crate::physics::field_split::{pair_position, FieldSplit, Meeting};
 use crate::physics::rigid_body::to3;
 use crate::physics::rigid_penalty::{penalty_force, ParticleContact, Penalty};
 use crate::physics::rigid_surface::{on_grid_boundary, rigid_surfaces, Inside, Placement, Surface};
-use crate::physics::shape::{evaluate, ShapeFunction, Stencils};
-use crate::physics::transfer::{interpolate, stencils, NodeMap};
+use crate::physics::shape::{deformation_for, evaluate, ShapeFunction, Stencils};
+use crate::physics::transfer::{stencils, NodeMap};
 use crate::scene::contact::ContactPlan;
 use rayon::prelude::*;
 
@@ -207,6 +214,12 @@ pub struct PenaltyContact<const D: usize> {
     motion: Vec<Vector<D>>,
     /// Contacts at the last residual, in particle order.
     pub touches: Vec<Touch<D>>,
+    /// Per stencil entry (stride of the step's stencils) of each particle: the
+    /// weight with which its contact point moves and takes its force
+    /// (`contact_points`); empty when the particles' own weights serve.
+    point_weights: Vec<f64>,
+    /// Each particle's contact point at the step start, where it has one.
+    contact_point: Vec<Option<Vector<D>>>,
     totals: Vec<PairTotal<D>>,
     /// The deepest penalty depth of a converged step so far.
     pub deepest: f64,
@@ -259,6 +272,8 @@ impl<const D: usize> PenaltyContact<D> {
             end: Vec::new(),
             motion: Vec::new(),
             touches: Vec::new(),
+            point_weights: Vec::new(),
+            contact_point: Vec::new(),
             totals,
             deepest: 0.0,
             fields,
@@ -371,7 +386,15 @@ impl<const D: usize> PenaltyContact<D> {
 
     /// The rigid bodies' motion over the step t → t + dt (their particles'
     /// velocity) and their placements at its end.
-    pub fn start_step(&mut self, p: &Particles<D>, dt: f64) {
+    pub fn start_step(
+        &mut self,
+        m: &Model<D>,
+        shape: ShapeFunction,
+        st: &Stencils<D>,
+        map: &NodeMap,
+        dt: f64,
+    ) {
+        let p = &m.particles;
         self.motion = (self.surfaces.iter())
             .map(|s| p.v[s.particle()] * dt)
             .collect();
@@ -379,6 +402,109 @@ impl<const D: usize> PenaltyContact<D> {
             .map(|(s, u)| s.placement(p).shifted(&to3(u)))
             .collect();
         self.touches.clear();
+        (self.point_weights, self.contact_point) = self.contact_points(m, shape, st, map);
+    }
+
+    /// Each particle's contact point at the step start and the weight of each
+    /// of its stencil entries there: c = x_p − F L² n / |L n|, the point of
+    /// its domain (the reach ellipse of half-lengths L, deformed by F where
+    /// the family reads F) that faces the nearest rigid surface (outward
+    /// normal n, at the end of the step), with the point basis of the family
+    /// (linear hats for uGIMP, cpGIMP and CPDI, quadratic B-splines for
+    /// cpbspline2) over the particle's own nodes, renormalised. None, and the
+    /// particle's own weights, where no rigid body is within two cells or the
+    /// basis is a point basis (linear, B-splines): such a particle is a point
+    /// with its reach.
+    fn contact_points(
+        &self,
+        m: &Model<D>,
+        shape: ShapeFunction,
+        st: &Stencils<D>,
+        map: &NodeMap,
+    ) -> (Vec<f64>, Vec<Option<Vector<D>>>) {
+        let point = match shape {
+            ShapeFunction::Ugimp | ShapeFunction::Cpgimp | ShapeFunction::Cpdi => {
+                ShapeFunction::Linear
+            }
+            ShapeFunction::Cpbspline2 => ShapeFunction::Bspline2,
+            _ => return (Vec::new(), Vec::new()),
+        };
+        if self.surfaces.is_empty() {
+            return (Vec::new(), Vec::new());
+        }
+        let p = &m.particles;
+        let on_boundary = on_grid_boundary(&m.grid);
+        let h = m.grid.h_min();
+        let stride = st.stride;
+        let mut out = vec![0.0; p.len() * stride];
+        let mut points = vec![None; p.len()];
+        out.par_chunks_mut(stride)
+            .zip(points.par_iter_mut())
+            .enumerate()
+            .with_min_len(MIN_PARALLEL_LEN)
+            .for_each(|(q, (w, point_of))| {
+                let own = |w: &mut [f64]| {
+                    for (k, e) in st.range(q).enumerate() {
+                        w[k] = st.weight(e);
+                    }
+                };
+                if !self.slave[self.field[q] as usize] || st.count[q] == 0 {
+                    return own(w);
+                }
+                let ell = &p.half_length0[q];
+                let near = ell.add_scalar(2.0 * h);
+                // The nearest of the bodies it is in contact with.
+                let found = (self.surfaces.iter().enumerate())
+                    .filter_map(|(k, s)| {
+                        self.plan.law(self.field[q], s.field)?;
+                        s.reached(&self.end[k], &p.x[q], &near, &on_boundary)
+                    })
+                    .max_by(|a, b| a.depth.total_cmp(&b.depth));
+                let Some(inside) = found else {
+                    return own(w);
+                };
+                let n = inside.normal;
+                // The support point of the reach ellipse along n, L² n / |L n|,
+                // carried by the domain's deformation where the family reads it.
+                let l2n = ell.component_mul(ell).component_mul(&n);
+                let support = l2n / l2n.dot(&n).sqrt();
+                let f = crate::dim::restrict::<D>(&deformation_for(shape, || p.f.get(q)));
+                let offset = f * support;
+                let c = (p.x[q] - offset).sup(&m.grid.min).inf(&m.grid.max);
+                let one = Vector::<D>::zeros();
+                let (mut node, mut nw, mut grad) =
+                    ([0u32; 64], [0.0; 64], [Vector::<D>::zeros(); 64]);
+                let count = evaluate(
+                    point,
+                    &m.grid,
+                    &c,
+                    &one,
+                    &Mat3::identity(),
+                    &mut node,
+                    &mut nw,
+                    &mut grad,
+                );
+                let mut total = 0.0;
+                for (k, e) in st.range(q).enumerate() {
+                    let g = map.grid_node(map.local_of(st, e)) as u32;
+                    w[k] = (0..count).find(|&i| node[i] == g).map_or(0.0, |i| nw[i]);
+                    total += w[k];
+                }
+                if total < 0.5 {
+                    return own(w);
+                }
+                w.iter_mut().for_each(|x| *x /= total);
+                *point_of = Some(c);
+            });
+        (out, points)
+    }
+
+    /// The weight of stencil entry e at its particle's contact point.
+    fn contact_weight(&self, st: &Stencils<D>, e: usize) -> f64 {
+        match self.point_weights.is_empty() {
+            true => st.weight(e),
+            false => self.point_weights[e],
+        }
     }
 
     /// The contacts at the nodal displacement increments u (`touches`).
@@ -392,9 +518,17 @@ impl<const D: usize> PenaltyContact<D> {
             .with_min_len(MIN_PARALLEL_LEN)
             .filter(|&q| this.slave[this.field[q] as usize] && st.count[q] > 0)
             .filter_map(|q| {
-                let dx = interpolate(map, st, q, u);
-                let x = p.x[q] + dx;
-                let (f, ell) = (this.field[q], &p.half_length0[q]);
+                let dx = st.range(q).fold(Vector::<D>::zeros(), |acc, e| {
+                    acc + u[map.local_of(st, e)] * this.contact_weight(st, e)
+                });
+                // At its contact point (a point: a reach of 1e-9 of the
+                // particle's), or at its centre with the particle's reach.
+                let point_reach = p.half_length0[q] * 1e-9;
+                let (x, ell) = match this.contact_point.get(q).copied().flatten() {
+                    Some(c) => (c + dx, &point_reach),
+                    _ => (p.x[q] + dx, &p.half_length0[q]),
+                };
+                let f = this.field[q];
                 (this.surfaces.iter().enumerate()).find_map(|(k, s)| {
                     let law = this.plan.law(f, s.field)?;
                     let inside = s.reached(&this.end[k], &x, ell, &on_boundary)?;
@@ -434,7 +568,7 @@ impl<const D: usize> PenaltyContact<D> {
     pub fn add_residual(&self, map: &NodeMap, st: &Stencils<D>, r: &mut [Vector<D>]) {
         for t in &self.touches {
             for e in st.range(t.particle) {
-                r[map.local_of(st, e)] -= t.contact.force * st.weight(e);
+                r[map.local_of(st, e)] -= t.contact.force * self.contact_weight(st, e);
             }
         }
         for (f, t) in self.node_touches() {
@@ -510,11 +644,12 @@ impl<const D: usize> PenaltyContact<D> {
                     return false;
                 };
                 let d = &touches[i].contact.derivative;
+                let w2 = self.contact_weight(st, e2);
                 for (local, e1) in st.range(q).enumerate() {
                     if !needed[local] {
                         continue;
                     }
-                    let w = -st.weight(e1) * st.weight(e2);
+                    let w = -self.contact_weight(st, e1) * w2;
                     for a in 0..D {
                         for b in 0..D {
                             block[local * D * D + a * D + b] = w * d[(a, b)];

@@ -178,7 +178,7 @@ impl StepSettings {
         let contact = sys.contact.as_mut();
         step_stencils(m, self.shape, contact, &mut sys.stencils, &mut sys.map);
         if let Some(contact) = sys.contact.as_mut() {
-            contact.start_step(p, dt);
+            contact.start_step(m, self.shape, &sys.stencils, &sys.map, dt);
         }
         if self.fbar {
             sys.trial.use_fbar(&m.grid, &p.x);
