@@ -298,8 +298,16 @@ impl Geometry {
                 let y: Vec<f64> = (0..x.len()).map(|d| x[d].clamp(min[d], max[d])).collect();
                 let outside: Vec<usize> = (0..x.len()).filter(|&d| y[d] != x[d]).collect();
                 match outside[..] {
-                    // On the boundary (`contains` is strict): distance zero.
-                    [] => Some((0.0, self.nearest_surface_point(x, on_boundary)?)),
+                    // On the boundary (`contains` is strict): as inside, the
+                    // distance to the nearest face that is surface (zero unless
+                    // the point's face lies on the grid's boundary).
+                    [] => {
+                        let s = self.nearest_surface_point(x, on_boundary)?;
+                        let depth: f64 = (0..x.len())
+                            .map(|d| (s.point[d] - x[d]) * s.normal[d])
+                            .sum();
+                        Some((-depth, s))
+                    }
                     [d] => {
                         let sign = if x[d] > max[d] { 1.0 } else { -1.0 };
                         let normal = (0..x.len()).map(|i| if i == d { sign } else { 0.0 });

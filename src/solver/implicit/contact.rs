@@ -68,7 +68,9 @@ use crate::physics::field_split::{pair_position, FieldSplit, Meeting};
 use crate::physics::rigid_body::to3;
 use crate::physics::rigid_penalty::{penalty_force, ParticleContact, Penalty};
 use crate::physics::rigid_surface::{on_grid_boundary, rigid_surfaces, Inside, Placement, Surface};
-use crate::physics::shape::{deformation_for, evaluate, ShapeFunction, Stencils};
+use crate::physics::shape::{
+    contiguous_half_length, deformation_for, evaluate, ShapeFunction, Stencils,
+};
 use crate::physics::transfer::{stencils, NodeMap};
 use crate::scene::contact::ContactPlan;
 use rayon::prelude::*;
@@ -80,6 +82,9 @@ pub struct Touch<const D: usize> {
     /// Index of the rigid body in `PenaltyContact::surfaces`.
     pub surface: usize,
     pub contact: ParticleContact<D>,
+    /// Whether it touches at its contact point (`PenaltyContact::contact_points`:
+    /// its force and motion go with the point's weights) or at its centre.
+    pub at_point: bool,
     /// What round-off in the particle's position leaves in its force:
     /// ε_n × 2.2e-16 × (|x|∞ + |surface point|∞).
     pub round_off: f64,
@@ -218,8 +223,9 @@ pub struct PenaltyContact<const D: usize> {
     /// weight with which its contact point moves and takes its force
     /// (`contact_points`); empty when the particles' own weights serve.
     point_weights: Vec<f64>,
-    /// Each particle's contact point at the step start, where it has one.
-    contact_point: Vec<Option<Vector<D>>>,
+    /// Each particle's contact point at the step start and the rigid body it
+    /// faces, where it has one.
+    contact_point: Vec<Option<(usize, Vector<D>)>>,
     totals: Vec<PairTotal<D>>,
     /// The deepest penalty depth of a converged step so far.
     pub deepest: f64,
@@ -421,7 +427,7 @@ impl<const D: usize> PenaltyContact<D> {
         shape: ShapeFunction,
         st: &Stencils<D>,
         map: &NodeMap,
-    ) -> (Vec<f64>, Vec<Option<Vector<D>>>) {
+    ) -> (Vec<f64>, Vec<Option<(usize, Vector<D>)>>) {
         let point = match shape {
             ShapeFunction::Ugimp | ShapeFunction::Cpgimp | ShapeFunction::Cpdi => {
                 ShapeFunction::Linear
@@ -457,19 +463,14 @@ impl<const D: usize> PenaltyContact<D> {
                 let found = (self.surfaces.iter().enumerate())
                     .filter_map(|(k, s)| {
                         self.plan.law(self.field[q], s.field)?;
-                        s.reached(&self.end[k], &p.x[q], &near, &on_boundary)
+                        Some((k, s.reached(&self.end[k], &p.x[q], &near, &on_boundary)?))
                     })
-                    .max_by(|a, b| a.depth.total_cmp(&b.depth));
-                let Some(inside) = found else {
+                    .max_by(|a, b| a.1.depth.total_cmp(&b.1.depth));
+                let Some((body, inside)) = found else {
                     return own(w);
                 };
-                let n = inside.normal;
-                // The support point of the reach ellipse along n, L² n / |L n|,
-                // carried by the domain's deformation where the family reads it.
-                let l2n = ell.component_mul(ell).component_mul(&n);
-                let support = l2n / l2n.dot(&n).sqrt();
-                let f = crate::dim::restrict::<D>(&deformation_for(shape, || p.f.get(q)));
-                let offset = f * support;
+                let f = deformation_for(shape, || p.f.get(q));
+                let offset = domain_support(shape, &m.grid, ell, &f, &inside.normal);
                 let c = (p.x[q] - offset).sup(&m.grid.min).inf(&m.grid.max);
                 let one = Vector::<D>::zeros();
                 let (mut node, mut nw, mut grad) =
@@ -494,16 +495,17 @@ impl<const D: usize> PenaltyContact<D> {
                     return own(w);
                 }
                 w.iter_mut().for_each(|x| *x /= total);
-                *point_of = Some(c);
+                *point_of = Some((body, c));
             });
         (out, points)
     }
 
-    /// The weight of stencil entry e at its particle's contact point.
-    fn contact_weight(&self, st: &Stencils<D>, e: usize) -> f64 {
-        match self.point_weights.is_empty() {
-            true => st.weight(e),
-            false => self.point_weights[e],
+    /// The weight of stencil entry e of a particle in contact (`at_point`:
+    /// at its contact point, else at its centre).
+    fn contact_weight(&self, at_point: bool, st: &Stencils<D>, e: usize) -> f64 {
+        match at_point {
+            true => self.point_weights[e],
+            false => st.weight(e),
         }
     }
 
@@ -518,19 +520,20 @@ impl<const D: usize> PenaltyContact<D> {
             .with_min_len(MIN_PARALLEL_LEN)
             .filter(|&q| this.slave[this.field[q] as usize] && st.count[q] > 0)
             .filter_map(|q| {
-                let dx = st.range(q).fold(Vector::<D>::zeros(), |acc, e| {
-                    acc + u[map.local_of(st, e)] * this.contact_weight(st, e)
-                });
-                // At its contact point (a point: a reach of 1e-9 of the
-                // particle's), or at its centre with the particle's reach.
-                let point_reach = p.half_length0[q] * 1e-9;
-                let (x, ell) = match this.contact_point.get(q).copied().flatten() {
-                    Some(c) => (c + dx, &point_reach),
-                    _ => (p.x[q] + dx, &p.half_length0[q]),
-                };
                 let f = this.field[q];
-                (this.surfaces.iter().enumerate()).find_map(|(k, s)| {
+                let touch = |k: usize, at_point: bool| {
+                    let s = &this.surfaces[k];
                     let law = this.plan.law(f, s.field)?;
+                    let dx = st.range(q).fold(Vector::<D>::zeros(), |acc, e| {
+                        acc + u[map.local_of(st, e)] * this.contact_weight(at_point, st, e)
+                    });
+                    // At its contact point (a point: a reach of 1e-9 of the
+                    // particle's), or at its centre with the particle's reach.
+                    let point_reach = p.half_length0[q] * 1e-9;
+                    let (x, ell) = match (at_point, this.contact_point.get(q).copied().flatten()) {
+                        (true, Some((_, c))) => (c + dx, &point_reach),
+                        _ => (p.x[q] + dx, &p.half_length0[q]),
+                    };
                     let inside = s.reached(&this.end[k], &x, ell, &on_boundary)?;
                     // ε = α M A / h.
                     let modulus = m.materials[p.material[q] as usize].p_wave_modulus();
@@ -552,8 +555,17 @@ impl<const D: usize> PenaltyContact<D> {
                         particle: q,
                         surface: k,
                         contact: penalty_force(&penalty, &inside, &relative, &f_t0),
+                        at_point,
                         round_off: epsilon * f64::EPSILON * magnitude,
                     })
+                };
+                // The body its contact point faces at that point; the others
+                // (a corner of two bodies) at its centre.
+                let faced = this.contact_point.get(q).copied().flatten().map(|(k, _)| k);
+                faced.and_then(|k| touch(k, true)).or_else(|| {
+                    (0..this.surfaces.len())
+                        .filter(|&k| Some(k) != faced)
+                        .find_map(|k| touch(k, false))
                 })
             })
             .collect();
@@ -568,7 +580,7 @@ impl<const D: usize> PenaltyContact<D> {
     pub fn add_residual(&self, map: &NodeMap, st: &Stencils<D>, r: &mut [Vector<D>]) {
         for t in &self.touches {
             for e in st.range(t.particle) {
-                r[map.local_of(st, e)] -= t.contact.force * self.contact_weight(st, e);
+                r[map.local_of(st, e)] -= t.contact.force * self.contact_weight(t.at_point, st, e);
             }
         }
         for (f, t) in self.node_touches() {
@@ -643,13 +655,13 @@ impl<const D: usize> PenaltyContact<D> {
                 let Ok(i) = touches.binary_search_by_key(&q, |t| t.particle) else {
                     return false;
                 };
-                let d = &touches[i].contact.derivative;
-                let w2 = self.contact_weight(st, e2);
+                let (d, at_point) = (&touches[i].contact.derivative, touches[i].at_point);
+                let w2 = self.contact_weight(at_point, st, e2);
                 for (local, e1) in st.range(q).enumerate() {
                     if !needed[local] {
                         continue;
                     }
-                    let w = -self.contact_weight(st, e1) * w2;
+                    let w = -self.contact_weight(at_point, st, e1) * w2;
                     for a in 0..D {
                         for b in 0..D {
                             block[local * D * D + a * D + b] = w * d[(a, b)];
@@ -809,6 +821,37 @@ fn add_node_block<const D: usize>(
     }
 }
 
+/// The point of a particle's domain that faces a surface of outward normal n,
+/// relative to the particle: the support point of its reach ellipse as the
+/// family shapes the domain. uGIMP: the reference half-lengths L, L² n / |L n|;
+/// cpGIMP and cpbspline2: the same with the contiguous half-lengths (L stretched
+/// by F_dd, axis-aligned, `contiguous_half_length`); CPDI: the ellipse carried by
+/// F, F L² Fᵀ n / |L Fᵀ n|.
+fn domain_support<const D: usize>(
+    shape: ShapeFunction,
+    grid: &Grid<D>,
+    half_length0: &Vector<D>,
+    f: &Mat3,
+    n: &Vector<D>,
+) -> Vector<D> {
+    let support = |l: &Vector<D>, n: &Vector<D>| {
+        let l2n = l.component_mul(l).component_mul(n);
+        l2n / l2n.dot(n).sqrt()
+    };
+    match shape {
+        ShapeFunction::Cpgimp | ShapeFunction::Cpbspline2 => {
+            support(&contiguous_half_length(grid, half_length0, f), n)
+        }
+        ShapeFunction::Cpdi => {
+            let f = crate::dim::restrict::<D>(f);
+            let ftn = f.transpose() * n;
+            let l2ftn = half_length0.component_mul(half_length0).component_mul(&ftn);
+            f * l2ftn / half_length0.component_mul(&ftn).norm()
+        }
+        _ => support(half_length0, n),
+    }
+}
+
 /// The nodes and signed weights that make a meeting's relative displacement
 /// u_r(c_r) − u_s(c_s).
 ///
@@ -867,4 +910,35 @@ fn surface_points<const D: usize>(
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Vector2;
+
+    /// The contact point faces the surface on the domain as each family shapes
+    /// it: CPDI's ellipse turns with F, cpGIMP's box stretches along the axes.
+    #[test]
+    fn a_domain_s_support_point_follows_its_family() {
+        let grid = Grid::<2>::new(Vector2::zeros(), Vector2::new(4.0, 4.0), [4, 4], 1);
+        let up = Vector2::new(0.0, 1.0);
+        // Turned by 90°: the long half-axis 0.2 now points along y.
+        let turn = Mat3::new(0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0);
+        let ell = Vector2::new(0.2, 0.1);
+        let cpdi = domain_support(ShapeFunction::Cpdi, &grid, &ell, &turn, &up);
+        assert!((cpdi - Vector2::new(0.0, 0.2)).norm() < 1e-15, "{cpdi}");
+        // Squashed to half along y (and stretched along x).
+        let squash = Mat3::new(1.5, 0.0, 0.0, 0.0, 0.5, 0.0, 0.0, 0.0, 1.0);
+        let round = Vector2::new(0.1, 0.1);
+        let cp = domain_support(ShapeFunction::Cpgimp, &grid, &round, &squash, &up);
+        assert!((cp - Vector2::new(0.0, 0.05)).norm() < 1e-15, "{cp}");
+        // uGIMP's domain does not deform; a tilted normal meets the ellipse
+        // where its outward normal is n.
+        let n = Vector2::new(0.6, 0.8);
+        let u = domain_support(ShapeFunction::Ugimp, &grid, &ell, &squash, &n);
+        let on_ellipse = (u[0] / ell[0]).powi(2) + (u[1] / ell[1]).powi(2);
+        let normal = Vector2::new(u[0] / ell[0].powi(2), u[1] / ell[1].powi(2)).normalize();
+        assert!((on_ellipse - 1.0).abs() < 1e-14 && (normal - n).norm() < 1e-14);
+    }
 }

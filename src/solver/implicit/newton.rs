@@ -171,7 +171,7 @@ impl Newton {
                     direct_correction(m, sys, solver, &r_free, export.map(|e| (e, at)))
                 }
                 Linear::Krylov(krylov) => {
-                    let stop = self.residual_tolerance * reference;
+                    let stop = (self.residual_tolerance * reference).max(ROUND_OFF_MARGIN * floor);
                     krylov.correction(m, sys, &u, &r_free, stop, iteration)
                 }
             };

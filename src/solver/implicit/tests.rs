@@ -266,6 +266,8 @@ fn tangent_with_rigid_contact_matches_finite_differences_of_the_residual() {
         ("linear", 0.0),
         ("linear", 0.3),
         ("cpgimp", 0.3),
+        ("cpdi", 0.3),
+        ("cpbspline2", 0.3),
         ("bspline2", 0.3),
     ] {
         let text = body.replace(
