@@ -1171,7 +1171,7 @@ fn implicit_contact_footing_converges_to_prandtl_at_first_order() {
 }
 
 #[test]
-#[ignore = "about 8 to 12 minutes: the h = B/32 footings, smooth and rough"]
+#[ignore = "about 10 to 20 minutes: the h = B/32 footings, smooth and rough"]
 fn implicit_contact_footing_is_within_5_percent_of_prandtl_at_h_b_over_32() {
     // Measured: smooth 5.269 (+2.5 %), rough (μ = 10) 5.283 (+2.8 %) (before
     // the contact points: +3.8 %, +4.3 %).
