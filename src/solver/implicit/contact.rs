@@ -417,8 +417,8 @@ impl<const D: usize> PenaltyContact<D> {
     /// the family reads F) that faces the nearest rigid surface (outward
     /// normal n, at the end of the step), with the point basis of the family
     /// (linear hats for uGIMP, cpGIMP and CPDI, quadratic B-splines for
-    /// cpbspline2) over the particle's own nodes, renormalised. None, and the
-    /// particle's own weights, where no rigid body is within two cells or the
+    /// cpbspline2) over the particle's own nodes, renormalised. None (and the
+    /// particle keeps its own weights) where no rigid body is within two cells or the
     /// basis is a point basis (linear, B-splines): such a particle is a point
     /// with its reach.
     fn contact_points(
@@ -449,13 +449,10 @@ impl<const D: usize> PenaltyContact<D> {
             .enumerate()
             .with_min_len(MIN_PARALLEL_LEN)
             .for_each(|(q, (w, point_of))| {
-                let own = |w: &mut [f64]| {
-                    for (k, e) in st.range(q).enumerate() {
-                        w[k] = st.weight(e);
-                    }
-                };
+                // A particle without a contact point keeps its own weights
+                // (`Touch::at_point` false): its row here is not read.
                 if !self.slave[self.field[q] as usize] || st.count[q] == 0 {
-                    return own(w);
+                    return;
                 }
                 let ell = &p.half_length0[q];
                 let near = ell.add_scalar(2.0 * h);
@@ -467,7 +464,7 @@ impl<const D: usize> PenaltyContact<D> {
                     })
                     .max_by(|a, b| a.1.depth.total_cmp(&b.1.depth));
                 let Some((body, inside)) = found else {
-                    return own(w);
+                    return;
                 };
                 let f = deformation_for(shape, || p.f.get(q));
                 let offset = domain_support(shape, &m.grid, ell, &f, &inside.normal);
@@ -492,7 +489,7 @@ impl<const D: usize> PenaltyContact<D> {
                     total += w[k];
                 }
                 if total < 0.5 {
-                    return own(w);
+                    return;
                 }
                 w.iter_mut().for_each(|x| *x /= total);
                 *point_of = Some((body, c));
