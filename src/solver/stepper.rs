@@ -29,6 +29,11 @@ pub struct SolverState {
     /// the last step, D values per particle (empty without friction).
     #[serde(default)]
     pub contact_tangential: Vec<f64>,
+    /// The implicit contact's contact points carried to the next step, 2 + D
+    /// values per particle that has one (empty in checkpoints written before
+    /// they were carried: the points are then set on the particles' domains).
+    #[serde(default)]
+    pub contact_points: Vec<f64>,
     /// The multigrid's counts (zero in checkpoints written before they were kept).
     #[serde(default)]
     pub multigrid: MultigridCounts,

@@ -64,6 +64,7 @@ pub struct Implicit<const D: usize> {
     /// Contact tangential forces from a checkpoint, for the contact set up at
     /// the first step.
     restored_contact: Vec<f64>,
+    restored_points: Option<Vec<f64>>,
 }
 
 impl<const D: usize> Implicit<D> {
@@ -79,6 +80,7 @@ impl<const D: usize> Implicit<D> {
             reaction: Vec::new(),
             cutbacks: 0,
             restored_contact: Vec::new(),
+            restored_points: None,
         }
     }
 
@@ -160,6 +162,15 @@ impl<const D: usize> Implicit<D> {
 
     /// Set up the step t → t + dt (`step`).
     fn prepare(&mut self, m: &Model<D>, t: f64, dt: f64) {
+        // A checkpoint's contact points before the step sets its own from them.
+        if let Some(points) = self.restored_points.take() {
+            if self.system.contact.is_none() {
+                self.system.contact = contact::PenaltyContact::new(m);
+            }
+            if let Some(contact) = self.system.contact.as_mut() {
+                contact.restore_carried_points(&points, m.particles.len());
+            }
+        }
         self.settings
             .prepare(m, &mut self.system, &mut self.accel, t, dt);
         if let Some(contact) = self.system.contact.as_mut() {
@@ -262,6 +273,8 @@ impl<const D: usize> Stepper<D> for Implicit<D> {
                 .map_or_else(Default::default, |d| d.statistics()),
             contact_tangential: (self.system.contact.as_ref())
                 .map_or_else(Vec::new, |c| c.tangential_state()),
+            contact_points: (self.system.contact.as_ref())
+                .map_or_else(Vec::new, |c| c.carried_points()),
             multigrid: krylov.map_or_else(Default::default, |k| k.multigrid_counts),
         }
     }
@@ -273,6 +286,7 @@ impl<const D: usize> Stepper<D> for Implicit<D> {
         self.newton.iterations = s.newton_iterations;
         self.cutbacks = s.cutbacks;
         self.restored_contact = s.contact_tangential.clone();
+        self.restored_points = Some(s.contact_points.clone());
         match &mut self.newton.linear {
             newton::Linear::Krylov(k) => {
                 k.iterations = s.krylov_iterations;
