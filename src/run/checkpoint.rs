@@ -8,7 +8,8 @@
 //! every particle field (x, X, v, m, V, V0, F, σ, the CPDI/GIMP half-lengths
 //! whose images F r⁰ are the domain vectors, body, material, loads, history
 //! variables), the stepper's state across steps (`solver::stepper::SolverState`:
-//! Newmark accelerations, counts) and the recorders' state (the streamed CSVs as
+//! Newmark accelerations, the implicit contact's tangential forces and contact
+//! points, counts) and the recorders' state (the streamed CSVs as
 //! written so far, the frame list, when the next row and frame are due).
 //!
 //! Format: two lines of JSON. The first is a header

@@ -11,7 +11,8 @@ use crate::solver::report::{MultigridCounts, NewtonRow, SolverReport};
 use serde::{Deserialize, Serialize};
 
 /// What a stepper carries from one step to the next that a restart needs
-/// (`run::checkpoint`): the Newmark particle accelerations and the counts that
+/// (`run::checkpoint`): the Newmark particle accelerations, the implicit
+/// contact's tangential forces and contact points, and the counts that
 /// summary.json reports. Buffers rebuilt every step are not part of it.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct SolverState {

@@ -1133,7 +1133,10 @@ fn implicit_footing_with(overrides: &[&str]) -> (f64, f64, f64, usize) {
     let q: Vec<f64> = c.col("fy").iter().map(|f| -f / 1.0e4).collect();
     let (last, earlier) = (q[q.len() - 1], q[q.len() * 4 / 5]);
     let prandtl = 2.0 + std::f64::consts::PI;
-    let rows = Table::read(&dir.path().join("newton.csv")).unwrap().col("step").len();
+    let rows = Table::read(&dir.path().join("newton.csv"))
+        .unwrap()
+        .col("step")
+        .len();
     (last, last / prandtl - 1.0, last / earlier - 1.0, rows)
 }
 

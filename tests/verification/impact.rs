@@ -496,6 +496,22 @@ fn particles_leaving_the_grid_stop_the_run_or_are_removed_with_their_mass_and_en
     let (result, _dir) = run_text(FLYING_BLOCK, &[]);
     let message = result.expect_err("a particle leaves the grid").to_string();
     assert!(message.contains("left the grid"), "{message}");
+    // Implicit: the step that takes it out is committed, so the run stops
+    // there; cutting the step back would retry from the committed particles
+    // (before: 5 cut-backs, each moving the block on, "t = 5.015625e-2").
+    let implicit = [
+        "solver.kind=\"implicit\"",
+        "solver.integrator=\"newmark\"",
+        "solver.dt=0.005",
+    ];
+    let (result, _dir) = run_text(FLYING_BLOCK, &implicit);
+    let message = result.expect_err("a particle leaves the grid").to_string();
+    assert!(
+        message.contains("left the grid")
+            && message.contains("t = 5.5")
+            && !message.contains("cut-back"),
+        "{message}"
+    );
 
     // "remove": the run ends; every particle is out, frozen within one step's
     // travel of the face (v Δt < v h/(2(c + v)) = 0.011 m), with its velocity,

@@ -14,10 +14,13 @@
 //!
 //! With a particle-domain basis (uGIMP, cpGIMP, CPDI, cpbspline2) the point
 //! that touches is the particle's contact point instead (`contact_points`):
-//! the point c of its domain that faces the nearest body at the step start,
-//! moved by the point basis N_I of the family, x_c(u) = c + Σ_I N_I(c) u_I,
-//! in contact when inside the body; S_Ip above becomes N_I(c). The load then
-//! enters at the body's surface, not half a particle inside it.
+//! the point c of its domain that faces the nearest body when it first comes
+//! within two cells of it, moved by the point basis N_I of the family,
+//! x_c(u) = c + Σ_I N_I(c) u_I, in contact when inside the body; S_Ip above
+//! becomes N_I(c). The next step starts from where the converged step left it
+//! (it moves with the grid, as the body's surface does), while the particle
+//! faces the same body. The load then enters at the body's surface, not half a
+//! particle inside it.
 //!
 //! The penalty of particle p is ε_n = ε_t = α M_p A_p / h (α the contact's
 //! `penalty_factor`, M_p its material's P-wave modulus, A_p = V⁰_p^{(D−1)/D} its
@@ -94,12 +97,12 @@ pub struct Touch<const D: usize> {
 /// point of the particle's domain that faces the body, as a fraction of its
 /// largest half-length, before it is set back there. Carried, the point rides
 /// on the soil's surface and its gap stays continuous from step to step; set
-/// anew from x_p − s every step it left the footing of
+/// anew from x_p − s every step the point left the footing of
 /// `problems/contact_footing_implicit.toml` where the soil flows (F of a
 /// plastic particle does not move its domain's edge with the grid: gaps of up
 /// to 1.4e-4 m grew under the footing's edge), and the points under the
-/// footing chattered in and out of contact (1,662 Newton rows, 32 cut-backs,
-/// against 577 and 3 carried). Carried, they strayed at most 0.14 of a
+/// footing chattered in and out of contact (1,662 Newton rows, 66 cut-backs,
+/// against 576 and 2 carried). Carried, they strayed at most 0.14 of a
 /// half-length in that run.
 const CARRIED_POINT_STRAY: f64 = 0.5;
 
@@ -810,12 +813,22 @@ impl<const D: usize> PenaltyContact<D> {
     }
 
     /// Continue with the contact points of a checkpoint (`carried_points`) for
-    /// the n particles.
+    /// the n particles. An entry that names no particle or rigid body, or whose
+    /// point is not finite, is left out: that particle's point is set on its
+    /// domain, as for a particle that comes near a body.
     pub fn restore_carried_points(&mut self, state: &[f64], n: usize) {
         self.carried = vec![None; n];
+        let index = |v: f64, len: usize| {
+            (v >= 0.0 && v.fract() == 0.0 && v < len as f64).then_some(v as usize)
+        };
         for c in state.chunks_exact(2 + D) {
-            if let Some(slot) = self.carried.get_mut(c[0] as usize) {
-                *slot = Some((c[1] as usize, Vector::<D>::from_column_slice(&c[2..])));
+            let point = Vector::<D>::from_column_slice(&c[2..]);
+            if let (Some(q), Some(k), true) = (
+                index(c[0], n),
+                index(c[1], self.surfaces.len()),
+                point.iter().all(|x| x.is_finite()),
+            ) {
+                self.carried[q] = Some((k, point));
             }
         }
     }

@@ -64,6 +64,8 @@ pub struct Implicit<const D: usize> {
     /// Contact tangential forces from a checkpoint, for the contact set up at
     /// the first step.
     restored_contact: Vec<f64>,
+    /// Contact points carried from a checkpoint's last step (`SolverState::
+    /// contact_points`), restored before the first step sets its own.
     restored_points: Option<Vec<f64>>,
 }
 
@@ -111,7 +113,10 @@ impl<const D: usize> Implicit<D> {
         level: usize,
     ) -> Result<f64, Divergence> {
         match self.attempt(m, t, dt, step, level) {
-            Ok(work) => Ok(work),
+            // The step is committed: a state it leaves unsound (a particle off
+            // the grid, F inverted) stops the run; a cut-back would restart
+            // from the committed model, not from the step's start.
+            Ok(work) => check_state(m, step + 1, t + dt).map(|()| work),
             Err(_) if level < self.max_cutbacks => {
                 self.cutbacks += 1;
                 let first = self.advance_level(m, t, dt / 2.0, step, level + 1)?;
@@ -130,7 +135,7 @@ impl<const D: usize> Implicit<D> {
     }
 
     /// One attempt at the step t → t + dt: prepare, Newton, commit. Leaves the
-    /// model untouched when Newton fails.
+    /// model untouched when Newton fails; the caller checks the committed state.
     fn attempt(
         &mut self,
         m: &mut Model<D>,
@@ -153,10 +158,6 @@ impl<const D: usize> Implicit<D> {
         let work = self
             .settings
             .commit(m, &mut self.system, &converged.u, &mut self.accel);
-        check_state(m, step + 1, t + dt).map_err(|d| Failure {
-            particle: d.particle,
-            message: d.message,
-        })?;
         Ok(work)
     }
 
