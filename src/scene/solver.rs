@@ -262,6 +262,8 @@ impl Scope {
 
 const EXPLICIT: &[SolverKind] = &[SolverKind::Explicit];
 const IMPLICIT: &[SolverKind] = &[SolverKind::Implicit];
+// Explicit solvers report the Newmark default of `integrator`.
+const EXPLICIT_OR_IMPLICIT: &[SolverKind] = &[SolverKind::Explicit, SolverKind::Implicit];
 const NEWMARK: &[Integrator] = &[Integrator::Newmark];
 const QUASI_STATIC: &[Integrator] = &[Integrator::QuasiStatic];
 const KRYLOV: &[LinearSolver] = &[LinearSolver::Gmres, LinearSolver::Cg];
@@ -271,6 +273,7 @@ const SET_KRYLOV: &str = " (set \"gmres\" or \"cg\")";
 const RESTART_LENGTH: &str = " (it is the GMRES restart length)";
 const FULL_GRAVITY: &str = " (gravity is always in full)";
 const GIVE_DT: &str = " (give dt)";
+const RAMP_WITH_LOAD: &str = " (gravity ramps with the load factor: gravity_ramp)";
 
 /// The `Scope` of the optional key `key`, a field of `SolverConfig` named as in
 /// the table.
@@ -288,7 +291,13 @@ pub const SCOPES: &[Scope] = &[
     scope!(cfl, EXPLICIT, &[], &[], ""),
     scope!(flip, EXPLICIT, &[], &[], ""),
     scope!(damping, EXPLICIT, &[], &[], ""),
-    scope!(gravity_ramp_time, EXPLICIT, &[], &[], ""),
+    scope!(
+        gravity_ramp_time,
+        EXPLICIT_OR_IMPLICIT,
+        NEWMARK,
+        &[],
+        RAMP_WITH_LOAD
+    ),
     scope!(bulk_viscosity_quadratic, EXPLICIT, &[], &[], ""),
     scope!(bulk_viscosity_linear, EXPLICIT, &[], &[], ""),
     scope!(transfer, EXPLICIT, &[], &[], ""),

@@ -636,8 +636,15 @@ fn gravity_ramp_time_is_checked() {
         &GOOD.replace("cfl = 0.5", "cfl = 0.5\ngravity_ramp_time = -1.0"),
         &["key `solver.gravity_ramp_time`", "finite time ≥ 0"],
     );
+    // Newmark takes it; quasi-static load steps ramp gravity with the load.
+    Scene::parse("scene.toml", &implicit("gravity_ramp_time = 0.1\n"), &[])
+        .expect("Newmark takes a gravity ramp");
     rejected(
-        &implicit("gravity_ramp_time = 0.1\n"),
-        &["key `solver.gravity_ramp_time`", "does not apply"],
+        &implicit("integrator = \"quasi_static\"\ngravity_ramp_time = 0.1\n"),
+        &[
+            "key `solver.gravity_ramp_time`",
+            "does not apply to the quasi-static",
+            "gravity_ramp)",
+        ],
     );
 }

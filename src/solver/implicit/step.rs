@@ -17,6 +17,7 @@ use super::newmark::Newmark;
 use super::ties::{merge, natural_end_ties, nodal_support, ties};
 use crate::dim::Vector;
 use crate::model::conditions::Constraint;
+use crate::model::loads::LoadTime;
 use crate::model::{load_factor, Model};
 use crate::parallel::MIN_PARALLEL_LEN;
 use crate::physics::absorbing::{self, AbsorbingStep};
@@ -43,6 +44,9 @@ pub struct StepSettings {
     pub end_time: f64,
     /// Quasi-static: gravity ramps with the load factor (else it is in full).
     pub gravity_ramp: bool,
+    /// Newmark: gravity rises linearly from zero over this time on the run's
+    /// clock (`gravity_ramp_time`; 0: in full from the start).
+    pub gravity_ramp_time: LoadTime,
     /// Nodes with less particle support (cells) are tied to their neighbours.
     pub min_node_support: f64,
     /// F-bar against volumetric locking (`crate::physics::fbar`).
@@ -138,6 +142,7 @@ impl StepSettings {
             t_start,
             end_time: s.end_time,
             gravity_ramp: s.gravity_ramp(),
+            gravity_ramp_time: LoadTime::Ramp(s.gravity_ramp_time()),
             min_node_support: s.min_node_support(),
             fbar: s.fbar(),
             direct_ordering: s.direct_ordering(),
@@ -149,7 +154,8 @@ impl StepSettings {
     }
 
     /// Load factor of gravity and loads at time t: (t − t_start) / duration when
-    /// quasi-static, otherwise 1 for gravity and the ramp of each load.
+    /// quasi-static, otherwise the gravity ramp's factor (1 without one) and
+    /// the ramp of each load.
     pub fn load_factors<const D: usize>(&self, m: &Model<D>, t: f64) -> (f64, Vec<f64>) {
         match self.integrator {
             Integrator::QuasiStatic => {
@@ -157,7 +163,7 @@ impl StepSettings {
                 let g = if self.gravity_ramp { lambda } else { 1.0 };
                 (g, vec![lambda; m.load_ramps.len()])
             }
-            Integrator::Newmark => (1.0, m.load_scales(t)),
+            Integrator::Newmark => (self.gravity_ramp_time.factor(t), m.load_scales(t)),
         }
     }
 
