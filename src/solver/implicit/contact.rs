@@ -75,7 +75,7 @@ use crate::physics::rigid_surface::{on_grid_boundary, rigid_surfaces, Inside, Pl
 use crate::physics::shape::{
     contiguous_half_length, deformation_for, evaluate, ShapeFunction, Stencils,
 };
-use crate::physics::transfer::{stencils, NodeMap};
+use crate::physics::transfer::{interpolate, stencils, NodeMap};
 use crate::scene::contact::ContactPlan;
 use rayon::prelude::*;
 
@@ -243,8 +243,8 @@ pub struct PenaltyContact<const D: usize> {
     /// Each particle's contact point at the step start and the rigid body it
     /// faces, where it has one.
     contact_point: Vec<Option<(usize, Vector<D>)>>,
-    /// Where the contact points are at the last residual (c + Σ N_I(c) u_I).
-    moved: Vec<Option<(usize, Vector<D>)>>,
+    /// How far each contact point has moved at the last residual, Σ N_I(c) u_I.
+    point_motion: Vec<Option<Vector<D>>>,
     /// Where the last converged step left them: the next step's contact points.
     carried: Vec<Option<(usize, Vector<D>)>>,
     totals: Vec<PairTotal<D>>,
@@ -301,7 +301,7 @@ impl<const D: usize> PenaltyContact<D> {
             touches: Vec::new(),
             point_weights: Vec::new(),
             contact_point: Vec::new(),
-            moved: Vec::new(),
+            point_motion: Vec::new(),
             carried: Vec::new(),
             totals,
             deepest: 0.0,
@@ -551,14 +551,14 @@ impl<const D: usize> PenaltyContact<D> {
         let p = &m.particles;
         let on_boundary = on_grid_boundary(&m.grid);
         let h = m.grid.h_min();
-        self.moved = (self.contact_point.par_iter().enumerate())
+        self.point_motion = (self.contact_point.par_iter().enumerate())
             .with_min_len(MIN_PARALLEL_LEN)
             .map(|(q, point)| {
-                let (body, c) = (*point)?;
-                let dx = st.range(q).fold(Vector::<D>::zeros(), |acc, e| {
-                    acc + u[map.local_of(st, e)] * self.point_weights[e]
-                });
-                Some((body, c + dx))
+                point.map(|_| {
+                    st.range(q).fold(Vector::<D>::zeros(), |acc, e| {
+                        acc + u[map.local_of(st, e)] * self.point_weights[e]
+                    })
+                })
             })
             .collect();
         let this = &*self;
@@ -568,18 +568,22 @@ impl<const D: usize> PenaltyContact<D> {
             .filter(|&q| this.slave[this.field[q] as usize] && st.count[q] > 0)
             .filter_map(|q| {
                 let f = this.field[q];
+                let point = this.contact_point.get(q).copied().flatten();
                 let touch = |k: usize, at_point: bool| {
                     let s = &this.surfaces[k];
                     let law = this.plan.law(f, s.field)?;
-                    let dx = st.range(q).fold(Vector::<D>::zeros(), |acc, e| {
-                        acc + u[map.local_of(st, e)] * this.contact_weight(at_point, st, e)
-                    });
                     // At its contact point (a point: a reach of 1e-9 of the
                     // particle's), or at its centre with the particle's reach.
                     let point_reach = p.half_length0[q] * 1e-9;
-                    let (x, ell) = match (at_point, this.contact_point.get(q).copied().flatten()) {
-                        (true, Some((_, c))) => (c + dx, &point_reach),
-                        _ => (p.x[q] + dx, &p.half_length0[q]),
+                    let (x, dx, ell) = match (at_point, point) {
+                        (true, Some((_, c))) => {
+                            let dx = this.point_motion[q].expect("a contact point moves");
+                            (c + dx, dx, &point_reach)
+                        }
+                        _ => {
+                            let dx = interpolate(map, st, q, u);
+                            (p.x[q] + dx, dx, &p.half_length0[q])
+                        }
                     };
                     let inside = s.reached(&this.end[k], &x, ell, &on_boundary)?;
                     // ε = α M A / h.
@@ -608,7 +612,7 @@ impl<const D: usize> PenaltyContact<D> {
                 };
                 // The body its contact point faces at that point; the others
                 // (a corner of two bodies) at its centre.
-                let faced = this.contact_point.get(q).copied().flatten().map(|(k, _)| k);
+                let faced = point.map(|(k, _)| k);
                 faced.and_then(|k| touch(k, true)).or_else(|| {
                     (0..this.surfaces.len())
                         .filter(|&k| Some(k) != faced)
@@ -724,7 +728,9 @@ impl<const D: usize> PenaltyContact<D> {
     /// carried to the next step, the contact forces into the pair totals
     /// (force × dt), and the rigid bodies' particles moved by their motion.
     pub fn commit(&mut self, p: &mut Particles<D>, dt: f64) {
-        self.carried = std::mem::take(&mut self.moved);
+        self.carried = (self.contact_point.iter().zip(&self.point_motion))
+            .map(|(c, dx)| Some((c.as_ref()?.0, c.as_ref()?.1 + (*dx)?)))
+            .collect();
         self.deepest = self.deepest.max(self.max_penetration());
         if !self.tangential.is_empty() {
             self.tangential

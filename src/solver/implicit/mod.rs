@@ -61,12 +61,10 @@ pub struct Implicit<const D: usize> {
     /// components exert on the body), nodes with a non-zero reaction only.
     pub reaction: Vec<(u32, Vector<D>)>,
     pub cutbacks: usize,
-    /// Contact tangential forces from a checkpoint, for the contact set up at
-    /// the first step.
-    restored_contact: Vec<f64>,
-    /// Contact points carried from a checkpoint's last step (`SolverState::
-    /// contact_points`), restored before the first step sets its own.
-    restored_points: Option<Vec<f64>>,
+    /// The contact's state from a checkpoint (`SolverState::contact_tangential`
+    /// and `contact_points`), restored before the first step sets up its
+    /// contact points from it.
+    restored_contact: Option<(Vec<f64>, Vec<f64>)>,
 }
 
 impl<const D: usize> Implicit<D> {
@@ -81,8 +79,7 @@ impl<const D: usize> Implicit<D> {
             accel: Vec::new(),
             reaction: Vec::new(),
             cutbacks: 0,
-            restored_contact: Vec::new(),
-            restored_points: None,
+            restored_contact: None,
         }
     }
 
@@ -163,20 +160,14 @@ impl<const D: usize> Implicit<D> {
 
     /// Set up the step t → t + dt (`step`).
     fn prepare(&mut self, m: &Model<D>, t: f64, dt: f64) {
-        // A checkpoint's contact points before the step sets its own from them.
-        if let Some(points) = self.restored_points.take() {
-            if self.system.contact.is_none() {
-                self.system.contact = contact::PenaltyContact::new(m);
-            }
-            if let Some(contact) = self.system.contact.as_mut() {
+        if let Some((tangential, points)) = self.restored_contact.take() {
+            if let Some(contact) = self.system.contact_of(m) {
+                contact.restore_tangential(&tangential);
                 contact.restore_carried_points(&points, m.particles.len());
             }
         }
         self.settings
             .prepare(m, &mut self.system, &mut self.accel, t, dt);
-        if let Some(contact) = self.system.contact.as_mut() {
-            contact.restore_tangential(&std::mem::take(&mut self.restored_contact));
-        }
     }
 }
 
@@ -286,8 +277,7 @@ impl<const D: usize> Stepper<D> for Implicit<D> {
             .collect();
         self.newton.iterations = s.newton_iterations;
         self.cutbacks = s.cutbacks;
-        self.restored_contact = s.contact_tangential.clone();
-        self.restored_points = Some(s.contact_points.clone());
+        self.restored_contact = Some((s.contact_tangential.clone(), s.contact_points.clone()));
         match &mut self.newton.linear {
             newton::Linear::Krylov(k) => {
                 k.iterations = s.krylov_iterations;

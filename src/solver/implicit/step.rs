@@ -127,6 +127,14 @@ impl<const D: usize> StepSystem<D> {
             linear_stress: None,
         }
     }
+
+    /// The contact of model m, set up on first use (None in a scene without).
+    pub fn contact_of(&mut self, m: &Model<D>) -> Option<&mut PenaltyContact<D>> {
+        if self.contact.is_none() && m.contact.is_some() {
+            self.contact = PenaltyContact::new(m);
+        }
+        self.contact.as_mut()
+    }
 }
 
 impl StepSettings {
@@ -178,9 +186,7 @@ impl StepSettings {
         dt: f64,
     ) {
         let p = &m.particles;
-        if sys.contact.is_none() && m.contact.is_some() {
-            sys.contact = PenaltyContact::new(m);
-        }
+        sys.contact_of(m);
         let contact = sys.contact.as_mut();
         step_stencils(m, self.shape, contact, &mut sys.stencils, &mut sys.map);
         if let Some(contact) = sys.contact.as_mut() {
