@@ -4,7 +4,7 @@
 //! maps a particle to a slice of a flat buffer, and a scene of elastic bodies has an
 //! empty buffer.
 
-use crate::dim::{Mat3, Vector};
+use crate::dim::{Mat3, Tensor, Vector};
 use crate::model::tensors::{Layout, Tensors};
 
 #[derive(Clone, Debug)]
@@ -31,6 +31,9 @@ pub struct Particles<const D: usize> {
     /// Applied force on the particle (point loads and tractions), before load scaling.
     pub load: Vec<Vector<D>>,
     pub history: History,
+    /// APIC's affine moment B_p = Σ_I S_Ip v_I (x_I − x_p)ᵀ (`physics::apic`):
+    /// one per particle in a stage with `velocity_transfer = "apic"`, else empty.
+    pub affine: Vec<Tensor<D>>,
 }
 
 /// Per-particle history variables, only for materials that declare some.
@@ -116,6 +119,7 @@ impl<const D: usize> Default for Particles<D> {
             material: Vec::new(),
             load: Vec::new(),
             history: History::default(),
+            affine: Vec::new(),
         }
     }
 }

@@ -3,6 +3,7 @@
 //! the boundary conditions. Nothing here knows which solver calls it.
 
 pub mod absorbing;
+pub mod apic;
 pub mod axisymmetry;
 pub mod boundary;
 pub mod bulk_viscosity;

@@ -20,7 +20,7 @@
 //! particle reads its nodes and writes only itself.
 
 use crate::dim::{Mat3, Vector};
-use crate::model::grid::Grid;
+use crate::model::grid::{greville, Grid};
 use crate::model::particles::Particles;
 use crate::model::tensors::Tensors;
 use crate::parallel::{bucket_sort, DisjointSlice, MIN_PARALLEL_LEN, NO_BUCKET};
@@ -70,6 +70,9 @@ pub struct Stencil<const D: usize> {
     count: [usize; 3],
     weight: [[f64; MAX_PER_AXIS]; 3],
     slope: [[f64; MAX_PER_AXIS]; 3],
+    /// Second 1D slopes, formed into a second "gradient" beside ∇S_I
+    /// (`for_each_with`): APIC's moments and affine weights (`set_second`).
+    second: [[f64; MAX_PER_AXIS]; 3],
 }
 
 impl<const D: usize> Stencil<D> {
@@ -79,19 +82,74 @@ impl<const D: usize> Stencil<D> {
     /// ∂S_I/∂z = S_x (S_y S'_z).
     #[inline(always)]
     pub fn for_each(&self, stride: &[usize; 3], mut visit: impl FnMut(usize, f64, Vector<D>)) {
-        let (w, s) = (&self.weight, &self.slope);
+        self.for_each_with(stride, |b, w, g, _| visit(b, w, g))
+    }
+
+    /// `for_each` that also forms the second slopes as ∇S_I forms the first:
+    /// `visit(node, S_I, ∇S_I, G_I)` with G_I,x = s_x (S_y S_z) and so on.
+    #[inline(always)]
+    pub fn for_each_with(
+        &self,
+        stride: &[usize; 3],
+        mut visit: impl FnMut(usize, f64, Vector<D>, Vector<D>),
+    ) {
+        let (w, s, t) = (&self.weight, &self.slope, &self.second);
         for k in 0..self.count[2] {
             for j in 0..self.count[1] {
                 let row = self.base + j * stride[1] + k * stride[2];
                 let wyz = w[1][j] * w[2][k];
-                let syz = s[1][j] * w[2][k];
-                let wysz = w[1][j] * s[2][k];
+                let (syz, wysz) = (s[1][j] * w[2][k], w[1][j] * s[2][k]);
+                let (tyz, wytz) = (t[1][j] * w[2][k], w[1][j] * t[2][k]);
                 for i in 0..self.count[0] {
                     let g = [s[0][i] * wyz, w[0][i] * syz, w[0][i] * wysz];
-                    visit(row + i, w[0][i] * wyz, Vector::<D>::from_fn(|d, _| g[d]));
+                    let h = [t[0][i] * wyz, w[0][i] * tyz, w[0][i] * wytz];
+                    visit(
+                        row + i,
+                        w[0][i] * wyz,
+                        Vector::<D>::from_fn(|d, _| g[d]),
+                        Vector::<D>::from_fn(|d, _| h[d]),
+                    );
                 }
             }
         }
+    }
+
+    /// The offsets δ_i = x_i − x_p of the stencil's nodes along every axis
+    /// (node positions as `Grid::node_position`: Greville abscissae for B-splines).
+    pub fn offsets(&self, grid: &Grid<D>, x: &Vector<D>) -> [[f64; MAX_PER_AXIS]; 3] {
+        let mut delta = [[0.0; MAX_PER_AXIS]; 3];
+        for d in 0..D {
+            for (i, o) in delta[d].iter_mut().enumerate().take(self.count[d]) {
+                let node = greville(self.first[d] + i, grid.degree, grid.cells[d]);
+                *o = grid.min[d] + grid.h[d] * node - x[d];
+            }
+        }
+        delta
+    }
+
+    /// The 1D factors of APIC (`physics::apic`) along every axis: the moments
+    /// w_i δ_i and the inertia D_dd = Σ_i w_i δ_i² (D_p is diagonal for a tensor
+    /// product of 1D bases that reproduce linear functions).
+    pub fn moments(&self, grid: &Grid<D>, x: &Vector<D>) -> ([[f64; MAX_PER_AXIS]; 3], [f64; 3]) {
+        let delta = self.offsets(grid, x);
+        let (mut moment, mut inertia) = ([[0.0; MAX_PER_AXIS]; 3], [0.0; 3]);
+        for d in 0..D {
+            for i in 0..self.count[d] {
+                moment[d][i] = self.weight[d][i] * delta[d][i];
+                inertia[d] += moment[d][i] * delta[d][i];
+            }
+        }
+        (moment, inertia)
+    }
+
+    /// Set the second slopes (`for_each_with`).
+    pub fn set_second(&mut self, second: [[f64; MAX_PER_AXIS]; 3]) {
+        self.second = second;
+    }
+
+    /// The first slopes S'_i along every axis.
+    pub fn slopes(&self) -> [[f64; MAX_PER_AXIS]; 3] {
+        self.slope
     }
 }
 
@@ -262,6 +320,7 @@ impl<const D: usize> NodeBox<D> {
             count: [1; 3],
             weight: [[1.0; MAX_PER_AXIS]; 3],
             slope: [[0.0; MAX_PER_AXIS]; 3],
+            second: [[0.0; MAX_PER_AXIS]; 3],
         };
         for (d, a) in axes.iter().enumerate() {
             // A node below the box wraps to an index beyond it: the reads and
@@ -289,17 +348,18 @@ impl<const D: usize> NodeBox<D> {
     }
 
     /// P2G by colours: for every particle q in the grid, `add(node, &source(q,
-    /// stencil), S_Iq, ∇S_Iq)` at each of its nodes, `nodes` one value per box
-    /// node. `source` is called once per particle (in its tile's task, so it may
-    /// also update particle q alone), `add` once per entry.
+    /// stencil), S_Iq, ∇S_Iq, G_Iq)` at each of its nodes, `nodes` one value per
+    /// box node, G_Iq formed from the second slopes that `source` may set
+    /// (`Stencil::for_each_with`). `source` is called once per particle (in its
+    /// tile's task, so it may also update particle q alone), `add` once per entry.
     pub fn scatter<N: Send, S>(
         &self,
         shape: ShapeFunction,
         grid: &Grid<D>,
         points: Points<D>,
         nodes: &mut [N],
-        source: impl Fn(usize, &Stencil<D>) -> S + Sync,
-        add: impl Fn(&mut N, &S, f64, &Vector<D>) + Sync,
+        source: impl Fn(usize, &mut Stencil<D>) -> S + Sync,
+        add: impl Fn(&mut N, &S, f64, &Vector<D>, &Vector<D>) + Sync,
     ) {
         assert_eq!(nodes.len(), self.nodes(), "one value per box node");
         let reach = Reach::of(shape).expect("a separable family");
@@ -322,18 +382,18 @@ impl<const D: usize> NodeBox<D> {
                     let q = q as usize;
                     let f = deformation_for(shape, || points.f.get(q));
                     let (x, half) = (&points.x[q], &points.half_length0[q]);
-                    let Some(st) = self.stencil(shape, grid, x, half, &f) else {
+                    let Some(mut st) = self.stencil(shape, grid, x, half, &f) else {
                         continue;
                     };
                     assert!(
                         (0..D).all(|d| st.first[d] >= first[d] && st.first[d] + st.count[d] <= end[d]),
                         "{shape:?} reaches beyond its tile's nodes: the colouring would not hold"
                     );
-                    let s = source(q, &st);
-                    st.for_each(&self.stride, |b, w, g| {
+                    let s = source(q, &mut st);
+                    st.for_each_with(&self.stride, |b, w, g, h| {
                         // SAFETY: tiles of one colour touch disjoint nodes (module doc),
                         // and this tile's particles are visited by this task alone.
-                        add(unsafe { out.at(b) }, &s, w, &g)
+                        add(unsafe { out.at(b) }, &s, w, &g, &h)
                     });
                 }
             });
@@ -385,7 +445,7 @@ mod tests {
             st.compute(shape, &grid, &p.x, &p.half_length0, &p.f);
             let mut map = NodeMap::default();
             map.build(&st, grid.node_count());
-            let (mass, momentum) = crate::physics::transfer::mass_momentum(&map, &st, &p);
+            let (mass, momentum) = crate::physics::transfer::mass_momentum(&map, &st, &p, None);
             let mut bits: Option<Vec<f64>> = None;
             for threads in [1, 3] {
                 let pool = rayon::ThreadPoolBuilder::new()
@@ -403,7 +463,7 @@ mod tests {
                         Points::of(&p),
                         &mut nodes,
                         |q, _| (p.mass[q], p.v[q] * p.mass[q]),
-                        |n, s, w, _| {
+                        |n, s, w, _, _| {
                             n.0 += s.0 * w;
                             n.1 += s.1 * w;
                         },

@@ -12,6 +12,7 @@ use crate::dim::{restrict, Mat3, Tensor, Vector};
 use crate::model::particles::Particles;
 use crate::model::Model;
 use crate::parallel::{DisjointSlice, MIN_PARALLEL_LEN};
+use crate::physics::apic::AffineMomentum;
 use crate::physics::axisymmetry::hoop_gradients;
 use crate::physics::shape::{Owner, ShapeFunction, Stencils};
 use rayon::prelude::*;
@@ -226,11 +227,13 @@ pub fn stencils_and_nodes<const D: usize>(
     map.build(st, m.grid.node_count());
 }
 
-/// Nodal mass (2-24) and momentum (2-25), in one pass over the entries.
+/// Nodal mass (2-24) and momentum (2-25), in one pass over the entries; with
+/// APIC's affine part of the particles' momentum (`physics::apic`) if given.
 pub fn mass_momentum<const D: usize>(
     map: &NodeMap,
     st: &Stencils<D>,
     p: &Particles<D>,
+    affine: Option<&AffineMomentum<D>>,
 ) -> (Vec<f64>, Vec<Vector<D>>) {
     let owner = st.owner();
     (0..map.len())
@@ -243,6 +246,9 @@ pub fn mass_momentum<const D: usize>(
                 let w = st.weight_at(q, e);
                 mass += p.mass[q] * w;
                 momentum += p.v[q] * (p.mass[q] * w);
+                if let Some(affine) = affine {
+                    momentum += affine.term(st, q, e, a);
+                }
             }
             (mass, momentum)
         })

@@ -24,7 +24,7 @@
 //! NaN or infinity (serde_json writes null): a checkpoint of such a state is
 //! refused when read (a run stops on a non-finite state before, `check_state`).
 
-use crate::dim::{Mat3, Vector};
+use crate::dim::{Mat3, Tensor, Vector};
 use crate::model::particles::{History, Particles};
 use crate::model::tensors::{Layout, Tensors};
 use crate::output::atomic::write_atomically;
@@ -105,6 +105,9 @@ pub struct ParticleState {
     pub history_offset: Vec<u32>,
     pub history_len: Vec<u16>,
     pub history: Vec<f64>,
+    /// APIC's B_p, D × D values per particle (column-major), or none.
+    #[serde(default)]
+    pub affine: Vec<f64>,
 }
 
 fn flat_vectors<const D: usize>(v: &[Vector<D>]) -> Vec<f64> {
@@ -147,6 +150,7 @@ impl ParticleState {
             history_offset: p.history.offset.clone(),
             history_len: p.history.len.clone(),
             history: p.history.data.clone(),
+            affine: p.affine.iter().flat_map(|b| b.iter().copied()).collect(),
         }
     }
 
@@ -169,6 +173,14 @@ impl ParticleState {
             ("history_offset", self.history_offset.len(), n),
             ("history_len", self.history_len.len(), n),
         ];
+        let affine = [0, n * D * D];
+        if !affine.contains(&self.affine.len()) {
+            return Err(format!(
+                "particles.affine has {} values, 0 or {} expected for {n} particles",
+                self.affine.len(),
+                affine[1]
+            ));
+        }
         for (name, got, want) in lengths {
             if got != want {
                 return Err(format!(
@@ -194,6 +206,9 @@ impl ParticleState {
                 len: self.history_len.clone(),
                 data: self.history.clone(),
             },
+            affine: (self.affine.chunks_exact(D * D))
+                .map(Tensor::<D>::from_column_slice)
+                .collect(),
         })
     }
 }

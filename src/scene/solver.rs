@@ -82,6 +82,19 @@ pub enum Transfer {
     Gather,
 }
 
+/// How the explicit step gives the particles their velocity back from the grid.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize, IntoStaticStr, EnumIter)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum VelocityTransfer {
+    /// The PIC/FLIP blend of `flip` (2-27).
+    Flip,
+    /// Affine particle-in-cell (Jiang et al. 2015, 2017; `physics::apic`): the
+    /// particle carries an affine velocity field, transferred without loss of
+    /// linear or angular momentum and without FLIP's noise.
+    Apic,
+}
+
 /// Preconditioner of the Krylov solvers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize, IntoStaticStr, EnumIter)]
 #[serde(rename_all = "snake_case")]
@@ -125,6 +138,8 @@ pub struct SolverConfig {
     pub scheme: Option<Scheme>,
     pub cfl: Option<f64>,
     pub flip: Option<f64>,
+    /// Explicit particle velocity update (default `flip`).
+    pub velocity_transfer: Option<VelocityTransfer>,
     pub damping: Option<f64>,
     /// Artificial bulk viscosity C_Q and C_L (`physics::bulk_viscosity`; off
     /// unless one is given, the other then takes its standard value).
@@ -290,6 +305,7 @@ pub const SCOPES: &[Scope] = &[
     scope!(scheme, EXPLICIT, &[], &[], ""),
     scope!(cfl, EXPLICIT, &[], &[], ""),
     scope!(flip, EXPLICIT, &[], &[], ""),
+    scope!(velocity_transfer, EXPLICIT, &[], &[], ""),
     scope!(damping, EXPLICIT, &[], &[], ""),
     scope!(
         gravity_ramp_time,
@@ -405,6 +421,10 @@ impl SolverConfig {
     }
     /// F-bar: per background cell, the particles' volume change is the cell
     /// average (default false). See `fbar`.
+    pub fn velocity_transfer(&self) -> VelocityTransfer {
+        self.velocity_transfer.unwrap_or(VelocityTransfer::Flip)
+    }
+
     pub fn transfer(&self) -> Transfer {
         self.transfer.unwrap_or(Transfer::Auto)
     }

@@ -9,6 +9,7 @@ use crate::model::loads::LoadTime;
 use crate::model::{load_factor, Model};
 use crate::parallel::{deterministic_sum, MIN_PARALLEL_LEN};
 use crate::physics::absorbing;
+use crate::physics::apic::{self, AffineMomentum};
 use crate::physics::boundary::{friction_contact, node_constraint, node_friction};
 use crate::physics::bulk_viscosity::BulkViscosity;
 use crate::physics::contact::{Contact, PairTotal};
@@ -20,7 +21,7 @@ use crate::physics::shape::{ShapeFunction, Stencils};
 use crate::physics::transfer::{
     applied_force, interpolate_two, mass_average, mass_momentum, nodal_force, NodeMap,
 };
-use crate::scene::{Scheme, SolverConfig, Transfer};
+use crate::scene::{Scheme, SolverConfig, Transfer, VelocityTransfer};
 use crate::solver::divergence::{check_state, inverted, Divergence};
 use crate::solver::explicit_scatter::{ScatterStep, Settings};
 use crate::solver::report::{SolverReport, TransferPath};
@@ -33,6 +34,8 @@ pub struct Explicit<const D: usize> {
     pub cfl: f64,
     pub fixed_dt: Option<f64>,
     pub flip: f64,
+    /// APIC (`physics::apic`) instead of the PIC/FLIP blend (`flip` is then 0).
+    pub apic: bool,
     pub damping: f64,
     /// Gravity rises linearly from zero over `gravity_ramp_time` on the run's
     /// clock, as a load's `ramp_time` (0: in full from the start).
@@ -59,7 +62,11 @@ impl<const D: usize> Explicit<D> {
             scheme: s.scheme(),
             cfl: s.cfl(),
             fixed_dt: s.dt,
-            flip: s.flip(),
+            flip: match s.velocity_transfer() {
+                VelocityTransfer::Flip => s.flip(),
+                VelocityTransfer::Apic => 0.0,
+            },
+            apic: s.velocity_transfer() == VelocityTransfer::Apic,
             damping: s.damping(),
             gravity_ramp: LoadTime::Ramp(s.gravity_ramp_time()),
             fbar: s.fbar(),
@@ -147,11 +154,15 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
     /// Advance the model from t to t + dt. Returns the work done by gravity and
     /// applied loads over the step.
     fn step(&mut self, m: &mut Model<D>, t: f64, dt: f64, step: usize) -> Result<f64, Divergence> {
+        if self.apic {
+            apic::ensure(m, self.shape);
+        }
         if self.scatter_serves(m) {
             let settings = Settings {
                 shape: self.shape,
                 scheme: self.scheme,
                 flip: self.flip,
+                apic: self.apic,
                 damping: self.damping,
                 gravity: m.gravity * self.gravity_ramp.factor(t),
             };
@@ -195,8 +206,17 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
             Mirror::build(&m.grid, &m.faces, map)
         };
 
+        // APIC: the node positions and the affine part of the momentum.
+        let hats = self.shape == ShapeFunction::Linear;
+        let positions = match self.apic {
+            true => apic::node_positions(map, &m.grid),
+            false => Vec::new(),
+        };
+        let affine = (self.apic).then(|| AffineMomentum::new(map, st, p, &p.x, &positions, hats));
+
         // Nodal velocity at the start of the step, with the conditions applied.
-        let (mass, momentum) = mass_momentum(map, st, p);
+        let (mass, momentum) = mass_momentum(map, st, p, affine.as_ref());
+        drop(affine);
         let mut raw_velocity = mass_average(&mass, &momentum);
         mirror.velocity(&mass, &momentum, &mut raw_velocity);
         // Contact after P2G: its momentum reaches the particles through the PIC part.
@@ -258,9 +278,19 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
             }
         }
 
-        // G2P: particle velocity (PIC/FLIP blend, 2-27) and position (2-26).
+        // G2P: particle velocity (PIC/FLIP blend, 2-27) and position (2-26);
+        // APIC: the affine moment where the particles are before they move.
         let flip = self.flip;
         let mp = &mut m.particles;
+        let step_start_x = (self.apic && self.scheme == Scheme::Musl).then(|| mp.x.clone());
+        if self.apic {
+            let (x, velocity_new) = (&mp.x, &velocity_new);
+            mp.affine = (0..mp.len())
+                .into_par_iter()
+                .with_min_len(MIN_PARALLEL_LEN)
+                .map(|q| apic::moment(map, st, q, &x[q], &positions, velocity_new))
+                .collect();
+        }
         let old_v = mp.v.clone();
         mp.v.par_iter_mut()
             .zip(mp.x.par_iter_mut())
@@ -305,8 +335,12 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
             Scheme::Usf => {}
             Scheme::Usl => update_stress(m, &mut self.trial, st, map, &velocity_new, dt, step, t)?,
             Scheme::Musl => {
-                // Map the updated particle momentum back and use that velocity.
-                let (_, momentum) = mass_momentum(map, st, &m.particles);
+                // Map the updated particle momentum back and use that velocity
+                // (APIC: with the affine part, where the particles were).
+                let p = &m.particles;
+                let x = step_start_x.as_deref().unwrap_or(&p.x);
+                let affine = (self.apic).then(|| AffineMomentum::new(map, st, p, x, &positions, hats));
+                let (_, momentum) = mass_momentum(map, st, p, affine.as_ref());
                 let mut remapped = mass_average(&mass, &momentum);
                 mirror.velocity(&mass, &momentum, &mut remapped);
                 if let Some(c) = &mut self.contact {

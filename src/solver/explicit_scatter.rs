@@ -16,6 +16,7 @@ use crate::model::particles::Particles;
 use crate::model::tensors::TensorsMut;
 use crate::model::{load_factor, Model};
 use crate::parallel::{deterministic_sum, DisjointSlice, MIN_PARALLEL_LEN, SUM_CHUNK};
+use crate::physics::apic;
 use crate::physics::boundary::{friction_contact, node_constraint, node_friction};
 use crate::physics::deformation::{update_particle, ParticleState};
 use crate::physics::grid_update::{acceleration, TINY_MASS_FRACTION};
@@ -56,6 +57,8 @@ pub struct Settings<const D: usize> {
     pub shape: ShapeFunction,
     pub scheme: Scheme,
     pub flip: f64,
+    /// APIC (`physics::apic`); `flip` is then 0.
+    pub apic: bool,
     pub damping: f64,
     pub gravity: Vector<D>,
 }
@@ -134,7 +137,9 @@ impl<const D: usize> ScatterStep<D> {
         scales: &[f64],
     ) {
         let p = &m.particles;
-        let source = |q: usize, _: &Stencil<D>| {
+        let apic = MOTION && s.apic;
+        let hats = s.shape == ShapeFunction::Linear;
+        let source = |q: usize, st: &mut Stencil<D>| {
             let applied = match FORCE {
                 true => applied_force(p, q, &s.gravity, &|q| {
                     load_factor(&m.load_ramp_of, q, scales)
@@ -142,18 +147,29 @@ impl<const D: usize> ScatterStep<D> {
                 false => Vector::<D>::zeros(),
             };
             let stress = crate::dim::restrict::<D>(&p.stress.get(q)) * p.volume[q];
-            (p.mass[q], p.v[q] * p.mass[q], applied, stress)
-        };
-        let add =
-            |n: &mut Node<D>, s: &(f64, Vector<D>, Vector<D>, Tensor<D>), w: f64, g: &Vector<D>| {
-                if MOTION {
-                    n.mass += s.0 * w;
-                    n.momentum += s.1 * w;
+            // APIC: m B_p, given to node I with the weight S_I D⁻¹ (x_I − x_p).
+            let affine = match apic {
+                true => {
+                    st.set_second(apic::weight_slopes(st, &m.grid, &p.x[q], hats));
+                    p.affine[q] * p.mass[q]
                 }
-                if FORCE {
-                    n.force += s.2 * w - s.3 * g;
-                }
+                false => Tensor::<D>::zeros(),
             };
+            (p.mass[q], p.v[q] * p.mass[q], applied, stress, affine)
+        };
+        type Source<const D: usize> = (f64, Vector<D>, Vector<D>, Tensor<D>, Tensor<D>);
+        let add = |n: &mut Node<D>, s: &Source<D>, w: f64, g: &Vector<D>, a: &Vector<D>| {
+            if MOTION {
+                n.mass += s.0 * w;
+                n.momentum += s.1 * w;
+                if apic {
+                    n.momentum += s.4 * a;
+                }
+            }
+            if FORCE {
+                n.force += s.2 * w - s.3 * g;
+            }
+        };
         self.nb.scatter(
             s.shape,
             &m.grid,
@@ -180,6 +196,7 @@ impl<const D: usize> ScatterStep<D> {
         self.second.clear();
         self.second.resize(self.nodes.len(), Vector::<D>::zeros());
         let n = m.particles.len();
+        let s_apic = s.apic;
         self.work.clear();
         self.work.resize(n, 0.0);
         let (grid, ramp_of) = (&m.grid, &m.load_ramp_of);
@@ -190,11 +207,14 @@ impl<const D: usize> ScatterStep<D> {
             half_length0,
             mass,
             load,
+            affine,
             ..
         } = &mut m.particles;
         let points = Points { x, half_length0, f };
         let (velocity, work) = (DisjointSlice::new(v), DisjointSlice::new(&mut self.work));
-        let source = |q: usize, st: &Stencil<D>| {
+        let affine = DisjointSlice::new(affine);
+        let hats = s.shape == ShapeFunction::Linear;
+        let source = |q: usize, st: &mut Stencil<D>| {
             let (vp, a, _) = gather::<D, true, 0>(st, nb, nodes, &[]);
             // SAFETY: particle q belongs to this tile's task alone.
             let (v, w) = unsafe { (velocity.at(q), work.at(q)) };
@@ -207,9 +227,25 @@ impl<const D: usize> ScatterStep<D> {
                 load_factor(ramp_of, q, scales),
             );
             *w = applied.dot(&(v_old + *v)) * 0.5;
-            *v * mass[q]
+            // APIC: B_p from the updated nodes, remapped with its affine weight.
+            let mb = match s.apic {
+                true => {
+                    let b = apic::box_moment(st, grid, &x[q], &nb.stride, |b| nodes[b].momentum);
+                    // SAFETY: as above.
+                    unsafe { *affine.at(q) = b };
+                    st.set_second(apic::weight_slopes(st, grid, &x[q], hats));
+                    b * mass[q]
+                }
+                false => Tensor::<D>::zeros(),
+            };
+            (*v * mass[q], mb)
         };
-        let add = |n: &mut Vector<D>, s: &Vector<D>, w: f64, _: &Vector<D>| *n += s * w;
+        let add = |n: &mut Vector<D>, s: &(Vector<D>, Tensor<D>), w: f64, _: &Vector<D>, a: &Vector<D>| {
+            *n += s.0 * w;
+            if s_apic {
+                *n += s.1 * a;
+            }
+        };
         nb.scatter(s.shape, grid, points, &mut self.second, source, add);
         deterministic_sum(n, |q| self.work[q]) * dt
     }
@@ -334,10 +370,12 @@ impl<const D: usize> ScatterStep<D> {
             half_length0,
             load,
             material,
+            affine,
             ..
         } = &mut m.particles;
         let (mass, volume0, half_length0, load, material) =
             (&*mass, &*volume0, &*half_length0, &*load, &*material);
+        let affine = DisjointSlice::new(affine);
         let applied = |q: usize| {
             applied(
                 &s.gravity,
@@ -368,6 +406,14 @@ impl<const D: usize> ScatterStep<D> {
                 (Pass::Remapped, Some(sc)) => gather::<D, true, 2>(&sc, nb, nodes, second),
             };
             let mut work = 0.0;
+            if s.apic && matches!(pass, Pass::Full | Pass::Motion) {
+                // APIC's B_p from the updated nodes, where the particle is now.
+                let b = sc.as_ref().map_or_else(Tensor::<D>::zeros, |sc| {
+                    apic::box_moment(sc, grid, state.x, &nb.stride, |b| nodes[b].momentum)
+                });
+                // SAFETY: particle q belongs to this chunk's task alone.
+                unsafe { *affine.at(q) = b };
+            }
             if matches!(pass, Pass::Full | Pass::Motion) {
                 // PIC/FLIP blend (2-27); the applied forces' work over the step.
                 let v_old = *state.v;

@@ -6,6 +6,7 @@
 mod common;
 
 mod absorbing;
+mod apic;
 mod axisymmetric;
 mod cantilever;
 mod collapse;

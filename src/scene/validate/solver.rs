@@ -5,7 +5,7 @@
 use super::check::{ensure, required, Check};
 use crate::material::Material;
 use crate::scene::{
-    Integrator, LinearSolver, PreconditionerKind, SceneConfig, SolverConfig, SolverKind,
+    Integrator, LinearSolver, PreconditionerKind, SceneConfig, SolverConfig, SolverKind, VelocityTransfer,
 };
 
 /// A material without an analytic tangent cannot run on an implicit stage with
@@ -114,6 +114,11 @@ fn explicit(s: &SolverConfig, prefix: &str) -> Check {
         (0.0..=1.0).contains(&s.flip()),
         format!("{prefix}.flip"),
         "must lie in [0, 1] (1 = FLIP, 0 = PIC)",
+    )?;
+    ensure(
+        s.flip.is_none() || s.velocity_transfer() == VelocityTransfer::Flip,
+        format!("{prefix}.flip"),
+        "applies to velocity_transfer = \"flip\" only (APIC has no FLIP fraction)",
     )?;
     ensure(
         (0.0..1.0).contains(&s.damping()),

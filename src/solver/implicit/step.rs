@@ -214,7 +214,7 @@ impl StepSettings {
         let (g_new, scales_new) = self.load_factors(m, t + dt);
         let load_new = |q: usize| load_factor(&m.load_ramp_of, q, &scales_new);
         let f_ext = external_force(map, st, p, &(m.gravity * g_new), &load_new);
-        let (mass, momentum) = mass_momentum(map, st, p);
+        let (mass, momentum) = mass_momentum(map, st, p, None);
         let nodal = |w: &[f64], a: usize| if w[a] > 0.0 { 1.0 / w[a] } else { 0.0 };
         let (a_n, u_tilde) = if self.dynamic() {
             let am = mass_weighted(map, st, p, accel.as_slice());
@@ -311,7 +311,7 @@ impl StepSettings {
         let (g, scales) = self.load_factors(m, self.t_start);
         let load = |q: usize| load_factor(&m.load_ramp_of, q, &scales);
         let mut force = nodal_force(map, st, p, &(m.gravity * g), &load);
-        let (mass, momentum) = mass_momentum(map, st, p);
+        let (mass, momentum) = mass_momentum(map, st, p, None);
         let v = mass_average(&mass, &momentum);
         absorbing::add_force(&m.absorbing, &m.grid, p, map, st, &v, &mut force);
         let a: Vec<Vector<D>> = force
