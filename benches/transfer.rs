@@ -82,7 +82,7 @@ fn bench_dim<const D: usize>(c: &mut Criterion, n: usize) {
                 b.iter(|| {
                     st.compute(shape, &grid, &p.x, &p.half_length0, &p.f);
                     map.build(&st, grid.node_count());
-                    let (m, mv) = mass_momentum(&map, &st, &p);
+                    let (m, mv) = mass_momentum(&map, &st, &p, None);
                     let f = nodal_force(&map, &st, &p, &gravity, &|_| 0.0);
                     (m.len(), mv.len(), f.len())
                 })
@@ -205,7 +205,7 @@ fn p2g_parts(c: &mut Criterion) {
         let gravity = Vector::<2>::zeros();
         group.bench_function(BenchmarkId::new("gathers", shape.name()), |b| {
             b.iter(|| {
-                let (m, mv) = mass_momentum(&map, &st, &p);
+                let (m, mv) = mass_momentum(&map, &st, &p, None);
                 let f = nodal_force(&map, &st, &p, &gravity, &|_| 0.0);
                 (m.len(), mv.len(), f.len())
             })

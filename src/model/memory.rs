@@ -6,7 +6,7 @@
 //! The estimate counts the large arrays, in bytes:
 //! - particles: the lattice points `Model::build` visits (each body's bounding
 //!   box at `particles_per_cell`, an upper bound of its particles) times the
-//!   fields of `Particles` (vectors, F and σ, history) and a step's stencil (the
+//!   fields of `Particles` (vectors, F and σ, history, APIC's B_p) and a step's stencil (the
 //!   shape function's support, a weight, a gradient and a node index each);
 //! - grid: the nodes times a step's nodal arrays (mass, momentum, force,
 //!   velocity and their implicit counterparts);
@@ -21,7 +21,7 @@
 //! take `--memory-limit GIB` to set another.
 
 use crate::model::tensors::Layout;
-use crate::scene::{LinearSolver, PreconditionerKind, SceneConfig, SolverKind};
+use crate::scene::{LinearSolver, PreconditionerKind, SceneConfig, SolverKind, VelocityTransfer};
 
 /// The estimate's parts, in bytes, and the counts they come from.
 #[derive(Clone, Debug, PartialEq)]
@@ -68,7 +68,13 @@ impl Estimate {
         // x, x0, v, half-lengths, load; mass and volumes; F and σ (packed); ids;
         // history; the stencil (weight, gradient, node).
         let tensors = 8 * (Layout::gradient(dim).components() + Layout::stress(dim).components());
-        let per_particle = 5.0 * 8.0 * d
+        // APIC's affine moment B_p (D × D) where a stage keeps one.
+        let apic = c.stages().into_iter().any(|s| {
+            s.kind == SolverKind::Explicit && s.velocity_transfer() == VelocityTransfer::Apic
+        });
+        let affine = if apic { 8.0 * d * d } else { 0.0 };
+        let per_particle = affine
+            + 5.0 * 8.0 * d
             + 3.0 * 8.0
             + tensors as f64
             + 8.0

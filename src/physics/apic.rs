@@ -24,12 +24,12 @@
 use crate::dim::{Tensor, Vector};
 use crate::model::grid::Grid;
 use crate::model::particles::Particles;
-use crate::physics::scatter::Stencil;
-use crate::physics::shape::{Stencils, MAX_PER_AXIS};
 use crate::model::Model;
-use crate::physics::shape::ShapeFunction;
-use crate::physics::transfer::{mass_average, mass_momentum, stencils, NodeMap};
 use crate::parallel::MIN_PARALLEL_LEN;
+use crate::physics::scatter::Stencil;
+use crate::physics::shape::ShapeFunction;
+use crate::physics::shape::{Stencils, MAX_PER_AXIS};
+use crate::physics::transfer::{mass_average, mass_momentum, stencils, NodeMap};
 use rayon::prelude::*;
 
 /// The positions x_I of the active nodes of `map` (a split node at its grid node).
@@ -147,7 +147,9 @@ pub fn ensure<const D: usize>(m: &mut Model<D>, shape: ShapeFunction) {
     for body in groups {
         let mut st = all.clone();
         if let Some(b) = body {
-            (0..n).filter(|&q| p.body[q] != b).for_each(|q| st.count[q] = 0);
+            (0..n)
+                .filter(|&q| p.body[q] != b)
+                .for_each(|q| st.count[q] = 0);
         }
         map.build(&st, m.grid.node_count());
         let (mass, momentum) = mass_momentum(&map, &st, p, None);
@@ -200,4 +202,169 @@ pub fn box_moment<const D: usize>(
         b += velocity(node) * moment.transpose()
     });
     b
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dim::Mat3;
+    use crate::physics::scatter::{NodeBox, Points};
+    use crate::physics::shape::tests::sample_points;
+    use crate::physics::transfer::interpolate;
+    use strum::IntoEnumIterator;
+
+    /// A grid of 8 cells per axis on [0, 2]^D for `shape`.
+    fn grid<const D: usize>(shape: ShapeFunction) -> Grid<D> {
+        Grid::new(
+            Vector::<D>::zeros(),
+            Vector::<D>::repeat(2.0),
+            [8; D],
+            shape.degree(),
+        )
+    }
+
+    /// Particles in the grid's middle half (no domain clipped by the grid's
+    /// faces), some on grid lines and within 1e-7 h of them, masses 1 to 5.
+    fn particles<const D: usize>(grid: &Grid<D>) -> Particles<D> {
+        let mut p = Particles::<D>::default();
+        let inside = |x: &Vector<D>| x.iter().all(|&c| (0.5..=1.5).contains(&c));
+        for (k, x) in sample_points(grid, 4000)
+            .into_iter()
+            .filter(inside)
+            .enumerate()
+        {
+            let half = Vector::<D>::repeat(0.25 * grid.h.min());
+            p.push(
+                x,
+                Vector::<D>::zeros(),
+                1.0 + (k % 5) as f64,
+                0.1,
+                half,
+                0,
+                0,
+                0,
+            );
+        }
+        p.affine = vec![Tensor::<D>::zeros(); p.len()];
+        p
+    }
+
+    /// The affine field v(x) = a + C x.
+    fn field<const D: usize>(x: &Vector<D>) -> Vector<D> {
+        let a = Vector::<D>::from_fn(|d, _| 0.3 - 0.2 * d as f64);
+        let c = Tensor::<D>::from_fn(|i, j| 1.0 + 0.5 * i as f64 - 1.5 * j as f64 + (i * j) as f64);
+        a + c * x
+    }
+
+    fn gradient<const D: usize>() -> Tensor<D> {
+        let (x0, mut c) = (Vector::<D>::zeros(), Tensor::<D>::zeros());
+        for j in 0..D {
+            c.set_column(
+                j,
+                &(field(&Vector::<D>::from_fn(|i, _| if i == j { 1.0 } else { 0.0 })) - field(&x0)),
+            );
+        }
+        c
+    }
+
+    fn close<const D: usize>(a: &Vector<D>, b: &Vector<D>, what: &str) {
+        assert!(
+            (a - b).norm() < 1e-12 * (1.0 + b.norm()),
+            "{what}: {a} against {b}"
+        );
+    }
+
+    /// An affine nodal field goes to the particles (v_p = v(x_p), B_p = C D_p)
+    /// and back to every node with mass unchanged, through the node map, for
+    /// every family, particles on grid lines included.
+    fn round_trip_on_the_node_map<const D: usize>() {
+        let c = gradient::<D>();
+        for shape in ShapeFunction::iter() {
+            let grid = grid::<D>(shape);
+            let mut p = particles(&grid);
+            let (mut st, mut map) = (Stencils::<D>::default(), NodeMap::default());
+            st.compute(shape, &grid, &p.x, &p.half_length0, &p.f);
+            map.build(&st, grid.node_count());
+            let positions = node_positions(&map, &grid);
+            let nodal: Vec<Vector<D>> = positions.iter().map(field).collect();
+            for q in 0..p.len() {
+                p.v[q] = interpolate(&map, &st, q, &nodal);
+                close(&p.v[q], &field(&p.x[q]), &format!("{shape:?}: v_p"));
+                p.affine[q] = moment(&map, &st, q, &p.x[q], &positions, &nodal);
+                let cd = c * inertia(&map, &st, q, &p.x[q], &positions);
+                assert!(
+                    (p.affine[q] - cd).norm() < 1e-12 * (1.0 + cd.norm()),
+                    "{shape:?}: B_p"
+                );
+            }
+            let hats = shape == ShapeFunction::Linear;
+            let affine = AffineMomentum::new(&map, &st, &p, &p.x, &positions, hats);
+            let term = |q, e, a| affine.term(&st, q, e, a);
+            let (mass, momentum) = mass_momentum(&map, &st, &p, Some(&term));
+            for a in (0..map.len()).filter(|&a| mass[a] > 0.0) {
+                close(
+                    &(momentum[a] / mass[a]),
+                    &nodal[a],
+                    &format!("{shape:?}: v_I"),
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn an_affine_field_goes_to_the_particles_and_back_on_the_node_map() {
+        round_trip_on_the_node_map::<2>();
+        round_trip_on_the_node_map::<3>();
+    }
+
+    /// The same on the box of nodes (`physics::scatter`) for the families it serves.
+    fn round_trip_on_the_box<const D: usize>() {
+        let c = gradient::<D>();
+        for shape in ShapeFunction::iter().filter(|&s| NodeBox::<D>::serves(s)) {
+            let grid = grid::<D>(shape);
+            let mut p = particles(&grid);
+            let mut nb = NodeBox::<D>::default();
+            nb.locate(shape, &grid, &p.x);
+            let position = |b: usize| grid.node_position(nb.grid_ijk(b));
+            let nodal: Vec<Vector<D>> = (0..nb.nodes()).map(|b| field(&position(b))).collect();
+            for q in 0..p.len() {
+                let (x, half) = (p.x[q], p.half_length0[q]);
+                let st = nb
+                    .stencil(shape, &grid, &x, &half, &Mat3::identity())
+                    .unwrap();
+                p.affine[q] = box_moment(&st, &grid, &x, &nb.stride, |b| nodal[b]);
+                let inertia = st.moments(&grid, &x).1;
+                let cd = c * Tensor::<D>::from_fn(|i, j| if i == j { inertia[i] } else { 0.0 });
+                assert!(
+                    (p.affine[q] - cd).norm() < 1e-12 * (1.0 + cd.norm()),
+                    "{shape:?}: B_p"
+                );
+                p.v[q] = field(&x);
+            }
+            let hats = shape == ShapeFunction::Linear;
+            let mut nodes = vec![(0.0, Vector::<D>::zeros()); nb.nodes()];
+            let source = |q: usize, st: &mut Stencil<D>| {
+                st.set_second(weight_slopes(st, &grid, &p.x[q], hats));
+                (p.mass[q], p.v[q] * p.mass[q], p.affine[q] * p.mass[q])
+            };
+            let add = |n: &mut (f64, Vector<D>),
+                       s: &(f64, Vector<D>, Tensor<D>),
+                       w: f64,
+                       _: &Vector<D>,
+                       a: &Vector<D>| {
+                n.0 += s.0 * w;
+                n.1 += s.1 * w + s.2 * a;
+            };
+            nb.scatter(shape, &grid, Points::of(&p), &mut nodes, source, add);
+            for (b, n) in nodes.iter().enumerate().filter(|(_, n)| n.0 > 0.0) {
+                close(&(n.1 / n.0), &nodal[b], &format!("{shape:?}: v_I"));
+            }
+        }
+    }
+
+    #[test]
+    fn an_affine_field_goes_to_the_particles_and_back_on_the_box() {
+        round_trip_on_the_box::<2>();
+        round_trip_on_the_box::<3>();
+    }
 }

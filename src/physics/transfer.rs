@@ -12,7 +12,6 @@ use crate::dim::{restrict, Mat3, Tensor, Vector};
 use crate::model::particles::Particles;
 use crate::model::Model;
 use crate::parallel::{DisjointSlice, MIN_PARALLEL_LEN};
-use crate::physics::apic::AffineMomentum;
 use crate::physics::axisymmetry::hoop_gradients;
 use crate::physics::shape::{Owner, ShapeFunction, Stencils};
 use rayon::prelude::*;
@@ -227,13 +226,18 @@ pub fn stencils_and_nodes<const D: usize>(
     map.build(st, m.grid.node_count());
 }
 
+/// A particle's momentum at a node beyond m_p S_Ip v_p: `extra(q, e, a)` for
+/// particle q, stencil entry e, active node a (APIC's affine part,
+/// `physics::apic::AffineMomentum::term`).
+pub type ExtraMomentum<'a, const D: usize> = &'a (dyn Fn(usize, usize, usize) -> Vector<D> + Sync);
+
 /// Nodal mass (2-24) and momentum (2-25), in one pass over the entries; with
-/// APIC's affine part of the particles' momentum (`physics::apic`) if given.
+/// an extra momentum per entry if given.
 pub fn mass_momentum<const D: usize>(
     map: &NodeMap,
     st: &Stencils<D>,
     p: &Particles<D>,
-    affine: Option<&AffineMomentum<D>>,
+    extra: Option<ExtraMomentum<D>>,
 ) -> (Vec<f64>, Vec<Vector<D>>) {
     let owner = st.owner();
     (0..map.len())
@@ -246,8 +250,8 @@ pub fn mass_momentum<const D: usize>(
                 let w = st.weight_at(q, e);
                 mass += p.mass[q] * w;
                 momentum += p.v[q] * (p.mass[q] * w);
-                if let Some(affine) = affine {
-                    momentum += affine.term(st, q, e, a);
+                if let Some(extra) = extra {
+                    momentum += extra(q, e, a);
                 }
             }
             (mass, momentum)

@@ -436,6 +436,13 @@ fn run_dim<const D: usize>(
         let (start, steps_before, last_dt) = resumed.map_or((line.t, line.step, 0.0), |c| {
             (c.stage_start, c.stage_first_step, c.dt)
         });
+        // APIC's affine moments belong to the APIC stages: a stage without them
+        // drops them, and an APIC stage after it forms them anew.
+        let apic = sc.kind == SolverKind::Explicit
+            && sc.velocity_transfer() == crate::scene::VelocityTransfer::Apic;
+        if !apic {
+            model.particles.affine = Vec::new();
+        }
         let mut stepper = crate::solver::stepper::<D>(cfg.grid.shape_function, sc, start);
         if let Some(c) = resumed {
             stepper.restore(&c.solver);

@@ -213,9 +213,10 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
             false => Vec::new(),
         };
         let affine = (self.apic).then(|| AffineMomentum::new(map, st, p, &p.x, &positions, hats));
+        let term = affine.as_ref().map(|a| move |q, e, n| a.term(st, q, e, n));
 
         // Nodal velocity at the start of the step, with the conditions applied.
-        let (mass, momentum) = mass_momentum(map, st, p, affine.as_ref());
+        let (mass, momentum) = mass_momentum(map, st, p, term.as_ref().map(|t| t as _));
         drop(affine);
         let mut raw_velocity = mass_average(&mass, &momentum);
         mirror.velocity(&mass, &momentum, &mut raw_velocity);
@@ -339,8 +340,10 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
                 // (APIC: with the affine part, where the particles were).
                 let p = &m.particles;
                 let x = step_start_x.as_deref().unwrap_or(&p.x);
-                let affine = (self.apic).then(|| AffineMomentum::new(map, st, p, x, &positions, hats));
-                let (_, momentum) = mass_momentum(map, st, p, affine.as_ref());
+                let affine =
+                    (self.apic).then(|| AffineMomentum::new(map, st, p, x, &positions, hats));
+                let term = affine.as_ref().map(|a| move |q, e, n| a.term(st, q, e, n));
+                let (_, momentum) = mass_momentum(map, st, p, term.as_ref().map(|t| t as _));
                 let mut remapped = mass_average(&mass, &momentum);
                 mirror.velocity(&mass, &momentum, &mut remapped);
                 if let Some(c) = &mut self.contact {

@@ -240,7 +240,11 @@ impl<const D: usize> ScatterStep<D> {
             };
             (*v * mass[q], mb)
         };
-        let add = |n: &mut Vector<D>, s: &(Vector<D>, Tensor<D>), w: f64, _: &Vector<D>, a: &Vector<D>| {
+        let add = |n: &mut Vector<D>,
+                   s: &(Vector<D>, Tensor<D>),
+                   w: f64,
+                   _: &Vector<D>,
+                   a: &Vector<D>| {
             *n += s.0 * w;
             if s_apic {
                 *n += s.1 * a;

@@ -648,3 +648,32 @@ fn gravity_ramp_time_is_checked() {
         ],
     );
 }
+
+#[test]
+fn a_flip_fraction_with_apic_is_refused() {
+    rejected(
+        &GOOD.replace(
+            "cfl = 0.5",
+            "cfl = 0.5\nvelocity_transfer = \"apic\"\nflip = 0.9",
+        ),
+        &[
+            "scene.toml:26:8",
+            "solver.flip",
+            "applies to velocity_transfer = \"flip\"",
+        ],
+    );
+    rejected(
+        &GOOD.replace("cfl = 0.5", "cfl = 0.5\nvelocity_transfer = \"apic_\""),
+        &["scene.toml:25:21", "unknown variant `apic_`"],
+    );
+    let implicit = "[solver]\nkind = \"implicit\"\nintegrator = \"quasi_static\"\n\
+                    end_time = 1.0\nload_steps = 1\nvelocity_transfer = \"apic\"\n";
+    let e = err(&format!(
+        "{}{implicit}",
+        GOOD.split("[solver]").next().unwrap()
+    ));
+    assert!(
+        e.contains("solver.velocity_transfer") && e.contains("does not apply"),
+        "{e}"
+    );
+}

@@ -130,6 +130,22 @@ fn explicit_restart_is_byte_identical() {
     assert!(steps[0] > 0 && steps[1] > steps[0], "{steps:?}");
 }
 
+/// APIC's affine moments are state: a restart that lost them (and formed them
+/// anew by the projection of the first step) would not be byte-identical.
+#[test]
+fn apic_restart_is_byte_identical() {
+    restarts_are_exact(
+        "column_explicit.toml",
+        &[
+            "solver={kind=\"explicit\",scheme=\"musl\",end_time=2,cfl=0.5,damping=0.5,\
+             velocity_transfer=\"apic\"}",
+            "output.history_interval=0",
+        ],
+        0.8,
+        1,
+    );
+}
+
 #[test]
 fn quasi_static_restart_is_byte_identical() {
     restarts_are_exact("column.toml", &[], 0.4, 1);

@@ -96,3 +96,20 @@ fn scatter_runs_give_identical_results_on_one_and_two_threads() {
         same_on_one_and_two_threads("collapse.toml", &overrides, scheme);
     }
 }
+
+/// APIC (`physics::apic`) on both paths: the collapse as above with USL on the
+/// box and MUSL on the node map.
+#[test]
+fn apic_runs_give_identical_results_on_one_and_two_threads() {
+    for (scheme, transfer) in [("usl", "auto"), ("musl", "gather")] {
+        let overrides = [
+            format!(
+                "solver={{kind=\"explicit\",scheme=\"{scheme}\",transfer=\"{transfer}\",\
+                 velocity_transfer=\"apic\",end_time=0.004,cfl=0.4}}"
+            ),
+            "grid.cells=[320,100]".to_string(),
+            "output.frames=0".to_string(),
+        ];
+        same_on_one_and_two_threads("collapse.toml", &overrides, &overrides[0]);
+    }
+}

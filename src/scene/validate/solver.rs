@@ -5,7 +5,8 @@
 use super::check::{ensure, required, Check};
 use crate::material::Material;
 use crate::scene::{
-    Integrator, LinearSolver, PreconditionerKind, SceneConfig, SolverConfig, SolverKind, VelocityTransfer,
+    Integrator, LinearSolver, PreconditionerKind, SceneConfig, SolverConfig, SolverKind,
+    VelocityTransfer,
 };
 
 /// A material without an analytic tangent cannot run on an implicit stage with
