@@ -118,10 +118,21 @@ impl<const D: usize> Stencil<D> {
     /// (node positions as `Grid::node_position`: Greville abscissae for B-splines).
     pub fn offsets(&self, grid: &Grid<D>, x: &Vector<D>) -> [[f64; MAX_PER_AXIS]; 3] {
         let mut delta = [[0.0; MAX_PER_AXIS]; 3];
+        let p = grid.degree;
         for d in 0..D {
-            for (i, o) in delta[d].iter_mut().enumerate().take(self.count[d]) {
-                let node = greville(self.first[d] + i, grid.degree, grid.cells[d]);
-                *o = grid.min[d] + grid.h[d] * node - x[d];
+            let (first, count, h) = (self.first[d], self.count[d], grid.h[d]);
+            // Away from the clamped ends the Greville abscissae are a cell apart,
+            // node i at i − (p − 1)/2 cells (every node of the degree-1 families).
+            if first + 1 >= p && first + count <= grid.cells[d] + 1 {
+                let start = grid.min[d] + h * (first as f64 - 0.5 * (p - 1) as f64) - x[d];
+                for (i, o) in delta[d].iter_mut().enumerate().take(count) {
+                    *o = start + h * i as f64;
+                }
+                continue;
+            }
+            for (i, o) in delta[d].iter_mut().enumerate().take(count) {
+                let node = greville(first + i, p, grid.cells[d]);
+                *o = grid.min[d] + h * node - x[d];
             }
         }
         delta

@@ -154,9 +154,6 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
     /// Advance the model from t to t + dt. Returns the work done by gravity and
     /// applied loads over the step.
     fn step(&mut self, m: &mut Model<D>, t: f64, dt: f64, step: usize) -> Result<f64, Divergence> {
-        if self.apic {
-            apic::ensure(m, self.shape);
-        }
         if self.scatter_serves(m) {
             let settings = Settings {
                 shape: self.shape,
@@ -170,6 +167,9 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
             return scatter.step(&settings, m, t, dt, step);
         }
         self.scatter = None;
+        if self.apic {
+            apic::ensure(m, self.shape);
+        }
         if let (None, Some(plan)) = (&self.contact, &m.contact) {
             self.contact = Some(Contact::new(plan.clone(), m));
         }

@@ -96,9 +96,13 @@ impl<const D: usize> ScatterStep<D> {
     ) -> Result<f64, Divergence> {
         let p = &m.particles;
         self.nb.locate(s.shape, &m.grid, &p.x);
+        let scales = m.load_scales(t);
+        if s.apic && p.affine.len() != p.len() {
+            self.initial_affine(s, m, &scales);
+        }
+        let p = &m.particles;
         self.nodes.clear();
         self.nodes.resize(self.nb.nodes(), Node::zero());
-        let scales = m.load_scales(t);
         let tiny = TINY_MASS_FRACTION * p.mass.iter().cloned().fold(f64::INFINITY, f64::min);
         // P2G: mass (2-24), momentum (2-25) and, but in USF, the force (2-51, 2-52).
         match s.scheme {
@@ -178,6 +182,31 @@ impl<const D: usize> ScatterStep<D> {
             source,
             add,
         );
+    }
+
+    /// APIC's first step on the box (as `physics::apic::ensure` on the node
+    /// map): B_p of the particles' velocities projected on the nodes.
+    fn initial_affine(&mut self, s: &Settings<D>, m: &mut Model<D>, scales: &[f64]) {
+        self.nodes.clear();
+        self.nodes.resize(self.nb.nodes(), Node::zero());
+        let pic = Settings { apic: false, ..*s };
+        self.scatter::<true, false>(&pic, m, scales);
+        let (nb, nodes, grid) = (&self.nb, &self.nodes, &m.grid);
+        let p = &m.particles;
+        let affine = (0..p.len())
+            .into_par_iter()
+            .with_min_len(MIN_PARALLEL_LEN)
+            .map(|q| {
+                let f = deformation_for(s.shape, || p.f.get(q));
+                let st = nb.stencil(s.shape, grid, &p.x[q], &p.half_length0[q], &f);
+                st.map_or_else(Tensor::<D>::zeros, |st| {
+                    apic::box_moment(&st, grid, &p.x[q], &nb.stride, |b| {
+                        nodal_velocity(nodes[b].mass, &nodes[b].momentum)
+                    })
+                })
+            })
+            .collect();
+        m.particles.affine = affine;
     }
 
     /// MUSL: the particles' velocity from the updated nodes (G2P, 2-27) and its
