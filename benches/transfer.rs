@@ -134,7 +134,7 @@ fn scatter_benches<const D: usize>(
                     nb.nodes(),
                     (0.0, Vector::<D>::zeros(), Vector::<D>::zeros()),
                 );
-                let source = |q: usize, _: &mut Stencil<D>| {
+                let source = |q: usize, _: &Stencil<D>| {
                     let stress: Tensor<D> = restrict::<D>(&p.stress.get(q)) * p.volume[q];
                     (p.mass[q], p.v[q] * p.mass[q], gravity * p.mass[q], stress)
                 };
@@ -144,7 +144,7 @@ fn scatter_benches<const D: usize>(
                     Points::of(p),
                     &mut nodes,
                     source,
-                    |n, s, w, g, _| {
+                    |n, s, w, g| {
                         n.0 += s.0 * w;
                         n.1 += s.1 * w;
                         n.2 += s.2 * w - s.3 * g;

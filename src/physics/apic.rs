@@ -355,7 +355,7 @@ mod tests {
                 n.0 += s.0 * w;
                 n.1 += s.1 * w + s.2 * a;
             };
-            nb.scatter(shape, &grid, Points::of(&p), &mut nodes, source, add);
+            nb.scatter_with_second(shape, &grid, Points::of(&p), &mut nodes, source, add);
             for (b, n) in nodes.iter().enumerate().filter(|(_, n)| n.0 > 0.0) {
                 close(&(n.1 / n.0), &nodal[b], &format!("{shape:?}: v_I"));
             }

@@ -82,7 +82,18 @@ impl<const D: usize> Stencil<D> {
     /// ∂S_I/∂z = S_x (S_y S'_z).
     #[inline(always)]
     pub fn for_each(&self, stride: &[usize; 3], mut visit: impl FnMut(usize, f64, Vector<D>)) {
-        self.for_each_with(stride, |b, w, g, _| visit(b, w, g))
+        let (w, s) = (&self.weight, &self.slope);
+        for k in 0..self.count[2] {
+            for j in 0..self.count[1] {
+                let row = self.base + j * stride[1] + k * stride[2];
+                let wyz = w[1][j] * w[2][k];
+                let (syz, wysz) = (s[1][j] * w[2][k], w[1][j] * s[2][k]);
+                for i in 0..self.count[0] {
+                    let g = [s[0][i] * wyz, w[0][i] * syz, w[0][i] * wysz];
+                    visit(row + i, w[0][i] * wyz, Vector::<D>::from_fn(|d, _| g[d]));
+                }
+            }
+        }
     }
 
     /// `for_each` that also forms the second slopes as ∇S_I forms the first:
@@ -359,11 +370,31 @@ impl<const D: usize> NodeBox<D> {
     }
 
     /// P2G by colours: for every particle q in the grid, `add(node, &source(q,
-    /// stencil), S_Iq, ∇S_Iq, G_Iq)` at each of its nodes, `nodes` one value per
-    /// box node, G_Iq formed from the second slopes that `source` may set
-    /// (`Stencil::for_each_with`). `source` is called once per particle (in its
-    /// tile's task, so it may also update particle q alone), `add` once per entry.
+    /// stencil), S_Iq, ∇S_Iq)` at each of its nodes, `nodes` one value per box
+    /// node. `source` is called once per particle (in its tile's task, so it may
+    /// also update particle q alone), `add` once per entry.
     pub fn scatter<N: Send, S>(
+        &self,
+        shape: ShapeFunction,
+        grid: &Grid<D>,
+        points: Points<D>,
+        nodes: &mut [N],
+        source: impl Fn(usize, &Stencil<D>) -> S + Sync,
+        add: impl Fn(&mut N, &S, f64, &Vector<D>) + Sync,
+    ) {
+        self.coloured(shape, grid, points, nodes, |q, st, out| {
+            let s = source(q, st);
+            st.for_each(&self.stride, |b, w, g| {
+                // SAFETY: tiles of one colour touch disjoint nodes (module doc),
+                // and this tile's particles are visited by this task alone.
+                add(unsafe { out.at(b) }, &s, w, &g)
+            })
+        });
+    }
+
+    /// `scatter` with the stencil's second slopes, which `source` sets
+    /// (`Stencil::set_second`): `add(node, &s, S_Iq, ∇S_Iq, G_Iq)`.
+    pub fn scatter_with_second<N: Send, S>(
         &self,
         shape: ShapeFunction,
         grid: &Grid<D>,
@@ -371,6 +402,25 @@ impl<const D: usize> NodeBox<D> {
         nodes: &mut [N],
         source: impl Fn(usize, &mut Stencil<D>) -> S + Sync,
         add: impl Fn(&mut N, &S, f64, &Vector<D>, &Vector<D>) + Sync,
+    ) {
+        self.coloured(shape, grid, points, nodes, |q, st, out| {
+            let s = source(q, st);
+            st.for_each_with(&self.stride, |b, w, g, h| {
+                // SAFETY: as in `scatter`.
+                add(unsafe { out.at(b) }, &s, w, &g, &h)
+            })
+        });
+    }
+
+    /// The colouring of the scatters (module doc): `each(q, stencil, nodes)`
+    /// for every particle q in the grid, the tiles of one colour in parallel.
+    fn coloured<N: Send>(
+        &self,
+        shape: ShapeFunction,
+        grid: &Grid<D>,
+        points: Points<D>,
+        nodes: &mut [N],
+        each: impl Fn(usize, &mut Stencil<D>, &DisjointSlice<N>) + Sync,
     ) {
         assert_eq!(nodes.len(), self.nodes(), "one value per box node");
         let reach = Reach::of(shape).expect("a separable family");
@@ -400,12 +450,7 @@ impl<const D: usize> NodeBox<D> {
                         (0..D).all(|d| st.first[d] >= first[d] && st.first[d] + st.count[d] <= end[d]),
                         "{shape:?} reaches beyond its tile's nodes: the colouring would not hold"
                     );
-                    let s = source(q, &mut st);
-                    st.for_each_with(&self.stride, |b, w, g, h| {
-                        // SAFETY: tiles of one colour touch disjoint nodes (module doc),
-                        // and this tile's particles are visited by this task alone.
-                        add(unsafe { out.at(b) }, &s, w, &g, &h)
-                    });
+                    each(q, &mut st, &out);
                 }
             });
         }
@@ -474,7 +519,7 @@ mod tests {
                         Points::of(&p),
                         &mut nodes,
                         |q, _| (p.mass[q], p.v[q] * p.mass[q]),
-                        |n, s, w, _, _| {
+                        |n, s, w, _| {
                             n.0 += s.0 * w;
                             n.1 += s.1 * w;
                         },

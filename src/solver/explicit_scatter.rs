@@ -106,8 +106,10 @@ impl<const D: usize> ScatterStep<D> {
         let tiny = TINY_MASS_FRACTION * p.mass.iter().cloned().fold(f64::INFINITY, f64::min);
         // P2G: mass (2-24), momentum (2-25) and, but in USF, the force (2-51, 2-52).
         match s.scheme {
-            Scheme::Usf => self.scatter::<true, false>(s, m, &scales),
-            _ => self.scatter::<true, true>(s, m, &scales),
+            Scheme::Usf if s.apic => self.scatter::<true, false, true>(s, m, &scales),
+            Scheme::Usf => self.scatter::<true, false, false>(s, m, &scales),
+            _ if s.apic => self.scatter::<true, true, true>(s, m, &scales),
+            _ => self.scatter::<true, true, false>(s, m, &scales),
         }
         let work = match s.scheme {
             Scheme::Usl => {
@@ -117,7 +119,7 @@ impl<const D: usize> ScatterStep<D> {
             Scheme::Usf => {
                 self.start_velocity(m);
                 self.particle_pass(s, m, t, dt, step, Pass::Stress, &scales)?;
-                self.scatter::<false, true>(s, m, &scales);
+                self.scatter::<false, true, false>(s, m, &scales);
                 self.node_pass(m, true, s.damping, tiny, dt);
                 self.particle_pass(s, m, t, dt, step, Pass::Motion, &scales)?
             }
@@ -134,16 +136,14 @@ impl<const D: usize> ScatterStep<D> {
 
     /// P2G into the nodes: mass and momentum (`MOTION`), the force
     /// f_ext − f_int = Σ S_I (m g + s f) − V σ ∇S_I (`FORCE`).
-    fn scatter<const MOTION: bool, const FORCE: bool>(
+    fn scatter<const MOTION: bool, const FORCE: bool, const APIC: bool>(
         &mut self,
         s: &Settings<D>,
         m: &Model<D>,
         scales: &[f64],
     ) {
         let p = &m.particles;
-        let apic = MOTION && s.apic;
-        let hats = s.shape == ShapeFunction::Linear;
-        let source = |q: usize, st: &mut Stencil<D>| {
+        let source = |q: usize| {
             let applied = match FORCE {
                 true => applied_force(p, q, &s.gravity, &|q| {
                     load_factor(&m.load_ramp_of, q, scales)
@@ -151,37 +151,37 @@ impl<const D: usize> ScatterStep<D> {
                 false => Vector::<D>::zeros(),
             };
             let stress = crate::dim::restrict::<D>(&p.stress.get(q)) * p.volume[q];
-            // APIC: m B_p, given to node I with the weight S_I D⁻¹ (x_I − x_p).
-            let affine = match apic {
-                true => {
-                    st.set_second(apic::weight_slopes(st, &m.grid, &p.x[q], hats));
-                    p.affine[q] * p.mass[q]
-                }
-                false => Tensor::<D>::zeros(),
-            };
-            (p.mass[q], p.v[q] * p.mass[q], applied, stress, affine)
+            (p.mass[q], p.v[q] * p.mass[q], applied, stress)
         };
-        type Source<const D: usize> = (f64, Vector<D>, Vector<D>, Tensor<D>, Tensor<D>);
-        let add = |n: &mut Node<D>, s: &Source<D>, w: f64, g: &Vector<D>, a: &Vector<D>| {
+        type Source<const D: usize> = (f64, Vector<D>, Vector<D>, Tensor<D>);
+        let add = |n: &mut Node<D>, s: &Source<D>, w: f64, g: &Vector<D>| {
             if MOTION {
                 n.mass += s.0 * w;
                 n.momentum += s.1 * w;
-                if apic {
-                    n.momentum += s.4 * a;
-                }
             }
             if FORCE {
                 n.force += s.2 * w - s.3 * g;
             }
         };
-        self.nb.scatter(
-            s.shape,
-            &m.grid,
-            Points::of(p),
-            &mut self.nodes,
-            source,
-            add,
-        );
+        let (shape, grid, points) = (s.shape, &m.grid, Points::of(p));
+        if !(MOTION && APIC) {
+            self.nb
+                .scatter(shape, grid, points, &mut self.nodes, |q, _| source(q), add);
+            return;
+        }
+        // APIC: m B_p, given to node I with the weight S_I D⁻¹ (x_I − x_p).
+        let hats = s.shape == ShapeFunction::Linear;
+        let source = |q: usize, st: &mut Stencil<D>| {
+            st.set_second(apic::weight_slopes(st, grid, &p.x[q], hats));
+            (source(q), p.affine[q] * p.mass[q])
+        };
+        let add =
+            |n: &mut Node<D>, s: &(Source<D>, Tensor<D>), w: f64, g: &Vector<D>, a: &Vector<D>| {
+                add(n, &s.0, w, g);
+                n.momentum += s.1 * a;
+            };
+        self.nb
+            .scatter_with_second(shape, grid, points, &mut self.nodes, source, add);
     }
 
     /// APIC's first step on the box (as `physics::apic::ensure` on the node
@@ -190,7 +190,7 @@ impl<const D: usize> ScatterStep<D> {
         self.nodes.clear();
         self.nodes.resize(self.nb.nodes(), Node::zero());
         let pic = Settings { apic: false, ..*s };
-        self.scatter::<true, false>(&pic, m, scales);
+        self.scatter::<true, false, false>(&pic, m, scales);
         let (nb, nodes, grid) = (&self.nb, &self.nodes, &m.grid);
         let p = &m.particles;
         let affine = (0..p.len())
@@ -225,7 +225,6 @@ impl<const D: usize> ScatterStep<D> {
         self.second.clear();
         self.second.resize(self.nodes.len(), Vector::<D>::zeros());
         let n = m.particles.len();
-        let s_apic = s.apic;
         self.work.clear();
         self.work.resize(n, 0.0);
         let (grid, ramp_of) = (&m.grid, &m.load_ramp_of);
@@ -243,7 +242,7 @@ impl<const D: usize> ScatterStep<D> {
         let (velocity, work) = (DisjointSlice::new(v), DisjointSlice::new(&mut self.work));
         let affine = DisjointSlice::new(affine);
         let hats = s.shape == ShapeFunction::Linear;
-        let source = |q: usize, st: &mut Stencil<D>| {
+        let source = |q: usize, st: &Stencil<D>| {
             let (vp, a, _) = gather::<D, true, 0>(st, nb, nodes, &[]);
             // SAFETY: particle q belongs to this tile's task alone.
             let (v, w) = unsafe { (velocity.at(q), work.at(q)) };
@@ -256,30 +255,31 @@ impl<const D: usize> ScatterStep<D> {
                 load_factor(ramp_of, q, scales),
             );
             *w = applied.dot(&(v_old + *v)) * 0.5;
-            // APIC: B_p from the updated nodes, remapped with its affine weight.
-            let mb = match s.apic {
-                true => {
-                    let b = apic::box_moment(st, grid, &x[q], &nb.stride, |b| nodes[b].momentum);
-                    // SAFETY: as above.
-                    unsafe { *affine.at(q) = b };
-                    st.set_second(apic::weight_slopes(st, grid, &x[q], hats));
-                    b * mass[q]
-                }
-                false => Tensor::<D>::zeros(),
-            };
-            (*v * mass[q], mb)
+            *v * mass[q]
+        };
+        let add = |n: &mut Vector<D>, s: &Vector<D>, w: f64, _: &Vector<D>| *n += s * w;
+        if !s.apic {
+            nb.scatter(s.shape, grid, points, &mut self.second, source, add);
+            return deterministic_sum(n, |q| self.work[q]) * dt;
+        }
+        // APIC: B_p from the updated nodes, remapped with its affine weight.
+        let source = |q: usize, st: &mut Stencil<D>| {
+            let momentum = source(q, st);
+            let b = apic::box_moment(st, grid, &x[q], &nb.stride, |b| nodes[b].momentum);
+            // SAFETY: as above.
+            unsafe { *affine.at(q) = b };
+            st.set_second(apic::weight_slopes(st, grid, &x[q], hats));
+            (momentum, b * mass[q])
         };
         let add = |n: &mut Vector<D>,
                    s: &(Vector<D>, Tensor<D>),
                    w: f64,
-                   _: &Vector<D>,
+                   g: &Vector<D>,
                    a: &Vector<D>| {
-            *n += s.0 * w;
-            if s_apic {
-                *n += s.1 * a;
-            }
+            add(n, &s.0, w, g);
+            *n += s.1 * a;
         };
-        nb.scatter(s.shape, grid, points, &mut self.second, source, add);
+        nb.scatter_with_second(s.shape, grid, points, &mut self.second, source, add);
         deterministic_sum(n, |q| self.work[q]) * dt
     }
 
