@@ -170,7 +170,14 @@ fn disks_without_contact() -> String {
 
 #[test]
 fn disks_bounce_off_and_separate_with_momentum_conserved() {
-    let (result, dir) = run_problem("contact_disks.toml", &["output.frames=0"]);
+    disks_bounce_off(&[]);
+    // APIC (`physics::apic`): the same with the affine transfers.
+    disks_bounce_off(&["solver.velocity_transfer=\"apic\""]);
+}
+
+fn disks_bounce_off(overrides: &[&str]) {
+    let sets = [&["output.frames=0"], overrides].concat();
+    let (result, dir) = run_problem("contact_disks.toml", &sets);
     result.unwrap();
     let p = final_particles(&dir);
     let gap = closest_approach(&p);
@@ -182,7 +189,7 @@ fn disks_bounce_off_and_separate_with_momentum_conserved() {
     let h = Table::read(&dir.path().join("history.csv")).unwrap();
     let vx0 = *h.col("body0_vx").last().unwrap();
     println!(
-        "contact: closest particles {gap:.4} m apart at the end, left disk vx {vx0:.4}, \
+        "contact {overrides:?}: closest particles {gap:.4} m apart at the end, left disk vx {vx0:.4}, \
          momentum ({:.1e}, {:.1e}) of m v0",
         px / scale,
         py / scale
