@@ -21,7 +21,7 @@
 //! take `--memory-limit GIB` to set another.
 
 use crate::model::tensors::Layout;
-use crate::scene::{LinearSolver, PreconditionerKind, SceneConfig, SolverKind, VelocityTransfer};
+use crate::scene::{LinearSolver, PreconditionerKind, SceneConfig, SolverKind};
 
 /// The estimate's parts, in bytes, and the counts they come from.
 #[derive(Clone, Debug, PartialEq)]
@@ -69,9 +69,7 @@ impl Estimate {
         // history; the stencil (weight, gradient, node).
         let tensors = 8 * (Layout::gradient(dim).components() + Layout::stress(dim).components());
         // APIC's affine moment B_p (D × D) where a stage keeps one.
-        let apic = c.stages().into_iter().any(|s| {
-            s.kind == SolverKind::Explicit && s.velocity_transfer() == VelocityTransfer::Apic
-        });
+        let apic = c.stages().into_iter().any(|s| s.apic());
         let affine = if apic { 8.0 * d * d } else { 0.0 };
         let per_particle = affine
             + 5.0 * 8.0 * d

@@ -26,9 +26,9 @@ use crate::model::grid::Grid;
 use crate::model::particles::Particles;
 use crate::model::Model;
 use crate::parallel::MIN_PARALLEL_LEN;
-use crate::physics::scatter::Stencil;
+use crate::physics::scatter::{Moments, Slopes, Stencil};
 use crate::physics::shape::ShapeFunction;
-use crate::physics::shape::{Stencils, MAX_PER_AXIS};
+use crate::physics::shape::Stencils;
 use crate::physics::transfer::{mass_average, mass_momentum, stencils, NodeMap};
 use rayon::prelude::*;
 
@@ -52,16 +52,17 @@ pub struct AffineMomentum<'a, const D: usize> {
 }
 
 impl<'a, const D: usize> AffineMomentum<'a, D> {
-    /// From the particles' B_p, at their positions `x` (where `st` was formed),
-    /// for linear hats (`hats`) or any other family.
+    /// From the particles' B_p, at their positions `x` (where `st` of
+    /// `shape` was formed).
     pub fn new(
         map: &NodeMap,
         st: &Stencils<D>,
         p: &Particles<D>,
         x: &'a [Vector<D>],
         positions: &'a [Vector<D>],
-        hats: bool,
+        shape: ShapeFunction,
     ) -> Self {
+        let hats = shape == ShapeFunction::Linear;
         let k = (0..p.len())
             .into_par_iter()
             .with_min_len(MIN_PARALLEL_LEN)
@@ -163,18 +164,18 @@ pub fn ensure<const D: usize>(m: &mut Model<D>, shape: ShapeFunction) {
 }
 
 /// The 1D slopes that make APIC's P2G weight S_I D_p⁻¹ (x_I − x_p) on a
-/// tensor-product stencil at x (`Stencil::for_each_with`): w_i δ_i / D_dd per
-/// axis, or the hats' own slopes (their weight is ∇S_I, module doc).
+/// tensor-product stencil of `shape` (`Stencil::for_each_with`), from its
+/// `moments` (`Stencil::moments`): w_i δ_i / D_dd per axis, or the hats' own
+/// slopes (their weight is ∇S_I, module doc).
 pub fn weight_slopes<const D: usize>(
     st: &Stencil<D>,
-    grid: &Grid<D>,
-    x: &Vector<D>,
-    hats: bool,
-) -> [[f64; MAX_PER_AXIS]; 3] {
-    if hats {
+    moments: &Moments,
+    shape: ShapeFunction,
+) -> Slopes {
+    if shape == ShapeFunction::Linear {
         return st.slopes();
     }
-    let (mut slopes, inertia) = st.moments(grid, x);
+    let (mut slopes, inertia) = *moments;
     for d in 0..D {
         let scale = match inertia[d] > 0.0 {
             true => 1.0 / inertia[d],
@@ -185,20 +186,18 @@ pub fn weight_slopes<const D: usize>(
     slopes
 }
 
-/// B_p = Σ_I S_Ip v_I (x_I − x_p)ᵀ on a tensor-product stencil at x, from the
-/// nodal values `velocity(node)` of a box of nodes.
+/// B_p = Σ_I S_Ip v_I (x_I − x_p)ᵀ on a tensor-product stencil with these
+/// `moments` (`Stencil::moments`), from the nodal values `velocity(node)` of a
+/// box of nodes.
 #[inline(always)]
 pub fn box_moment<const D: usize>(
     st: &Stencil<D>,
-    grid: &Grid<D>,
-    x: &Vector<D>,
+    moments: &Moments,
     stride: &[usize; 3],
     velocity: impl Fn(usize) -> Vector<D>,
 ) -> Tensor<D> {
-    let mut st = *st;
-    st.set_second(st.moments(grid, x).0);
     let mut b = Tensor::<D>::zeros();
-    st.for_each_with(stride, |node, _, _, moment| {
+    st.for_each_with(stride, &moments.0, |node, _, _, moment| {
         b += velocity(node) * moment.transpose()
     });
     b
@@ -297,8 +296,7 @@ mod tests {
                     "{shape:?}: B_p"
                 );
             }
-            let hats = shape == ShapeFunction::Linear;
-            let affine = AffineMomentum::new(&map, &st, &p, &p.x, &positions, hats);
+            let affine = AffineMomentum::new(&map, &st, &p, &p.x, &positions, shape);
             let term = |q, e, a| affine.term(&st, q, e, a);
             let (mass, momentum) = mass_momentum(&map, &st, &p, Some(&term));
             for a in (0..map.len()).filter(|&a| mass[a] > 0.0) {
@@ -332,8 +330,9 @@ mod tests {
                 let st = nb
                     .stencil(shape, &grid, &x, &half, &Mat3::identity())
                     .unwrap();
-                p.affine[q] = box_moment(&st, &grid, &x, &nb.stride, |b| nodal[b]);
-                let inertia = st.moments(&grid, &x).1;
+                let moments = st.moments(&grid, &x);
+                p.affine[q] = box_moment(&st, &moments, &nb.stride, |b| nodal[b]);
+                let inertia = moments.1;
                 let cd = c * Tensor::<D>::from_fn(|i, j| if i == j { inertia[i] } else { 0.0 });
                 assert!(
                     (p.affine[q] - cd).norm() < 1e-12 * (1.0 + cd.norm()),
@@ -341,11 +340,13 @@ mod tests {
                 );
                 p.v[q] = field(&x);
             }
-            let hats = shape == ShapeFunction::Linear;
             let mut nodes = vec![(0.0, Vector::<D>::zeros()); nb.nodes()];
-            let source = |q: usize, st: &mut Stencil<D>| {
-                st.set_second(weight_slopes(st, &grid, &p.x[q], hats));
-                (p.mass[q], p.v[q] * p.mass[q], p.affine[q] * p.mass[q])
+            let source = |q: usize, st: &Stencil<D>| {
+                let slopes = weight_slopes(st, &st.moments(&grid, &p.x[q]), shape);
+                (
+                    (p.mass[q], p.v[q] * p.mass[q], p.affine[q] * p.mass[q]),
+                    slopes,
+                )
             };
             let add = |n: &mut (f64, Vector<D>),
                        s: &(f64, Vector<D>, Tensor<D>),

@@ -70,9 +70,6 @@ pub struct Stencil<const D: usize> {
     count: [usize; 3],
     weight: [[f64; MAX_PER_AXIS]; 3],
     slope: [[f64; MAX_PER_AXIS]; 3],
-    /// Second 1D slopes, formed into a second "gradient" beside ∇S_I
-    /// (`for_each_with`): APIC's moments and affine weights (`set_second`).
-    second: [[f64; MAX_PER_AXIS]; 3],
 }
 
 impl<const D: usize> Stencil<D> {
@@ -82,29 +79,21 @@ impl<const D: usize> Stencil<D> {
     /// ∂S_I/∂z = S_x (S_y S'_z).
     #[inline(always)]
     pub fn for_each(&self, stride: &[usize; 3], mut visit: impl FnMut(usize, f64, Vector<D>)) {
-        let (w, s) = (&self.weight, &self.slope);
-        for k in 0..self.count[2] {
-            for j in 0..self.count[1] {
-                let row = self.base + j * stride[1] + k * stride[2];
-                let wyz = w[1][j] * w[2][k];
-                let (syz, wysz) = (s[1][j] * w[2][k], w[1][j] * s[2][k]);
-                for i in 0..self.count[0] {
-                    let g = [s[0][i] * wyz, w[0][i] * syz, w[0][i] * wysz];
-                    visit(row + i, w[0][i] * wyz, Vector::<D>::from_fn(|d, _| g[d]));
-                }
-            }
-        }
+        // The second "gradient" is the first again, unused: the compiler drops it.
+        self.for_each_with(stride, &self.slope, |b, w, g, _| visit(b, w, g))
     }
 
-    /// `for_each` that also forms the second slopes as ∇S_I forms the first:
-    /// `visit(node, S_I, ∇S_I, G_I)` with G_I,x = s_x (S_y S_z) and so on.
+    /// `for_each` that also forms `second` 1D slopes t as ∇S_I forms the
+    /// first: `visit(node, S_I, ∇S_I, G_I)` with G_I,x = t_x (S_y S_z) and so on
+    /// (APIC's moments and affine weights).
     #[inline(always)]
     pub fn for_each_with(
         &self,
         stride: &[usize; 3],
+        second: &Slopes,
         mut visit: impl FnMut(usize, f64, Vector<D>, Vector<D>),
     ) {
-        let (w, s, t) = (&self.weight, &self.slope, &self.second);
+        let (w, s, t) = (&self.weight, &self.slope, second);
         for k in 0..self.count[2] {
             for j in 0..self.count[1] {
                 let row = self.base + j * stride[1] + k * stride[2];
@@ -127,7 +116,7 @@ impl<const D: usize> Stencil<D> {
 
     /// The offsets δ_i = x_i − x_p of the stencil's nodes along every axis
     /// (node positions as `Grid::node_position`: Greville abscissae for B-splines).
-    pub fn offsets(&self, grid: &Grid<D>, x: &Vector<D>) -> [[f64; MAX_PER_AXIS]; 3] {
+    pub fn offsets(&self, grid: &Grid<D>, x: &Vector<D>) -> Slopes {
         let mut delta = [[0.0; MAX_PER_AXIS]; 3];
         let p = grid.degree;
         for d in 0..D {
@@ -152,7 +141,7 @@ impl<const D: usize> Stencil<D> {
     /// The 1D factors of APIC (`physics::apic`) along every axis: the moments
     /// w_i δ_i and the inertia D_dd = Σ_i w_i δ_i² (D_p is diagonal for a tensor
     /// product of 1D bases that reproduce linear functions).
-    pub fn moments(&self, grid: &Grid<D>, x: &Vector<D>) -> ([[f64; MAX_PER_AXIS]; 3], [f64; 3]) {
+    pub fn moments(&self, grid: &Grid<D>, x: &Vector<D>) -> Moments {
         let delta = self.offsets(grid, x);
         let (mut moment, mut inertia) = ([[0.0; MAX_PER_AXIS]; 3], [0.0; 3]);
         for d in 0..D {
@@ -164,16 +153,18 @@ impl<const D: usize> Stencil<D> {
         (moment, inertia)
     }
 
-    /// Set the second slopes (`for_each_with`).
-    pub fn set_second(&mut self, second: [[f64; MAX_PER_AXIS]; 3]) {
-        self.second = second;
-    }
-
     /// The first slopes S'_i along every axis.
-    pub fn slopes(&self) -> [[f64; MAX_PER_AXIS]; 3] {
+    pub fn slopes(&self) -> Slopes {
         self.slope
     }
 }
+
+/// APIC's 1D moments w_i δ_i of a stencil along every axis and its inertia
+/// D_dd per axis (`Stencil::moments`).
+pub type Moments = (Slopes, [f64; 3]);
+
+/// One value per node along every axis of a stencil (1D factors).
+pub type Slopes = [[f64; MAX_PER_AXIS]; 3];
 
 /// What the shape functions read of the particles: the positions and, for
 /// GIMP and the domain B-splines, the domains' reference half-lengths and F.
@@ -342,7 +333,6 @@ impl<const D: usize> NodeBox<D> {
             count: [1; 3],
             weight: [[1.0; MAX_PER_AXIS]; 3],
             slope: [[0.0; MAX_PER_AXIS]; 3],
-            second: [[0.0; MAX_PER_AXIS]; 3],
         };
         for (d, a) in axes.iter().enumerate() {
             // A node below the box wraps to an index beyond it: the reads and
@@ -392,20 +382,20 @@ impl<const D: usize> NodeBox<D> {
         });
     }
 
-    /// `scatter` with the stencil's second slopes, which `source` sets
-    /// (`Stencil::set_second`): `add(node, &s, S_Iq, ∇S_Iq, G_Iq)`.
+    /// `scatter` with second slopes that `source` gives beside its value
+    /// (`Stencil::for_each_with`): `add(node, &s, S_Iq, ∇S_Iq, G_Iq)`.
     pub fn scatter_with_second<N: Send, S>(
         &self,
         shape: ShapeFunction,
         grid: &Grid<D>,
         points: Points<D>,
         nodes: &mut [N],
-        source: impl Fn(usize, &mut Stencil<D>) -> S + Sync,
+        source: impl Fn(usize, &Stencil<D>) -> (S, Slopes) + Sync,
         add: impl Fn(&mut N, &S, f64, &Vector<D>, &Vector<D>) + Sync,
     ) {
         self.coloured(shape, grid, points, nodes, |q, st, out| {
-            let s = source(q, st);
-            st.for_each_with(&self.stride, |b, w, g, h| {
+            let (s, second) = source(q, st);
+            st.for_each_with(&self.stride, &second, |b, w, g, h| {
                 // SAFETY: as in `scatter`.
                 add(unsafe { out.at(b) }, &s, w, &g, &h)
             })
@@ -420,7 +410,7 @@ impl<const D: usize> NodeBox<D> {
         grid: &Grid<D>,
         points: Points<D>,
         nodes: &mut [N],
-        each: impl Fn(usize, &mut Stencil<D>, &DisjointSlice<N>) + Sync,
+        each: impl Fn(usize, &Stencil<D>, &DisjointSlice<N>) + Sync,
     ) {
         assert_eq!(nodes.len(), self.nodes(), "one value per box node");
         let reach = Reach::of(shape).expect("a separable family");
@@ -443,14 +433,14 @@ impl<const D: usize> NodeBox<D> {
                     let q = q as usize;
                     let f = deformation_for(shape, || points.f.get(q));
                     let (x, half) = (&points.x[q], &points.half_length0[q]);
-                    let Some(mut st) = self.stencil(shape, grid, x, half, &f) else {
+                    let Some(st) = self.stencil(shape, grid, x, half, &f) else {
                         continue;
                     };
                     assert!(
                         (0..D).all(|d| st.first[d] >= first[d] && st.first[d] + st.count[d] <= end[d]),
                         "{shape:?} reaches beyond its tile's nodes: the colouring would not hold"
                     );
-                    each(q, &mut st, &out);
+                    each(q, &st, &out);
                 }
             });
         }

@@ -438,9 +438,7 @@ fn run_dim<const D: usize>(
         });
         // APIC's affine moments belong to the APIC stages: a stage without them
         // drops them, and an APIC stage after it forms them anew.
-        let apic = sc.kind == SolverKind::Explicit
-            && sc.velocity_transfer() == crate::scene::VelocityTransfer::Apic;
-        if !apic {
+        if !sc.apic() {
             model.particles.affine = Vec::new();
         }
         let mut stepper = crate::solver::stepper::<D>(cfg.grid.shape_function, sc, start);

@@ -419,16 +419,21 @@ impl SolverConfig {
     pub fn min_node_support(&self) -> f64 {
         self.min_node_support.unwrap_or(1e-2)
     }
-    /// F-bar: per background cell, the particles' volume change is the cell
-    /// average (default false). See `fbar`.
     pub fn velocity_transfer(&self) -> VelocityTransfer {
         self.velocity_transfer.unwrap_or(VelocityTransfer::Flip)
+    }
+
+    /// An explicit stage with APIC: its particles keep affine moments.
+    pub fn apic(&self) -> bool {
+        self.kind == SolverKind::Explicit && self.velocity_transfer() == VelocityTransfer::Apic
     }
 
     pub fn transfer(&self) -> Transfer {
         self.transfer.unwrap_or(Transfer::Auto)
     }
 
+    /// F-bar: per background cell, the particles' volume change is the cell
+    /// average (default false). See `fbar`.
     pub fn fbar(&self) -> bool {
         self.fbar.unwrap_or(false)
     }

@@ -21,7 +21,7 @@ use crate::physics::shape::{ShapeFunction, Stencils};
 use crate::physics::transfer::{
     applied_force, interpolate_two, mass_average, mass_momentum, nodal_force, NodeMap,
 };
-use crate::scene::{Scheme, SolverConfig, Transfer, VelocityTransfer};
+use crate::scene::{Scheme, SolverConfig, Transfer};
 use crate::solver::divergence::{check_state, inverted, Divergence};
 use crate::solver::explicit_scatter::{ScatterStep, Settings};
 use crate::solver::report::{SolverReport, TransferPath};
@@ -62,11 +62,8 @@ impl<const D: usize> Explicit<D> {
             scheme: s.scheme(),
             cfl: s.cfl(),
             fixed_dt: s.dt,
-            flip: match s.velocity_transfer() {
-                VelocityTransfer::Flip => s.flip(),
-                VelocityTransfer::Apic => 0.0,
-            },
-            apic: s.velocity_transfer() == VelocityTransfer::Apic,
+            flip: if s.apic() { 0.0 } else { s.flip() },
+            apic: s.apic(),
             damping: s.damping(),
             gravity_ramp: LoadTime::Ramp(s.gravity_ramp_time()),
             fbar: s.fbar(),
@@ -207,12 +204,12 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
         };
 
         // APIC: the node positions and the affine part of the momentum.
-        let hats = self.shape == ShapeFunction::Linear;
         let positions = match self.apic {
             true => apic::node_positions(map, &m.grid),
             false => Vec::new(),
         };
-        let affine = (self.apic).then(|| AffineMomentum::new(map, st, p, &p.x, &positions, hats));
+        let affine =
+            (self.apic).then(|| AffineMomentum::new(map, st, p, &p.x, &positions, self.shape));
         let term = affine.as_ref().map(|a| move |q, e, n| a.term(st, q, e, n));
 
         // Nodal velocity at the start of the step, with the conditions applied.
@@ -341,7 +338,7 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
                 let p = &m.particles;
                 let x = step_start_x.as_deref().unwrap_or(&p.x);
                 let affine =
-                    (self.apic).then(|| AffineMomentum::new(map, st, p, x, &positions, hats));
+                    (self.apic).then(|| AffineMomentum::new(map, st, p, x, &positions, self.shape));
                 let term = affine.as_ref().map(|a| move |q, e, n| a.term(st, q, e, n));
                 let (_, momentum) = mass_momentum(map, st, p, term.as_ref().map(|t| t as _));
                 let mut remapped = mass_average(&mass, &momentum);

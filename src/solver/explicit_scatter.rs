@@ -170,10 +170,9 @@ impl<const D: usize> ScatterStep<D> {
             return;
         }
         // APIC: m B_p, given to node I with the weight S_I D⁻¹ (x_I − x_p).
-        let hats = s.shape == ShapeFunction::Linear;
-        let source = |q: usize, st: &mut Stencil<D>| {
-            st.set_second(apic::weight_slopes(st, grid, &p.x[q], hats));
-            (source(q), p.affine[q] * p.mass[q])
+        let source = |q: usize, st: &Stencil<D>| {
+            let slopes = apic::weight_slopes(st, &st.moments(grid, &p.x[q]), shape);
+            ((source(q), p.affine[q] * p.mass[q]), slopes)
         };
         let add =
             |n: &mut Node<D>, s: &(Source<D>, Tensor<D>), w: f64, g: &Vector<D>, a: &Vector<D>| {
@@ -189,8 +188,7 @@ impl<const D: usize> ScatterStep<D> {
     fn initial_affine(&mut self, s: &Settings<D>, m: &mut Model<D>, scales: &[f64]) {
         self.nodes.clear();
         self.nodes.resize(self.nb.nodes(), Node::zero());
-        let pic = Settings { apic: false, ..*s };
-        self.scatter::<true, false, false>(&pic, m, scales);
+        self.scatter::<true, false, false>(s, m, scales);
         let (nb, nodes, grid) = (&self.nb, &self.nodes, &m.grid);
         let p = &m.particles;
         let affine = (0..p.len())
@@ -200,7 +198,7 @@ impl<const D: usize> ScatterStep<D> {
                 let f = deformation_for(s.shape, || p.f.get(q));
                 let st = nb.stencil(s.shape, grid, &p.x[q], &p.half_length0[q], &f);
                 st.map_or_else(Tensor::<D>::zeros, |st| {
-                    apic::box_moment(&st, grid, &p.x[q], &nb.stride, |b| {
+                    apic::box_moment(&st, &st.moments(grid, &p.x[q]), &nb.stride, |b| {
                         nodal_velocity(nodes[b].mass, &nodes[b].momentum)
                     })
                 })
@@ -241,7 +239,6 @@ impl<const D: usize> ScatterStep<D> {
         let points = Points { x, half_length0, f };
         let (velocity, work) = (DisjointSlice::new(v), DisjointSlice::new(&mut self.work));
         let affine = DisjointSlice::new(affine);
-        let hats = s.shape == ShapeFunction::Linear;
         let source = |q: usize, st: &Stencil<D>| {
             let (vp, a, _) = gather::<D, true, 0>(st, nb, nodes, &[]);
             // SAFETY: particle q belongs to this tile's task alone.
@@ -263,13 +260,14 @@ impl<const D: usize> ScatterStep<D> {
             return deterministic_sum(n, |q| self.work[q]) * dt;
         }
         // APIC: B_p from the updated nodes, remapped with its affine weight.
-        let source = |q: usize, st: &mut Stencil<D>| {
+        let source = |q: usize, st: &Stencil<D>| {
             let momentum = source(q, st);
-            let b = apic::box_moment(st, grid, &x[q], &nb.stride, |b| nodes[b].momentum);
+            let moments = st.moments(grid, &x[q]);
+            let b = apic::box_moment(st, &moments, &nb.stride, |b| nodes[b].momentum);
             // SAFETY: as above.
             unsafe { *affine.at(q) = b };
-            st.set_second(apic::weight_slopes(st, grid, &x[q], hats));
-            (momentum, b * mass[q])
+            let slopes = apic::weight_slopes(st, &moments, s.shape);
+            ((momentum, b * mass[q]), slopes)
         };
         let add = |n: &mut Vector<D>,
                    s: &(Vector<D>, Tensor<D>),
@@ -427,22 +425,24 @@ impl<const D: usize> ScatterStep<D> {
                 &half_length0[q],
                 &deformation_for(s.shape, || state.deformation.f.get()),
             );
-            let (vp, a, l) = match (pass, sc) {
+            let (vp, a, l) = match (pass, &sc) {
                 (_, None) => (
                     Vector::<D>::zeros(),
                     Vector::<D>::zeros(),
                     Tensor::<D>::zeros(),
                 ),
-                (Pass::Full, Some(sc)) => gather::<D, true, 1>(&sc, nb, nodes, second),
-                (Pass::Stress, Some(sc)) => gather::<D, false, 2>(&sc, nb, nodes, second),
-                (Pass::Motion, Some(sc)) => gather::<D, true, 0>(&sc, nb, nodes, second),
-                (Pass::Remapped, Some(sc)) => gather::<D, true, 2>(&sc, nb, nodes, second),
+                (Pass::Full, Some(sc)) => gather::<D, true, 1>(sc, nb, nodes, second),
+                (Pass::Stress, Some(sc)) => gather::<D, false, 2>(sc, nb, nodes, second),
+                (Pass::Motion, Some(sc)) => gather::<D, true, 0>(sc, nb, nodes, second),
+                (Pass::Remapped, Some(sc)) => gather::<D, true, 2>(sc, nb, nodes, second),
             };
             let mut work = 0.0;
             if s.apic && matches!(pass, Pass::Full | Pass::Motion) {
                 // APIC's B_p from the updated nodes, where the particle is now.
                 let b = sc.as_ref().map_or_else(Tensor::<D>::zeros, |sc| {
-                    apic::box_moment(sc, grid, state.x, &nb.stride, |b| nodes[b].momentum)
+                    apic::box_moment(sc, &sc.moments(grid, state.x), &nb.stride, |b| {
+                        nodes[b].momentum
+                    })
                 });
                 // SAFETY: particle q belongs to this chunk's task alone.
                 unsafe { *affine.at(q) = b };
