@@ -22,8 +22,20 @@ pub fn run_problem(
     let dir = tempfile::tempdir().unwrap();
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     let scene = Scene::load(&problem(name), &overrides).expect("scene loads");
-    let result = run(&scene, dir.path(), &RunOptions::default());
+    let result = one_thread(|| run(&scene, dir.path(), &RunOptions::default()));
     (result, dir)
+}
+
+/// `f` on a pool of one thread. The test harness already runs one test per core,
+/// and results do not depend on the number of threads (tests/solvers/threads.rs
+/// checks it byte for byte): two runs sharing the cores' two workers only wait
+/// on each other.
+pub fn one_thread<R: Send>(f: impl FnOnce() -> R + Send) -> R {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("a thread pool")
+        .install(f)
 }
 
 /// Run the strength-reduction search of `problems/NAME` with overrides.
@@ -34,7 +46,7 @@ pub fn search_problem(
     let dir = tempfile::tempdir().unwrap();
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     let scene = Scene::load(&problem(name), &overrides).expect("scene loads");
-    let result = search(&scene, dir.path(), &RunOptions::default());
+    let result = one_thread(|| search(&scene, dir.path(), &RunOptions::default()));
     (result, dir)
 }
 
@@ -50,7 +62,7 @@ pub fn run_text(text: &str, overrides: &[&str]) -> (Result<Summary, RunError>, t
     let dir = tempfile::tempdir().unwrap();
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     let scene = Scene::parse("scene.toml", text, &overrides).expect("scene parses");
-    let result = run(&scene, dir.path(), &RunOptions::default());
+    let result = one_thread(|| run(&scene, dir.path(), &RunOptions::default()));
     (result, dir)
 }
 
