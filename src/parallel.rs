@@ -81,6 +81,17 @@ impl<'a, T> DisjointSlice<'a, T> {
     }
 }
 
+/// `f` on a pool of `threads` threads of its own (every parallel loop inside it
+/// runs there): the thread-independence tests run the same work on 1, 2 or 3
+/// threads and compare the bits.
+pub fn on_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("a thread pool")
+        .install(f)
+}
+
 /// Items without a bucket in `bucket_sort`.
 pub const NO_BUCKET: u32 = u32::MAX;
 
@@ -162,12 +173,8 @@ mod tests {
             .collect();
         expected.sort();
         for threads in 1..=3 {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
             let (mut start, mut order) = (vec![7], vec![1, 2, 3]);
-            pool.install(|| bucket_sort(&keys, 40, &mut start, &mut order));
+            on_threads(threads, || bucket_sort(&keys, 40, &mut start, &mut order));
             assert_eq!(start.len(), 41);
             let got: Vec<(u32, u32)> = (0..40)
                 .flat_map(|b| {

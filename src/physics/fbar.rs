@@ -287,13 +287,7 @@ load_steps = 1
             );
             assert!(spread > 1e-4, "{shape}: the field varies within the cells");
             assert!(worst_j < 1e-14 && worst_shape < 1e-14, "{shape}");
-            let on = |threads: usize| {
-                rayon::ThreadPoolBuilder::new()
-                    .num_threads(threads)
-                    .build()
-                    .unwrap()
-                    .install(|| trials(shape, u).1)
-            };
+            let on = |threads| crate::parallel::on_threads(threads, || trials(shape, u).1);
             let (one, two) = (on(1), on(2));
             assert!(one.df.len() > 1024, "enough particles to run in parallel");
             assert_eq!(

@@ -494,13 +494,9 @@ mod tests {
             let (mass, momentum) = crate::physics::transfer::mass_momentum(&map, &st, &p, None);
             let mut bits: Option<Vec<f64>> = None;
             for threads in [1, 3] {
-                let pool = rayon::ThreadPoolBuilder::new()
-                    .num_threads(threads)
-                    .build()
-                    .unwrap();
                 let mut nb = NodeBox::<D>::default();
                 let mut nodes = Vec::new();
-                pool.install(|| {
+                crate::parallel::on_threads(threads, || {
                     nb.locate(shape, &grid, &p.x);
                     nodes = vec![(0.0, Vector::<D>::zeros()); nb.nodes()];
                     nb.scatter(

@@ -526,12 +526,8 @@ mod tests {
         st.compute(ShapeFunction::Bspline2, &grid, &x, &half, &f);
         let (active, entries) = by_definition(&st);
         for threads in 1..=3 {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
             for mut map in [NodeMap::default(), earlier.clone()] {
-                pool.install(|| map.build(&st, grid.node_count()));
+                crate::parallel::on_threads(threads, || map.build(&st, grid.node_count()));
                 assert_eq!(map.active, active, "{threads} threads");
                 for (a, expected) in entries.iter().enumerate() {
                     assert_eq!(

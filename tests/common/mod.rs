@@ -31,11 +31,7 @@ pub fn run_problem(
 /// checks it byte for byte): two runs sharing the cores' two workers only wait
 /// on each other.
 pub fn one_thread<R: Send>(f: impl FnOnce() -> R + Send) -> R {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .expect("a thread pool")
-        .install(f)
+    mpm::parallel::on_threads(1, f)
 }
 
 /// Run the strength-reduction search of `problems/NAME` with overrides.

@@ -758,11 +758,7 @@ fn tangent_does_not_depend_on_the_number_of_threads() {
         let scene = Scene::parse("block.toml", &text, &overrides).unwrap();
         let m = Model::<2>::build(&scene).unwrap();
         let values = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            pool.install(|| {
+            crate::parallel::on_threads(threads, || {
                 let mut solver = Implicit::<2>::new(
                     scene.config.grid.shape_function,
                     scene.config.stages()[0],

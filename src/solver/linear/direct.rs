@@ -1402,11 +1402,7 @@ mod tests {
         ] {
             let b = apply(n, &t, &x_star(n));
             let solve = |threads: usize| {
-                let pool = rayon::ThreadPoolBuilder::new()
-                    .num_threads(threads)
-                    .build()
-                    .unwrap();
-                pool.install(|| {
+                crate::parallel::on_threads(threads, || {
                     let mut s = DirectSolver::new();
                     s.factorize_triplets(n, &t, Structure::Symmetric).unwrap();
                     let a = csc_from_triplets(n, &t, Structure::Symmetric).unwrap();
