@@ -91,16 +91,49 @@ impl<const D: usize> Stencil<D> {
         &self,
         stride: &[usize; 3],
         second: &Slopes,
+        visit: impl FnMut(usize, f64, Vector<D>, Vector<D>),
+    ) {
+        // The usual counts as constants, so that the loops unroll (the same
+        // entries in the same order as the general loop).
+        match self.count {
+            [3, 3, 1] => self.product::<3, 3, 1>(stride, second, visit),
+            [2, 2, 1] => self.product::<2, 2, 1>(stride, second, visit),
+            [4, 4, 1] => self.product::<4, 4, 1>(stride, second, visit),
+            [3, 3, 3] => self.product::<3, 3, 3>(stride, second, visit),
+            [2, 2, 2] => self.product::<2, 2, 2>(stride, second, visit),
+            [4, 4, 4] => self.product::<4, 4, 4>(stride, second, visit),
+            [i, j, k] => self.product_of(stride, second, [i, j, k], visit),
+        }
+    }
+
+    /// `for_each_with` with the counts of the three axes as constants.
+    #[inline(always)]
+    fn product<const I: usize, const J: usize, const K: usize>(
+        &self,
+        stride: &[usize; 3],
+        second: &Slopes,
+        visit: impl FnMut(usize, f64, Vector<D>, Vector<D>),
+    ) {
+        self.product_of(stride, second, [I, J, K], visit)
+    }
+
+    /// The tensor product over `count` factors per axis (x fastest).
+    #[inline(always)]
+    fn product_of(
+        &self,
+        stride: &[usize; 3],
+        second: &Slopes,
+        count: [usize; 3],
         mut visit: impl FnMut(usize, f64, Vector<D>, Vector<D>),
     ) {
         let (w, s, t) = (&self.weight, &self.slope, second);
-        for k in 0..self.count[2] {
-            for j in 0..self.count[1] {
+        for k in 0..count[2] {
+            for j in 0..count[1] {
                 let row = self.base + j * stride[1] + k * stride[2];
                 let wyz = w[1][j] * w[2][k];
                 let (syz, wysz) = (s[1][j] * w[2][k], w[1][j] * s[2][k]);
                 let (tyz, wytz) = (t[1][j] * w[2][k], w[1][j] * t[2][k]);
-                for i in 0..self.count[0] {
+                for i in 0..count[0] {
                     let g = [s[0][i] * wyz, w[0][i] * syz, w[0][i] * wysz];
                     let h = [t[0][i] * wyz, w[0][i] * tyz, w[0][i] * wytz];
                     visit(
@@ -248,24 +281,30 @@ impl<const D: usize> NodeBox<D> {
     /// grid touch no node, as in `Stencils::compute`).
     pub fn locate(&mut self, shape: ShapeFunction, grid: &Grid<D>, x: &[Vector<D>]) {
         let reach = Reach::of(shape).expect("a separable family");
-        let cell = |q: usize| -> [usize; D] {
-            std::array::from_fn(|d| cell_index(cell_coordinate(grid, &x[q], d), grid.cells[d]))
+        let cell = |xq: &Vector<D>| -> [usize; D] {
+            std::array::from_fn(|d| cell_index(cell_coordinate(grid, xq, d), grid.cells[d]))
         };
-        let inside = |q: &usize| grid.contains(&x[*q]);
-        let (lo, hi) = (0..x.len())
-            .into_par_iter()
-            .with_min_len(MIN_PARALLEL_LEN)
-            .filter(inside)
-            .map(|q| (cell(q), cell(q)))
+        // The cells' range from the positions' range: the cell of a point is
+        // non-decreasing in each of its coordinates. In chunks, plain loops.
+        let (x_lo, x_hi) = x
+            .par_chunks(MIN_PARALLEL_LEN)
+            .map(|xs| {
+                let (mut lo, mut hi) =
+                    (Vector::<D>::repeat(f64::MAX), Vector::<D>::repeat(f64::MIN));
+                for xq in xs.iter().filter(|xq| grid.contains(xq)) {
+                    lo = lo.inf(xq);
+                    hi = hi.sup(xq);
+                }
+                (lo, hi)
+            })
             .reduce(
-                || ([usize::MAX; D], [0; D]),
-                |(a, b), (c, e)| {
-                    (
-                        std::array::from_fn(|d| a[d].min(c[d])),
-                        std::array::from_fn(|d| b[d].max(e[d])),
-                    )
-                },
+                || (Vector::<D>::repeat(f64::MAX), Vector::<D>::repeat(f64::MIN)),
+                |(a, b), (c, e)| (a.inf(&c), b.sup(&e)),
             );
+        let (lo, hi) = match x_lo[0] <= x_hi[0] {
+            true => (cell(&x_lo), cell(&x_hi)),
+            false => ([usize::MAX; D], [0; D]),
+        };
         if lo[0] == usize::MAX {
             // No particle in the grid: an empty box.
             let (key, order) = (
@@ -294,19 +333,20 @@ impl<const D: usize> NodeBox<D> {
         let tile_stride = strides(&self.tiles);
         let (cell_lo, key) = (self.cell_lo, &mut self.key);
         key.resize(x.len(), 0);
-        key.par_iter_mut()
-            .enumerate()
-            .with_min_len(MIN_PARALLEL_LEN)
-            .for_each(|(q, k)| {
-                *k = match grid.contains(&x[q]) {
-                    true => {
-                        let c = cell(q);
-                        (0..D)
-                            .map(|d| (c[d] - cell_lo[d]) / TILE * tile_stride[d])
-                            .sum::<usize>() as u32
-                    }
-                    false => NO_BUCKET,
-                };
+        key.par_chunks_mut(MIN_PARALLEL_LEN)
+            .zip(x.par_chunks(MIN_PARALLEL_LEN))
+            .for_each(|(ks, xs)| {
+                for (k, xq) in ks.iter_mut().zip(xs) {
+                    *k = match grid.contains(xq) {
+                        true => {
+                            let c = cell(xq);
+                            (0..D)
+                                .map(|d| (c[d] - cell_lo[d]) / TILE * tile_stride[d])
+                                .sum::<usize>() as u32
+                        }
+                        false => NO_BUCKET,
+                    };
+                }
             });
         let n_tiles = self.tiles.iter().product();
         bucket_sort(&self.key, n_tiles, &mut self.start, &mut self.order);

@@ -409,6 +409,7 @@ pub fn nodal_force<const D: usize>(
 }
 
 /// Force applied to particle q: m_q g + s_q f_q (gravity and its scaled load).
+#[inline(always)]
 pub fn applied_force<const D: usize>(
     p: &Particles<D>,
     q: usize,

@@ -50,10 +50,13 @@ pub(crate) fn cell_coordinate<const D: usize>(grid: &Grid<D>, x: &Vector<D>, d: 
 
 /// Cell containing cell coordinate `xi` ≥ 0; a point on the max face belongs to
 /// the last cell. (The cast truncates, which is ⌊xi⌋ for xi ≥ 0, without a call
-/// to libm's `floor`; NaN gives 0 either way.)
+/// to libm's `floor`; NaN gives 0 either way. Through `u32`, whose saturating
+/// cast takes half the instructions of `usize`'s: equal for grids of fewer than
+/// 2³² cells per axis.)
+#[inline(always)]
 pub(crate) fn cell_index(xi: f64, cells: usize) -> usize {
     debug_assert!(xi >= 0.0 || xi.is_nan(), "cell coordinate {xi} < 0");
-    (xi as usize).min(cells - 1)
+    (xi as u32 as usize).min(cells - 1)
 }
 
 /// The two hats of the cell containing `xi` along axis `d`.
