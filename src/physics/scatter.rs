@@ -91,49 +91,16 @@ impl<const D: usize> Stencil<D> {
         &self,
         stride: &[usize; 3],
         second: &Slopes,
-        visit: impl FnMut(usize, f64, Vector<D>, Vector<D>),
-    ) {
-        // The usual counts as constants, so that the loops unroll (the same
-        // entries in the same order as the general loop).
-        match self.count {
-            [3, 3, 1] => self.product::<3, 3, 1>(stride, second, visit),
-            [2, 2, 1] => self.product::<2, 2, 1>(stride, second, visit),
-            [4, 4, 1] => self.product::<4, 4, 1>(stride, second, visit),
-            [3, 3, 3] => self.product::<3, 3, 3>(stride, second, visit),
-            [2, 2, 2] => self.product::<2, 2, 2>(stride, second, visit),
-            [4, 4, 4] => self.product::<4, 4, 4>(stride, second, visit),
-            [i, j, k] => self.product_of(stride, second, [i, j, k], visit),
-        }
-    }
-
-    /// `for_each_with` with the counts of the three axes as constants.
-    #[inline(always)]
-    fn product<const I: usize, const J: usize, const K: usize>(
-        &self,
-        stride: &[usize; 3],
-        second: &Slopes,
-        visit: impl FnMut(usize, f64, Vector<D>, Vector<D>),
-    ) {
-        self.product_of(stride, second, [I, J, K], visit)
-    }
-
-    /// The tensor product over `count` factors per axis (x fastest).
-    #[inline(always)]
-    fn product_of(
-        &self,
-        stride: &[usize; 3],
-        second: &Slopes,
-        count: [usize; 3],
         mut visit: impl FnMut(usize, f64, Vector<D>, Vector<D>),
     ) {
         let (w, s, t) = (&self.weight, &self.slope, second);
-        for k in 0..count[2] {
-            for j in 0..count[1] {
+        for k in 0..self.count[2] {
+            for j in 0..self.count[1] {
                 let row = self.base + j * stride[1] + k * stride[2];
                 let wyz = w[1][j] * w[2][k];
                 let (syz, wysz) = (s[1][j] * w[2][k], w[1][j] * s[2][k]);
                 let (tyz, wytz) = (t[1][j] * w[2][k], w[1][j] * t[2][k]);
-                for i in 0..count[0] {
+                for i in 0..self.count[0] {
                     let g = [s[0][i] * wyz, w[0][i] * syz, w[0][i] * wysz];
                     let h = [t[0][i] * wyz, w[0][i] * tyz, w[0][i] * wytz];
                     visit(
