@@ -253,26 +253,16 @@ impl<const D: usize> NodeBox<D> {
         };
         // The cells' range from the positions' range: the cell of a point is
         // non-decreasing in each of its coordinates. In chunks, plain loops.
+        let none = || (Vector::<D>::repeat(f64::MAX), Vector::<D>::repeat(f64::MIN));
         let (x_lo, x_hi) = x
             .par_chunks(MIN_PARALLEL_LEN)
             .map(|xs| {
-                let (mut lo, mut hi) =
-                    (Vector::<D>::repeat(f64::MAX), Vector::<D>::repeat(f64::MIN));
-                for xq in xs.iter().filter(|xq| grid.contains(xq)) {
-                    lo = lo.inf(xq);
-                    hi = hi.sup(xq);
-                }
-                (lo, hi)
+                xs.iter()
+                    .filter(|xq| grid.contains(xq))
+                    .fold(none(), |(lo, hi), xq| (lo.inf(xq), hi.sup(xq)))
             })
-            .reduce(
-                || (Vector::<D>::repeat(f64::MAX), Vector::<D>::repeat(f64::MIN)),
-                |(a, b), (c, e)| (a.inf(&c), b.sup(&e)),
-            );
-        let (lo, hi) = match x_lo[0] <= x_hi[0] {
-            true => (cell(&x_lo), cell(&x_hi)),
-            false => ([usize::MAX; D], [0; D]),
-        };
-        if lo[0] == usize::MAX {
+            .reduce(none, |(a, b), (c, e)| (a.inf(&c), b.sup(&e)));
+        if x_lo[0] > x_hi[0] {
             // No particle in the grid: an empty box.
             let (key, order) = (
                 std::mem::take(&mut self.key),
@@ -286,6 +276,7 @@ impl<const D: usize> NodeBox<D> {
             self.order.clear();
             return;
         }
+        let (lo, hi) = (cell(&x_lo), cell(&x_hi));
         self.cell_lo = lo;
         self.tiles = std::array::from_fn(|d| (hi[d] - lo[d]) / TILE + 1);
         self.lo = std::array::from_fn(|d| lo[d].saturating_sub(reach.below));
