@@ -146,13 +146,7 @@ fn deformation_gradient(u: &[[f64; 2]; 9], grad: &[[f64; 2]; 9]) -> Mat3 {
 }
 
 fn increment(f: &Mat3) -> Increment<'static> {
-    Increment {
-        f_old: Mat3::identity(),
-        df: *f,
-        dt: 0.0,
-        stress_old: Mat3::zeros(),
-        history_old: &[],
-    }
+    Increment::at_rest(*f, &[])
 }
 
 /// First Piola–Kirchhoff stress P = J σ F⁻ᵀ and, if asked, A_iJkL = ∂P_iJ/∂F_kL

@@ -43,13 +43,13 @@ pub fn run_from<M: Material + ?Sized>(
     for k in 1..path.len() {
         let f_inv = path[k - 1].try_inverse().expect("singular F in path");
         let mut h_new = vec![0.0; material.n_history()];
-        let inc = Increment {
-            f_old: path[k - 1],
-            df: path[k] * f_inv,
+        let inc = Increment::new(
+            path[k - 1],
+            path[k] * f_inv,
             dt,
-            stress_old: stress[k - 1],
-            history_old: &history[k - 1],
-        };
+            stress[k - 1],
+            &history[k - 1],
+        );
         stress.push(material.update(&inc, &mut h_new));
         history.push(h_new);
     }
@@ -110,13 +110,7 @@ pub fn run_mixed<M: Material + ?Sized>(
         let mut h_new = vec![0.0; material.n_history()];
         let mut log = Vec::new();
         let converged = loop {
-            let inc = Increment {
-                f_old: f[k],
-                df,
-                dt,
-                stress_old: stress[k],
-                history_old: &history[k],
-            };
+            let inc = Increment::new(f[k], df, dt, stress[k], &history[k]);
             let s = material.update(&inc, &mut h_new);
             let scale = controls
                 .iter()
@@ -227,10 +221,10 @@ pub fn numerical_stress_derivative<M: Material + ?Sized>(
     let mut hist = vec![0.0; material.n_history()];
     for k in 0..3 {
         for l in 0..3 {
-            let mut plus = *inc;
-            let mut minus = *inc;
-            plus.df[(k, l)] += h;
-            minus.df[(k, l)] -= h;
+            let (mut plus, mut minus) = (inc.df, inc.df);
+            plus[(k, l)] += h;
+            minus[(k, l)] -= h;
+            let (plus, minus) = (inc.with_df(plus), inc.with_df(minus));
             let ds = (material.update(&plus, &mut hist) - material.update(&minus, &mut hist))
                 / (2.0 * h);
             crate::material::set_derivative_column(&mut d, k, l, &ds);

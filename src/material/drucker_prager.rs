@@ -340,7 +340,7 @@ mod tests {
     /// Which part of the surface the update ended on: elastic, cone or apex.
     fn state(m: &DruckerPrager, i: &Increment) -> &'static str {
         let mut h = [0.0];
-        let s = m.update(i, &mut h) * (i.df * i.f_old).determinant();
+        let s = m.update(i, &mut h) * i.f.determinant();
         let eig = nalgebra::SymmetricEigen::new(s).eigenvalues;
         if h[0] == i.history_old[0] {
             "elastic"

@@ -169,7 +169,7 @@ impl Material for Hencky {
     }
 
     fn update(&self, inc: &Increment, _history_new: &mut [f64]) -> Mat3 {
-        self.cauchy(&(inc.df * inc.f_old))
+        self.cauchy(&inc.f)
     }
 
     fn p_wave_modulus(&self) -> f64 {
@@ -189,7 +189,7 @@ impl Material for Hencky {
     /// Daleckii–Krein derivative of ln b (module documentation).
     fn stress_derivative(&self, inc: &Increment) -> Option<StressDerivative> {
         let (lambda, mu) = self.lame();
-        let f = inc.df * inc.f_old;
+        let f = inc.f;
         let j = f.determinant();
         let df_inv = inc.df.try_inverse()?;
         let sp = Spectral::of(&f);

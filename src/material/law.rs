@@ -9,12 +9,18 @@ use nalgebra::SMatrix;
 pub type StressDerivative = SMatrix<f64, 9, 9>;
 
 /// The state at the start of an increment and the increment itself.
+///
+/// `f` is F_new = ΔF F_old, formed once by the constructors for the frame and
+/// every model that reads it: build increments with `new` (or `with_df` from
+/// another), not field by field, so that `f` follows `df`.
 #[derive(Clone, Copy, Debug)]
 pub struct Increment<'a> {
     /// Deformation gradient at the start of the increment.
     pub f_old: Mat3,
     /// Incremental deformation gradient: F_new = ΔF F_old.
     pub df: Mat3,
+    /// Deformation gradient at the end of the increment, ΔF F_old (2-31).
+    pub f: Mat3,
     /// Time increment (rate-dependent models; 0 for quasi-static calls).
     pub dt: f64,
     /// Cauchy stress at the start of the increment.
@@ -23,17 +29,54 @@ pub struct Increment<'a> {
     pub history_old: &'a [f64],
 }
 
-impl Increment<'_> {
-    /// An increment ΔF from the undeformed, unstressed state.
-    pub fn at_rest(df: Mat3, history_old: &[f64]) -> Increment<'_> {
+impl<'a> Increment<'a> {
+    /// The increment ΔF from the state (F_old, σ_old, history) over `dt`.
+    #[inline(always)]
+    pub fn new(f_old: Mat3, df: Mat3, dt: f64, stress_old: Mat3, history_old: &'a [f64]) -> Self {
         Increment {
-            f_old: Mat3::identity(),
+            f_old,
             df,
-            dt: 0.0,
-            stress_old: Mat3::zeros(),
+            f: compose(&df, &f_old),
+            dt,
+            stress_old,
             history_old,
         }
     }
+
+    /// An increment ΔF from the undeformed, unstressed state.
+    pub fn at_rest(df: Mat3, history_old: &'a [f64]) -> Self {
+        Increment::new(Mat3::identity(), df, 0.0, Mat3::zeros(), history_old)
+    }
+
+    /// The same start state under another ΔF.
+    pub fn with_df(&self, df: Mat3) -> Self {
+        Increment::new(self.f_old, df, self.dt, self.stress_old, self.history_old)
+    }
+}
+
+/// The product a b of two deformation gradients, in the plane (a 2 × 2 block
+/// and zz) when neither has out-of-plane shear: the plane strain and
+/// axisymmetric gradients. Equal to the full product, term for term, but for
+/// the sign of the zero out-of-plane shear.
+#[inline(always)]
+pub fn compose(a: &Mat3, b: &Mat3) -> Mat3 {
+    let plane =
+        |m: &Mat3| m[(0, 2)] == 0.0 && m[(1, 2)] == 0.0 && m[(2, 0)] == 0.0 && m[(2, 1)] == 0.0;
+    if !(plane(a) && plane(b)) {
+        return a * b;
+    }
+    let e = |i: usize, j: usize| a[(i, 0)] * b[(0, j)] + a[(i, 1)] * b[(1, j)];
+    Mat3::new(
+        e(0, 0),
+        e(0, 1),
+        0.0,
+        e(1, 0),
+        e(1, 1),
+        0.0,
+        0.0,
+        0.0,
+        a[(2, 2)] * b[(2, 2)],
+    )
 }
 
 /// Cohesion, friction angle and dilation angle (radians), or their derivatives.

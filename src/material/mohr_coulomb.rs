@@ -718,7 +718,7 @@ mod tests {
     /// τ1 = τ2 and τ2 = τ3, the apex, the cut-off T).
     fn state(m: &MohrCoulomb, i: &Increment) -> String {
         let mut h = [0.0];
-        let s = m.update(i, &mut h) * (i.df * i.f_old).determinant();
+        let s = m.update(i, &mut h) * i.f.determinant();
         if h[0] == i.history_old[0] {
             return "elastic".into();
         }

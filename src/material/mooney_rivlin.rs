@@ -163,7 +163,7 @@ impl Material for MooneyRivlin {
     }
 
     fn update(&self, inc: &Increment, _history_new: &mut [f64]) -> Mat3 {
-        self.cauchy(&(inc.df * inc.f_old))
+        self.cauchy(&inc.f)
     }
 
     /// λ + 2G from the small-strain relations 3-14, 3-15.
@@ -181,7 +181,7 @@ impl Material for MooneyRivlin {
     /// dT = ½ L : dC (3-12), d ln J = tr(F⁻¹ dF) and
     /// dσ = (dF T Fᵀ + F T dFᵀ + F dT Fᵀ)/J − σ d ln J.
     fn stress_derivative(&self, inc: &Increment) -> Option<StressDerivative> {
-        let f = inc.df * inc.f_old;
+        let f = inc.f;
         let j = f.determinant();
         let f_inv = f.try_inverse()?;
         let c = f.transpose() * f;

@@ -68,7 +68,7 @@ impl Material for NeoHookean {
     }
 
     fn update(&self, inc: &Increment, _history_new: &mut [f64]) -> Mat3 {
-        self.cauchy(&(inc.df * inc.f_old))
+        self.cauchy(&inc.f)
     }
 
     fn p_wave_modulus(&self) -> f64 {
@@ -88,7 +88,7 @@ impl Material for NeoHookean {
     /// dσ = (μ/J)(db − (b − I) d ln J) + λ (1 − ln J)/J d ln J I.
     fn stress_derivative(&self, inc: &Increment) -> Option<StressDerivative> {
         let (lambda, mu) = self.lame();
-        let f = inc.df * inc.f_old;
+        let f = inc.f;
         let j = f.determinant();
         let ln_j = j.ln();
         let f_inv = f.try_inverse()?;

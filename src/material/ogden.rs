@@ -111,7 +111,7 @@ impl Material for Ogden {
     }
 
     fn update(&self, inc: &Increment, _history_new: &mut [f64]) -> Mat3 {
-        self.cauchy(&(inc.df * inc.f_old))
+        self.cauchy(&inc.f)
     }
 
     fn p_wave_modulus(&self) -> f64 {

@@ -770,13 +770,7 @@ mod tests {
         let history = [2.0, 1.0, 1.0 - m.eos.alpha0, 500.0];
         let f_old = Mat3::identity() * 1.2f64.cbrt();
         let df = Mat3::identity() * (1.3f64 / 1.2).cbrt();
-        let inc = Increment {
-            f_old,
-            df,
-            dt: 1e-3,
-            stress_old: Mat3::zeros(),
-            history_old: &history,
-        };
+        let inc = Increment::new(f_old, df, 1e-3, Mat3::zeros(), &history);
         let mut h_new = [0.0; 4];
         let stress = m.update(&inc, &mut h_new);
         assert_eq!(stress, Mat3::zeros());
@@ -784,7 +778,7 @@ mod tests {
         // Recompacted past the solid density (J < 1/α₀ = 0.887 at α = 1), it
         // carries pressure again.
         let df = Mat3::identity() * (0.85f64 / 1.2).cbrt();
-        let inc = Increment { df, ..inc };
+        let inc = inc.with_df(df);
         let stress = m.update(&inc, &mut h_new);
         assert!(-stress.trace() / 3.0 > 0.0, "{stress}");
     }

@@ -7,13 +7,7 @@ use nalgebra::{Rotation3, Unit, Vector3};
 
 /// An increment ΔF from (F_old, σ_old, history); the models here ignore dt.
 pub fn increment<'a>(f_old: Mat3, df: Mat3, stress_old: Mat3, history: &'a [f64]) -> Increment<'a> {
-    Increment {
-        f_old,
-        df,
-        dt: 0.0,
-        stress_old,
-        history_old: history,
-    }
+    Increment::new(f_old, df, 0.0, stress_old, history)
 }
 
 /// A start stress with shear components (the hyperelastic models ignore it).

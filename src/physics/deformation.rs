@@ -101,13 +101,8 @@ impl<const D: usize> Trial<D> {
             .with_min_len(MIN_PARALLEL_LEN)
             .map(|(q, ((mut stress, volume), hist))| {
                 let material = materials[p.material[q] as usize].as_ref();
-                let inc = Increment {
-                    f_old: p.f.get(q),
-                    df: df_of(u, fbar, st, map, q),
-                    dt,
-                    stress_old: p.stress.get(q),
-                    history_old: history_old[q],
-                };
+                let df = df_of(u, fbar, st, map, q);
+                let inc = Increment::new(p.f.get(q), df, dt, p.stress.get(q), history_old[q]);
                 let new = advance(material, &inc, p.volume0[q], hist);
                 stress.set(&new.stress);
                 *volume = new.volume;
@@ -220,7 +215,7 @@ fn advance(
     history: &mut [f64],
 ) -> Advanced {
     let stress = material.update(inc, history);
-    let f = inc.df * inc.f_old;
+    let f = inc.f;
     let det = f.determinant();
     Advanced {
         stress,
@@ -337,13 +332,7 @@ pub fn update_particle(
             &old
         }
     };
-    let inc = Increment {
-        f_old: state.f.get(),
-        df: *df,
-        dt,
-        stress_old: state.stress.get(),
-        history_old,
-    };
+    let inc = Increment::new(state.f.get(), *df, dt, state.stress.get(), history_old);
     let new = advance(material, &inc, volume0, hist);
     state.stress.set(&new.stress);
     state.f.set(&new.f);

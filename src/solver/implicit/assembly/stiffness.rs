@@ -147,13 +147,7 @@ pub fn particle_tangents<const D: usize>(
         .with_min_len(MIN_PARALLEL_LEN)
         .filter_map(|(q, (a_q, hoop_q))| {
             let df = trial.df(st, map, q);
-            let inc = Increment {
-                f_old: p.f.get(q),
-                df,
-                dt: 0.0,
-                stress_old: p.stress.get(q),
-                history_old: history_old[q],
-            };
+            let inc = Increment::new(p.f.get(q), df, 0.0, p.stress.get(q), history_old[q]);
             let mat = m.materials[p.material[q] as usize].as_ref();
             mat.stress_derivative(&inc)
                 .or_else(|| {
@@ -352,22 +346,10 @@ mod tests {
         let df = Mat3::new(1.02, 0.05, 0.01, -0.03, 0.97, 0.02, 0.01, -0.02, 1.01);
         let stress_old = m.cauchy(&f_old);
         let pk1 = |df: &Mat3| {
-            let inc = Increment {
-                f_old,
-                df: *df,
-                dt: 0.0,
-                stress_old,
-                history_old: &[],
-            };
+            let inc = Increment::new(f_old, *df, 0.0, stress_old, &[]);
             relative_pk1(df, &m.update(&inc, &mut []))
         };
-        let inc = Increment {
-            f_old,
-            df,
-            dt: 0.0,
-            stress_old,
-            history_old: &[],
-        };
+        let inc = Increment::new(f_old, df, 0.0, stress_old, &[]);
         let a = pk1_derivative::<3>(
             &df,
             &m.update(&inc, &mut []),
