@@ -235,3 +235,37 @@ pub fn shear_modulus(m: &dyn Material) -> f64 {
     };
     (sigma_xy(h) - sigma_xy(-h)) / (2.0 * h)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Gradients of a plane strain or axisymmetric step (no out-of-plane shear).
+    fn plane(k: u32) -> Mat3 {
+        let r = |i: u32| ((k * 7 + i * 13) % 17) as f64 / 17.0 - 0.5;
+        Mat3::new(1.0 + r(0), r(1), 0.0, r(2), 1.0 + r(3), 0.0, 0.0, 0.0, 1.0 + r(4))
+    }
+
+    #[test]
+    fn compose_equals_the_full_product() {
+        for k in 0..40 {
+            let (a, b) = (plane(k), plane(k + 3));
+            // Bit for bit: the full product adds only exact zeros to each term.
+            assert_eq!(compose(&a, &b), a * b, "plane pair {k}");
+            let mut general = b;
+            general[(1, 2)] = 0.1;
+            assert_eq!(compose(&a, &general), a * general, "general pair {k}");
+            assert_eq!(compose(&general, &a), general * a, "general pair {k}");
+        }
+    }
+
+    #[test]
+    fn increments_keep_f_with_their_df() {
+        let (f_old, df) = (plane(1), plane(2));
+        let inc = Increment::new(f_old, df, 0.0, Mat3::zeros(), &[]);
+        assert_eq!(inc.f, df * f_old);
+        let other = inc.with_df(plane(5));
+        assert_eq!(other.f, plane(5) * f_old);
+        assert_eq!(Increment::at_rest(df, &[]).f, df);
+    }
+}
