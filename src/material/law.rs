@@ -59,7 +59,7 @@ impl<'a> Increment<'a> {
 /// axisymmetric gradients. Equal to the full product, term for term, but for
 /// the sign of the zero out-of-plane shear.
 #[inline(always)]
-pub fn compose(a: &Mat3, b: &Mat3) -> Mat3 {
+fn compose(a: &Mat3, b: &Mat3) -> Mat3 {
     let plane =
         |m: &Mat3| m[(0, 2)] == 0.0 && m[(1, 2)] == 0.0 && m[(2, 0)] == 0.0 && m[(2, 1)] == 0.0;
     if !(plane(a) && plane(b)) {
