@@ -243,7 +243,17 @@ mod tests {
     /// Gradients of a plane strain or axisymmetric step (no out-of-plane shear).
     fn plane(k: u32) -> Mat3 {
         let r = |i: u32| ((k * 7 + i * 13) % 17) as f64 / 17.0 - 0.5;
-        Mat3::new(1.0 + r(0), r(1), 0.0, r(2), 1.0 + r(3), 0.0, 0.0, 0.0, 1.0 + r(4))
+        Mat3::new(
+            1.0 + r(0),
+            r(1),
+            0.0,
+            r(2),
+            1.0 + r(3),
+            0.0,
+            0.0,
+            0.0,
+            1.0 + r(4),
+        )
     }
 
     #[test]
