@@ -35,3 +35,62 @@ pub fn embed_deformation<const D: usize>(a: &Tensor<D>) -> Mat3 {
     }
     m
 }
+
+/// The product a b of two deformation gradients, in the plane (a 2 × 2 block
+/// and zz) when neither has out-of-plane shear: the plane strain and
+/// axisymmetric gradients. Equal to the full product, term for term, but for
+/// the sign of the zero out-of-plane shear.
+#[inline(always)]
+pub fn compose(a: &Mat3, b: &Mat3) -> Mat3 {
+    let plane =
+        |m: &Mat3| m[(0, 2)] == 0.0 && m[(1, 2)] == 0.0 && m[(2, 0)] == 0.0 && m[(2, 1)] == 0.0;
+    if !(plane(a) && plane(b)) {
+        return a * b;
+    }
+    let e = |i: usize, j: usize| a[(i, 0)] * b[(0, j)] + a[(i, 1)] * b[(1, j)];
+    Mat3::new(
+        e(0, 0),
+        e(0, 1),
+        0.0,
+        e(1, 0),
+        e(1, 1),
+        0.0,
+        0.0,
+        0.0,
+        a[(2, 2)] * b[(2, 2)],
+    )
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    /// Gradients of a plane strain or axisymmetric step (no out-of-plane shear).
+    pub fn plane(k: u32) -> Mat3 {
+        let r = |i: u32| ((k * 7 + i * 13) % 17) as f64 / 17.0 - 0.5;
+        Mat3::new(
+            1.0 + r(0),
+            r(1),
+            0.0,
+            r(2),
+            1.0 + r(3),
+            0.0,
+            0.0,
+            0.0,
+            1.0 + r(4),
+        )
+    }
+
+    #[test]
+    fn compose_equals_the_full_product() {
+        for k in 0..40 {
+            let (a, b) = (plane(k), plane(k + 3));
+            // Bit for bit: the full product adds only exact zeros to each term.
+            assert_eq!(compose(&a, &b), a * b, "plane pair {k}");
+            let mut general = b;
+            general[(1, 2)] = 0.1;
+            assert_eq!(compose(&a, &general), a * general, "general pair {k}");
+            assert_eq!(compose(&general, &a), general * a, "general pair {k}");
+        }
+    }
+}

@@ -283,7 +283,7 @@ mod tests {
             }
             fn update(&self, inc: &Increment, h: &mut [f64]) -> Mat3 {
                 h[0] = inc.history_old[0] + inc.dt;
-                inc.df * inc.f_old - Mat3::identity()
+                inc.f - Mat3::identity()
             }
             fn p_wave_modulus(&self) -> f64 {
                 1.0

@@ -2,7 +2,7 @@
 //! updates from (`Increment`) and the small helpers models share (Lamé constants,
 //! reduced angles, the stress-derivative layout).
 
-use crate::dim::Mat3;
+use crate::dim::{compose, Mat3};
 use nalgebra::SMatrix;
 
 /// ∂σ_ij/∂ΔF_kl with (i,j) and (k,l) flattened row-major (index 3i + j).
@@ -52,31 +52,6 @@ impl<'a> Increment<'a> {
     pub fn with_df(&self, df: Mat3) -> Self {
         Increment::new(self.f_old, df, self.dt, self.stress_old, self.history_old)
     }
-}
-
-/// The product a b of two deformation gradients, in the plane (a 2 × 2 block
-/// and zz) when neither has out-of-plane shear: the plane strain and
-/// axisymmetric gradients. Equal to the full product, term for term, but for
-/// the sign of the zero out-of-plane shear.
-#[inline(always)]
-fn compose(a: &Mat3, b: &Mat3) -> Mat3 {
-    let plane =
-        |m: &Mat3| m[(0, 2)] == 0.0 && m[(1, 2)] == 0.0 && m[(2, 0)] == 0.0 && m[(2, 1)] == 0.0;
-    if !(plane(a) && plane(b)) {
-        return a * b;
-    }
-    let e = |i: usize, j: usize| a[(i, 0)] * b[(0, j)] + a[(i, 1)] * b[(1, j)];
-    Mat3::new(
-        e(0, 0),
-        e(0, 1),
-        0.0,
-        e(1, 0),
-        e(1, 1),
-        0.0,
-        0.0,
-        0.0,
-        a[(2, 2)] * b[(2, 2)],
-    )
 }
 
 /// Cohesion, friction angle and dilation angle (radians), or their derivatives.
@@ -239,35 +214,7 @@ pub fn shear_modulus(m: &dyn Material) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Gradients of a plane strain or axisymmetric step (no out-of-plane shear).
-    fn plane(k: u32) -> Mat3 {
-        let r = |i: u32| ((k * 7 + i * 13) % 17) as f64 / 17.0 - 0.5;
-        Mat3::new(
-            1.0 + r(0),
-            r(1),
-            0.0,
-            r(2),
-            1.0 + r(3),
-            0.0,
-            0.0,
-            0.0,
-            1.0 + r(4),
-        )
-    }
-
-    #[test]
-    fn compose_equals_the_full_product() {
-        for k in 0..40 {
-            let (a, b) = (plane(k), plane(k + 3));
-            // Bit for bit: the full product adds only exact zeros to each term.
-            assert_eq!(compose(&a, &b), a * b, "plane pair {k}");
-            let mut general = b;
-            general[(1, 2)] = 0.1;
-            assert_eq!(compose(&a, &general), a * general, "general pair {k}");
-            assert_eq!(compose(&general, &a), general * a, "general pair {k}");
-        }
-    }
+    use crate::dim::tests::plane;
 
     #[test]
     fn increments_keep_f_with_their_df() {

@@ -7,7 +7,7 @@
 //! the particles follow ΔF̄ instead of ΔF. In axisymmetric mode ΔF_θθ is the hoop
 //! stretch of the increment (`physics::axisymmetry`) instead of 1.
 
-use crate::dim::{embed_deformation, Mat3, Tensor, Vector};
+use crate::dim::{compose, embed_deformation, Mat3, Tensor, Vector};
 use crate::material::{Increment, Material};
 use crate::model::grid::Grid;
 use crate::model::particles::Particles;
@@ -148,7 +148,7 @@ impl<const D: usize> Trial<D> {
     /// The trial deformation gradient of particle q, F = ΔF F_old (2-31); not
     /// stored: only a commit and an inversion's report need it.
     pub fn f(&self, p: &Particles<D>, st: &Stencils<D>, map: &NodeMap, q: usize) -> Mat3 {
-        self.df(st, map, q) * p.f.get(q)
+        compose(&self.df(st, map, q), &p.f.get(q))
     }
 
     /// Make the trial state the particles' state: F = ΔF F_old formed in place,
@@ -158,7 +158,7 @@ impl<const D: usize> Trial<D> {
         (p.f.par_iter_mut())
             .enumerate()
             .with_min_len(MIN_PARALLEL_LEN)
-            .for_each(|(q, mut f)| f.set(&(self.df(st, map, q) * f.get())));
+            .for_each(|(q, mut f)| f.set(&compose(&self.df(st, map, q), &f.get())));
         std::mem::swap(&mut p.stress, &mut self.stress);
         std::mem::swap(&mut p.volume, &mut self.volume);
         std::mem::swap(&mut p.history.data, &mut self.history);
