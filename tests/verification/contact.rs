@@ -123,8 +123,9 @@ fn block_sticks_undamped_under_gradual_gravity_on_a_30_degree_slope() {
     // Measured: 0.38 mm on the elastic base, 0.15 mm on a rigid one;
     // frictionless 1.79 m. What it does not cover
     // (docs/contact.md, "Sticking needs damping"): gravity applied at once (the
-    // block slides 94 mm and 0.41 m) and slopes from 40° on (at 45°: 0.59 m on
-    // a rough grid face even with the ramp).
+    // block slides 94 mm and 0.41 m) and slopes from 40° on with FLIP (at 45°:
+    // 0.27 m here, 0.59 m on a rough grid face, even with the ramp; PIC, or a
+    // block whose weight acts within the middle third, holds: the tests below).
     let gradual = ["solver.gravity_ramp_time=0.3", "solver.end_time=1.0"];
     let elastic = std::fs::read_to_string(problem("contact_incline.toml")).unwrap();
     let moved = |text: &str, mu: f64| slide_on(text, 30.0, mu, &gradual).1;
@@ -139,6 +140,63 @@ fn block_sticks_undamped_under_gradual_gravity_on_a_30_degree_slope() {
         on_elastic.abs() < 1e-3 && on_rigid.abs() < 1e-3,
         "{on_elastic}, {on_rigid}"
     );
+}
+
+/// The block's displacement at t ≥ `ramp` when gravity rises linearly from zero
+/// over `ramp` (`solver.gravity_ramp_time`): the acceleration a = g (sin θ − μ cos θ)
+/// grows as a t / T, so x = a (t²/2 − T t/2 + T²/6).
+fn closed_form_ramped(theta_deg: f64, mu: f64, t: f64, ramp: f64) -> f64 {
+    assert!(t >= ramp);
+    let a = closed_form(theta_deg, mu, 1.0) * 2.0;
+    a * (t * t / 2.0 - ramp * t / 2.0 + ramp * ramp / 6.0)
+}
+
+#[test]
+fn block_slides_and_sticks_near_the_limit_with_pic_and_gravity_raised() {
+    // 45°, PIC, gravity raised over 0.3 s, undamped, 1 s. Near tan θ = 1 FLIP's
+    // and APIC's particle velocities lift the block off the base (10–30 mm) and
+    // its friction falls short; PIC keeps it down (docs/contact.md, "Sliding near
+    // the sticking limit"). Measured: μ = 0.7: −0.0 % (FLIP +1.3 %, APIC −0.8 %);
+    // μ = 0.8: +0.7 % (FLIP +24.2 %, APIC +0.3 %); μ = 1.2 sticks: 1.2 mm
+    // (FLIP 0.27 m, APIC 0.16 m).
+    let pic = [
+        "solver.flip=0.0",
+        "solver.gravity_ramp_time=0.3",
+        "solver.end_time=1.0",
+    ];
+    for mu in [0.7, 0.8] {
+        let (t, x, _) = slide(45.0, mu, &pic);
+        let exact = closed_form_ramped(45.0, mu, t, 0.3);
+        let err = (x / exact - 1.0).abs();
+        println!("PIC, mu {mu}: x = {x:.5} m, closed form {exact:.5} m, error {err:.2e}");
+        assert!(err < 0.01, "mu {mu}: x = {x}, exact {exact}");
+    }
+    let (_, stuck, _) = slide(45.0, 1.2, &pic);
+    println!("PIC, mu 1.2: x = {stuck:.2e} m");
+    assert!(stuck.abs() < 3e-3, "block crept {stuck} m with tan θ < μ");
+}
+
+#[test]
+fn block_sticks_undamped_on_45_degrees_when_its_weight_acts_within_the_middle_third() {
+    // The 1 m × 0.5 m block sticking on 45° takes a friction force m g sin θ at its
+    // base, H/2 below its centre; the base's reaction then acts e = (H/2) tan θ =
+    // 0.25 m ahead of the centre, beyond the middle third (L/6 = 0.167 m), so the
+    // rear of the base unloads and the undamped block rocks and creeps (0.27 m
+    // in 1 s with FLIP). Half as tall (e = 0.125 m) it sticks: measured 0.25 mm.
+    let gradual = [
+        "solver.gravity_ramp_time=0.3",
+        "solver.end_time=1.0",
+        "body.1.max=[1.0,0.5]",
+    ];
+    let (_, stuck, _) = slide(45.0, 1.2, &gradual);
+    let (t, x, _) = slide(45.0, 0.5, &gradual);
+    let exact = closed_form_ramped(45.0, 0.5, t, 0.3);
+    println!(
+        "H = 0.25 m, FLIP, undamped: mu 1.2 moved {stuck:.2e} m; mu 0.5 slid {x:.4} m \
+         (closed form {exact:.4} m)"
+    );
+    assert!((x / exact - 1.0).abs() < 0.01, "mu 0.5: {x}, exact {exact}");
+    assert!(stuck.abs() < 1e-3, "block crept {stuck} m with tan θ < μ");
 }
 
 /// Particles of the final state: (body, x, y, vx, vy, mass).
