@@ -39,12 +39,13 @@ impl LoadTime {
     }
 }
 
-/// Load factor of particle q from its ramp (`Model::load_ramp_of`) and the factor
-/// of each ramp (0: the particle carries no load).
+/// Load factor of particle q from its ramp (`Model::load_ramp_of`, empty when
+/// the scene has no loads) and the factor of each ramp (0: the particle carries
+/// no load).
 pub fn load_factor(ramp_of: &[u32], q: usize, scales: &[f64]) -> f64 {
-    match ramp_of[q] {
-        u32::MAX => 0.0,
-        r => scales[r as usize],
+    match ramp_of.get(q) {
+        None | Some(&u32::MAX) => 0.0,
+        Some(&r) => scales[r as usize],
     }
 }
 
@@ -52,7 +53,8 @@ pub fn load_factor(ramp_of: &[u32], q: usize, scales: &[f64]) -> f64 {
 pub struct Loads {
     /// The distinct time histories.
     pub ramps: Vec<LoadTime>,
-    /// For each particle, the index into `ramps` of its load (u32::MAX: none).
+    /// For each particle, the index into `ramps` of its load (u32::MAX: none);
+    /// empty, as `Particles::load`, when the scene has no loads.
     pub ramp_of: Vec<u32>,
 }
 
@@ -64,7 +66,14 @@ impl Loads {
         particles: &mut Particles<D>,
     ) -> Result<Loads, (String, String)> {
         let vec = |v: &[f64]| Vector::<D>::from_fn(|d, _| v[d]);
+        if c.loads.is_empty() {
+            return Ok(Loads {
+                ramps: Vec::new(),
+                ramp_of: Vec::new(),
+            });
+        }
         let mut ramp_of = vec![u32::MAX; particles.len()];
+        particles.load = vec![Vector::<D>::zeros(); particles.len()];
         let mut ramps = Vec::new();
         for (i, l) in c.loads.iter().enumerate() {
             let body = l.body.as_ref().map(|n| {

@@ -28,7 +28,8 @@ pub struct Particles<const D: usize> {
     pub half_length0: Vec<Vector<D>>,
     pub body: Vec<u32>,
     pub material: Vec<u32>,
-    /// Applied force on the particle (point loads and tractions), before load scaling.
+    /// Applied force on the particle (point loads and tractions), before load
+    /// scaling; empty when no particle carries a load (`model::loads`).
     pub load: Vec<Vector<D>>,
     pub history: History,
     /// APIC's affine moment B_p = Σ_I S_Ip v_I (x_I − x_p)ᵀ (`physics::apic`):
@@ -147,7 +148,6 @@ impl<const D: usize> Particles<D> {
         self.half_length0.reserve_exact(n);
         self.body.reserve_exact(n);
         self.material.reserve_exact(n);
-        self.load.reserve_exact(n);
     }
 
     /// Add one particle at rest, undeformed and unstressed.
@@ -174,7 +174,9 @@ impl<const D: usize> Particles<D> {
         self.half_length0.push(half_length0);
         self.body.push(body);
         self.material.push(material);
-        self.load.push(Vector::<D>::zeros());
+        if !self.load.is_empty() {
+            self.load.push(Vector::<D>::zeros());
+        }
         self.history.push(n_history);
     }
 }

@@ -416,7 +416,23 @@ pub fn applied_force<const D: usize>(
     gravity: &Vector<D>,
     load_factor: &impl Fn(usize) -> f64,
 ) -> Vector<D> {
-    applied(gravity, p.mass[q], &p.load[q], load_factor(q))
+    applied_to(gravity, p.mass[q], &p.load, q, || load_factor(q))
+}
+
+/// [`applied`] for particle q of the loads `load` (`Particles::load`: empty
+/// when no particle carries one, and then neither load nor factor is read).
+#[inline(always)]
+pub fn applied_to<const D: usize>(
+    gravity: &Vector<D>,
+    mass: f64,
+    load: &[Vector<D>],
+    q: usize,
+    factor: impl Fn() -> f64,
+) -> Vector<D> {
+    match load.get(q) {
+        Some(f) => applied(gravity, mass, f, factor()),
+        None => gravity * mass,
+    }
 }
 
 /// m g + s f: gravity on a mass m and a load f at load factor s.

@@ -169,10 +169,18 @@ impl ParticleState {
             ("half_length0", self.half_length0.len(), n * D),
             ("body", self.body.len(), n),
             ("material", self.material.len(), n),
-            ("load", self.load.len(), n * D),
             ("history_offset", self.history_offset.len(), n),
             ("history_len", self.history_len.len(), n),
         ];
+        // The loads and the affine moments are kept only where a scene has them.
+        let load = [0, n * D];
+        if !load.contains(&self.load.len()) {
+            return Err(format!(
+                "particles.load has {} values, 0 or {} expected for {n} particles",
+                self.load.len(),
+                load[1]
+            ));
+        }
         let affine = [0, n * D * D];
         if !affine.contains(&self.affine.len()) {
             return Err(format!(

@@ -22,7 +22,7 @@ use crate::physics::deformation::{update_particle, ParticleState};
 use crate::physics::grid_update::{acceleration, TINY_MASS_FRACTION};
 use crate::physics::scatter::{NodeBox, Points, Stencil};
 use crate::physics::shape::{deformation_for, ShapeFunction};
-use crate::physics::transfer::{applied, applied_force, nodal_velocity};
+use crate::physics::transfer::{applied_force, applied_to, nodal_velocity};
 use crate::scene::Scheme;
 use crate::solver::divergence::{inverted, sound, unsound, Divergence};
 use rayon::prelude::*;
@@ -245,12 +245,9 @@ impl<const D: usize> ScatterStep<D> {
             let (v, w) = unsafe { (velocity.at(q), work.at(q)) };
             let v_old = *v;
             *v = (v_old + a * dt) * s.flip + vp * (1.0 - s.flip);
-            let applied = applied(
-                &s.gravity,
-                mass[q],
-                &load[q],
-                load_factor(ramp_of, q, scales),
-            );
+            let applied = applied_to(&s.gravity, mass[q], load, q, || {
+                load_factor(ramp_of, q, scales)
+            });
             *w = applied.dot(&(v_old + *v)) * 0.5;
             *v * mass[q]
         };
@@ -408,12 +405,9 @@ impl<const D: usize> ScatterStep<D> {
             (&*mass, &*volume0, &*half_length0, &*load, &*material);
         let affine = DisjointSlice::new(affine);
         let applied = |q: usize| {
-            applied(
-                &s.gravity,
-                mass[q],
-                &load[q],
-                load_factor(ramp_of, q, scales),
-            )
+            applied_to(&s.gravity, mass[q], load, q, || {
+                load_factor(ramp_of, q, scales)
+            })
         };
         // The last pass checks the state, as `check_state` does after a step.
         let checks = matches!(pass, Pass::Full | Pass::Motion | Pass::Remapped);
