@@ -134,3 +134,60 @@ impl Loads {
         Ok(Loads { ramps, ramp_of })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::model::Model;
+    use crate::scene::Scene;
+
+    const BLOCK: &str = r#"
+dimension = 2
+gravity = [0.0, -9.81]
+[grid]
+min = [0.0, 0.0]
+max = [2.0, 2.0]
+cells = [4, 4]
+[[material]]
+name = "m"
+model = "linear_elastic"
+density = 1000.0
+youngs_modulus = 1.0e6
+poisson_ratio = 0.3
+[[body]]
+material = "m"
+shape = "rectangle"
+min = [0.0, 0.0]
+max = [1.0, 1.0]
+[solver]
+kind = "explicit"
+end_time = 0.01
+"#;
+
+    const LOAD: &str = r#"
+[[load]]
+kind = "point"
+force = [0.0, -10.0]
+region_min = [0.5, 0.5]
+region_max = [1.0, 1.0]
+"#;
+
+    #[test]
+    fn only_a_scene_with_loads_keeps_them_per_particle() {
+        let model = |text: &str| {
+            let scene = Scene::parse("block.toml", text, &[]).unwrap();
+            Model::<2>::build(&scene).unwrap()
+        };
+        let bare = model(BLOCK);
+        assert!(bare.particles.len() > 0);
+        assert!(bare.particles.load.is_empty() && bare.load_ramp_of.is_empty());
+        let loaded = model(&format!("{BLOCK}{LOAD}"));
+        let n = loaded.particles.len();
+        assert_eq!(
+            (loaded.particles.load.len(), loaded.load_ramp_of.len()),
+            (n, n)
+        );
+        let carrying = (0..n).filter(|&q| loaded.load_ramp_of[q] != u32::MAX);
+        let total = carrying.fold(0.0, |t, q| t + loaded.particles.load[q][1]);
+        assert!((total + 10.0).abs() < 1e-12, "{total}");
+    }
+}

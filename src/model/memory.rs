@@ -65,14 +65,20 @@ impl Estimate {
             })
             .collect();
         let particles: f64 = lattice_points.iter().sum();
-        // x, x0, v, half-lengths, load; mass and volumes; F and σ (packed); ids;
-        // history; the stencil (weight, gradient, node).
+        // x, x0, v, half-lengths and, in a scene with loads, the load and its ramp;
+        // mass and volumes; F and σ (packed); ids; history; the stencil (weight,
+        // gradient, node).
         let tensors = 8 * (Layout::gradient(dim).components() + Layout::stress(dim).components());
         // APIC's affine moment B_p (D × D) where a stage keeps one.
         let apic = c.stages().into_iter().any(|s| s.apic());
         let affine = if apic { 8.0 * d * d } else { 0.0 };
         let per_particle = affine
-            + 5.0 * 8.0 * d
+            + 4.0 * 8.0 * d
+            + if c.loads.is_empty() {
+                0.0
+            } else {
+                8.0 * d + 4.0
+            }
             + 3.0 * 8.0
             + tensors as f64
             + 8.0

@@ -130,6 +130,20 @@ fn explicit_restart_is_byte_identical() {
     assert!(steps[0] > 0 && steps[1] > steps[0], "{steps:?}");
 }
 
+/// The loads live on the particles (`Particles::load`, kept only by scenes that
+/// have loads): a restart in the middle of a traction pulse takes them from the
+/// checkpoint.
+#[test]
+fn loaded_restart_is_byte_identical() {
+    let steps = restarts_are_exact(
+        "wave_p.toml",
+        &["solver.end_time=0.02", "output.frames=2"],
+        0.008,
+        2,
+    );
+    assert!(steps[0] > 0 && steps[1] > steps[0], "{steps:?}");
+}
+
 /// APIC's affine moments are state: a restart that lost them (and formed them
 /// anew by the projection of the first step) would not be byte-identical.
 #[test]
