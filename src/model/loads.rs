@@ -138,30 +138,8 @@ impl Loads {
 #[cfg(test)]
 mod tests {
     use crate::model::Model;
+    use crate::scene::testing::BLOCK;
     use crate::scene::Scene;
-
-    const BLOCK: &str = r#"
-dimension = 2
-gravity = [0.0, -9.81]
-[grid]
-min = [0.0, 0.0]
-max = [2.0, 2.0]
-cells = [4, 4]
-[[material]]
-name = "m"
-model = "linear_elastic"
-density = 1000.0
-youngs_modulus = 1.0e6
-poisson_ratio = 0.3
-[[body]]
-material = "m"
-shape = "rectangle"
-min = [0.0, 0.0]
-max = [1.0, 1.0]
-[solver]
-kind = "explicit"
-end_time = 0.01
-"#;
 
     const LOAD: &str = r#"
 [[load]]

@@ -14,6 +14,8 @@ mod grid;
 mod material;
 pub mod overrides;
 mod solver;
+#[cfg(test)]
+pub(crate) mod testing;
 pub mod validate;
 
 pub use config::*;

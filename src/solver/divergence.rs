@@ -126,28 +126,8 @@ pub fn unsound<const D: usize>(m: &Model<D>, q: usize, step: usize, time: f64) -
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::testing::BLOCK;
     use crate::scene::Scene;
-
-    const BLOCK: &str = r#"dimension = 2
-[grid]
-min = [0.0, 0.0]
-max = [2.0, 1.0]
-cells = [2, 1]
-[[material]]
-name = "m"
-model = "linear_elastic"
-density = 1.0
-youngs_modulus = 100.0
-poisson_ratio = 0.3
-[[body]]
-material = "m"
-shape = "rectangle"
-min = [0.0, 0.0]
-max = [1.0, 1.0]
-[solver]
-kind = "explicit"
-end_time = 1.0
-"#;
 
     #[test]
     fn a_collapsed_or_inverted_particle_stops_the_run() {
