@@ -156,7 +156,7 @@ region_max = [1.0, 1.0]
             Model::<2>::build(&scene).unwrap()
         };
         let bare = model(BLOCK);
-        assert!(bare.particles.len() > 0);
+        assert!(!bare.particles.is_empty());
         assert!(bare.particles.load.is_empty() && bare.load_ramp_of.is_empty());
         let loaded = model(&format!("{BLOCK}{LOAD}"));
         let n = loaded.particles.len();
