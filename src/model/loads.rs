@@ -65,13 +65,13 @@ impl Loads {
         c: &SceneConfig,
         particles: &mut Particles<D>,
     ) -> Result<Loads, (String, String)> {
-        let vec = |v: &[f64]| Vector::<D>::from_fn(|d, _| v[d]);
         if c.loads.is_empty() {
             return Ok(Loads {
                 ramps: Vec::new(),
                 ramp_of: Vec::new(),
             });
         }
+        let vec = |v: &[f64]| Vector::<D>::from_fn(|d, _| v[d]);
         let mut ramp_of = vec![u32::MAX; particles.len()];
         particles.load = vec![Vector::<D>::zeros(); particles.len()];
         let mut ramps = Vec::new();

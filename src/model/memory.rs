@@ -196,33 +196,25 @@ pub fn limit(given: Option<f64>) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::testing::BLOCK;
     use crate::scene::Scene;
 
-    const SCENE: &str = r#"dimension = 2
-[grid]
-min = [0.0, 0.0]
-max = [10.0, 10.0]
-cells = [100, 100]
-[[material]]
-name = "m"
-model = "linear_elastic"
-density = 1.0
-youngs_modulus = 100.0
-poisson_ratio = 0.3
-[[body]]
-material = "m"
-shape = "rectangle"
-min = [0.0, 0.0]
-max = [5.0, 5.0]
-[solver]
-kind = "implicit"
-end_time = 1.0
-dt = 0.1
-"#;
+    /// `BLOCK` made a 10 m square of 100² cells with a 5 m body, implicit.
+    const SCENE: [&str; 5] = [
+        "grid.max=[10.0, 10.0]",
+        "grid.cells=[100, 100]",
+        "body.0.max=[5.0, 5.0]",
+        "solver.kind=\"implicit\"",
+        "solver.dt=0.1",
+    ];
 
     fn estimate(overrides: &[&str]) -> Estimate {
-        let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-        Estimate::of(&Scene::parse("s.toml", SCENE, &o).unwrap().config)
+        let o: Vec<String> = SCENE
+            .iter()
+            .chain(overrides)
+            .map(|s| s.to_string())
+            .collect();
+        Estimate::of(&Scene::parse("s.toml", BLOCK, &o).unwrap().config)
     }
 
     #[test]

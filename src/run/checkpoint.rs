@@ -173,21 +173,16 @@ impl ParticleState {
             ("history_len", self.history_len.len(), n),
         ];
         // The loads and the affine moments are kept only where a scene has them.
-        let load = [0, n * D];
-        if !load.contains(&self.load.len()) {
-            return Err(format!(
-                "particles.load has {} values, 0 or {} expected for {n} particles",
-                self.load.len(),
-                load[1]
-            ));
-        }
-        let affine = [0, n * D * D];
-        if !affine.contains(&self.affine.len()) {
-            return Err(format!(
-                "particles.affine has {} values, 0 or {} expected for {n} particles",
-                self.affine.len(),
-                affine[1]
-            ));
+        let optional = [
+            ("load", self.load.len(), n * D),
+            ("affine", self.affine.len(), n * D * D),
+        ];
+        for (name, got, want) in optional {
+            if got != 0 && got != want {
+                return Err(format!(
+                    "particles.{name} has {got} values, 0 or {want} expected for {n} particles"
+                ));
+            }
         }
         for (name, got, want) in lengths {
             if got != want {

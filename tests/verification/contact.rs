@@ -41,9 +41,15 @@ fn slide_on(text: &str, theta_deg: f64, mu: f64, extra: &[&str]) -> (f64, f64, t
     (*t.last().unwrap(), x.last().unwrap() - x[0], dir)
 }
 
-fn closed_form(theta_deg: f64, mu: f64, t: f64) -> f64 {
+/// The rigid block's acceleration down the slope, g (sin θ − μ cos θ), or 0 where
+/// it sticks.
+fn acceleration(theta_deg: f64, mu: f64) -> f64 {
     let th = theta_deg.to_radians();
-    0.5 * G * t * t * (th.sin() - mu * th.cos()).max(0.0)
+    G * (th.sin() - mu * th.cos()).max(0.0)
+}
+
+fn closed_form(theta_deg: f64, mu: f64, t: f64) -> f64 {
+    0.5 * acceleration(theta_deg, mu) * t * t
 }
 
 #[test]
@@ -160,8 +166,7 @@ fn block_sticks_undamped_under_gradual_gravity_on_a_30_degree_slope() {
 /// grows as a t / T, so x = a (t²/2 − T t/2 + T²/6).
 fn closed_form_ramped(theta_deg: f64, mu: f64, t: f64, ramp: f64) -> f64 {
     assert!(t >= ramp);
-    let a = closed_form(theta_deg, mu, 1.0) * 2.0;
-    a * (t * t / 2.0 - ramp * t / 2.0 + ramp * ramp / 6.0)
+    acceleration(theta_deg, mu) * (t * t / 2.0 - ramp * t / 2.0 + ramp * ramp / 6.0)
 }
 
 #[test]
