@@ -350,4 +350,5 @@ def main():
         CASES[name](out, quick)
 
 
-main()
+if __name__ == "__main__":
+    main()
