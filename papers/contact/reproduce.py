@@ -7,9 +7,10 @@ Markdown. Standard library only.
 usage (from the repository root, after `cargo build --release`):
     python3 papers/contact/reproduce.py [OUT_DIR] [--quick] [--only NAME,...]
 MPM=path/to/mpm picks the binary (default target/release/mpm, else `mpm`).
---quick leaves out the finest grids (R/20 and R/16 cylinders, the h = B/32
-footings); NAME is one of cylinder, seed, seed3d, incline, terrain, disks,
-plate, footing. The whole run takes 15–25 minutes on 2 cores.
+--quick leaves out the finest grids (R/20, R/16 and R/32 cylinders, the h = B/32
+footings, the 1.25 ms implicit runs near the sticking limit); NAME is one of
+cylinder, seed, seed3d, incline, limit, terrain, disks, plate, footing. The
+whole run takes 20–30 minutes on 2 cores.
 """
 import csv
 import json
@@ -153,7 +154,9 @@ def seed(out, quick):
     scene = HERE / "seed_cylinder.toml"
     print("\n### Rolling cylinder at the seed's scale, `seed_cylinder.toml` (θ = 30°, R = 3.2 m, E = 42 MPa on 420 MPa)\n")
     print(CYL_HEADER)
-    grids = [("[50,23]", "0.4 m = R/8 (the seed's)")] + ([] if quick else [("[100,46]", "0.2 m = R/16")])
+    grids = [("[50,23]", "0.4 m = R/8 (the seed's)")]
+    if not quick:
+        grids += [("[100,46]", "0.2 m = R/16"), ("[200,92]", "0.1 m = R/32")]
     for cells, h in grids:
         for mu in (0.0, 0.1, 0.3):
             tag = f"seed_{cells.strip('[]').replace(',', 'x')}_{mu}"
@@ -216,6 +219,47 @@ def incline(out, quick):
         t, x = moved(d)
         print(f"| {base} base, θ = 30°, 0.7 (= 1.21 tan θ), undamped, gravity over 0.3 s, t = {t:.1f} s "
               f"| {x:.2e} | 0 | — |")
+
+
+def limit(out, quick):
+    """The block of problems/contact_incline.toml near the sticking limit,
+    undamped, explicit (PIC, APIC, FLIP) beside the implicit solver
+    (problems/contact_incline_implicit.toml) at several time steps."""
+    explicit = ROOT / "problems" / "contact_incline.toml"
+    implicit = ROOT / "problems" / "contact_incline_implicit.toml"
+    th, g = math.radians(45.0), 9.81
+    transfers = (("PIC", "solver.flip=0.0"), ("APIC", 'solver.velocity_transfer="apic"'),
+                 ("FLIP", "solver.flip=1.0"))
+    steps = (0.005, 0.0025) if quick else (0.005, 0.0025, 0.00125)
+
+    def rigid_law(mu, t, ramp):
+        a = g * max(math.sin(th) - mu * math.cos(th), 0.0)
+        if ramp == 0.0:
+            return 0.5 * a * t * t
+        return a * (ramp * ramp / 6.0 + ramp * (t - ramp) / 2.0 + (t - ramp) ** 2 / 2.0)
+
+    def measure(scene, tag, mu, sets, ramp):
+        d = out / tag
+        run(scene, d, [f"contact.0.friction_coefficient={mu}", "output.frames=0", *sets])
+        t, x = moved(d)
+        x0 = rigid_law(mu, t, ramp)
+        return pct(x, x0) if x0 > 0.0 else f"{x:.3g} m"
+
+    print("\n### Near the sticking limit: explicit beside implicit (θ = 45°, undamped)\n")
+    print("| case | implicit, Δt = " + " / ".join(f"{1e3 * dt:g}" for dt in steps)
+          + " ms | explicit " + " / ".join(n for n, _ in transfers) + " |\n|---|---|---|")
+    cases = (("μ = 0.8, gravity at once, 0.5 s", 0.8, [], 0.0),
+             ("μ = 0.9, gravity at once, 0.5 s", 0.9, [], 0.0),
+             ("μ = 0.8, gravity over 0.3 s, 1 s", 0.8, ["solver.gravity_ramp_time=0.3", "solver.end_time=1.0"], 0.3),
+             ("μ = 1.2, gravity over 0.3 s, 1 s: moved", 1.2,
+              ["solver.gravity_ramp_time=0.3", "solver.end_time=1.0"], 0.3),
+             ("block half as tall, μ = 1.2, over 0.3 s, 1 s: moved", 1.2,
+              ["body.1.max=[1.0,0.5]", "solver.gravity_ramp_time=0.3", "solver.end_time=1.0"], 0.3))
+    for k, (label, mu, sets, ramp) in enumerate(cases):
+        imp = [measure(implicit, f"limit_{k}_implicit_{dt}", mu, [f"solver.dt={dt}", *sets], ramp)
+               for dt in steps]
+        exp = [measure(explicit, f"limit_{k}_{name}", mu, [key, *sets], ramp) for name, key in transfers]
+        print(f"| {label} | {' / '.join(imp)} | {' / '.join(exp)} |")
 
 
 def terrain(out, quick):
@@ -332,8 +376,8 @@ def footing(out, quick):
             print(f"| {h} | {label} | {q:.3f} | {pct(q, prandtl)} | {wall:.0f} |")
 
 
-CASES = {"cylinder": cylinder, "seed": seed, "seed3d": seed3d, "incline": incline, "terrain": terrain,
-         "disks": disks, "plate": plate, "footing": footing}
+CASES = {"cylinder": cylinder, "seed": seed, "seed3d": seed3d, "incline": incline, "limit": limit,
+         "terrain": terrain, "disks": disks, "plate": plate, "footing": footing}
 
 
 def main():
