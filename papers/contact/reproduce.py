@@ -161,6 +161,11 @@ def seed(out, quick):
         for mu in (0.0, 0.1, 0.3):
             tag = f"seed_{cells.strip('[]').replace(',', 'x')}_{mu}"
             roll(out, scene, tag, f"h = {h}", mu, [f"grid.cells={cells}"])
+    if not quick:
+        # Contact declared closer to touch: λ = 0.005 instead of the scene's 0.02.
+        for mu in (0.0, 0.1, 0.3):
+            roll(out, scene, f"seed_200x92_gap0.005_{mu}", "h = R/32, λ = 0.005", mu,
+                 ["grid.cells=[200,92]", "contact.0.gap_factor=0.005"])
 
 
 def seed3d(out, quick):
