@@ -10,7 +10,7 @@ MPM=path/to/mpm picks the binary (default target/release/mpm, else `mpm`).
 --quick leaves out the finest grids (R/20, R/16 and R/32 cylinders, the h = B/32
 footings, the 1.25 ms implicit runs near the sticking limit); NAME is one of
 cylinder, seed, seed3d, incline, limit, terrain, disks, plate, footing. The
-whole run takes 20–30 minutes on 2 cores.
+whole run takes 35–50 minutes on 2 cores.
 """
 import csv
 import json
