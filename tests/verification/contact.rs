@@ -1773,11 +1773,11 @@ fn near_the_sticking_limit_both_solvers_slide_the_ringing_block_past_the_rigid_l
     // μ = 0.8 tan θ, gravity in full at once, undamped: the elastic block rings
     // on the base and both solvers, with their different contact laws (explicit:
     // velocity corrections at shared nodes; implicit: a penalty between split
-    // nodes), slide it farther than the rigid block's law, by the same amount.
+    // nodes), slide it farther than the rigid block's law, by about as much.
     // Measured at 0.5 s: implicit +14.45 % (Δt = 5 ms), explicit PIC +11.66 %,
     // FLIP +16.29 % (APIC +13.51 %). So the excess of the explicit runs near
-    // the limit (docs/contact.md, "Sliding near the sticking limit") is the
-    // undamped elastic block's, not the explicit contact's.
+    // the limit (docs/contact.md, "Sliding near the sticking limit") belongs to
+    // the undamped elastic block on this grid, not to the explicit contact law.
     let mu = 0.8;
     let (t, implicit, _) = implicit_slide(mu, &[]);
     let rigid = closed_form(45.0, mu, t);
