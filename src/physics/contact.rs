@@ -384,6 +384,7 @@ mod tests {
             area: 1.0,
             gap: 0.0,
             reach: [0.0; 2],
+            outermost: [u32::MAX; 2],
             close: true,
             law: ContactLaw {
                 friction: mu,

@@ -64,6 +64,10 @@ pub struct Meeting<const D: usize> {
     /// normal (n for r, −n for s): r's surface is at x_I + reach[0] n, s's at
     /// x_I − reach[1] n.
     pub reach: [f64; 2],
+    /// The particles of r and s whose centres lie farthest along n and −n
+    /// among those that give the gap (`u32::MAX` where none does): the implicit
+    /// contact follows them from step to step (`solver::implicit::contact`).
+    pub outermost: [u32; 2],
     /// The gap criterion D ≤ λ h holds.
     pub close: bool,
     pub law: ContactLaw,
@@ -235,8 +239,9 @@ impl FieldSplit {
         // a: over all its particles, or (`local`) over those whose domain spans
         // the node's line along n, so that D is the gap at the node and not the
         // smallest gap in its support (a rolling body's surface just ahead of
-        // the contact point is not in contact).
-        let extent = |a: usize, x_node: &Vector<D>, n: &Vector<D>, local: bool| -> f64 {
+        // the contact point is not in contact). With it, the particle whose
+        // centre lies farthest along n.
+        let extent = |a: usize, x_node: &Vector<D>, n: &Vector<D>, local: bool| -> (f64, u32) {
             // A particle's reach along a unit direction u: Σ_d l_d |u · F e_d|.
             let reach = |q: usize, u: &Vector<D>| -> f64 {
                 let f = &p.f.get(q);
@@ -247,19 +252,21 @@ impl FieldSplit {
                     })
                     .sum()
             };
-            map.node_entries(a)
-                .iter()
-                .map(|&e| {
-                    let q = owner.of(e);
-                    let r = p.x[q] - x_node;
-                    let lateral = r - n * r.dot(n);
-                    let off = lateral.norm();
-                    if local && off > 0.0 && off > reach(q, &(lateral / off)) * (1.0 + 1e-9) {
-                        return f64::NEG_INFINITY;
-                    }
-                    r.dot(n) + reach(q, n)
-                })
-                .fold(f64::NEG_INFINITY, f64::max)
+            let (mut farthest, mut outermost) = (f64::NEG_INFINITY, (f64::NEG_INFINITY, u32::MAX));
+            for &e in map.node_entries(a) {
+                let q = owner.of(e);
+                let r = p.x[q] - x_node;
+                let lateral = r - n * r.dot(n);
+                let off = lateral.norm();
+                if local && off > 0.0 && off > reach(q, &(lateral / off)) * (1.0 + 1e-9) {
+                    continue;
+                }
+                farthest = farthest.max(r.dot(n) + reach(q, n));
+                if r.dot(n) > outermost.0 {
+                    outermost = (r.dot(n), q as u32);
+                }
+            }
+            (farthest, outermost.1)
         };
         let unit = |v: Vector<D>| {
             let n = v.norm();
@@ -304,10 +311,9 @@ impl FieldSplit {
                     // striker's deceleration and the momentum of the rigid-disk
                     // impact left their tolerances (tests/verification/contact.rs).
                     let local = !(plan.rigid[fr] || plan.rigid[fs]);
-                    let reach = [
-                        extent(r, &x_node, &normal, local),
-                        extent(s, &x_node, &-normal, local),
-                    ];
+                    let (reach_r, outer_r) = extent(r, &x_node, &normal, local);
+                    let (reach_s, outer_s) = extent(s, &x_node, &-normal, local);
+                    let reach = [reach_r, reach_s];
                     let gap = -reach[0] - reach[1];
                     // The contact area (adhesion), per radian in axisymmetric mode.
                     let ring = if axisymmetric { x_node[0] } else { 1.0 };
@@ -322,6 +328,7 @@ impl FieldSplit {
                         area: 0.5 * (gr.norm() + gs.norm()) * ring,
                         gap,
                         reach,
+                        outermost: [outer_r, outer_s],
                         close: gap <= law.gap_factor * h,
                         law,
                     });

@@ -38,7 +38,7 @@ use std::path::{Path, PathBuf};
 /// What a checkpoint file says it is.
 pub const FORMAT: &str = "mpm checkpoint";
 /// The layout of the body; a build reads only its own version.
-pub const VERSION: u32 = 1;
+pub const VERSION: u32 = 2;
 /// How many checkpoints a run keeps (the older ones it wrote are removed).
 pub const KEEP: usize = 2;
 

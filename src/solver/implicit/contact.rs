@@ -110,6 +110,14 @@ const CARRIED_POINT_STRAY: f64 = 0.5;
 /// The smallest nodal area of a meeting, as a fraction of a cell face h^{D−1}.
 const MIN_AREA: f64 = 0.05;
 
+/// How far, as a fraction of the smallest cell size, the outermost particle of
+/// a side at a meeting must lie beyond or short of its reference particle along
+/// the normal before the carried gap follows it (`Fields::assign_history`).
+/// A sliding disk of radius R changes the gap at a node by about h²/(8R) as it
+/// passes (0.0125 h at R = 10 h); the strain between neighbouring particles of a
+/// flat face moves them by much less.
+const OUTERMOST_SWITCH: f64 = 1e-3;
+
 /// ε_t / ε_n at a meeting of two deformable fields. With ε_t = ε_n a meeting
 /// sticks only while its tangential slip in the step stays below μ g, g the
 /// normal penetration (about 1e-6 of a cell): where the bodies hardly move
@@ -150,6 +158,10 @@ struct Joint<const D: usize> {
     gap_end: f64,
 }
 
+/// What a meeting carries to the next step: (grid node, r, s), tangential
+/// force, gap at the step's end, outermost particles.
+type Carried<const D: usize> = ([u32; 3], Vector<D>, f64, [u32; 2]);
+
 /// The contact between deformable bodies on the split grid.
 #[derive(Clone, Debug)]
 struct Fields<const D: usize> {
@@ -159,8 +171,9 @@ struct Fields<const D: usize> {
     /// The meetings of this step.
     joints: Vec<Joint<D>>,
     /// What each meeting carried out of the last step, by (grid node, r, s):
-    /// its tangential force and its gap at the step's end.
-    history: Vec<([u32; 3], Vector<D>, f64)>,
+    /// its tangential force, its gap at the step's end and its outermost
+    /// particles (`Meeting::outermost`).
+    history: Vec<Carried<D>>,
     /// Meetings in contact at the last residual.
     touches: Vec<NodeTouch<D>>,
 }
@@ -173,13 +186,40 @@ impl<const D: usize> Fields<D> {
     /// compressed particle's extent shrinks with F, so the gap they show opens
     /// by the compression of the two half-domains at every step, and the
     /// penalty, closing it, strains the cells at the interface.)
-    fn assign_history(&mut self) {
+    ///
+    /// The carried gap is pinned to the grid node, and a body that slides past
+    /// the node brings other particles to it: on a curved surface the gap
+    /// there changes although neither surface moved along n (ahead of a
+    /// sliding disk's lowest point it closes, behind it opens). So each side
+    /// keeps a reference particle, the outermost at the node when the meeting
+    /// began; where the outermost particle now lies farther along n than the
+    /// reference by more than `OUTERMOST_SWITCH` h, or nearer by as much, the
+    /// gap changes by that difference of their centres (both at their
+    /// step-start positions x) and the outermost becomes the reference. On a
+    /// flat face neighbouring particles differ by the strain between them
+    /// only, the reference stays and so does the carried gap.
+    fn assign_history(&mut self, x: &[Vector<D>], h: f64) {
         let history = &self.history;
         for j in &mut self.joints {
             j.f_t0 = Vector::<D>::zeros();
-            if let Ok(i) = history.binary_search_by_key(&j.key, |h| h.0) {
-                j.f_t0 = history[i].1;
-                j.meeting.gap = history[i].2;
+            if let Ok(i) = history.binary_search_by_key(&j.key, |k| k.0) {
+                let (_, f_t0, gap_end, reference) = history[i];
+                j.f_t0 = f_t0;
+                j.meeting.gap = gap_end;
+                let n = j.meeting.normal;
+                for (side, sign) in [(0, -1.0), (1, 1.0)] {
+                    // How far the outermost particle lies beyond the reference
+                    // along the side's outward normal (n for r, −n for s).
+                    let (now, then) = (j.meeting.outermost[side], reference[side]);
+                    let (Some(a), Some(b)) = (x.get(now as usize), x.get(then as usize)) else {
+                        continue;
+                    };
+                    let beyond = -sign * (a - b).dot(&n);
+                    match beyond.abs() > OUTERMOST_SWITCH * h {
+                        true => j.meeting.gap -= beyond,
+                        false => j.meeting.outermost[side] = then,
+                    }
+                }
             }
         }
     }
@@ -364,7 +404,7 @@ impl<const D: usize> PenaltyContact<D> {
             })
             .collect();
         fields.nodes = Some(nodes);
-        fields.assign_history();
+        fields.assign_history(&p.x, h);
         fields.touches.clear();
     }
 
@@ -759,7 +799,7 @@ impl<const D: usize> PenaltyContact<D> {
                 tangential[t.meeting] = t.contact.tangential;
             }
             f.history = (f.joints.iter().zip(tangential))
-                .map(|(j, f_t)| (j.key, f_t, j.gap_end))
+                .map(|(j, f_t)| (j.key, f_t, j.gap_end, j.meeting.outermost))
                 .collect();
             f.history.sort_by_key(|h| h.0);
             for t in &f.touches {
@@ -778,37 +818,46 @@ impl<const D: usize> PenaltyContact<D> {
 
     /// The tangential forces carried to the next step, D values per particle
     /// (empty without friction), for a checkpoint.
-    /// Then, with contact between deformable bodies, 4 + D values per meeting:
-    /// its grid node, fields r and s, tangential force and gap.
+    /// Then, with contact between deformable bodies, 6 + D values per meeting:
+    /// its grid node, fields r and s, tangential force, gap and outermost
+    /// particles.
     pub fn tangential_state(&self) -> Vec<f64> {
         let particles = self.tangential.iter().flat_map(|f| f.iter().copied());
         let meetings = (self.fields.iter()).flat_map(|f| {
-            (f.history.iter()).flat_map(|(key, v, gap)| {
+            (f.history.iter()).flat_map(|(key, v, gap, outermost)| {
                 let key = key.iter().map(|&k| k as f64);
-                key.chain(v.iter().copied()).chain([*gap])
+                let outermost = outermost.iter().map(|&q| q as f64);
+                key.chain(v.iter().copied()).chain([*gap]).chain(outermost)
             })
         });
         particles.chain(meetings).collect()
     }
 
     /// Continue with the tangential forces of a checkpoint (`tangential_state`;
-    /// nothing happens with an empty one).
-    pub fn restore_tangential(&mut self, state: &[f64]) {
+    /// nothing happens with an empty one), the particles at x, h the smallest
+    /// cell size.
+    pub fn restore_tangential(&mut self, state: &[f64], x: &[Vector<D>], h: f64) {
         let n = self.tangential.len() * D;
-        if state.is_empty() || state.len() < n || (state.len() - n) % (4 + D) != 0 {
+        if state.is_empty() || state.len() < n || (state.len() - n) % (6 + D) != 0 {
             return;
         }
         self.tangential = (state[..n].chunks_exact(D))
             .map(Vector::<D>::from_column_slice)
             .collect();
         if let Some(f) = self.fields.as_mut() {
-            f.history = (state[n..].chunks_exact(4 + D))
+            f.history = (state[n..].chunks_exact(6 + D))
                 .map(|c| {
                     let key = [c[0] as u32, c[1] as u32, c[2] as u32];
-                    (key, Vector::<D>::from_column_slice(&c[3..3 + D]), c[3 + D])
+                    let outermost = [c[4 + D] as u32, c[5 + D] as u32];
+                    (
+                        key,
+                        Vector::<D>::from_column_slice(&c[3..3 + D]),
+                        c[3 + D],
+                        outermost,
+                    )
                 })
                 .collect();
-            f.assign_history();
+            f.assign_history(x, h);
         }
     }
 

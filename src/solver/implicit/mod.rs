@@ -162,7 +162,7 @@ impl<const D: usize> Implicit<D> {
     fn prepare(&mut self, m: &Model<D>, t: f64, dt: f64) {
         if let Some((tangential, points)) = self.restored_contact.take() {
             if let Some(contact) = self.system.contact_of(m) {
-                contact.restore_tangential(&tangential);
+                contact.restore_tangential(&tangential, &m.particles.x, m.grid.h_min());
                 contact.restore_carried_points(&points, m.particles.len());
             }
         }
