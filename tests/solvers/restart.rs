@@ -5,6 +5,7 @@
 //! stage boundary; a checkpoint that does not fit is refused with its name.
 
 use crate::common::problem;
+use mpm::run::checkpoint::VERSION;
 use mpm::run::summary::Summary;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -292,7 +293,12 @@ fn a_damaged_truncated_or_foreign_checkpoint_is_refused() {
     assert!(refused(&bad, "column.toml", &sets).contains("checksum"));
 
     let text = String::from_utf8(bytes.clone()).unwrap();
-    std::fs::write(&bad, text.replacen("\"version\":1,", "\"version\":99,", 1)).unwrap();
+    let version = format!("\"version\":{VERSION},");
+    assert!(
+        text.contains(&version),
+        "the header names version {VERSION}"
+    );
+    std::fs::write(&bad, text.replacen(&version, "\"version\":99,", 1)).unwrap();
     assert!(refused(&bad, "column.toml", &sets).contains("format version 99"));
 
     std::fs::write(&bad, b"{\"status\":\"completed\"}\n").unwrap();
@@ -321,7 +327,7 @@ fn the_restart_takes_its_state_from_the_checkpoint() {
     ck["external_work"] = serde_json::json!(work + 1000.0);
     let body = serde_json::to_string(&ck).unwrap();
     let header = format!(
-        "{{\"format\":\"mpm checkpoint\",\"version\":1,\"body_bytes\":{},\"body_fnv1a64\":\"{:016x}\"}}",
+        "{{\"format\":\"mpm checkpoint\",\"version\":{VERSION},\"body_bytes\":{},\"body_fnv1a64\":\"{:016x}\"}}",
         body.len(),
         fnv1a64(body.as_bytes())
     );
@@ -464,10 +470,10 @@ fn implicit_contact_restart_keeps_the_friction_history() {
 #[test]
 fn implicit_deformable_contact_restart_keeps_the_meetings_gaps_and_friction() {
     // A block sliding on a deformable base (Newmark, split nodes, μ = 0.3): each
-    // meeting's gap and tangential force at a step's end are carried to the next
-    // step under its grid node and fields, and a checkpoint keeps them
-    // (`contact_tangential`); without them the restarted run takes the gaps from
-    // the particles and differs.
+    // meeting's gap, tangential force and reference particles at a step's end
+    // are carried to the next step under its grid node and fields, and a
+    // checkpoint keeps them (`contact_tangential`); without them the restarted
+    // run takes the gaps from the particles and differs.
     restarts_are_exact(
         "contact_incline_implicit.toml",
         &[
