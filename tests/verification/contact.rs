@@ -1774,7 +1774,7 @@ fn near_the_sticking_limit_both_solvers_slide_the_ringing_block_past_the_rigid_l
     // on the base and both solvers, with their different contact laws (explicit:
     // velocity corrections at shared nodes; implicit: a penalty between split
     // nodes), slide it farther than the rigid block's law, by about as much.
-    // Measured at 0.5 s: implicit +14.45 % (Δt = 5 ms), explicit PIC +11.66 %,
+    // Measured at 0.5 s: implicit +14.43 % (Δt = 5 ms), explicit PIC +11.66 %,
     // FLIP +16.29 % (APIC +13.51 %). So the excess of the explicit runs near
     // the limit (docs/contact.md, "Sliding near the sticking limit") belongs to
     // the undamped elastic block on this grid, not to the explicit contact law.
