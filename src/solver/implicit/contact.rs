@@ -206,15 +206,15 @@ impl<const D: usize> Fields<D> {
                 let (_, f_t0, gap_end, reference) = history[i];
                 j.f_t0 = f_t0;
                 j.meeting.gap = gap_end;
-                let n = j.meeting.normal;
-                for (side, sign) in [(0, -1.0), (1, 1.0)] {
-                    // How far the outermost particle lies beyond the reference
-                    // along the side's outward normal (n for r, −n for s).
+                // Each side's outward normal: n for r, −n for s.
+                let outward = [j.meeting.normal, -j.meeting.normal];
+                for side in 0..2 {
+                    // How far the outermost particle lies beyond the reference.
                     let (now, then) = (j.meeting.outermost[side], reference[side]);
                     let (Some(a), Some(b)) = (x.get(now as usize), x.get(then as usize)) else {
                         continue;
                     };
-                    let beyond = -sign * (a - b).dot(&n);
+                    let beyond = (a - b).dot(&outward[side]);
                     match beyond.abs() > OUTERMOST_SWITCH * h {
                         true => j.meeting.gap -= beyond,
                         false => j.meeting.outermost[side] = then,
