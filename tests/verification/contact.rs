@@ -41,6 +41,13 @@ fn slide_on(text: &str, theta_deg: f64, mu: f64, extra: &[&str]) -> (f64, f64, t
     (*t.last().unwrap(), x.last().unwrap() - x[0], dir)
 }
 
+/// The text of `problems/NAME` with `from`, which it must hold, replaced by `to`.
+fn problem_with(name: &str, from: &str, to: &str) -> String {
+    let text = std::fs::read_to_string(problem(name)).unwrap();
+    assert!(text.contains(from), "{name} holds no {from:?}");
+    text.replace(from, to)
+}
+
 /// The rigid block's acceleration down the slope, g (sin θ − μ cos θ), or 0 where
 /// it sticks.
 fn acceleration(theta_deg: f64, mu: f64) -> f64 {
@@ -1002,13 +1009,11 @@ fn rigid_cylinder_rolls_and_slips_as_the_closed_form_up_to_its_stepped_bottom() 
     // turns: Newton–Euler, physics::rigid_body). Slipping within 1.5 % (measured
     // −1.3 % at μ = 0, −0.19 % at μ = 0.1); rolling lags like the elastic disk,
     // from the same stepped lattice bottom, at first order: −25.0 %, −11.7 %.
-    let text = std::fs::read_to_string(problem("contact_cylinder.toml"))
-        .unwrap()
-        .replace(
-            "[[body]]\nname = \"cylinder\"\nmaterial = \"elastic\"",
-            "[[material]]\nname = \"rigid\"\nmodel = \"rigid\"\nmotion = \"free\"\ndensity = 1000.0\n\n[[body]]\nname = \"cylinder\"\nmaterial = \"rigid\"",
-        );
-    assert!(text.contains("motion = \"free\""));
+    let text = problem_with(
+        "contact_cylinder.toml",
+        "[[body]]\nname = \"cylinder\"\nmaterial = \"elastic\"",
+        "[[material]]\nname = \"rigid\"\nmodel = \"rigid\"\nmotion = \"free\"\ndensity = 1000.0\n\n[[body]]\nname = \"cylinder\"\nmaterial = \"rigid\"",
+    );
     let th = 45f64.to_radians();
     let run = |mu: f64, cells: &str| {
         let mu = format!("contact.0.friction_coefficient={mu}");
@@ -1814,13 +1819,11 @@ fn implicit_cylinder_slips_down_a_deformable_incline_with_the_rigid_cylinder_s_s
     // (solver::implicit::contact, `Fields::assign_history`), measured: centre
     // −0.47 %, spin −1.1 % (frictionless +0.082 rad/s; rolling at μ = 0.5 centre
     // −0.41 %, spin −2.2 %).
-    let text = std::fs::read_to_string(problem("contact_cylinder.toml"))
-        .unwrap()
-        .replace(
-            "kind = \"explicit\"\nend_time = 0.5\ncfl = 0.5",
-            "kind = \"implicit\"\nintegrator = \"newmark\"\nend_time = 0.5\ndt = 0.0025\nline_search = true",
-        );
-    assert!(text.contains("integrator = \"newmark\""));
+    let text = problem_with(
+        "contact_cylinder.toml",
+        "kind = \"explicit\"\nend_time = 0.5\ncfl = 0.5",
+        "kind = \"implicit\"\nintegrator = \"newmark\"\nend_time = 0.5\ndt = 0.0025\nline_search = true",
+    );
     let mu = 0.1;
     let (result, dir) = run_text(
         &text,
