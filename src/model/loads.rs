@@ -50,6 +50,7 @@ pub fn load_factor(ramp_of: &[u32], q: usize, scales: &[f64]) -> f64 {
 }
 
 /// The loads of a scene, put on the particles at full value.
+#[derive(Default)]
 pub struct Loads {
     /// The distinct time histories.
     pub ramps: Vec<LoadTime>,
@@ -66,10 +67,7 @@ impl Loads {
         particles: &mut Particles<D>,
     ) -> Result<Loads, (String, String)> {
         if c.loads.is_empty() {
-            return Ok(Loads {
-                ramps: Vec::new(),
-                ramp_of: Vec::new(),
-            });
+            return Ok(Loads::default());
         }
         let vec = |v: &[f64]| Vector::<D>::from_fn(|d, _| v[d]);
         let mut ramp_of = vec![u32::MAX; particles.len()];

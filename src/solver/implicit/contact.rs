@@ -156,10 +156,13 @@ struct Joint<const D: usize> {
     points: Vec<(usize, f64)>,
     /// Gap at the last residual, D − δ·n.
     gap_end: f64,
+    /// Each side's reference particle (`Fields::assign_history`): the
+    /// meeting's outermost particles when it began, or where they moved on.
+    reference: [u32; 2],
 }
 
 /// What a meeting carries to the next step: (grid node, r, s), tangential
-/// force, gap at the step's end, outermost particles.
+/// force, gap at the step's end, reference particles.
 type Carried<const D: usize> = ([u32; 3], Vector<D>, f64, [u32; 2]);
 
 /// The contact between deformable bodies on the split grid.
@@ -171,8 +174,8 @@ struct Fields<const D: usize> {
     /// The meetings of this step.
     joints: Vec<Joint<D>>,
     /// What each meeting carried out of the last step, by (grid node, r, s):
-    /// its tangential force, its gap at the step's end and its outermost
-    /// particles (`Meeting::outermost`).
+    /// its tangential force, its gap at the step's end and its reference
+    /// particles (`Joint::reference`).
     history: Vec<Carried<D>>,
     /// Meetings in contact at the last residual.
     touches: Vec<NodeTouch<D>>,
@@ -206,6 +209,7 @@ impl<const D: usize> Fields<D> {
                 let (_, f_t0, gap_end, reference) = history[i];
                 j.f_t0 = f_t0;
                 j.meeting.gap = gap_end;
+                j.reference = j.meeting.outermost;
                 // Each side's outward normal: n for r, −n for s.
                 let outward = [j.meeting.normal, -j.meeting.normal];
                 for side in 0..2 {
@@ -217,7 +221,7 @@ impl<const D: usize> Fields<D> {
                     let beyond = (a - b).dot(&outward[side]);
                     match beyond.abs() > OUTERMOST_SWITCH * h {
                         true => j.meeting.gap -= beyond,
-                        false => j.meeting.outermost[side] = then,
+                        false => j.reference[side] = then,
                     }
                 }
             }
@@ -399,6 +403,7 @@ impl<const D: usize> PenaltyContact<D> {
                     f_t0: Vector::<D>::zeros(),
                     points: surface_points(&mt, shape, &m.grid, &nodes),
                     gap_end: mt.gap,
+                    reference: mt.outermost,
                     meeting: mt,
                 }
             })
@@ -799,7 +804,7 @@ impl<const D: usize> PenaltyContact<D> {
                 tangential[t.meeting] = t.contact.tangential;
             }
             f.history = (f.joints.iter().zip(tangential))
-                .map(|(j, f_t)| (j.key, f_t, j.gap_end, j.meeting.outermost))
+                .map(|(j, f_t)| (j.key, f_t, j.gap_end, j.reference))
                 .collect();
             f.history.sort_by_key(|h| h.0);
             for t in &f.touches {
@@ -819,15 +824,15 @@ impl<const D: usize> PenaltyContact<D> {
     /// The tangential forces carried to the next step, D values per particle
     /// (empty without friction), for a checkpoint.
     /// Then, with contact between deformable bodies, 6 + D values per meeting:
-    /// its grid node, fields r and s, tangential force, gap and outermost
+    /// its grid node, fields r and s, tangential force, gap and reference
     /// particles.
     pub fn tangential_state(&self) -> Vec<f64> {
         let particles = self.tangential.iter().flat_map(|f| f.iter().copied());
         let meetings = (self.fields.iter()).flat_map(|f| {
-            (f.history.iter()).flat_map(|(key, v, gap, outermost)| {
+            (f.history.iter()).flat_map(|(key, v, gap, reference)| {
                 let key = key.iter().map(|&k| k as f64);
-                let outermost = outermost.iter().map(|&q| q as f64);
-                key.chain(v.iter().copied()).chain([*gap]).chain(outermost)
+                let reference = reference.iter().map(|&q| q as f64);
+                key.chain(v.iter().copied()).chain([*gap]).chain(reference)
             })
         });
         particles.chain(meetings).collect()
@@ -848,12 +853,12 @@ impl<const D: usize> PenaltyContact<D> {
             f.history = (state[n..].chunks_exact(6 + D))
                 .map(|c| {
                     let key = [c[0] as u32, c[1] as u32, c[2] as u32];
-                    let outermost = [c[4 + D] as u32, c[5 + D] as u32];
+                    let reference = [c[4 + D] as u32, c[5 + D] as u32];
                     (
                         key,
                         Vector::<D>::from_column_slice(&c[3..3 + D]),
                         c[3 + D],
-                        outermost,
+                        reference,
                     )
                 })
                 .collect();
