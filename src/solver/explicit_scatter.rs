@@ -15,7 +15,7 @@ use crate::model::conditions::Constraint;
 use crate::model::particles::Particles;
 use crate::model::tensors::TensorsMut;
 use crate::model::{load_factor, Model};
-use crate::parallel::{deterministic_sum, DisjointSlice, MIN_PARALLEL_LEN, SUM_CHUNK};
+use crate::parallel::{deterministic_sum, fill, min, DisjointSlice, MIN_PARALLEL_LEN, SUM_CHUNK};
 use crate::physics::apic;
 use crate::physics::boundary::{friction_contact, node_constraint, node_friction};
 use crate::physics::deformation::{update_particle, ParticleState};
@@ -101,9 +101,8 @@ impl<const D: usize> ScatterStep<D> {
             self.initial_affine(s, m, &scales);
         }
         let p = &m.particles;
-        self.nodes.clear();
-        self.nodes.resize(self.nb.nodes(), Node::zero());
-        let tiny = TINY_MASS_FRACTION * p.mass.iter().cloned().fold(f64::INFINITY, f64::min);
+        fill(&mut self.nodes, self.nb.nodes(), Node::zero());
+        let tiny = TINY_MASS_FRACTION * min(&p.mass);
         // P2G: mass (2-24), momentum (2-25) and, but in USF, the force (2-51, 2-52).
         match s.scheme {
             Scheme::Usf if s.apic => self.scatter::<true, false, true>(s, m, &scales),
@@ -186,8 +185,7 @@ impl<const D: usize> ScatterStep<D> {
     /// APIC's first step on the box (as `physics::apic::ensure` on the node
     /// map): B_p of the particles' velocities projected on the nodes.
     fn initial_affine(&mut self, s: &Settings<D>, m: &mut Model<D>, scales: &[f64]) {
-        self.nodes.clear();
-        self.nodes.resize(self.nb.nodes(), Node::zero());
+        fill(&mut self.nodes, self.nb.nodes(), Node::zero());
         self.scatter::<true, false, false>(s, m, scales);
         let (nb, nodes, grid) = (&self.nb, &self.nodes, &m.grid);
         let p = &m.particles;
@@ -220,11 +218,9 @@ impl<const D: usize> ScatterStep<D> {
         scales: &[f64],
     ) -> f64 {
         let (nb, nodes) = (&self.nb, &self.nodes[..]);
-        self.second.clear();
-        self.second.resize(self.nodes.len(), Vector::<D>::zeros());
+        fill(&mut self.second, self.nodes.len(), Vector::<D>::zeros());
         let n = m.particles.len();
-        self.work.clear();
-        self.work.resize(n, 0.0);
+        fill(&mut self.work, n, 0.0);
         let (grid, ramp_of) = (&m.grid, &m.load_ramp_of);
         let Particles {
             x,
