@@ -25,11 +25,10 @@ pub fn voigt(m: &Mat3) -> [f64; 6] {
     ]
 }
 
-/// Are all values finite? Without a branch per value: v · 0 is ±0 for a finite
-/// v and NaN for an infinite or NaN one, so the sum is 0 only if all are finite.
+/// Are all values finite? Without a branch per value (a bitwise and, not `&&`).
 #[inline(always)]
 pub fn all_finite<'a>(values: impl IntoIterator<Item = &'a f64>) -> bool {
-    values.into_iter().fold(0.0, |sum, v| sum + v * 0.0) == 0.0
+    values.into_iter().fold(true, |all, v| all & v.is_finite())
 }
 
 /// Embed a D×D increment of a deformation gradient: identity in the missing directions.

@@ -25,9 +25,7 @@ use crate::model::particles::Particles;
 use crate::model::tensors::Tensors;
 use crate::parallel::{bucket_sort, DisjointSlice, MIN_PARALLEL_LEN, NO_BUCKET};
 use crate::physics::shape::linear::{cell_coordinate, cell_index};
-use crate::physics::shape::{
-    deformation_for, separable_axes, AxisFactors, ShapeFunction, MAX_PER_AXIS,
-};
+use crate::physics::shape::{deformation_for, separable_axes, ShapeFunction, MAX_PER_AXIS};
 use rayon::prelude::*;
 
 /// Cells per axis of a tile. Must be at least the family's reach − 1
@@ -63,15 +61,16 @@ impl Reach {
 }
 
 /// The shape functions of one particle on the box: the 1D factors of every
-/// axis and the box index of its first node.
+/// axis (a 2D particle has a third axis with one factor 1, slope 0) and the box
+/// index of its first node.
 #[derive(Clone, Copy, Debug)]
 pub struct Stencil<const D: usize> {
     base: usize,
-    axes: [AxisFactors; D],
+    first: [usize; 3],
+    count: [usize; 3],
+    weight: [[f64; MAX_PER_AXIS]; 3],
+    slope: [[f64; MAX_PER_AXIS]; 3],
 }
-
-/// No second slopes (`Stencil::for_each`).
-const NO_SLOPES: Slopes = [[0.0; MAX_PER_AXIS]; 3];
 
 impl<const D: usize> Stencil<D> {
     /// Calls `visit(node, S_Ip, ∇S_Ip)` for every node of the tensor product,
@@ -80,8 +79,8 @@ impl<const D: usize> Stencil<D> {
     /// ∂S_I/∂z = S_x (S_y S'_z).
     #[inline(always)]
     pub fn for_each(&self, stride: &[usize; 3], mut visit: impl FnMut(usize, f64, Vector<D>)) {
-        // The second "gradient" is unused: the compiler drops it.
-        self.for_each_with(stride, &NO_SLOPES, |b, w, g, _| visit(b, w, g))
+        // The second "gradient" is the first again, unused: the compiler drops it.
+        self.for_each_with(stride, &self.slope, |b, w, g, _| visit(b, w, g))
     }
 
     /// `for_each` that also forms `second` 1D slopes t as ∇S_I forms the
@@ -94,25 +93,19 @@ impl<const D: usize> Stencil<D> {
         second: &Slopes,
         mut visit: impl FnMut(usize, f64, Vector<D>, Vector<D>),
     ) {
-        let (a, t) = (&self.axes, second);
-        // In 2D one layer: a z axis with one factor 1 and slope 0.
-        let (layers, wz, sz) = match D {
-            3 => (a[D - 1].count, a[D - 1].weight, a[D - 1].slope),
-            _ => (1, [1.0; MAX_PER_AXIS], [0.0; MAX_PER_AXIS]),
-        };
-        let (w0, s0, w1, s1) = (&a[0].weight, &a[0].slope, &a[1].weight, &a[1].slope);
-        for k in 0..layers {
-            for j in 0..a[1].count {
+        let (w, s, t) = (&self.weight, &self.slope, second);
+        for k in 0..self.count[2] {
+            for j in 0..self.count[1] {
                 let row = self.base + j * stride[1] + k * stride[2];
-                let wyz = w1[j] * wz[k];
-                let (syz, wysz) = (s1[j] * wz[k], w1[j] * sz[k]);
-                let (tyz, wytz) = (t[1][j] * wz[k], w1[j] * t[2][k]);
-                for i in 0..a[0].count {
-                    let g = [s0[i] * wyz, w0[i] * syz, w0[i] * wysz];
-                    let h = [t[0][i] * wyz, w0[i] * tyz, w0[i] * wytz];
+                let wyz = w[1][j] * w[2][k];
+                let (syz, wysz) = (s[1][j] * w[2][k], w[1][j] * s[2][k]);
+                let (tyz, wytz) = (t[1][j] * w[2][k], w[1][j] * t[2][k]);
+                for i in 0..self.count[0] {
+                    let g = [s[0][i] * wyz, w[0][i] * syz, w[0][i] * wysz];
+                    let h = [t[0][i] * wyz, w[0][i] * tyz, w[0][i] * wytz];
                     visit(
                         row + i,
-                        w0[i] * wyz,
+                        w[0][i] * wyz,
                         Vector::<D>::from_fn(|d, _| g[d]),
                         Vector::<D>::from_fn(|d, _| h[d]),
                     );
@@ -127,7 +120,7 @@ impl<const D: usize> Stencil<D> {
         let mut delta = [[0.0; MAX_PER_AXIS]; 3];
         let p = grid.degree;
         for d in 0..D {
-            let (first, count, h) = (self.axes[d].first, self.axes[d].count, grid.h[d]);
+            let (first, count, h) = (self.first[d], self.count[d], grid.h[d]);
             // Away from the clamped ends the Greville abscissae are a cell apart,
             // node i at i − (p − 1)/2 cells (every node of the degree-1 families).
             if first + 1 >= p && first + count <= grid.cells[d] + 1 {
@@ -152,8 +145,8 @@ impl<const D: usize> Stencil<D> {
         let delta = self.offsets(grid, x);
         let (mut moment, mut inertia) = ([[0.0; MAX_PER_AXIS]; 3], [0.0; 3]);
         for d in 0..D {
-            for i in 0..self.axes[d].count {
-                moment[d][i] = self.axes[d].weight[i] * delta[d][i];
+            for i in 0..self.count[d] {
+                moment[d][i] = self.weight[d][i] * delta[d][i];
                 inertia[d] += moment[d][i] * delta[d][i];
             }
         }
@@ -162,11 +155,7 @@ impl<const D: usize> Stencil<D> {
 
     /// The first slopes S'_i along every axis.
     pub fn slopes(&self) -> Slopes {
-        let mut slopes = NO_SLOPES;
-        for (out, axis) in slopes.iter_mut().zip(&self.axes) {
-            *out = axis.slope;
-        }
-        slopes
+        self.slope
     }
 }
 
@@ -336,13 +325,25 @@ impl<const D: usize> NodeBox<D> {
             return None;
         }
         let axes = separable_axes(shape, grid, x, half_length0, f);
-        let mut base = 0usize;
+        let mut st = Stencil {
+            base: 0,
+            first: [0; 3],
+            count: [1; 3],
+            weight: [[1.0; MAX_PER_AXIS]; 3],
+            slope: [[0.0; MAX_PER_AXIS]; 3],
+        };
         for (d, a) in axes.iter().enumerate() {
             // A node below the box wraps to an index beyond it: the reads and
             // writes check their bounds.
-            base = base.wrapping_add(a.first.wrapping_sub(self.lo[d]) * self.stride[d]);
+            st.base = st
+                .base
+                .wrapping_add(a.first.wrapping_sub(self.lo[d]) * self.stride[d]);
+            st.first[d] = a.first;
+            st.count[d] = a.count;
+            st.weight[d] = a.weight;
+            st.slope[d] = a.slope;
         }
-        Some(Stencil { base, axes })
+        Some(st)
     }
 
     /// The nodes the particles of tile `t` may write along every axis without
@@ -424,28 +425,22 @@ impl<const D: usize> NodeBox<D> {
             // scene scatters in one task (the sums are the same either way).
             let per_tile = self.order.len() / n_tiles.max(1) + 1;
             let tiles_per_task = MIN_PARALLEL_LEN.div_ceil(per_tile);
-            of_colour
-                .par_iter()
-                .with_min_len(tiles_per_task)
-                .for_each(|&t| {
-                    let (first, end) = self.tile_nodes(t, reach);
-                    for &q in &self.order[self.start[t] as usize..self.start[t + 1] as usize] {
-                        let q = q as usize;
-                        let f = deformation_for(shape, || points.f.get(q));
-                        let (x, half) = (&points.x[q], &points.half_length0[q]);
-                        let Some(st) = self.stencil(shape, grid, x, half, &f) else {
-                            continue;
-                        };
-                        assert!(
-                        (0..D).all(|d| {
-                            let a = &st.axes[d];
-                            a.first >= first[d] && a.first + a.count <= end[d]
-                        }),
+            of_colour.par_iter().with_min_len(tiles_per_task).for_each(|&t| {
+                let (first, end) = self.tile_nodes(t, reach);
+                for &q in &self.order[self.start[t] as usize..self.start[t + 1] as usize] {
+                    let q = q as usize;
+                    let f = deformation_for(shape, || points.f.get(q));
+                    let (x, half) = (&points.x[q], &points.half_length0[q]);
+                    let Some(st) = self.stencil(shape, grid, x, half, &f) else {
+                        continue;
+                    };
+                    assert!(
+                        (0..D).all(|d| st.first[d] >= first[d] && st.first[d] + st.count[d] <= end[d]),
                         "{shape:?} reaches beyond its tile's nodes: the colouring would not hold"
                     );
-                        each(q, &st, &out);
-                    }
-                });
+                    each(q, &st, &out);
+                }
+            });
         }
     }
 }
