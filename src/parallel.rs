@@ -92,24 +92,6 @@ pub fn on_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
         .install(f)
 }
 
-/// `n` copies of `value` in `v`, written in parallel (a buffer reset every
-/// step: a serial fill of a large one holds the other threads up).
-pub fn fill<T: Copy + Send + Sync>(v: &mut Vec<T>, n: usize, value: T) {
-    v.resize(n, value);
-    v.par_iter_mut()
-        .with_min_len(4 * SUM_CHUNK)
-        .for_each(|x| *x = value);
-}
-
-/// The least value of `values` (∞ if there are none), in parallel; exact on
-/// any number of threads.
-pub fn min(values: &[f64]) -> f64 {
-    values
-        .par_chunks(SUM_CHUNK)
-        .map(|c| c.iter().copied().fold(f64::INFINITY, f64::min))
-        .reduce(|| f64::INFINITY, f64::min)
-}
-
 /// Items without a bucket in `bucket_sort`.
 pub const NO_BUCKET: u32 = u32::MAX;
 
@@ -203,23 +185,5 @@ mod tests {
                 .collect();
             assert_eq!(got, expected, "{threads} threads");
         }
-    }
-
-    #[test]
-    fn min_and_fill_match_their_serial_forms() {
-        let values: Vec<f64> = (0..20_000u64)
-            .map(|q| ((q * 2654435761) % 10_007) as f64 * 0.5 + 3.0)
-            .collect();
-        let serial = values.iter().copied().fold(f64::INFINITY, f64::min);
-        for threads in 1..=3 {
-            assert_eq!(on_threads(threads, || min(&values)), serial);
-            let mut buffer = vec![1.5; 7];
-            on_threads(threads, || fill(&mut buffer, 70_000, -2.0));
-            assert_eq!(buffer.len(), 70_000);
-            assert!(buffer.iter().all(|&x| x == -2.0), "{threads} threads");
-            on_threads(threads, || fill(&mut buffer, 3, 4.0));
-            assert_eq!(buffer, [4.0; 3]);
-        }
-        assert_eq!(min(&[]), f64::INFINITY);
     }
 }

@@ -2,7 +2,7 @@
 //! updates from (`Increment`) and the small helpers models share (Lamé constants,
 //! reduced angles, the stress-derivative layout).
 
-use crate::dim::{compose_plane, is_plane, Mat3};
+use crate::dim::{compose, Mat3};
 use nalgebra::SMatrix;
 
 /// ∂σ_ij/∂ΔF_kl with (i,j) and (k,l) flattened row-major (index 3i + j).
@@ -21,9 +21,6 @@ pub struct Increment<'a> {
     pub df: Mat3,
     /// Deformation gradient at the end of the increment, ΔF F_old (2-31).
     pub f: Mat3,
-    /// Neither ΔF nor F_old has out-of-plane shear (`dim::is_plane`: plane
-    /// strain and axisymmetry), so neither has F.
-    pub plane: bool,
     /// Time increment (rate-dependent models; 0 for quasi-static calls).
     pub dt: f64,
     /// Cauchy stress at the start of the increment.
@@ -36,15 +33,10 @@ impl<'a> Increment<'a> {
     /// The increment ΔF from the state (F_old, σ_old, history) over `dt`.
     #[inline(always)]
     pub fn new(f_old: Mat3, df: Mat3, dt: f64, stress_old: Mat3, history_old: &'a [f64]) -> Self {
-        let plane = is_plane(&df) && is_plane(&f_old);
         Increment {
             f_old,
             df,
-            f: match plane {
-                true => compose_plane(&df, &f_old),
-                false => df * f_old,
-            },
-            plane,
+            f: compose(&df, &f_old),
             dt,
             stress_old,
             history_old,

@@ -6,7 +6,7 @@
 
 use super::parameters::{FromParameters, KeyError, Parameters};
 use super::{lame, Increment, Material, StressDerivative};
-use crate::dim::{determinant, is_plane, left_cauchy_green, Mat3};
+use crate::dim::Mat3;
 
 /// Compressible neo-Hookean solid with Lamé constants from (E, ν).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -39,27 +39,11 @@ impl NeoHookean {
 
     /// Cauchy stress at total deformation gradient `f`.
     pub fn cauchy(&self, f: &Mat3) -> Mat3 {
-        self.cauchy_of(f, is_plane(f))
-    }
-
-    /// `cauchy`, told whether f has out-of-plane shear (`dim::is_plane`).
-    #[inline(always)]
-    fn cauchy_of(&self, f: &Mat3, plane: bool) -> Mat3 {
         let (lambda, mu) = self.lame();
-        let j = determinant(f, plane);
+        let j = f.determinant();
         debug_assert!(j > 0.0, "det F must be positive");
-        let b = left_cauchy_green(f, plane);
-        let (shear, bulk) = (mu / j, lambda * j.ln() / j);
-        // σ_ik = (b_ik − δ_ik) μ/J + δ_ik λ ln J / J; a plane b leaves the
-        // out-of-plane shear zero.
-        let s = |i: usize, k: usize| {
-            let delta = (i == k) as u8 as f64;
-            (b[(i, k)] - delta) * shear + delta * bulk
-        };
-        match plane {
-            true => Mat3::new(s(0, 0), s(0, 1), 0.0, s(1, 0), s(1, 1), 0.0, 0.0, 0.0, s(2, 2)),
-            false => Mat3::from_fn(s),
-        }
+        let b = f * f.transpose();
+        (b - Mat3::identity()) * (mu / j) + Mat3::identity() * (lambda * j.ln() / j)
     }
 }
 
@@ -84,7 +68,7 @@ impl Material for NeoHookean {
     }
 
     fn update(&self, inc: &Increment, _history_new: &mut [f64]) -> Mat3 {
-        self.cauchy_of(&inc.f, inc.plane)
+        self.cauchy(&inc.f)
     }
 
     fn p_wave_modulus(&self) -> f64 {

@@ -17,8 +17,6 @@ pub struct Grid<const D: usize> {
     pub cells: [usize; D],
     /// Cell size per direction.
     pub h: Vector<D>,
-    /// 1 / h per direction, formed once (the shape functions' slopes read it).
-    pub inv_h: Vector<D>,
     /// Polynomial degree of the shape functions (1, 2 or 3); sets the node layout.
     pub degree: usize,
     /// Nodes per direction: `cells + degree`.
@@ -33,7 +31,6 @@ impl<const D: usize> Grid<D> {
             min,
             max,
             cells,
-            inv_h: h.map(|h| 1.0 / h),
             h,
             degree,
             nodes,

@@ -7,7 +7,7 @@
 //! the particles follow ΔF̄ instead of ΔF. In axisymmetric mode ΔF_θθ is the hoop
 //! stretch of the increment (`physics::axisymmetry`) instead of 1.
 
-use crate::dim::{compose, determinant, embed_deformation, Mat3, Tensor, Vector};
+use crate::dim::{compose, embed_deformation, Mat3, Tensor, Vector};
 use crate::material::{Increment, Material};
 use crate::model::grid::Grid;
 use crate::model::particles::Particles;
@@ -216,7 +216,7 @@ fn advance(
 ) -> Advanced {
     let stress = material.update(inc, history);
     let f = inc.f;
-    let det = determinant(&f, inc.plane);
+    let det = f.determinant();
     Advanced {
         stress,
         f,

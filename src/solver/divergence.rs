@@ -1,7 +1,7 @@
 //! A run that stops early says what happened where: the step, the time and,
 //! where there is one, the particle.
 
-use crate::dim::{all_finite, Vector};
+use crate::dim::{Mat3, Vector};
 use crate::model::Model;
 use crate::parallel::MIN_PARALLEL_LEN;
 use rayon::prelude::*;
@@ -44,7 +44,7 @@ pub fn check_state<const D: usize>(m: &Model<D>, step: usize, time: f64) -> Resu
             !sound(
                 &p.x[q],
                 &p.v[q],
-                all_finite(p.stress.get(q).iter()),
+                &p.stress.get(q),
                 p.f.get(q).determinant(),
                 inside && off_axis,
             )
@@ -71,11 +71,15 @@ pub fn inverted(q: usize, det: f64, step: usize, time: f64) -> Divergence {
 pub fn sound<const D: usize>(
     x: &Vector<D>,
     v: &Vector<D>,
-    stress_finite: bool,
+    stress: &Mat3,
     det_f: f64,
     placed: bool,
 ) -> bool {
-    all_finite(x.iter().chain(v.iter())) && stress_finite && det_f > 0.0 && placed
+    x.iter().all(|v| v.is_finite())
+        && v.iter().all(|v| v.is_finite())
+        && stress.iter().all(|v| v.is_finite())
+        && det_f > 0.0
+        && placed
 }
 
 /// What went wrong with particle q, which is not `sound`.
@@ -122,7 +126,6 @@ pub fn unsound<const D: usize>(m: &Model<D>, q: usize, step: usize, time: f64) -
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dim::Mat3;
     use crate::scene::testing::BLOCK;
     use crate::scene::Scene;
 

@@ -10,12 +10,12 @@
 //! scatter and a particle pass each. `Explicit` chooses this path for the
 //! scenes it serves (`Explicit::scatter_serves`).
 
-use crate::dim::{all_finite, embed_deformation, Tensor, Vector};
+use crate::dim::{embed_deformation, Tensor, Vector};
 use crate::model::conditions::Constraint;
 use crate::model::particles::Particles;
 use crate::model::tensors::TensorsMut;
 use crate::model::{load_factor, Model};
-use crate::parallel::{deterministic_sum, fill, min, DisjointSlice, MIN_PARALLEL_LEN, SUM_CHUNK};
+use crate::parallel::{deterministic_sum, DisjointSlice, MIN_PARALLEL_LEN, SUM_CHUNK};
 use crate::physics::apic;
 use crate::physics::boundary::{friction_contact, node_constraint, node_friction};
 use crate::physics::deformation::{update_particle, ParticleState};
@@ -101,8 +101,9 @@ impl<const D: usize> ScatterStep<D> {
             self.initial_affine(s, m, &scales);
         }
         let p = &m.particles;
-        fill(&mut self.nodes, self.nb.nodes(), Node::zero());
-        let tiny = TINY_MASS_FRACTION * min(&p.mass);
+        self.nodes.clear();
+        self.nodes.resize(self.nb.nodes(), Node::zero());
+        let tiny = TINY_MASS_FRACTION * p.mass.iter().cloned().fold(f64::INFINITY, f64::min);
         // P2G: mass (2-24), momentum (2-25) and, but in USF, the force (2-51, 2-52).
         match s.scheme {
             Scheme::Usf if s.apic => self.scatter::<true, false, true>(s, m, &scales),
@@ -185,7 +186,8 @@ impl<const D: usize> ScatterStep<D> {
     /// APIC's first step on the box (as `physics::apic::ensure` on the node
     /// map): B_p of the particles' velocities projected on the nodes.
     fn initial_affine(&mut self, s: &Settings<D>, m: &mut Model<D>, scales: &[f64]) {
-        fill(&mut self.nodes, self.nb.nodes(), Node::zero());
+        self.nodes.clear();
+        self.nodes.resize(self.nb.nodes(), Node::zero());
         self.scatter::<true, false, false>(s, m, scales);
         let (nb, nodes, grid) = (&self.nb, &self.nodes, &m.grid);
         let p = &m.particles;
@@ -218,9 +220,11 @@ impl<const D: usize> ScatterStep<D> {
         scales: &[f64],
     ) -> f64 {
         let (nb, nodes) = (&self.nb, &self.nodes[..]);
-        fill(&mut self.second, self.nodes.len(), Vector::<D>::zeros());
+        self.second.clear();
+        self.second.resize(self.nodes.len(), Vector::<D>::zeros());
         let n = m.particles.len();
-        fill(&mut self.work, n, 0.0);
+        self.work.clear();
+        self.work.resize(n, 0.0);
         let (grid, ramp_of) = (&m.grid, &m.load_ramp_of);
         let Particles {
             x,
@@ -236,7 +240,7 @@ impl<const D: usize> ScatterStep<D> {
         let (velocity, work) = (DisjointSlice::new(v), DisjointSlice::new(&mut self.work));
         let affine = DisjointSlice::new(affine);
         let source = |q: usize, st: &Stencil<D>| {
-            let (vp, a, _) = gather::<D, true, true, 0>(st, nb, nodes, &[]);
+            let (vp, a, _) = gather::<D, true, 0>(st, nb, nodes, &[]);
             // SAFETY: particle q belongs to this tile's task alone.
             let (v, w) = unsafe { (velocity.at(q), work.at(q)) };
             let v_old = *v;
@@ -421,10 +425,10 @@ impl<const D: usize> ScatterStep<D> {
                     Vector::<D>::zeros(),
                     Tensor::<D>::zeros(),
                 ),
-                (Pass::Full, Some(sc)) => gather::<D, true, true, 1>(sc, nb, nodes, second),
-                (Pass::Stress, Some(sc)) => gather::<D, false, false, 2>(sc, nb, nodes, second),
-                (Pass::Motion, Some(sc)) => gather::<D, true, true, 0>(sc, nb, nodes, second),
-                (Pass::Remapped, Some(sc)) => gather::<D, true, false, 2>(sc, nb, nodes, second),
+                (Pass::Full, Some(sc)) => gather::<D, true, 1>(sc, nb, nodes, second),
+                (Pass::Stress, Some(sc)) => gather::<D, false, 2>(sc, nb, nodes, second),
+                (Pass::Motion, Some(sc)) => gather::<D, true, 0>(sc, nb, nodes, second),
+                (Pass::Remapped, Some(sc)) => gather::<D, true, 2>(sc, nb, nodes, second),
             };
             let mut work = 0.0;
             if s.apic && matches!(pass, Pass::Full | Pass::Motion) {
@@ -460,8 +464,8 @@ impl<const D: usize> ScatterStep<D> {
             };
             // NaN counts as inverted, as in `check_state`.
             let intact = det > 0.0;
-            let finite = all_finite(state.deformation.stress.get().iter());
-            let bad = checks && !sound(state.x, state.v, finite, det, grid.contains(state.x));
+            let stress = state.deformation.stress.get();
+            let bad = checks && !sound(state.x, state.v, &stress, det, grid.contains(state.x));
             (work, !intact, bad)
         };
         let chunk = |c: usize,
@@ -557,41 +561,32 @@ struct Moving<'a, const D: usize> {
     deformation: ParticleState<'a>,
 }
 
-/// A particle's Σ S_I v_I (`VELOCITY`) and Σ S_I a_I (`ACCELERATION`) from the
-/// updated nodes, and L = Σ v_I ⊗ ∇S_I from the updated velocity (`GRAD` = 1)
-/// or from `second` (`GRAD` = 2).
+/// A particle's Σ S_I v_I and Σ S_I a_I from the updated nodes (`MOTION`), and
+/// L = Σ v_I ⊗ ∇S_I from the updated velocity (`GRAD` = 1) or from `second`
+/// (`GRAD` = 2).
 #[inline(always)]
-fn gather<const D: usize, const VELOCITY: bool, const ACCELERATION: bool, const GRAD: u8>(
+fn gather<const D: usize, const MOTION: bool, const GRAD: u8>(
     sc: &crate::physics::scatter::Stencil<D>,
     nb: &NodeBox<D>,
     nodes: &[Node<D>],
     second: &[Vector<D>],
 ) -> (Vector<D>, Vector<D>, Tensor<D>) {
-    // Sums in plain arrays, component by component (the same terms in the
-    // same order as the vector forms, which compiled to slower code).
-    let (mut vp, mut a, mut l) = ([0.0; D], [0.0; D], [[0.0; D]; D]);
+    let (mut vp, mut a, mut l) = (
+        Vector::<D>::zeros(),
+        Vector::<D>::zeros(),
+        Tensor::<D>::zeros(),
+    );
     sc.for_each(&nb.stride, |b, w, g| {
         let n = &nodes[b];
-        for i in 0..D {
-            if VELOCITY {
-                vp[i] += n.momentum[i] * w;
-            }
-            if ACCELERATION {
-                a[i] += n.force[i] * w;
-            }
-            let v = match GRAD {
-                1 => n.momentum[i],
-                2 => second[b][i],
-                _ => continue,
-            };
-            for j in 0..D {
-                l[i][j] += v * g[j];
-            }
+        if MOTION {
+            vp += n.momentum * w;
+            a += n.force * w;
+        }
+        match GRAD {
+            1 => l += n.momentum * g.transpose(),
+            2 => l += second[b] * g.transpose(),
+            _ => {}
         }
     });
-    (
-        Vector::<D>::from(vp),
-        Vector::<D>::from(a),
-        Tensor::<D>::from_fn(|i, j| l[i][j]),
-    )
+    (vp, a, l)
 }

@@ -342,7 +342,7 @@ pub(super) fn axes<const D: usize>(
     for (d, f) in axes.iter_mut().enumerate() {
         *f = basis(cell_coordinate(grid, x, d), degree, grid.cells[d]);
         // Derivatives from cell units to physical units.
-        let per_length = grid.inv_h[d];
+        let per_length = 1.0 / grid.h[d];
         f.slope[..=degree].iter_mut().for_each(|s| *s *= per_length);
     }
     axes

@@ -65,7 +65,7 @@ fn hat_factors<const D: usize>(grid: &Grid<D>, x: &Vector<D>, d: usize) -> AxisF
     let xi = cell_coordinate(grid, x, d);
     let cell = cell_index(xi, grid.cells[d]);
     let t = xi - cell as f64;
-    let slope = grid.inv_h[d];
+    let slope = 1.0 / grid.h[d];
     let mut f = AxisFactors {
         first: cell,
         count: 2,
