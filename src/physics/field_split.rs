@@ -261,9 +261,10 @@ impl FieldSplit {
                 if local && off > 0.0 && off > reach(q, &(lateral / off)) * (1.0 + 1e-9) {
                     continue;
                 }
-                farthest = farthest.max(r.dot(n) + reach(q, n));
-                if r.dot(n) > outermost.0 {
-                    outermost = (r.dot(n), q as u32);
+                let along = r.dot(n);
+                farthest = farthest.max(along + reach(q, n));
+                if along > outermost.0 {
+                    outermost = (along, q as u32);
                 }
             }
             (farthest, outermost.1)

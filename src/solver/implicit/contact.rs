@@ -821,11 +821,14 @@ impl<const D: usize> PenaltyContact<D> {
         }
     }
 
+    /// Values per meeting in `tangential_state`: its grid node, fields r and
+    /// s, tangential force (D), gap and reference particles (2).
+    const MEETING_VALUES: usize = 6 + D;
+
     /// The tangential forces carried to the next step, D values per particle
     /// (empty without friction), for a checkpoint.
-    /// Then, with contact between deformable bodies, 6 + D values per meeting:
-    /// its grid node, fields r and s, tangential force, gap and reference
-    /// particles.
+    /// Then, with contact between deformable bodies, `MEETING_VALUES` per
+    /// meeting.
     pub fn tangential_state(&self) -> Vec<f64> {
         let particles = self.tangential.iter().flat_map(|f| f.iter().copied());
         let meetings = (self.fields.iter()).flat_map(|f| {
@@ -843,14 +846,14 @@ impl<const D: usize> PenaltyContact<D> {
     /// cell size.
     pub fn restore_tangential(&mut self, state: &[f64], x: &[Vector<D>], h: f64) {
         let n = self.tangential.len() * D;
-        if state.is_empty() || state.len() < n || (state.len() - n) % (6 + D) != 0 {
+        if state.is_empty() || state.len() < n || (state.len() - n) % Self::MEETING_VALUES != 0 {
             return;
         }
         self.tangential = (state[..n].chunks_exact(D))
             .map(Vector::<D>::from_column_slice)
             .collect();
         if let Some(f) = self.fields.as_mut() {
-            f.history = (state[n..].chunks_exact(6 + D))
+            f.history = (state[n..].chunks_exact(Self::MEETING_VALUES))
                 .map(|c| {
                     let key = [c[0] as u32, c[1] as u32, c[2] as u32];
                     let reference = [c[4 + D] as u32, c[5 + D] as u32];
