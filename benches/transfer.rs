@@ -5,7 +5,7 @@
 //! force. G2P = interpolation of nodal velocity and acceleration to particles and
 //! the velocity gradient (what the explicit step does per particle).
 //! `scatter_p2g` and `scatter_g2p` are the same work on the explicit step's box
-//! of nodes (`physics::scatter`, the families it serves): the box and the tile
+//! of nodes (`solver::explicit::node_box`, the families it serves): the box and the tile
 //! order, the coloured scatter of mass, momentum and force; the 1D factors
 //! evaluated again per particle and the same three sums.
 
@@ -13,9 +13,9 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Through
 use mpm::dim::{restrict, Mat3, Tensor, Vector};
 use mpm::model::grid::Grid;
 use mpm::model::particles::Particles;
-use mpm::physics::scatter::{NodeBox, Points, Stencil};
 use mpm::physics::shape::{ShapeFunction, Stencils};
 use mpm::physics::transfer::{gradient, interpolate, mass_momentum, nodal_force, NodeMap};
+use mpm::solver::explicit::node_box::{NodeBox, Points, Stencil};
 use rayon::prelude::*;
 
 const SHAPES: [ShapeFunction; 6] = [

@@ -3,7 +3,7 @@
 //! Particle-to-grid transfers are gathers (each node sums its particles in
 //! increasing order, `physics::transfer::NodeMap::gather`) or, in the explicit
 //! step on a box of nodes, scatters coloured so that every node sums in one
-//! fixed order (`physics::scatter`); sorts are stable (`bucket_sort`); sums over
+//! fixed order (`solver::explicit::node_box`); sorts are stable (`bucket_sort`); sums over
 //! particles use a fixed chunking (`deterministic_sum`). Loops over fewer items
 //! than `MIN_PARALLEL_LEN` run serially.
 
@@ -29,7 +29,7 @@ pub fn deterministic_sum(n: usize, f: impl Fn(usize) -> f64 + Sync) -> f64 {
 /// A mutable slice that parallel tasks write through a shared copy, each task to
 /// elements that no other task touches at the same time: the placements of
 /// `bucket_sort` and `NodeMap::build`, the colour-by-colour scatter of
-/// `physics::scatter`. (Atomics would do it safely, at the price of a second
+/// `solver::explicit::node_box`. (Atomics would do it safely, at the price of a second
 /// array and a copy, or of compare-and-swap loops for floating-point sums.)
 pub struct DisjointSlice<'a, T> {
     ptr: *mut T,

@@ -1,5 +1,5 @@
 //! A rigid body: it carries no stress and meets deformable bodies only through
-//! contact (`crate::physics::contact`, where it acts as a field of infinite mass
+//! contact (`crate::solver::explicit::contact`, where it acts as a field of infinite mass
 //! within a step), so a scene check requires a `[[contact]]` between it and every
 //! other body, and the explicit solver. With `motion = "prescribed"` (the default)
 //! it keeps the velocity it starts with (a footing, a pile, a plate, a projectile

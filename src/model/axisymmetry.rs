@@ -7,7 +7,7 @@
 //! volume), and a traction on one of its faces acts over that face's area per
 //! radian. Gravity, the nodal masses, momenta and forces, reactions and energies
 //! built from them are then per radian too. The hoop terms of the kinematics
-//! and of the internal force are in `physics::axisymmetry`.
+//! and of the internal force are in `physics::shape::hoop`.
 
 use crate::dim::Vector;
 use crate::model::conditions::{Constraint, FaceCondition};

@@ -2,7 +2,7 @@
 //! faces (fixed, roller, prescribed velocity, optionally on a region: a rigid
 //! footing), rough rigid faces with Coulomb friction, and absorbing faces with the
 //! wave properties of the materials next to them. The laws that act with them are
-//! in `physics::boundary` and `physics::absorbing`.
+//! in `physics::boundary::conditions` and `physics::boundary::absorbing`.
 //!
 //! A velocity condition acts on the layer of nodes on its face (for clamped
 //! B-splines, the control points that interpolate the face), component by

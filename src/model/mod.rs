@@ -51,7 +51,7 @@ pub struct Model<const D: usize> {
     pub load_ramp_of: Vec<u32>,
     /// `dimension = "axisymmetric"` (D = 2, x = r, y = z): masses, volumes and
     /// loads are per radian, and the stencils carry the hoop terms
-    /// (`physics::axisymmetry`).
+    /// (`physics::shape::hoop`).
     pub axisymmetric: bool,
     /// Whether some material erodes its failed points (`Material::erodes`).
     pub erosion: bool,
@@ -59,7 +59,7 @@ pub struct Model<const D: usize> {
     /// (`[grid] particles_outside = "remove"`) instead of stopping the run.
     pub remove_outside: bool,
     /// `[grid] domain_stress = "linear"`: a stress linear within each particle
-    /// domain in the implicit internal force (`physics::stress_gradient`).
+    /// domain in the implicit internal force (`solver::implicit::stress_gradient`).
     pub linear_domain_stress: bool,
 }
 

@@ -32,7 +32,7 @@ pub struct Particles<const D: usize> {
     /// scaling; empty when no particle carries a load (`model::loads`).
     pub load: Vec<Vector<D>>,
     pub history: History,
-    /// APIC's affine moment B_p = Σ_I S_Ip v_I (x_I − x_p)ᵀ (`physics::apic`):
+    /// APIC's affine moment B_p = Σ_I S_Ip v_I (x_I − x_p)ᵀ (`solver::explicit::apic`):
     /// one per particle in a stage with `velocity_transfer = "apic"`, else empty.
     pub affine: Vec<Tensor<D>>,
 }

@@ -1,23 +1,18 @@
-//! Physics shared by the explicit and the implicit solver: shape functions,
-//! particle–grid transfers, the stress update, F-bar kinematics, and the laws of
-//! the boundary conditions. Nothing here knows which solver calls it.
+//! Physics shared by the explicit and the implicit solver, by concept: shape
+//! functions (`shape`, with the hoop terms of axisymmetry), particle–grid
+//! transfers (`transfer`), the kinematics of the stress update (`kinematics`:
+//! ΔF, F-bar), the laws of the grid-face conditions (`boundary`: velocity
+//! conditions, rough walls, absorbing faces), rigid bodies (`rigid`: their
+//! surfaces and Newton–Euler motion), what contact between bodies shares
+//! (`contact`: the split grid of velocity fields, the per-pair totals) and the
+//! geostatic initial stress. Nothing here knows which solver calls it: what
+//! only one solver uses lives under that solver (`solver::explicit`,
+//! `solver::implicit`).
 
-pub mod absorbing;
-pub mod apic;
-pub mod axisymmetry;
 pub mod boundary;
-pub mod bulk_viscosity;
 pub mod contact;
-pub mod deformation;
-pub mod fbar;
-pub mod field_split;
 pub mod geostatic;
-pub mod grid_update;
-pub mod mirror;
-pub mod rigid_body;
-pub mod rigid_penalty;
-pub mod rigid_surface;
-pub mod scatter;
+pub mod kinematics;
+pub mod rigid;
 pub mod shape;
-pub mod stress_gradient;
 pub mod transfer;

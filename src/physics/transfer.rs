@@ -6,13 +6,13 @@
 //! sums its particle contributions in increasing particle order, so the result is
 //! bit-identical for any number of threads. G2P loops over particles, each reading
 //! its own stencil. (The explicit step of scenes that need no node map takes the
-//! particle-side scatter of `physics::scatter` instead.)
+//! particle-side scatter of `solver::explicit::node_box` instead.)
 
 use crate::dim::{restrict, Mat3, Tensor, Vector};
 use crate::model::particles::Particles;
 use crate::model::Model;
 use crate::parallel::{DisjointSlice, MIN_PARALLEL_LEN};
-use crate::physics::axisymmetry::hoop_gradients;
+use crate::physics::shape::hoop::hoop_gradients;
 use crate::physics::shape::{Owner, ShapeFunction, Stencils};
 use rayon::prelude::*;
 use std::sync::atomic::AtomicBool;
@@ -29,7 +29,7 @@ pub struct NodeMap {
     pub start: Vec<u32>,
     /// Stencil entry indices (p·stride + k) in increasing order within each node.
     pub entries: Vec<u32>,
-    /// Grid node of each split node (`physics::contact`): node ids from
+    /// Grid node of each split node (`solver::explicit::contact`): node ids from
     /// `local.len() − split.len()` on stand for one velocity field at a grid node
     /// that several fields share. Empty without contact.
     pub split: Vec<u32>,
@@ -215,7 +215,7 @@ pub fn stencils<const D: usize>(m: &Model<D>, shape: ShapeFunction, st: &mut Ste
 }
 
 /// The particles' stencils and the active nodes they touch: what every step
-/// starts from (with contact: `physics::contact::Contact::stencils_and_fields`).
+/// starts from (with contact: `solver::explicit::contact::Contact::stencils_and_fields`).
 pub fn stencils_and_nodes<const D: usize>(
     m: &Model<D>,
     shape: ShapeFunction,
@@ -228,7 +228,7 @@ pub fn stencils_and_nodes<const D: usize>(
 
 /// A particle's momentum at a node beyond m_p S_Ip v_p: `extra(q, e, a)` for
 /// particle q, stencil entry e, active node a (APIC's affine part,
-/// `physics::apic::AffineMomentum::term`).
+/// `solver::explicit::apic::AffineMomentum::term`).
 pub type ExtraMomentum<'a, const D: usize> = &'a (dyn Fn(usize, usize, usize) -> Vector<D> + Sync);
 
 /// Nodal mass (2-24) and momentum (2-25), in one pass over the entries; with
@@ -307,7 +307,7 @@ pub fn consistent_mass_product<const D: usize>(
 /// Internal force of a particle at one stencil entry, V τ ∇S_I: the Cauchy stress
 /// and the current volume (2-51), or the relative first Piola-Kirchhoff stress and
 /// the step-start volume (the implicit step, 2-21 pulled back). Axisymmetric:
-/// plus V τ_θθ S_I / r_p on the radial component (`physics::axisymmetry`).
+/// plus V τ_θθ S_I / r_p on the radial component (`physics::shape::hoop`).
 fn internal_force_at<const D: usize>(
     stress: &Mat3,
     volume: f64,

@@ -1,11 +1,11 @@
-//! contact.csv: what contact between bodies did (`crate::physics::contact`), one
+//! contact.csv: what contact between bodies did (`crate::solver::explicit::contact`), one
 //! row per pair of velocity fields at every history.csv row: the mean contact force
 //! on the pair's first field since the previous row (impulse over elapsed time), the
 //! nodes in contact in the last step, and the energy friction has dissipated since
 //! the start.
 
 use crate::output::{CsvWriter, Field};
-use crate::physics::contact::PairTotal;
+use crate::physics::contact::totals::PairTotal;
 use serde::{Deserialize, Serialize};
 use std::io;
 use std::path::Path;

@@ -6,7 +6,7 @@
 use crate::dim::Vector;
 use crate::model::Model;
 use crate::output::{body_centres, CsvWriter, Field, FrameWriter, HistoryWriter};
-use crate::physics::contact::PairTotal;
+use crate::physics::contact::totals::PairTotal;
 use crate::run::contact::{ContactLog, ContactState};
 use crate::run::energy::{kinetic_energy, strain_energy};
 use crate::run::footing::FootingCurve;

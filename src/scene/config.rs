@@ -383,7 +383,7 @@ pub struct LoadConfig {
 }
 
 /// A `[[contact]]` table: the bodies it pairs and their contact law
-/// (`crate::physics::contact`; docs/contact.md).
+/// (`crate::solver::explicit::contact`; docs/contact.md).
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ContactConfig {
@@ -403,7 +403,7 @@ pub struct ContactConfig {
     #[serde(default)]
     pub normal: ContactNormal,
     /// Put deformable particles that enter a rigid body back on its surface
-    /// (`crate::physics::rigid_surface`; default true).
+    /// (`crate::physics::rigid::surface`; default true).
     #[serde(default = "yes")]
     pub rigid_projection: bool,
     /// Implicit solver: the penalty ε_n = α M A_p / h of a particle against a
@@ -422,7 +422,7 @@ fn yes() -> bool {
 }
 
 /// The common normal of two fields at a contact node, from their volume gradients
-/// g = Σ_p V_p ∇S_Ip (`crate::physics::contact`).
+/// g = Σ_p V_p ∇S_Ip (`crate::solver::explicit::contact`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, IntoStaticStr, EnumIter)]
 #[serde(rename_all = "snake_case")]
 #[strum(serialize_all = "snake_case")]

@@ -24,7 +24,7 @@ pub struct GridConfig {
 /// `domain_stress`: the stress within each particle domain is the particle's
 /// (`"constant"`, the default, as in every MPM code) or linear about it with
 /// a least-squares gradient from the neighbouring particles of the same body
-/// (`"linear"`, `physics::stress_gradient`): for `cpgimp` and `cpbspline2` in
+/// (`"linear"`, `solver::implicit::stress_gradient`): for `cpgimp` and `cpbspline2` in
 /// implicit stages; it removes the O(h) stress error of the particles at a
 /// body's faces (docs/accuracy.md).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]

@@ -74,7 +74,7 @@ pub enum DirectOrdering {
 #[serde(rename_all = "snake_case")]
 #[strum(serialize_all = "snake_case")]
 pub enum Transfer {
-    /// Particle-side scatter on a box of nodes (`physics::scatter`) where the
+    /// Particle-side scatter on a box of nodes (`solver::explicit::node_box`) where the
     /// scene allows it, else `Gather`.
     Auto,
     /// Node-side gathers through the node map (`physics::transfer`): every
@@ -89,7 +89,7 @@ pub enum Transfer {
 pub enum VelocityTransfer {
     /// The PIC/FLIP blend of `flip` (2-27).
     Flip,
-    /// Affine particle-in-cell (Jiang et al. 2015, 2017; `physics::apic`): the
+    /// Affine particle-in-cell (Jiang et al. 2015, 2017; `solver::explicit::apic`): the
     /// particle carries an affine velocity field, transferred without loss of
     /// linear or angular momentum and without FLIP's noise.
     Apic,
@@ -141,7 +141,7 @@ pub struct SolverConfig {
     /// Explicit particle velocity update (default `flip`).
     pub velocity_transfer: Option<VelocityTransfer>,
     pub damping: Option<f64>,
-    /// Artificial bulk viscosity C_Q and C_L (`physics::bulk_viscosity`; off
+    /// Artificial bulk viscosity C_Q and C_L (`solver::explicit::bulk_viscosity`; off
     /// unless one is given, the other then takes its standard value).
     pub bulk_viscosity_quadratic: Option<f64>,
     pub bulk_viscosity_linear: Option<f64>,

@@ -4,7 +4,6 @@
 
 pub mod divergence;
 pub mod explicit;
-pub mod explicit_scatter;
 pub mod implicit;
 pub mod linear;
 pub mod report;

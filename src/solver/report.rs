@@ -93,7 +93,7 @@ pub struct MultigridCounts {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum TransferPath {
-    /// Particle-side scatter on a box of nodes (`solver::explicit_scatter`).
+    /// Particle-side scatter on a box of nodes (`solver::explicit::scatter`).
     Scatter,
     /// Node-side gathers through the node map.
     Gather,

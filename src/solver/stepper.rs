@@ -3,7 +3,7 @@
 
 use crate::dim::Vector;
 use crate::model::Model;
-use crate::physics::contact::PairTotal;
+use crate::physics::contact::totals::PairTotal;
 use crate::scene::LinearSystems;
 use crate::solver::divergence::Divergence;
 use crate::solver::linear::direct::Statistics;

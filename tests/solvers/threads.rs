@@ -80,7 +80,7 @@ fn axisymmetric_runs_give_identical_results_on_one_and_two_threads() {
     }
 }
 
-/// The scatter path (`solver::explicit_scatter`), every scheme: the granular
+/// The scatter path (`solver::explicit::scatter`), every scheme: the granular
 /// collapse at twice its resolution (12,800 particles, so that both the tiles
 /// of the scatter and the chunks of the particle passes split across threads),
 /// Mohr–Coulomb with history and a friction base.
@@ -97,7 +97,7 @@ fn scatter_runs_give_identical_results_on_one_and_two_threads() {
     }
 }
 
-/// APIC (`physics::apic`) on both paths: the collapse as above with USL on the
+/// APIC (`solver::explicit::apic`) on both paths: the collapse as above with USL on the
 /// box and MUSL on the node map.
 #[test]
 fn apic_runs_give_identical_results_on_one_and_two_threads() {

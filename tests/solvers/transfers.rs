@@ -1,5 +1,5 @@
 //! The explicit step's two transfer paths (`solver.transfer`, docs/scene.md):
-//! the scatter on a box of nodes (`solver::explicit_scatter`) against the node
+//! the scatter on a box of nodes (`solver::explicit::scatter`) against the node
 //! map's gathers (`solver::explicit`). Their sums differ in order only, so the
 //! two runs agree to round-off, with every scheme and separable family, face
 //! conditions, a friction face, local damping, a PIC/FLIP blend, a point load

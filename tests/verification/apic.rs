@@ -1,4 +1,4 @@
-//! APIC (`solver.velocity_transfer = "apic"`, `physics::apic`) in whole explicit
+//! APIC (`solver.velocity_transfer = "apic"`, `solver::explicit::apic`) in whole explicit
 //! steps: a free elastic disk spinning without gravity keeps its angular
 //! momentum (x × m v plus the skew part of m B_p: Jiang et al. 2017) to
 //! round-off on both transfer paths, where FLIP and PIC do not.

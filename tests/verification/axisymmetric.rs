@@ -426,7 +426,7 @@ fn solid_cylinder_compressed_radially_is_uniform_up_to_the_axis() {
 fn solid_cylinder_compressed_radially_explicit() {
     for scheme in ["usf", "usl", "musl"] {
         // cpbspline2 and bspline3 take the mirror masses at the axis and the
-        // outer face (`physics::mirror`).
+        // outer face (`solver::explicit::mirror`).
         for (shape, max) in [
             ("linear", 5e-3),
             ("cpgimp", 1e-2),

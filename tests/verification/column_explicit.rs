@@ -126,7 +126,7 @@ fn standard_mpm_does_not_converge() {
 }
 
 /// Cubic B-splines (mirror extension at the fixed base: natural end condition and
-/// the image problem's masses, `mpm::physics::mirror`) and quadratic B-splines
+/// the image problem's masses, `mpm::solver::explicit::mirror`) and quadratic B-splines
 /// averaged over the contiguous particle domains (`cpbspline2`, no knot-crossing
 /// error) converge. Measured (8, 16, 32, 64 cells): bspline3 9.2e-3 … 3.7e-4,
 /// mean rate 1.5 (0.5 before the mirror, from an O(1) error at the base);

@@ -1,5 +1,5 @@
 //! Contact between bodies in the explicit solver (`[[contact]]`,
-//! `mpm::physics::contact`).
+//! `mpm::solver::explicit::contact`).
 //!
 //! - A block sliding on an elastic base tilted by rotating gravity,
 //!   g = 9.81 (sin θ, −cos θ), θ = 45° (`problems/contact_incline.toml`): the
@@ -254,7 +254,7 @@ fn disks_without_contact() -> String {
 #[test]
 fn disks_bounce_off_and_separate_with_momentum_conserved() {
     disks_bounce_off(&[]);
-    // APIC (`physics::apic`): the same with the affine transfers.
+    // APIC (`solver::explicit::apic`): the same with the affine transfers.
     disks_bounce_off(&["solver.velocity_transfer=\"apic\""]);
 }
 
@@ -1014,7 +1014,7 @@ fn free_rigid_body_spins_as_a_rigid_body() {
 #[test]
 fn rigid_cylinder_rolls_and_slips_as_the_closed_form_up_to_its_stepped_bottom() {
     // The lattice cylinder (LATTICE_CYLINDER) made a free rigid body (it now
-    // turns: Newton–Euler, physics::rigid_body). Slipping within 1.5 % (measured
+    // turns: Newton–Euler, physics::rigid::newton_euler). Slipping within 1.5 % (measured
     // −1.3 % at μ = 0, −0.19 % at μ = 0.1); rolling lags like the elastic disk,
     // from the same stepped lattice bottom, at first order: −25.0 %, −11.7 %.
     let text = problem_with(

@@ -8,6 +8,7 @@
 pub mod bspline;
 pub mod cpdi;
 pub mod gimp;
+pub mod hoop;
 pub mod linear;
 
 pub use linear::{AxisFactors, MAX_PER_AXIS};
@@ -55,7 +56,7 @@ pub fn evaluate<const D: usize>(
 
 /// The first moments M_kj = (1/|Ω|) ∫_Ω (y − x)_k ∂_j N_I of the gradients over
 /// the particle domain about the particle, entry by entry in the order of
-/// `evaluate` (`physics::stress_gradient`): for the families that integrate over
+/// `evaluate` (`solver::implicit::stress_gradient`): for the families that integrate over
 /// a box domain stretched with the material, `cpgimp` and `cpbspline2`; `None`
 /// for the others.
 pub fn gradient_moments<const D: usize>(
@@ -184,7 +185,7 @@ pub struct Stencils<const D: usize> {
     values: Values<D>,
     owner: Owner,
     /// Axisymmetric mode only (else empty): S_Ip / r_p per entry, the hoop
-    /// gradient (`physics::axisymmetry`).
+    /// gradient (`physics::shape::hoop`).
     pub hoop: Vec<f64>,
 }
 

@@ -134,7 +134,7 @@ pub fn validate(s: &SceneConfig) -> Check {
     Ok(())
 }
 
-/// `domain_stress = "linear"` (`physics::stress_gradient`): box domains
+/// `domain_stress = "linear"` (`solver::implicit::stress_gradient`): box domains
 /// (cpGIMP, cpB-spline), implicit stages only, without F-bar (whose tangent
 /// it does not combine with), not in axisymmetric mode, and not with CG (the
 /// tangent is unsymmetric).

@@ -5,7 +5,7 @@
 //! particles touch no node (their stencils are emptied) and move at their
 //! velocity when a step is committed. Its `[[body]]` geometry, carried by that
 //! motion to the end of the step, is the master surface of a penalty contact
-//! (`physics::rigid_penalty`) with every deformable particle of a body declared
+//! (`solver::implicit::rigid_penalty`) with every deformable particle of a body declared
 //! in contact with it: a particle at x_p(u) = x_p + Σ_I S_Ip u_I inside the body
 //! feels f_p, which enters the residual like an external force and the tangent
 //! through its derivative:
@@ -32,7 +32,7 @@
 //! for the next step (stick carries over steps).
 //!
 //! **Two deformable bodies** are kept apart on the grid: every grid node that
-//! both touch is split into one node per body (`physics::field_split`), so each
+//! both touch is split into one node per body (`physics::contact::field_split`), so each
 //! body has its own displacement there and neither drags the other along. At
 //! such a node I the two fields r < s meet with the common normal n (from r to
 //! s) and the distance D between their surfaces at the step start (both from the
@@ -67,16 +67,18 @@ use crate::model::grid::Grid;
 use crate::model::particles::Particles;
 use crate::model::Model;
 use crate::parallel::MIN_PARALLEL_LEN;
-use crate::physics::contact::{pair_totals, PairTotal};
-use crate::physics::field_split::{pair_position, FieldSplit, Meeting};
-use crate::physics::rigid_body::to3;
-use crate::physics::rigid_penalty::{penalty_force, ParticleContact, Penalty};
-use crate::physics::rigid_surface::{on_grid_boundary, rigid_surfaces, Inside, Placement, Surface};
+use crate::physics::contact::field_split::{pair_position, FieldSplit, Meeting};
+use crate::physics::contact::totals::{pair_totals, PairTotal};
+use crate::physics::rigid::newton_euler::to3;
+use crate::physics::rigid::surface::{
+    on_grid_boundary, rigid_surfaces, Inside, Placement, Surface,
+};
 use crate::physics::shape::{
     contiguous_half_length, deformation_for, evaluate, ShapeFunction, Stencils,
 };
 use crate::physics::transfer::{interpolate, stencils, NodeMap};
 use crate::scene::contact::ContactPlan;
+use crate::solver::implicit::rigid_penalty::{penalty_force, ParticleContact, Penalty};
 use rayon::prelude::*;
 
 /// A particle in contact at the last evaluation of the residual.

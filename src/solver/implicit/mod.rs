@@ -25,14 +25,16 @@ pub mod krylov;
 pub mod newmark;
 pub mod newton;
 pub mod residual;
+pub mod rigid_penalty;
 pub mod step;
+pub mod stress_gradient;
 #[cfg(test)]
 mod tests;
 pub mod ties;
 
 use crate::dim::Vector;
 use crate::model::Model;
-use crate::physics::contact::PairTotal;
+use crate::physics::contact::totals::PairTotal;
 use crate::physics::shape::{ShapeFunction, Stencils};
 use crate::physics::transfer::NodeMap;
 use crate::scene::{

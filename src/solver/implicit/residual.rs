@@ -52,7 +52,7 @@ pub fn residual<const D: usize>(
         .map(|q| relative_pk1(&sys.trial.df(st, map, q), &sys.trial.stress.get(q)))
         .collect();
     let mut f_int = internal_force(map, st, &p.volume, &pk1);
-    // A stress linear within each particle domain (`physics::stress_gradient`).
+    // A stress linear within each particle domain (`solver::implicit::stress_gradient`).
     if let Some(linear) = &sys.linear_stress {
         let f_linear = linear.force(map, st, &p.volume, &pk1);
         f_int.iter_mut().zip(f_linear).for_each(|(f, g)| *f += g);

@@ -20,16 +20,16 @@ use crate::model::conditions::Constraint;
 use crate::model::loads::LoadTime;
 use crate::model::{load_factor, Model};
 use crate::parallel::MIN_PARALLEL_LEN;
-use crate::physics::absorbing::{self, AbsorbingStep};
-use crate::physics::boundary::implicit_node_constraint;
-use crate::physics::deformation::Trial;
+use crate::physics::boundary::absorbing::{self, AbsorbingStep};
+use crate::physics::boundary::conditions::implicit_node_constraint;
+use crate::physics::kinematics::deformation::Trial;
 use crate::physics::shape::{domain_corner_mean, ShapeFunction, Stencils};
-use crate::physics::stress_gradient::LinearStress;
 use crate::physics::transfer::{
     applied_force, external_force, interpolate, mass_average, mass_momentum, mass_weighted,
     nodal_force, stencils, NodeMap,
 };
 use crate::scene::{DirectOrdering, Integrator, MassMatrix, SolverConfig};
+use crate::solver::implicit::stress_gradient::LinearStress;
 use rayon::prelude::*;
 use std::sync::OnceLock;
 
@@ -49,7 +49,7 @@ pub struct StepSettings {
     pub gravity_ramp_time: LoadTime,
     /// Nodes with less particle support (cells) are tied to their neighbours.
     pub min_node_support: f64,
-    /// F-bar against volumetric locking (`crate::physics::fbar`).
+    /// F-bar against volumetric locking (`crate::physics::kinematics::fbar`).
     pub fbar: bool,
     /// The direct solver's fill-reducing ordering.
     pub direct_ordering: DirectOrdering,

@@ -31,7 +31,7 @@ use crate::physics::shape::Stencils;
 use crate::physics::transfer::NodeMap;
 use crate::scene::Face;
 
-/// The field (body group, `physics::field_split`) of every active node, with
+/// The field (body group, `physics::contact::field_split`) of every active node, with
 /// contact between deformable bodies: a grid node they share holds one node
 /// per field, and a node's neighbours for a tie are those of its own field (a
 /// tie across fields would glue the bodies together).

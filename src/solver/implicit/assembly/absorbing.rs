@@ -5,7 +5,7 @@
 
 use super::{Components, Dofs, Pattern, Tangent};
 use crate::dim::Vector;
-use crate::physics::absorbing::AbsorbingStep;
+use crate::physics::boundary::absorbing::AbsorbingStep;
 use crate::physics::shape::Stencils;
 use crate::physics::transfer::NodeMap;
 

@@ -1,4 +1,4 @@
-//! The tangent of the F-bar internal force (Coombs et al. 2018, `physics::fbar`):
+//! The tangent of the F-bar internal force (Coombs et al. 2018, `physics::kinematics::fbar`):
 //! each particle follows ΔF̄_p = (ΔJ̄_c / ΔJ_p)^{1/n} ΔF_p, so it couples to the
 //! nodes of every particle in its cell. Axisymmetric: n = 3 and the hoop
 //! components join every contraction (`assembly::stiffness`).
@@ -7,7 +7,7 @@ use super::stiffness::{add_stiffness, indices, ParticleTangents};
 use super::{Dofs, Pattern, Tangent};
 use crate::dim::{Mat3, Vector};
 use crate::parallel::MIN_PARALLEL_LEN;
-use crate::physics::fbar::{scale_factor, FBarState};
+use crate::physics::kinematics::fbar::{scale_factor, FBarState};
 use crate::physics::shape::Stencils;
 use crate::physics::transfer::NodeMap;
 use rayon::prelude::*;

@@ -1,5 +1,5 @@
 //! The tangent of the internal force with a stress linear within each particle
-//! domain (`physics::stress_gradient`):
+//! domain (`solver::implicit::stress_gradient`):
 //!
 //!   f_I += Σ_p V_p Σ_k ∂_kP_p M_Ip,k·,  ∂_kP_p = Σ_{q∈n(p)} c_pq,k (P_q − P_p),
 //!
@@ -16,8 +16,8 @@ use super::{Dofs, Pattern, Tangent};
 use crate::dim::Vector;
 use crate::parallel::MIN_PARALLEL_LEN;
 use crate::physics::shape::Stencils;
-use crate::physics::stress_gradient::LinearStress;
 use crate::physics::transfer::NodeMap;
+use crate::solver::implicit::stress_gradient::LinearStress;
 use rayon::prelude::*;
 
 /// Adds the linear domain stress's part of the tangent to `k` (stored whole).

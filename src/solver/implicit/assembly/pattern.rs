@@ -17,11 +17,11 @@
 //! number of threads.
 
 use super::Dofs;
-use crate::physics::fbar::Cells;
+use crate::physics::kinematics::fbar::Cells;
 use crate::physics::shape::Stencils;
-use crate::physics::stress_gradient::LeastSquares;
 use crate::physics::transfer::NodeMap;
 use crate::scene::DirectOrdering;
+use crate::solver::implicit::stress_gradient::LeastSquares;
 use crate::solver::linear::direct::spmv;
 use crate::solver::linear::node_pattern::NodeLists;
 use crate::solver::linear::ordering::{node_amd, node_metis, NodeGraph};

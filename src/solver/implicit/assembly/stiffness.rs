@@ -8,7 +8,7 @@
 //! the material part (from the exact derivative of the stress update, 2-41) and
 //! the geometric part (2-42).
 //!
-//! Axisymmetric (`physics::axisymmetry`): ΔF_θθ = 1 + Σ_J u_Jr h_Jp with the hoop
+//! Axisymmetric (`physics::shape::hoop`): ΔF_θθ = 1 + Σ_J u_Jr h_Jp with the hoop
 //! gradient h_Jp = S_Jp / R_p (R_p the step-start radius) and f_Ir gains
 //! V_p P_θθ h_Ip, so K gains the hoop couplings (θ = index 2 of A)
 //!
@@ -20,7 +20,7 @@ use crate::material::driver::numerical_stress_derivative;
 use crate::material::{Increment, StressDerivative};
 use crate::model::Model;
 use crate::parallel::MIN_PARALLEL_LEN;
-use crate::physics::deformation::Trial;
+use crate::physics::kinematics::deformation::Trial;
 use crate::physics::shape::Stencils;
 use crate::physics::transfer::NodeMap;
 use crate::solver::implicit::failure::Failure;

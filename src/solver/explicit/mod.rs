@@ -1,31 +1,40 @@
 //! Explicit MPM: central difference in time (thesis 2-29, 2-30) with the USF, USL
 //! and MUSL orderings of the stress update (§2.2.1), a PIC/FLIP blend, and local
 //! damping for dynamic relaxation. B-spline grids take the mirror extension at
-//! faces with prescribed velocities (`crate::physics::mirror`).
+//! faces with prescribed velocities (`crate::solver::explicit::mirror`).
+
+pub mod apic;
+pub mod bulk_viscosity;
+pub mod contact;
+pub mod grid_update;
+pub mod mirror;
+pub mod node_box;
+pub mod scatter;
 
 use crate::dim::Vector;
 use crate::model::conditions::{Constraint, FrictionFace};
 use crate::model::loads::LoadTime;
 use crate::model::{load_factor, Model};
 use crate::parallel::{deterministic_sum, MIN_PARALLEL_LEN};
-use crate::physics::absorbing;
-use crate::physics::apic::{self, AffineMomentum};
-use crate::physics::boundary::{friction_contact, node_constraint, node_friction};
-use crate::physics::bulk_viscosity::BulkViscosity;
-use crate::physics::contact::{Contact, PairTotal};
-use crate::physics::deformation::Trial;
-use crate::physics::grid_update::{acceleration, local_damping, TINY_MASS_FRACTION};
-use crate::physics::mirror::Mirror;
-use crate::physics::scatter::NodeBox;
+use crate::physics::boundary::absorbing;
+use crate::physics::boundary::conditions::{friction_contact, node_constraint, node_friction};
+use crate::physics::contact::totals::PairTotal;
+use crate::physics::kinematics::deformation::Trial;
 use crate::physics::shape::{ShapeFunction, Stencils};
 use crate::physics::transfer::{
     applied_force, interpolate_two, mass_average, mass_momentum, nodal_force, NodeMap,
 };
 use crate::scene::{Scheme, SolverConfig, Transfer};
 use crate::solver::divergence::{check_state, inverted, Divergence};
-use crate::solver::explicit_scatter::{ScatterStep, Settings};
+use crate::solver::explicit::bulk_viscosity::BulkViscosity;
+use crate::solver::explicit::grid_update::{acceleration, local_damping, TINY_MASS_FRACTION};
+use crate::solver::explicit::mirror::Mirror;
+use crate::solver::explicit::node_box::NodeBox;
+use crate::solver::explicit::scatter::{ScatterStep, Settings};
 use crate::solver::report::{SolverReport, TransferPath};
 use crate::solver::stepper::Stepper;
+use apic::AffineMomentum;
+use contact::Contact;
 use rayon::prelude::*;
 
 pub struct Explicit<const D: usize> {
@@ -34,24 +43,24 @@ pub struct Explicit<const D: usize> {
     pub cfl: f64,
     pub fixed_dt: Option<f64>,
     pub flip: f64,
-    /// APIC (`physics::apic`) instead of the PIC/FLIP blend (`flip` is then 0).
+    /// APIC (`solver::explicit::apic`) instead of the PIC/FLIP blend (`flip` is then 0).
     pub apic: bool,
     pub damping: f64,
     /// Gravity rises linearly from zero over `gravity_ramp_time` on the run's
     /// clock, as a load's `ramp_time` (0: in full from the start).
     pub gravity_ramp: LoadTime,
-    /// F-bar against volumetric locking (`crate::physics::fbar`).
+    /// F-bar against volumetric locking (`crate::physics::kinematics::fbar`).
     pub fbar: bool,
     stencils: Stencils<D>,
     map: NodeMap,
     trial: Trial<D>,
-    /// Contact between bodies (`crate::physics::contact`), when the scene has some.
+    /// Contact between bodies (`crate::solver::explicit::contact`), when the scene has some.
     contact: Option<Contact<D>>,
-    /// Artificial bulk viscosity (`crate::physics::bulk_viscosity`), if asked for.
+    /// Artificial bulk viscosity (`crate::solver::explicit::bulk_viscosity`), if asked for.
     pub viscosity: Option<BulkViscosity>,
     /// `solver.transfer`: `Auto` takes the scatter path where it serves.
     pub transfer: Transfer,
-    /// The scatter path's buffers (`solver::explicit_scatter`), once it has run.
+    /// The scatter path's buffers (`solver::explicit::scatter`), once it has run.
     scatter: Option<ScatterStep<D>>,
 }
 
@@ -79,7 +88,7 @@ impl<const D: usize> Explicit<D> {
         }
     }
 
-    /// Can this step run on the scatter path (`solver::explicit_scatter`)? Not
+    /// Can this step run on the scatter path (`solver::explicit::scatter`)? Not
     /// with what needs the node map or per-entry values: CPDI, contact, F-bar,
     /// bulk viscosity, absorbing faces, axisymmetry, removed particles, the
     /// mirror of cubic and domain B-splines at faces with prescribed velocity;
@@ -301,7 +310,7 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
                 *x += v_pic * dt;
             });
         // Free rigid bodies: Newton–Euler under the step's contact impulses and
-        // the applied forces (`physics::rigid_body`).
+        // the applied forces (`physics::rigid::newton_euler`).
         if let Some(free) = self.contact.as_mut().and_then(|c| c.free_bodies()) {
             let force: Vec<Vector<D>> = (free.particles())
                 .map(|q| applied_force(&m.particles, q, &gravity, &load_factor))

@@ -18,7 +18,7 @@
 //! Linear hats: S_I D_p⁻¹ (x_I − x_p) = ∇S_I wherever D_p is invertible, and
 //! D_p is singular on grid lines, so the P2G weight there is ∇S_I (the same
 //! field; Hu et al. 2018, MLS-MPM §4). The tensor-product families take D_p per
-//! axis (it is diagonal for them: `physics::scatter::Stencil::moments`); CPDI
+//! axis (it is diagonal for them: `solver::explicit::node_box::Stencil::moments`); CPDI
 //! takes it whole.
 
 use crate::dim::{Tensor, Vector};
@@ -26,10 +26,10 @@ use crate::model::grid::Grid;
 use crate::model::particles::Particles;
 use crate::model::Model;
 use crate::parallel::MIN_PARALLEL_LEN;
-use crate::physics::scatter::{Moments, Slopes, Stencil};
 use crate::physics::shape::ShapeFunction;
 use crate::physics::shape::Stencils;
 use crate::physics::transfer::{mass_average, mass_momentum, stencils, NodeMap};
+use crate::solver::explicit::node_box::{Moments, Slopes, Stencil};
 use rayon::prelude::*;
 
 /// The positions x_I of the active nodes of `map` (a split node at its grid node).
@@ -207,9 +207,9 @@ pub fn box_moment<const D: usize>(
 mod tests {
     use super::*;
     use crate::dim::Mat3;
-    use crate::physics::scatter::{NodeBox, Points};
     use crate::physics::shape::tests::sample_points;
     use crate::physics::transfer::interpolate;
+    use crate::solver::explicit::node_box::{NodeBox, Points};
     use strum::IntoEnumIterator;
 
     /// A grid of 8 cells per axis on [0, 2]^D for `shape`.
@@ -315,7 +315,7 @@ mod tests {
         round_trip_on_the_node_map::<3>();
     }
 
-    /// The same on the box of nodes (`physics::scatter`) for the families it serves.
+    /// The same on the box of nodes (`solver::explicit::node_box`) for the families it serves.
     fn round_trip_on_the_box<const D: usize>() {
         let c = gradient::<D>();
         for shape in ShapeFunction::iter().filter(|&s| NodeBox::<D>::serves(s)) {

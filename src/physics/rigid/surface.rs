@@ -1,7 +1,7 @@
 //! Rigid bodies are impenetrable (explicit solver; `[[contact]]` key
 //! `rigid_projection`, on by default).
 //!
-//! Node-based contact (`physics::contact`) acts at grid nodes, so a deformable
+//! Node-based contact (`solver::explicit::contact`) acts at grid nodes, so a deformable
 //! particle can enter a rigid body by up to about a cell before the nodes it
 //! touches stop it: in a penetration, concrete that the nose carries along the
 //! axis ends up inside the shank and is crushed there
@@ -28,7 +28,7 @@ use crate::model::geometry::{Bend, Geometry};
 use crate::model::grid::Grid;
 use crate::model::particles::Particles;
 use crate::model::Model;
-use crate::physics::rigid_body::{from3, to3};
+use crate::physics::rigid::newton_euler::{from3, to3};
 use crate::scene::contact::ContactPlan;
 use nalgebra::Vector3;
 

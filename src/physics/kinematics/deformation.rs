@@ -5,7 +5,7 @@
 //! trial state, so an implicit solver can evaluate it at every Newton iterate
 //! without drift and commit it once the step has converged. With F-bar (`fbar`)
 //! the particles follow ΔF̄ instead of ΔF. In axisymmetric mode ΔF_θθ is the hoop
-//! stretch of the increment (`physics::axisymmetry`) instead of 1.
+//! stretch of the increment (`physics::shape::hoop`) instead of 1.
 
 use crate::dim::{compose, embed_deformation, Mat3, Tensor, Vector};
 use crate::material::{Increment, Material};
@@ -13,8 +13,8 @@ use crate::model::grid::Grid;
 use crate::model::particles::Particles;
 use crate::model::tensors::{Layout, TensorMut, Tensors};
 use crate::parallel::MIN_PARALLEL_LEN;
-use crate::physics::axisymmetry::hoop_stretch;
-use crate::physics::fbar::{scale_factor, scaled, Cells, FBarState};
+use crate::physics::kinematics::fbar::{scale_factor, scaled, Cells, FBarState};
+use crate::physics::shape::hoop::hoop_stretch;
 use crate::physics::shape::Stencils;
 use crate::physics::transfer::{gradient, NodeMap};
 use rayon::prelude::*;

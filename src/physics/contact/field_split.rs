@@ -2,7 +2,7 @@
 //! without a contact between them form one) gets a node of its own at each grid
 //! node that particles of two or more fields touch, and each pair of fields
 //! that meets there gets a common normal, a nodal area and the gap between
-//! their surfaces (a [`Meeting`]). The explicit contact (`physics::contact`)
+//! their surfaces (a [`Meeting`]). The explicit contact (`solver::explicit::contact`)
 //! corrects the fields' velocities at the meetings; the implicit one
 //! (`solver::implicit::contact`) puts a penalty between their displacements.
 //!
@@ -30,7 +30,7 @@
 use crate::dim::Vector;
 use crate::model::Model;
 use crate::parallel::MIN_PARALLEL_LEN;
-use crate::physics::rigid_surface::on_grid_boundary;
+use crate::physics::rigid::surface::on_grid_boundary;
 use crate::physics::shape::Stencils;
 use crate::physics::transfer::NodeMap;
 use crate::scene::contact::{ContactLaw, ContactPlan};

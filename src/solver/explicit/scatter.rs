@@ -1,5 +1,5 @@
 //! The explicit step with particle-side transfers on a box of nodes
-//! (`physics::scatter`): the step of `solver::explicit` (USF, USL, MUSL; the
+//! (`solver::explicit::node_box`): the step of `solver::explicit` (USF, USL, MUSL; the
 //! PIC/FLIP blend, local damping, face conditions, friction faces, gravity and
 //! loads) without a node map or stored stencils. Each particle pass evaluates
 //! the particle's 1D factors again, which costs less than storing the tensor
@@ -16,15 +16,15 @@ use crate::model::particles::Particles;
 use crate::model::tensors::TensorsMut;
 use crate::model::{load_factor, Model};
 use crate::parallel::{deterministic_sum, DisjointSlice, MIN_PARALLEL_LEN, SUM_CHUNK};
-use crate::physics::apic;
-use crate::physics::boundary::{friction_contact, node_constraint, node_friction};
-use crate::physics::deformation::{update_particle, ParticleState};
-use crate::physics::grid_update::{acceleration, TINY_MASS_FRACTION};
-use crate::physics::scatter::{NodeBox, Points, Stencil};
+use crate::physics::boundary::conditions::{friction_contact, node_constraint, node_friction};
+use crate::physics::kinematics::deformation::{update_particle, ParticleState};
 use crate::physics::shape::{deformation_for, ShapeFunction};
 use crate::physics::transfer::{applied_force, applied_to, nodal_velocity};
 use crate::scene::Scheme;
 use crate::solver::divergence::{inverted, sound, unsound, Divergence};
+use crate::solver::explicit::apic;
+use crate::solver::explicit::grid_update::{acceleration, TINY_MASS_FRACTION};
+use crate::solver::explicit::node_box::{NodeBox, Points, Stencil};
 use rayon::prelude::*;
 
 /// Particles per task of a particle pass: the chunking of
@@ -57,7 +57,7 @@ pub struct Settings<const D: usize> {
     pub shape: ShapeFunction,
     pub scheme: Scheme,
     pub flip: f64,
-    /// APIC (`physics::apic`); `flip` is then 0.
+    /// APIC (`solver::explicit::apic`); `flip` is then 0.
     pub apic: bool,
     pub damping: f64,
     pub gravity: Vector<D>,
@@ -183,7 +183,7 @@ impl<const D: usize> ScatterStep<D> {
             .scatter_with_second(shape, grid, points, &mut self.nodes, source, add);
     }
 
-    /// APIC's first step on the box (as `physics::apic::ensure` on the node
+    /// APIC's first step on the box (as `solver::explicit::apic::ensure` on the node
     /// map): B_p of the particles' velocities projected on the nodes.
     fn initial_affine(&mut self, s: &Settings<D>, m: &mut Model<D>, scales: &[f64]) {
         self.nodes.clear();
@@ -566,7 +566,7 @@ struct Moving<'a, const D: usize> {
 /// (`GRAD` = 2).
 #[inline(always)]
 fn gather<const D: usize, const MOTION: bool, const GRAD: u8>(
-    sc: &crate::physics::scatter::Stencil<D>,
+    sc: &crate::solver::explicit::node_box::Stencil<D>,
     nb: &NodeBox<D>,
     nodes: &[Node<D>],
     second: &[Vector<D>],

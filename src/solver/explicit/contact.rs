@@ -5,7 +5,7 @@
 //! P2G and again after the grid update (Bardenhagen et al., CMES 2, 2001; Nairn,
 //! Hammerquist & Smith, CMAME 362, 2020).
 //!
-//! **Split nodes and meetings** (`physics::field_split`): every grid node that
+//! **Split nodes and meetings** (`physics::contact::field_split`): every grid node that
 //! particles of two or more velocity fields touch is split, one node per field,
 //! so every transfer (mass, momentum, forces, the velocity gradient, G2P) works
 //! per field there without change; a scene whose fields never share a node splits
@@ -31,47 +31,14 @@
 use crate::dim::Vector;
 use crate::model::Model;
 use crate::parallel::MIN_PARALLEL_LEN;
-use crate::physics::field_split::{pair_position, FieldSplit, Meeting};
-use crate::physics::rigid_body::FreeBodies;
-use crate::physics::rigid_surface::{on_grid_boundary, rigid_surfaces, Push, Surface};
+use crate::physics::contact::field_split::{pair_position, FieldSplit, Meeting};
+use crate::physics::contact::totals::{pair_totals, PairTotal};
+use crate::physics::rigid::newton_euler::FreeBodies;
+use crate::physics::rigid::surface::{on_grid_boundary, rigid_surfaces, Push, Surface};
 use crate::physics::shape::{ShapeFunction, Stencils};
 use crate::physics::transfer::NodeMap;
 use crate::scene::contact::ContactPlan;
 use rayon::prelude::*;
-
-/// What the contact of one field pair did since the totals were last taken.
-#[derive(Clone, Debug, PartialEq)]
-pub struct PairTotal<const D: usize> {
-    /// The fields' first bodies (r < s).
-    pub bodies: [u32; 2],
-    /// Momentum the contact delivered to field r's particles (s got the opposite).
-    pub impulse: Vector<D>,
-    /// Energy dissipated by friction: the work of the tangential impulses on the
-    /// slip, −J_t·(w_t + w_t')/2 per correction (w = v_r − v_s before and after).
-    pub dissipation: f64,
-    /// Nodes in contact in the last step.
-    pub nodes: usize,
-}
-
-/// A zero total for every pair of fields i < j, in the order of
-/// [`pair_position`] (contact.csv's rows).
-pub fn pair_totals<const D: usize>(plan: &ContactPlan) -> Vec<PairTotal<D>> {
-    let first_body = |field: usize| {
-        (plan.field_of_body.iter())
-            .position(|&x| x as usize == field)
-            .unwrap() as u32
-    };
-    let f = plan.fields;
-    (0..f)
-        .flat_map(|i| (i + 1..f).map(move |j| (i, j)))
-        .map(|(i, j)| PairTotal {
-            bodies: [first_body(i), first_body(j)],
-            impulse: Vector::<D>::zeros(),
-            dissipation: 0.0,
-            nodes: 0,
-        })
-        .collect()
-}
 
 /// The contact state of an explicit run.
 #[derive(Debug)]
@@ -79,16 +46,16 @@ pub struct Contact<const D: usize> {
     plan: ContactPlan,
     /// Field of each particle.
     field: Vec<u32>,
-    /// The split of the shared nodes (`physics::field_split`).
+    /// The split of the shared nodes (`physics::contact::field_split`).
     fields: FieldSplit,
     meetings: Vec<Meeting<D>>,
     /// Active nodes of rigid fields this step, with the rigid body's velocity.
     rigid_nodes: Vec<(usize, Vector<D>)>,
     totals: Vec<PairTotal<D>>,
-    /// The free rigid bodies (`physics::rigid_body`), if any.
+    /// The free rigid bodies (`physics::rigid::newton_euler`), if any.
     free: Option<FreeBodies<D>>,
     /// The rigid fields that keep deformable particles out
-    /// (`physics::rigid_surface`).
+    /// (`physics::rigid::surface`).
     surfaces: Vec<Surface>,
 }
 
@@ -233,7 +200,7 @@ impl<const D: usize> Contact<D> {
 
     /// Put the deformable particles that entered a rigid body back on its
     /// surface, without inward velocity relative to it, and give the body the
-    /// opposite momentum (`physics::rigid_surface`). After G2P and the free
+    /// opposite momentum (`physics::rigid::surface`). After G2P and the free
     /// bodies' advance.
     pub fn keep_out_of_rigid_bodies(&mut self, m: &mut Model<D>) {
         if self.surfaces.is_empty() {

@@ -1,5 +1,5 @@
 //! Rules of the explicit grid update that both transfer paths apply
-//! (`solver::explicit`, `solver::explicit_scatter`): local damping of the nodal
+//! (`solver::explicit`, `solver::explicit::scatter`): local damping of the nodal
 //! force, and no acceleration on nodes too light to carry one.
 
 use crate::dim::Vector;

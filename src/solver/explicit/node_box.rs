@@ -138,7 +138,7 @@ impl<const D: usize> Stencil<D> {
         delta
     }
 
-    /// The 1D factors of APIC (`physics::apic`) along every axis: the moments
+    /// The 1D factors of APIC (`solver::explicit::apic`) along every axis: the moments
     /// w_i δ_i and the inertia D_dd = Σ_i w_i δ_i² (D_p is diagonal for a tensor
     /// product of 1D bases that reproduce linear functions).
     pub fn moments(&self, grid: &Grid<D>, x: &Vector<D>) -> Moments {

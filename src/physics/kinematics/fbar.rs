@@ -133,7 +133,7 @@ pub struct FBarState {
 mod tests {
     use crate::dim::{Mat3, Tensor, Vector};
     use crate::model::Model;
-    use crate::physics::deformation::Trial;
+    use crate::physics::kinematics::deformation::Trial;
     use crate::physics::shape::Stencils;
     use crate::physics::transfer::NodeMap;
     use crate::scene::Scene;

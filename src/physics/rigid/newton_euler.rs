@@ -6,7 +6,7 @@
 //! I = Σ m_p (|r_p|² 1 − r_p r_pᵀ) and spin Ω = I⁻¹ Σ m_p r_p × (v_p − V)
 //! (r_p = x_p − c) are computed from them, so a restart needs nothing more. In
 //! the step the body is a field of infinite mass whose nodes move with
-//! V + Ω × (x_I − c) (`physics::contact`), and the contact corrections that
+//! V + Ω × (x_I − c) (`solver::explicit::contact`), and the contact corrections that
 //! reach the particles give it the impulse J = Σ Δp_I and the angular impulse
 //! H = Σ (x_I − c) × Δp_I (the opposite of what its partners received, so
 //! linear and angular momentum are conserved). After G2P:

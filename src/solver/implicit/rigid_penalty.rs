@@ -1,7 +1,7 @@
 //! Penalty contact of a deformable particle with a rigid body (the implicit
 //! solver's contact, `solver::implicit::contact`).
 //!
-//! The node-based contact of `physics::contact` corrects grid velocities, which
+//! The node-based contact of `solver::explicit::contact` corrects grid velocities, which
 //! has no residual to put into a Newton iteration. Here the particle is the
 //! slave point and the rigid body's exact `[[body]]` geometry the master
 //! surface. A particle at x that reaches r along the normal (its domain's
@@ -35,7 +35,7 @@
 //! mean of the step's start and end (trapezoidal: second order in the step).
 
 use crate::dim::{Tensor, Vector};
-use crate::physics::rigid_surface::Inside;
+use crate::physics::rigid::surface::Inside;
 
 /// The law at one particle: penalties and friction.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -124,7 +124,7 @@ mod tests {
     use super::*;
     use crate::model::geometry::Geometry;
     use crate::model::particles::Particles;
-    use crate::physics::rigid_surface::Surface;
+    use crate::physics::rigid::surface::Surface;
     use nalgebra::{Vector2, Vector3};
 
     /// A rigid body of one particle at its centre with the given shape.

@@ -1,0 +1,6 @@
+//! The laws of the grid-face conditions: node constraints and rough rigid walls
+//! (`conditions`), and the dashpots and springs of absorbing faces
+//! (`absorbing`).
+
+pub mod absorbing;
+pub mod conditions;
