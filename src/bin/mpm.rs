@@ -7,7 +7,7 @@ use mpm::analyses::bench::{bench, BenchError, BenchOptions};
 use mpm::analyses::reference;
 use mpm::analyses::strength_reduction::{search, SearchError};
 use mpm::run::{run, set_up_check, RunError, RunOptions};
-use mpm::scene::Scene;
+use mpm::scene::{BodyKindName, Scene};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -186,8 +186,15 @@ fn main() -> ExitCode {
             Ok(s) => {
                 let c = &s.config;
                 let stages: Vec<&str> = c.stages().iter().map(|st| st.kind.name()).collect();
+                let rigid = (0..c.bodies.len())
+                    .filter(|&i| c.body_kind(i) == BodyKindName::Rigid)
+                    .count();
+                let kinds = match rigid {
+                    0 => String::new(),
+                    n => format!(" ({n} rigid)"),
+                };
                 println!(
-                    "{}: ok ({}, {} material(s), {} body(ies), {} boundary condition(s), {} load(s), shape function {}, solver stages: {})",
+                    "{}: ok ({}, {} material(s), {} body(ies){kinds}, {} boundary condition(s), {} load(s), shape function {}, solver stages: {})",
                     s.file,
                     c.dimension.label(),
                     c.materials.len(),

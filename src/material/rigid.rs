@@ -1,44 +1,51 @@
-//! A rigid body: it carries no stress and meets deformable bodies only through
-//! contact (`crate::solver::explicit::contact`, where it acts as a field of infinite mass
-//! within a step), so a scene check requires a `[[contact]]` between it and every
-//! other body, and the explicit solver. With `motion = "prescribed"` (the default)
-//! it keeps the velocity it starts with (a footing, a pile, a plate, a projectile
-//! at constant speed); with `motion = "free"` it translates under the contact
-//! impulses, gravity and loads with the mass of its particles (a projectile whose
-//! residual velocity is wanted, a falling block; no rotation). Its density gives
-//! the particles their mass; the reaction the contact exerts on it is in
-//! contact.csv.
+//! The material of a rigid body's particles: no stress, no stiffness, no
+//! waves, only the density that gives them their mass. What makes a body rigid
+//! is its kind (`model::body::BodyKind::Rigid`, `[[body]] kind = "rigid"`), not
+//! this material: the model gives every rigid body's particles this material
+//! with the density of the body's `[[material]]` table, so every transfer works
+//! on them unchanged (zero stress and internal force, no limit on the time step,
+//! no strain energy) while the solvers treat the body by its kind.
+//!
+//! `model = "rigid"` in a `[[material]]` table is the old form of a rigid body,
+//! still read: a body with such a material and no `kind` is rigid, with the
+//! table's `motion` (`Motion`, checked here) as its motion.
 
 use super::parameters::{FromParameters, KeyError, Parameters};
 use super::{Increment, Material, StressDerivative};
 use crate::dim::Mat3;
 use serde::Deserialize;
 
-/// How a rigid body moves.
+/// How a rigid body moves (`[[body]] motion`, or the `motion` of an old-form
+/// rigid material).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Motion {
     /// At its initial velocity throughout.
     #[default]
     Prescribed,
-    /// Translation under the forces on it: M dV/dt = J/Δt + Σ f_ext.
+    /// Translation and rotation under the forces on it (Newton–Euler,
+    /// `physics::rigid::newton_euler`).
     Free,
 }
 
 impl Motion {
-    /// The motion a rigid material table asks for (its `motion` key, checked
-    /// when the material is built).
-    pub fn of(parameters: &toml::Table) -> Motion {
-        (parameters.get("motion"))
-            .and_then(|v| Motion::deserialize(v.clone()).ok())
-            .unwrap_or_default()
+    /// The `motion` key of an old-form rigid material table (checked when the
+    /// material is built), if it has one.
+    pub fn of(parameters: &toml::Table) -> Option<Motion> {
+        (parameters.get("motion")).and_then(|v| Motion::deserialize(v.clone()).ok())
     }
 }
 
 #[derive(Clone, Debug)]
 pub struct Rigid {
     density: f64,
-    pub motion: Motion,
+}
+
+impl Rigid {
+    /// The material of a rigid body's particles of density ρ.
+    pub fn new(density: f64) -> Rigid {
+        Rigid { density }
+    }
 }
 
 impl FromParameters for Rigid {
@@ -46,11 +53,11 @@ impl FromParameters for Rigid {
     const KEYS: &'static [&'static str] = &["motion"];
     const EXAMPLE: &'static str = "";
 
+    /// The old form: the table's `motion` is the body's (`SceneConfig::rigid_motion`),
+    /// only checked here.
     fn from_parameters(density: f64, p: &Parameters) -> Result<Self, KeyError> {
-        Ok(Rigid {
-            density,
-            motion: p.get("motion")?.unwrap_or_default(),
-        })
+        p.get::<Motion>("motion")?;
+        Ok(Rigid::new(density))
     }
 }
 

@@ -8,14 +8,15 @@
 use crate::dim::Vector;
 use crate::material::Material;
 use crate::model::conditions::{Absorbing, Constraint, FaceCondition, Footing, FrictionFace};
+use crate::model::body::Body;
 use crate::model::geometry::Geometry;
 use crate::model::grid::Grid;
 use crate::model::loads::Loads;
 use crate::model::particles::Particles;
 use crate::model::{axisymmetry, Model};
 use crate::scene::{
-    axis, expr, BodyConfig, BoundaryConfig, Condition, DomainStress, Face, Fill, ParticlesOutside,
-    Scene, SceneError,
+    axis, expr, particle_materials, BodyConfig, BoundaryConfig, Condition, DomainStress, Face,
+    Fill, ParticlesOutside, Scene, SceneError,
 };
 
 impl<const D: usize> Model<D> {
@@ -35,11 +36,13 @@ impl<const D: usize> Model<D> {
             cells,
             c.grid.shape_function.degree(),
         );
-        let base_materials = (c.materials.iter().enumerate())
+        let tables = (c.materials.iter().enumerate())
             .map(|(i, m)| m.build(i))
             .collect::<Result<Vec<_>, _>>()
             .map_err(err)?;
-        let bodies: Vec<Geometry> = c.bodies.iter().map(Geometry::of).collect();
+        // A rigid body's particles carry the zero-stress material (`model::body`).
+        let base_materials = particle_materials(c, tables);
+        let bodies: Vec<Body> = (0..c.bodies.len()).map(|i| Body::of(c, i)).collect();
         let mut particles = Particles::default();
         for (i, b) in c.bodies.iter().enumerate() {
             let m = c
@@ -48,7 +51,7 @@ impl<const D: usize> Model<D> {
                 .position(|m| m.name == b.material)
                 .expect("validated");
             let material = base_materials[m].as_ref();
-            let added = fill_body(&mut particles, &grid, b, &bodies[i], i, m as u32, material)
+            let added = fill_body(&mut particles, &grid, b, &bodies[i].geometry, i, m as u32, material)
                 .map_err(err)?;
             if c.dimension.is_axisymmetric() {
                 axisymmetry::per_radian(&mut particles, added);

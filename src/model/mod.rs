@@ -1,8 +1,9 @@
 //! The state every solver works on: grid, particles, materials, conditions,
-//! loads and the geometry of the bodies, built once from a validated scene
-//! (`build.rs`) and then independent of it.
+//! loads and the bodies (their geometry and kind, `body.rs`), built once from a
+//! validated scene (`build.rs`) and then independent of it.
 
 pub mod axisymmetry;
+pub mod body;
 mod build;
 pub mod conditions;
 pub mod geometry;
@@ -16,8 +17,8 @@ pub use loads::{load_factor, LoadTime};
 
 use crate::dim::Vector;
 use crate::material::Material;
+use crate::model::body::{Body, BodyKind};
 use crate::model::conditions::{Absorbing, FaceCondition, Footing, FrictionFace};
-use crate::model::geometry::Geometry;
 use crate::model::grid::Grid;
 use crate::model::particles::Particles;
 use crate::scene::contact::ContactPlan;
@@ -32,8 +33,8 @@ pub struct Model<const D: usize> {
     /// The materials as built from the scene (factor 1), which `reduce_strength`
     /// starts from.
     pub base_materials: Vec<Box<dyn Material>>,
-    /// The geometry of each body (by `Particles::body`).
-    pub bodies: Vec<Geometry>,
+    /// Each body's geometry and kind (by `Particles::body`).
+    pub bodies: Vec<Body>,
     pub faces: Vec<FaceCondition<D>>,
     /// Rigid rough faces (Coulomb friction; held fixed in implicit steps).
     pub friction: Vec<FrictionFace>,
@@ -130,6 +131,11 @@ impl<const D: usize> Model<D> {
         let p = &self.particles;
         let d2 = |q: usize| (0..D).map(|d| (p.x0[q][d] - x[d]).powi(2)).sum::<f64>();
         (0..p.len()).min_by(|&a, &b| d2(a).total_cmp(&d2(b)))
+    }
+
+    /// The kind of particle q's body.
+    pub fn kind_of(&self, q: usize) -> BodyKind {
+        self.bodies[self.particles.body[q] as usize].kind
     }
 
     /// Number of bodies (for per-body outputs).

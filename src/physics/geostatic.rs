@@ -16,8 +16,6 @@
 //! given, before any strength reduction).
 
 use crate::dim::Mat3;
-use crate::material::parameters::FromParameters;
-use crate::material::rigid::Rigid;
 use crate::model::Model;
 use crate::scene::GeostaticConfig;
 
@@ -33,8 +31,9 @@ pub fn initialise<const D: usize>(model: &mut Model<D>, g: &GeostaticConfig) {
     let p = &mut model.particles;
     for q in 0..p.len() {
         let m = p.material[q] as usize;
+        let body = &model.bodies[p.body[q] as usize];
         // A rigid body carries no stress.
-        if model.base_materials[m].model() == Rigid::NAME {
+        if !body.kind.carries_stress() {
             continue;
         }
         let k0 = g.k0.unwrap_or_else(|| {
@@ -43,7 +42,7 @@ pub fn initialise<const D: usize>(model: &mut Model<D>, g: &GeostaticConfig) {
                 .expect("validated");
             1.0 - phi.friction_angle.sin()
         });
-        let depth = (model.bodies[p.body[q] as usize].top(p.x0[q].as_slice(), v, up)
+        let depth = (body.geometry.top(p.x0[q].as_slice(), v, up)
             - up * p.x0[q][v])
             .max(0.0);
         let sigma_v = -model.materials[m].density() * g_mag * depth;

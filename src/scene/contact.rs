@@ -7,9 +7,9 @@
 //! declared pair must not end up in one group, and every declared pair between two
 //! groups must carry the same law.
 
-use super::config::{ContactConfig, ContactNormal, SceneConfig};
-use crate::material::parameters::{FromParameters, KeyError};
-use crate::material::rigid::{Motion, Rigid};
+use super::config::{BodyKindName, ContactConfig, ContactNormal, SceneConfig};
+use crate::material::parameters::KeyError;
+use crate::material::rigid::Motion;
 
 /// Velocity fields a scene may have (the split of shared nodes keeps the fields at
 /// a node as the bits of a u64).
@@ -53,9 +53,11 @@ pub struct ContactPlan {
     /// the diagonal.
     pub laws: Vec<Option<ContactLaw>>,
     pub fields: usize,
-    /// Whether each field is a rigid body (`material::rigid`).
+    /// Whether each field is a rigid body (`SceneConfig::body_kind`, the kind
+    /// `model::body::BodyKind` is built from; a rigid body has a field of its
+    /// own).
     pub rigid: Vec<bool>,
-    /// Whether each field is a free rigid body (`motion = "free"`).
+    /// Whether each field is a free rigid body (`SceneConfig::rigid_motion`).
     pub free: Vec<bool>,
 }
 
@@ -129,17 +131,12 @@ fn check_law(c: &ContactConfig, i: usize) -> Result<(), KeyError> {
 /// Resolve the `[[contact]]` tables (None when there are none), with the first
 /// problem named by its key.
 pub fn plan(s: &SceneConfig) -> Result<Option<ContactPlan>, KeyError> {
-    let rigid_material = |b: usize| {
-        let name = &s.bodies[b].material;
-        (s.materials.iter()).find(|m| &m.name == name && m.model == Rigid::NAME)
-    };
-    let rigid = |b: usize| rigid_material(b).is_some();
-    let free =
-        |b: usize| rigid_material(b).is_some_and(|m| Motion::of(&m.parameters) == Motion::Free);
+    let rigid = |b: usize| s.body_kind(b) == BodyKindName::Rigid;
+    let free = |b: usize| rigid(b) && s.rigid_motion(b) == Motion::Free;
     if s.contacts.is_empty() {
         return match (0..s.bodies.len()).find(|&b| rigid(b)) {
             Some(b) => Err((
-                format!("body.{b}.material"),
+                s.body_kind_key(b),
                 "a rigid body meets other bodies only through contact: add a [[contact]] \
                  between it and every body it may touch"
                     .into(),
@@ -210,7 +207,7 @@ pub fn plan(s: &SceneConfig) -> Result<Option<ContactPlan>, KeyError> {
     for b in (0..n).filter(|&b| rigid(b)) {
         if let Some(other) = (0..n).find(|&o| o != b && field_of_body[o] == field_of_body[b]) {
             return Err((
-                format!("body.{b}.material"),
+                s.body_kind_key(b),
                 format!(
                     "rigid body {b} would share a velocity field with body {other} (no \
                      [[contact]] between them): a rigid body needs a contact with every \

@@ -21,7 +21,7 @@ pub mod validate;
 pub use config::*;
 pub use error::{SceneError, Source};
 pub use grid::*;
-pub use material::MaterialConfig;
+pub use material::{particle_materials, MaterialConfig};
 pub use solver::*;
 
 use std::path::Path;
@@ -109,6 +109,7 @@ mod tests {
     fn enum_names_are_the_scene_names() {
         names_agree::<ShapeFunction>();
         names_agree::<BodyShape>();
+        names_agree::<BodyKindName>();
         names_agree::<Condition>();
         names_agree::<LoadKind>();
         names_agree::<SolverKind>();

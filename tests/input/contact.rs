@@ -211,5 +211,5 @@ fn a_rigid_motion_other_than_prescribed_or_free_is_named() {
     .unwrap();
     Scene::parse("scene.toml", &text, &[]).unwrap();
     let bad = text.replace("motion = \"free\"", "motion = \"spinning\"");
-    rejected(&bad, "material.1.motion", &["scene.toml:", "spinning"]);
+    rejected(&bad, "body.0.motion", &["scene.toml:", "spinning"]);
 }

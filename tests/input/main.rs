@@ -7,6 +7,7 @@ mod common;
 
 mod axisymmetric;
 mod bench;
+mod body_kinds;
 mod contact;
 mod domain_stress;
 mod fuzz;

@@ -1,4 +1,4 @@
-//! Free rigid bodies (`model = "rigid"`, `motion = "free"`) in the explicit
+//! Free rigid bodies (`model::body::BodyKind::Rigid`, `motion = "free"`) in the explicit
 //! solver: Newton–Euler for a body of point masses, its particles.
 //!
 //! The state lives in the particles: at the start of every step the body's mass

@@ -280,7 +280,7 @@ pub fn rigid_surfaces<const D: usize>(
                 .collect();
             let shapes = (plan.field_of_body.iter().enumerate())
                 .filter(|&(_, &f)| f as usize == k)
-                .map(|(b, _)| m.bodies[b].clone())
+                .map(|(b, _)| m.bodies[b].geometry.clone())
                 .collect();
             let rotates = plan.free[k] && !m.axisymmetric;
             Surface::new(k as u32, members, shapes, &m.particles, rotates)

@@ -2,11 +2,9 @@
 //! `[strength_reduction]` and `[bench]`.
 
 use super::check::{ensure, required, vector, Check};
-use crate::material::parameters::FromParameters;
-use crate::material::rigid::Rigid;
 use crate::material::Material;
 use crate::scene::{
-    BenchConfig, GeostaticConfig, SceneConfig, SolverKind, StrengthReductionConfig,
+    BenchConfig, BodyKindName, GeostaticConfig, SceneConfig, SolverKind, StrengthReductionConfig,
 };
 
 pub fn geostatic(g: &GeostaticConfig, s: &SceneConfig, materials: &[Box<dyn Material>]) -> Check {
@@ -25,16 +23,16 @@ pub fn geostatic(g: &GeostaticConfig, s: &SceneConfig, materials: &[Box<dyn Mate
         )?;
     }
     for (i, b) in s.bodies.iter().enumerate() {
+        // A rigid body carries no stress: it takes no K0 state.
+        if s.body_kind(i) == BodyKindName::Rigid {
+            continue;
+        }
         let k = s
             .materials
             .iter()
             .position(|m| m.name == b.material)
             .unwrap();
         let (m, built) = (&s.materials[k], &materials[k]);
-        // A rigid body carries no stress: it takes no K0 state.
-        if m.model == Rigid::NAME {
-            continue;
-        }
         ensure(
             built.integrates_from_stored_stress(),
             format!("body.{i}.material"),

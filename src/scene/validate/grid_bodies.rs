@@ -1,8 +1,11 @@
 //! The `[grid]` and `[[body]]` tables: the grid box and cells; each body's
-//! material, the keys of its shape, and its extent inside the grid.
+//! material and kind, the keys of its shape, and its extent inside the grid.
 
 use super::check::{ensure, forbidden, required, vector, Check};
-use crate::scene::{BodyConfig, BodyShape, Condition, Fill, GridConfig, PerDirection, SceneConfig};
+use crate::material::rigid::Motion;
+use crate::scene::{
+    BodyConfig, BodyKindName, BodyShape, Condition, Fill, GridConfig, PerDirection, SceneConfig,
+};
 
 pub fn grid(g: &GridConfig, dim: usize) -> Check {
     vector(&g.min, dim, "grid.min")?;
@@ -55,6 +58,7 @@ pub fn body(b: &BodyConfig, i: usize, s: &SceneConfig) -> Check {
         key("material"),
         format!("no material is named `{}`", b.material),
     )?;
+    kind(i, s)?;
     shape_keys(b, i, dim)?;
     let (lo, hi) = b.bounds();
     // A body may cross a grid face with a roller (a symmetry plane: the model
@@ -111,6 +115,59 @@ pub fn body(b: &BodyConfig, i: usize, s: &SceneConfig) -> Check {
         }
     }
     Ok(())
+}
+
+/// The body's kind and what it asks of the other keys: a continuum body needs
+/// a material with a constitutive model and has no `motion`; a rigid body's
+/// motion is given once (on the body or, in the old form, on its material), and
+/// its material is no continuum body's (the particles of a rigid body carry the
+/// zero-stress `material::rigid::Rigid` with the table's density,
+/// `scene::particle_materials`).
+fn kind(i: usize, s: &SceneConfig) -> Check {
+    let (b, key) = (&s.bodies[i], |k: &str| format!("body.{i}.{k}"));
+    let old_form = s.old_form_rigid(i);
+    match s.body_kind(i) {
+        BodyKindName::Continuum => {
+            ensure(
+                old_form.is_none(),
+                key("kind"),
+                format!(
+                    "a continuum body needs a material with a constitutive model, and `{}` \
+                     has model = \"rigid\" (the old form of a rigid body): give kind = \
+                     \"rigid\" or another material",
+                    b.material
+                ),
+            )?;
+            forbidden(&b.motion, key("motion"), "a continuum body (kind = \"rigid\" has one)")
+        }
+        BodyKindName::Rigid => {
+            let twice = b.motion.is_some() && old_form.and_then(|m| Motion::of(&m.parameters)).is_some();
+            ensure(
+                !twice,
+                key("motion"),
+                format!(
+                    "material `{}` gives the motion too (its `motion`, the old form): give \
+                     it once",
+                    b.material
+                ),
+            )?;
+            let shared = (0..s.bodies.len()).find(|&j| {
+                s.bodies[j].material == b.material && s.body_kind(j) != BodyKindName::Rigid
+            });
+            match shared {
+                Some(j) => Err((
+                    key("material"),
+                    format!(
+                        "material `{}` is also the material of continuum body {j}: a rigid \
+                         body takes only the density of its material, so give it a \
+                         [[material]] table of its own",
+                        b.material
+                    ),
+                )),
+                None => Ok(()),
+            }
+        }
+    }
 }
 
 /// The keys a body's shape needs, and no others.

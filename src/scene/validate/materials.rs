@@ -3,10 +3,11 @@
 
 use super::check::{ensure, KeyError};
 use crate::material::Material;
-use crate::scene::SceneConfig;
+use crate::scene::{particle_materials, SceneConfig};
 
 /// The `[[material]]` tables: a positive density, the model's own keys and
-/// checks (`material::registry`), a unique name. Returns the materials as built.
+/// checks (`material::registry`), a unique name. Returns the materials as the
+/// particles carry them (`scene::particle_materials`).
 pub fn materials(s: &SceneConfig) -> Result<Vec<Box<dyn Material>>, KeyError> {
     ensure(
         !s.materials.is_empty(),
@@ -28,5 +29,5 @@ pub fn materials(s: &SceneConfig) -> Result<Vec<Box<dyn Material>>, KeyError> {
             format!("material name `{}` is used twice", m.name),
         )?;
     }
-    Ok(built)
+    Ok(particle_materials(s, built))
 }
