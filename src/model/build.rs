@@ -7,8 +7,8 @@
 
 use crate::dim::Vector;
 use crate::material::Material;
-use crate::model::conditions::{Absorbing, Constraint, FaceCondition, Footing, FrictionFace};
 use crate::model::body::Body;
+use crate::model::conditions::{Absorbing, Constraint, FaceCondition, Footing, FrictionFace};
 use crate::model::geometry::Geometry;
 use crate::model::grid::Grid;
 use crate::model::loads::Loads;
@@ -51,8 +51,16 @@ impl<const D: usize> Model<D> {
                 .position(|m| m.name == b.material)
                 .expect("validated");
             let material = base_materials[m].as_ref();
-            let added = fill_body(&mut particles, &grid, b, &bodies[i].geometry, i, m as u32, material)
-                .map_err(err)?;
+            let added = fill_body(
+                &mut particles,
+                &grid,
+                b,
+                &bodies[i].geometry,
+                i,
+                m as u32,
+                material,
+            )
+            .map_err(err)?;
             if c.dimension.is_axisymmetric() {
                 axisymmetry::per_radian(&mut particles, added);
             }

@@ -42,9 +42,7 @@ pub fn initialise<const D: usize>(model: &mut Model<D>, g: &GeostaticConfig) {
                 .expect("validated");
             1.0 - phi.friction_angle.sin()
         });
-        let depth = (body.geometry.top(p.x0[q].as_slice(), v, up)
-            - up * p.x0[q][v])
-            .max(0.0);
+        let depth = (body.geometry.top(p.x0[q].as_slice(), v, up) - up * p.x0[q][v]).max(0.0);
         let sigma_v = -model.materials[m].density() * g_mag * depth;
         let mut s = Mat3::from_diagonal_element(k0 * sigma_v);
         s[(v, v)] = sigma_v;

@@ -529,7 +529,9 @@ impl SceneConfig {
     /// The motion of rigid body i: its `motion`, else its old-form rigid
     /// material's, else prescribed.
     pub fn rigid_motion(&self, i: usize) -> Motion {
-        let old_form = self.old_form_rigid(i).and_then(|m| Motion::of(&m.parameters));
+        let old_form = self
+            .old_form_rigid(i)
+            .and_then(|m| Motion::of(&m.parameters));
         (self.bodies[i].motion).or(old_form).unwrap_or_default()
     }
 

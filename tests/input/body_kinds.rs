@@ -7,7 +7,10 @@ use mpm::scene::{BodyKindName, Scene};
 /// problems/rigid_disk_impact.toml: body 0 (`left`) is a free rigid disk of
 /// material 1 (`steel`, model = "rigid"), in the new form.
 fn impact() -> String {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/problems/rigid_disk_impact.toml");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/problems/rigid_disk_impact.toml"
+    );
     std::fs::read_to_string(path).unwrap()
 }
 
@@ -18,6 +21,17 @@ fn old_form(text: &str) -> String {
             "model = \"rigid\"\ndensity",
             "model = \"rigid\"\nmotion = \"free\"\ndensity",
         )
+}
+
+/// "scene.toml:L:" for the line L of `text` that starts with `line`, and the
+/// n-th such line (from 0).
+fn at_line(text: &str, line: &str, n: usize) -> String {
+    let l = (text.lines().enumerate())
+        .filter(|(_, l)| l.starts_with(line))
+        .nth(n)
+        .unwrap()
+        .0;
+    format!("scene.toml:{}:", l + 1)
 }
 
 /// The error names `key`, and its text holds every one of `parts`.
@@ -34,7 +48,10 @@ fn rejected(text: &str, key: &str, parts: &[&str]) {
 fn the_new_and_the_old_form_read_as_the_same_rigid_body() {
     let new = Scene::parse("scene.toml", &impact(), &[]).unwrap();
     let text = old_form(&impact());
-    assert!(!text.contains("kind ="), "the old form has no kind");
+    assert!(
+        !text.lines().any(|l| l.starts_with("kind = \"rigid\"")),
+        "the old form has no kind"
+    );
     let old = Scene::parse("scene.toml", &text, &[]).unwrap();
     for s in [&new.config, &old.config] {
         assert_eq!(s.body_kind(0), BodyKindName::Rigid);
@@ -65,7 +82,8 @@ fn a_rigid_body_of_any_material_takes_its_density_only() {
 #[test]
 fn an_unknown_kind_is_named() {
     let bad = impact().replace("kind = \"rigid\"", "kind = \"rigd\"");
-    rejected(&bad, "body.0.kind", &["scene.toml:", "rigd", "continuum", "rigid"]);
+    let line = at_line(&bad, "kind = \"rigd\"", 0);
+    rejected(&bad, "body.0.kind", &[&line, "rigd", "continuum", "rigid"]);
 }
 
 #[test]
@@ -82,13 +100,15 @@ fn a_motion_on_a_continuum_body_is_rejected() {
         "material = \"elastic\"",
         "motion = \"free\"\nmaterial = \"elastic\"",
     );
+    let line = at_line(&bad, "motion = \"free\"", 1);
     rejected(
         &bad,
         "body.1.motion",
-        &["scene.toml:", "does not apply to a continuum body"],
+        &[&line, "does not apply to a continuum body"],
     );
     let bad = impact().replace("kind = \"rigid\"\n", "kind = \"continuum\"\n");
-    rejected(&bad, "body.0.kind", &["scene.toml:", "has model = \"rigid\""]);
+    let line = at_line(&bad, "kind = \"continuum\"", 0);
+    rejected(&bad, "body.0.kind", &[&line, "has model = \"rigid\""]);
 }
 
 #[test]
@@ -109,10 +129,11 @@ fn a_material_shared_by_a_rigid_and_a_continuum_body_is_rejected() {
             "model = \"neo_hookean\"\ndensity = 1000.0\nyoungs_modulus = 1000.0\npoisson_ratio = 0.3",
         )
         .replace("material = \"elastic\"", "material = \"steel\"");
+    let line = at_line(&shared, "material = \"steel\"", 0);
     rejected(
         &shared,
         "body.0.material",
-        &["scene.toml:", "also the material of continuum body 1"],
+        &[&line, "also the material of continuum body 1"],
     );
 }
 
@@ -133,11 +154,17 @@ fn a_rigid_body_without_contact_is_named_at_the_key_that_makes_it_rigid() {
 
 #[test]
 fn mpm_check_counts_the_rigid_bodies() {
-    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/problems/rigid_disk_impact.toml");
+    let scene = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/problems/rigid_disk_impact.toml"
+    );
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_mpm"))
         .args(["check", scene])
         .output()
         .unwrap();
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success() && text.contains("2 body(ies) (1 rigid)"), "{text}");
+    assert!(
+        out.status.success() && text.contains("2 body(ies) (1 rigid)"),
+        "{text}"
+    );
 }

@@ -138,10 +138,15 @@ fn kind(i: usize, s: &SceneConfig) -> Check {
                     b.material
                 ),
             )?;
-            forbidden(&b.motion, key("motion"), "a continuum body (kind = \"rigid\" has one)")
+            forbidden(
+                &b.motion,
+                key("motion"),
+                "a continuum body (kind = \"rigid\" has one)",
+            )
         }
         BodyKindName::Rigid => {
-            let twice = b.motion.is_some() && old_form.and_then(|m| Motion::of(&m.parameters)).is_some();
+            let twice =
+                b.motion.is_some() && old_form.and_then(|m| Motion::of(&m.parameters)).is_some();
             ensure(
                 !twice,
                 key("motion"),
