@@ -22,7 +22,7 @@
 //! material with `model = "rigid"` (`SceneConfig::body_kind`, `rigid_motion`).
 //! The particles of a rigid body carry the zero-stress
 //! `material::rigid::Rigid` with the density of the body's material
-//! (`scene::particle_materials`), so every transfer works on them unchanged.
+//! (`SceneConfig::particle_materials`), so every transfer works on them unchanged.
 //! The contact plan's per-field flags (`ContactPlan::rigid`, `free`) come from
 //! the same kinds; a rigid body has a velocity field of its own.
 //!

@@ -15,8 +15,8 @@ use crate::model::loads::Loads;
 use crate::model::particles::Particles;
 use crate::model::{axisymmetry, Model};
 use crate::scene::{
-    axis, expr, particle_materials, BodyConfig, BoundaryConfig, Condition, DomainStress, Face,
-    Fill, ParticlesOutside, Scene, SceneError,
+    axis, expr, BodyConfig, BoundaryConfig, Condition, DomainStress, Face, Fill, ParticlesOutside,
+    Scene, SceneError,
 };
 
 impl<const D: usize> Model<D> {
@@ -41,7 +41,7 @@ impl<const D: usize> Model<D> {
             .collect::<Result<Vec<_>, _>>()
             .map_err(err)?;
         // A rigid body's particles carry the zero-stress material (`model::body`).
-        let base_materials = particle_materials(c, tables);
+        let base_materials = c.particle_materials(tables);
         let bodies: Vec<Body> = (0..c.bodies.len()).map(|i| Body::of(c, i)).collect();
         let mut particles = Particles::default();
         for (i, b) in c.bodies.iter().enumerate() {

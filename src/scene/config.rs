@@ -9,8 +9,7 @@
 use super::grid::GridConfig;
 use super::material::MaterialConfig;
 use super::solver::SolverConfig;
-use crate::material::parameters::FromParameters;
-use crate::material::rigid::{Motion, Rigid};
+use crate::material::rigid::Motion;
 use serde::Deserialize;
 use strum::{EnumIter, IntoStaticStr};
 
@@ -170,7 +169,7 @@ pub struct BodyConfig {
     pub name: Option<String>,
     /// `continuum` or `rigid`; without it, rigid when the material is an
     /// old-form rigid one (`model = "rigid"`), else continuum
-    /// (`SceneConfig::body_kind`).
+    /// (`SceneConfig::body_kind`, `body_kind.rs`).
     pub kind: Option<BodyKindName>,
     /// A rigid body's motion: `prescribed` (the default) or `free`.
     pub motion: Option<Motion>,
@@ -506,43 +505,6 @@ impl StrengthReductionConfig {
 }
 
 impl SceneConfig {
-    /// The kind of body i: its `kind`, else rigid when its material is an
-    /// old-form rigid material (`model = "rigid"`), else continuum.
-    pub fn body_kind(&self, i: usize) -> BodyKindName {
-        let old_form = self.old_form_rigid(i).is_some();
-        match self.bodies[i].kind {
-            Some(kind) => kind,
-            None if old_form => BodyKindName::Rigid,
-            None => BodyKindName::Continuum,
-        }
-    }
-
-    /// The key that makes body i what it is, for messages about its kind:
-    /// `body.i.kind`, or `body.i.material` for the old form of a rigid body.
-    pub fn body_kind_key(&self, i: usize) -> String {
-        match self.bodies[i].kind {
-            None if self.old_form_rigid(i).is_some() => format!("body.{i}.material"),
-            _ => format!("body.{i}.kind"),
-        }
-    }
-
-    /// The motion of rigid body i: its `motion`, else its old-form rigid
-    /// material's, else prescribed.
-    pub fn rigid_motion(&self, i: usize) -> Motion {
-        let old_form = self
-            .old_form_rigid(i)
-            .and_then(|m| Motion::of(&m.parameters));
-        (self.bodies[i].motion).or(old_form).unwrap_or_default()
-    }
-
-    /// Body i's material when it is an old-form rigid material
-    /// (`model = "rigid"`, `material::rigid`): the one place the scene reads
-    /// rigidity from a material.
-    pub fn old_form_rigid(&self, i: usize) -> Option<&MaterialConfig> {
-        let name = &self.bodies[i].material;
-        (self.materials.iter()).find(|m| &m.name == name && m.model == Rigid::NAME)
-    }
-
     /// The stages of the run: the `[solver]` table alone, or the `[[stage]]` tables.
     pub fn stages(&self) -> Vec<&SolverConfig> {
         match &self.solver {

@@ -7,13 +7,8 @@
 //! position of a bad value (toml-rs/toml#535, #802). Here an unknown model is an
 //! error at its value and a key no model takes an error at the key, each with its
 //! line and column; the model's checks name their key and are located from it.
-//!
-//! A rigid body takes only the density of its material: `particle_materials`
-//! gives the particles of rigid bodies the zero-stress `material::rigid::Rigid`.
 
-use super::{BodyKindName, SceneConfig};
 use crate::material::parameters::{KeyError, Parameters};
-use crate::material::rigid::Rigid;
 use crate::material::{registry, Material};
 use serde::de::{self, Deserialize, Deserializer, MapAccess, Visitor};
 use std::fmt;
@@ -42,22 +37,6 @@ impl MaterialConfig {
     pub fn parameters<'a>(&'a self, table: &'a str) -> Parameters<'a> {
         Parameters::new(table, &self.model, &self.parameters)
     }
-}
-
-/// The materials the particles carry, one per table, from the tables' own
-/// (`built`): the table of a rigid body gives the zero-stress `Rigid` with its
-/// density instead, whatever its model (only its density acts on a rigid body;
-/// the validation refuses a table shared by a rigid and a continuum body).
-pub fn particle_materials(
-    s: &SceneConfig,
-    mut built: Vec<Box<dyn Material>>,
-) -> Vec<Box<dyn Material>> {
-    for i in (0..s.bodies.len()).filter(|&i| s.body_kind(i) == BodyKindName::Rigid) {
-        if let Some(k) = (s.materials.iter()).position(|m| m.name == s.bodies[i].material) {
-            built[k] = Box::new(Rigid::new(s.materials[k].density));
-        }
-    }
-    built
 }
 
 /// Every key a material table may have: name, model, density and the keys of

@@ -4,8 +4,10 @@
 //! paths, values in TOML syntax), deserialises, and validates physical ranges.
 //! Every error names the file and the key path and, where the TOML gives it, the
 //! line and column; an error at a key set by `--set` names the override instead
-//! (`error.rs`). The keys are documented in `docs/scene.md`.
+//! (`error.rs`). The keys are documented in `docs/scene.md`. What each body is
+//! (its `kind`, or the old form of a rigid body) is read in `body_kind.rs`.
 
+mod body_kind;
 mod config;
 pub mod contact;
 mod error;
@@ -21,7 +23,7 @@ pub mod validate;
 pub use config::*;
 pub use error::{SceneError, Source};
 pub use grid::*;
-pub use material::{particle_materials, MaterialConfig};
+pub use material::MaterialConfig;
 pub use solver::*;
 
 use std::path::Path;

@@ -122,7 +122,7 @@ pub fn body(b: &BodyConfig, i: usize, s: &SceneConfig) -> Check {
 /// motion is given once (on the body or, in the old form, on its material), and
 /// its material is no continuum body's (the particles of a rigid body carry the
 /// zero-stress `material::rigid::Rigid` with the table's density,
-/// `scene::particle_materials`).
+/// `SceneConfig::particle_materials`).
 fn kind(i: usize, s: &SceneConfig) -> Check {
     let (b, key) = (&s.bodies[i], |k: &str| format!("body.{i}.{k}"));
     let old_form = s.old_form_rigid(i);

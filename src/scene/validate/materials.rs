@@ -3,11 +3,11 @@
 
 use super::check::{ensure, KeyError};
 use crate::material::Material;
-use crate::scene::{particle_materials, SceneConfig};
+use crate::scene::SceneConfig;
 
 /// The `[[material]]` tables: a positive density, the model's own keys and
 /// checks (`material::registry`), a unique name. Returns the materials as the
-/// particles carry them (`scene::particle_materials`).
+/// particles carry them (`SceneConfig::particle_materials`).
 pub fn materials(s: &SceneConfig) -> Result<Vec<Box<dyn Material>>, KeyError> {
     ensure(
         !s.materials.is_empty(),
@@ -29,5 +29,5 @@ pub fn materials(s: &SceneConfig) -> Result<Vec<Box<dyn Material>>, KeyError> {
             format!("material name `{}` is used twice", m.name),
         )?;
     }
-    Ok(particle_materials(s, built))
+    Ok(s.particle_materials(built))
 }
