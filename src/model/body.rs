@@ -5,7 +5,7 @@
 //! - how its particles are advanced over a step (`BodyKind::advance`): by the
 //!   grid (G2P), at their own velocity (a prescribed rigid motion), or as one
 //!   rigid body by Newton–Euler (`physics::rigid::newton_euler`);
-//! - how they meet the grid (`BodyKind::grid`): integrated (their mass,
+//! - how they meet the grid (`BodyKind::meets_grid`): integrated (their mass,
 //!   momentum, stress and internal force go to the nodes), or through contact
 //!   only. A rigid body's particles mark out a velocity field of its own whose
 //!   nodes move with the body and have infinite mass in the contact
@@ -32,13 +32,17 @@
 //!    `SceneConfig::body_kind`, checked in `scene::validate::grid_bodies::kind`,
 //!    documented in docs/scene.md;
 //! 2. its variant of `BodyKind`, built in `BodyKind::of`;
-//! 3. its answers to `advance` and `grid`, with a new `Advance` or
+//! 3. its answers to `advance` and `meets_grid`, with a new `Advance` or
 //!    `GridCoupling` where no existing one says what it does;
 //! 4. its work at each solver's one site that hands every kind its work (the
-//!    explicit step after G2P, the implicit step at commit), and at the sites
-//!    that ask `grid` (the stencils of the particles that stay off the grid, the
-//!    contact fields);
-//! 5. whether it carries stress (`carries_stress`: K0 states, outputs).
+//!    explicit step after G2P, the implicit step at commit) and at the sites
+//!    that ask how it meets the grid (the stencils of particles that stay off
+//!    the grid, the contact fields: today `ContactPlan::rigid` and `free`,
+//!    filled from the kinds, in `solver::explicit::contact`,
+//!    `solver::implicit::contact` and `physics::rigid`);
+//! 5. the material its particles carry, where its table's constitutive model
+//!    should not act (`SceneConfig::particle_materials`), and whether it
+//!    carries stress (`carries_stress`: K0 states).
 
 use crate::material::rigid::Motion;
 use crate::model::geometry::Geometry;
@@ -118,7 +122,7 @@ impl BodyKind {
         }
     }
 
-    pub fn grid(self) -> GridCoupling {
+    pub fn meets_grid(self) -> GridCoupling {
         match self {
             BodyKind::Continuum => GridCoupling::Integrated,
             BodyKind::Rigid { .. } => GridCoupling::ContactOnly,
@@ -128,7 +132,7 @@ impl BodyKind {
     /// Whether its particles carry a stress (a K0 state, a stress update): those
     /// integrated through the grid.
     pub fn carries_stress(self) -> bool {
-        self.grid() == GridCoupling::Integrated
+        self.meets_grid() == GridCoupling::Integrated
     }
 
     pub fn is_rigid(self) -> bool {
@@ -148,7 +152,14 @@ mod tests {
         let free = BodyKind::Rigid {
             motion: Motion::Free,
         };
-        let declared = |k: BodyKind| (k.advance(), k.grid(), k.carries_stress(), k.is_rigid());
+        let declared = |k: BodyKind| {
+            (
+                k.advance(),
+                k.meets_grid(),
+                k.carries_stress(),
+                k.is_rigid(),
+            )
+        };
         use {Advance::*, GridCoupling::*};
         assert_eq!(
             declared(BodyKind::Continuum),

@@ -156,12 +156,6 @@ pub enum BodyKindName {
     Rigid,
 }
 
-impl BodyKindName {
-    pub fn name(&self) -> &'static str {
-        self.into()
-    }
-}
-
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BodyConfig {
