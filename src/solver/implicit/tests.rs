@@ -75,7 +75,8 @@ fn tangent_error_of<const D: usize>(
     );
     solver.prepare(&m, 0.0, 0.01);
     let sys = &mut solver.system;
-    assert_eq!(sys.absorbing.is_empty(), !absorbing);
+    let layer = crate::physics::boundary::absorbing::layer(&m.absorbing, &m.grid, &m.particles);
+    assert_eq!(layer.is_empty(), !absorbing);
     // A smooth, finite-strain iterate (strains of a few per cent).
     let nodes: Vec<usize> = (0..sys.map.len()).map(|a| sys.map.grid_node(a)).collect();
     let mut u: Vec<Vector<D>> = nodes
@@ -93,8 +94,7 @@ fn tangent_error_of<const D: usize>(
         .collect();
     // With contact between deformable bodies, the nodes of the second body are
     // pushed into the first (`SHIFT`).
-    let contact = sys.contact.as_ref();
-    if let Some(fields) = contact.and_then(|c| c.node_fields()) {
+    if let Some(fields) = sys.grid.node_fields() {
         let shift = SHIFT.with(|s| s.get());
         for (a, u_a) in u.iter_mut().enumerate() {
             if fields.field(a) > 0 {
@@ -115,9 +115,9 @@ fn tangent_error_of<const D: usize>(
     let n = dofs.free;
     let mut k = vec![0.0; n * n];
     let kt = tangent(&m, sys, false).unwrap();
-    if let Some(c) = &sys.contact {
-        let (stick, slip) = c.stick_and_slip();
-        CONTACTS.with(|x| x.set((stick, slip)));
+    let report = sys.report();
+    if report.contact_penetration.is_some() {
+        CONTACTS.with(|x| x.set((report.sticking, report.slipping)));
     }
     let km = kt.matrix();
     for c in 0..n {
@@ -230,7 +230,7 @@ fn global_tangent_matches_finite_differences_of_the_residual() {
 }
 
 /// Two rigid bodies pressed into the block: a disk on its top and a box at its
-/// right side, moving with prescribed velocities (`super::contact`).
+/// right side, moving with prescribed velocities (`super::terms::contact::rigid`).
 const RIGID_BODIES: &str = r#"[[material]]
 name = "steel"
 model = "rigid"
@@ -364,7 +364,7 @@ fn tangent_with_deformable_contact_matches_finite_differences_of_the_residual() 
         .replace("min = [0.5, 1.5]", "min = [0.5, 1.25]");
     let on_node = STACK.to_string();
     // μ = 0.03: a meeting slips once its tangential trial force ε_t |Δ| exceeds
-    // μ ε_n g; with ε_t = ε_n/10 (`contact::TANGENTIAL_PENALTY`) μ = 0.3 left
+    // μ ε_n g; with ε_t = ε_n/10 (`terms::contact::bodies::TANGENTIAL_PENALTY`) μ = 0.3 left
     // every meeting sticking at this iterate, 0.03 leaves 1–2 sticking and 5–9
     // slipping.
     let cases = [
