@@ -167,7 +167,12 @@ impl<const D: usize> Trial<D> {
         });
         let history_old = p.history.slots(&p.history.data);
         let inverted = AtomicUsize::new(usize::MAX);
-        let scratch = || (Vec::new(), Tensors::filled(Layout::stress(D), 1, &Mat3::zeros()));
+        let scratch = || {
+            (
+                Vec::new(),
+                Tensors::filled(Layout::stress(D), 1, &Mat3::zeros()),
+            )
+        };
         let out = (0..n)
             .into_par_iter()
             .with_min_len(MIN_PARALLEL_LEN)

@@ -102,5 +102,4 @@ impl StepGrid {
             p.x[q] += p.v[q] * dt;
         }
     }
-
 }

@@ -197,7 +197,8 @@ impl<const D: usize> StepSystem<D> {
     /// any term has such forces.
     pub fn particle_forces(&self, n: usize) -> Option<Vec<Vector<D>>> {
         let mut forces = vec![Vector::<D>::zeros(); n];
-        let any = (self.terms.iter()).fold(false, |any, t| t.add_particle_forces(&mut forces) | any);
+        let any =
+            (self.terms.iter()).fold(false, |any, t| t.add_particle_forces(&mut forces) | any);
         any.then_some(forces)
     }
 
@@ -263,7 +264,8 @@ impl StepSettings {
     ) {
         let p = &m.particles;
         sys.set_up(m);
-        sys.grid.build(m, self.shape, &mut sys.stencils, &mut sys.map);
+        sys.grid
+            .build(m, self.shape, &mut sys.stencils, &mut sys.map);
         if self.fbar {
             sys.trial.use_fbar(&m.grid, &p.x);
         }

@@ -825,3 +825,112 @@ fn a_pattern_is_kept_only_while_it_fits() {
     solver.prepare(&m, 0.02, 0.01);
     assert!(solver.system.pattern.get().is_none(), "dropped");
 }
+
+/// A smooth iterate of a step, `scale` times a field of strains of about a
+/// per cent, zero at the prescribed components, tied nodes following their
+/// masters.
+fn smooth_iterate(m: &Model<2>, sys: &StepSystem<2>, scale: f64) -> Vec<Vector<2>> {
+    let mut u: Vec<Vector<2>> = (0..sys.map.len())
+        .zip(&sys.constraint)
+        .map(|(a, c)| {
+            let x = m.grid.node_position(m.grid.node_ijk(sys.map.grid_node(a)));
+            let mut v = Vector::<2>::new(0.02 * (0.7 * x[1]).sin(), -0.01 * x[0] * x[1] / 4.0);
+            for d in 0..2 {
+                if c.fixed[d] {
+                    v[d] = 0.0;
+                }
+            }
+            v * scale
+        })
+        .collect();
+    sys.dofs.follow_ties(&mut u);
+    u
+}
+
+/// The bits of nodal vectors, to compare them exactly.
+fn bits(v: &[Vector<2>]) -> Vec<u64> {
+    v.iter()
+        .flat_map(|x| x.iter().map(|c| c.to_bits()))
+        .collect()
+}
+
+/// A residual away from the iterate (`probe_residual`, the Krylov solver's
+/// difference products) has the bits of `residual` at the same point, and
+/// leaves the step's iterate where it was: after a probe the tangent and the
+/// terms' report are those before it, bit for bit (`terms`, the iterate).
+/// With F-bar, a linear domain stress, absorbing faces, friction against
+/// rigid bodies and between two deformable bodies (contacts at the iterate).
+#[test]
+fn a_probe_is_the_residual_and_leaves_the_iterate() {
+    use super::residual::probe_residual;
+    let rigid = BLOCK
+        .replace(
+            "[[body]]\nmaterial = \"m\"",
+            "[[body]]\nname = \"block\"\nmaterial = \"m\"",
+        )
+        .replace("[[boundary]]", &format!("{RIGID_BODIES}[[boundary]]"))
+        .replace(
+            "[solver]",
+            "[[contact]]\nfriction_coefficient = 0.3\n[solver]",
+        );
+    let absorbing = BLOCK.replace("[solver]", &format!("{ABSORBING}[solver]"));
+    let cases: [(&str, &str, Vec<&str>, bool); 5] = [
+        ("F-bar", BLOCK, vec!["solver.fbar=true"], false),
+        (
+            "linear domain stress",
+            BLOCK,
+            vec!["grid.shape_function=cpgimp", "grid.domain_stress=linear"],
+            false,
+        ),
+        ("absorbing faces", &absorbing, vec![], false),
+        (
+            "rigid bodies",
+            &rigid,
+            vec!["grid.shape_function=cpgimp"],
+            true,
+        ),
+        (
+            "two deformable bodies",
+            STACK,
+            vec![
+                "grid.shape_function=cpgimp",
+                "contact.0.friction_coefficient=0.03",
+            ],
+            true,
+        ),
+    ];
+    for (name, text, overrides, contact) in cases {
+        let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+        let scene = Scene::parse("block.toml", text, &overrides).unwrap();
+        let m = Model::<2>::build(&scene).unwrap();
+        let stage = scene.config.stages()[0];
+        let mut solver = Implicit::<2>::new(scene.config.grid.shape_function, stage, 0.0);
+        solver.prepare(&m, 0.0, 0.01);
+        let sys = &mut solver.system;
+        let (u, w) = (smooth_iterate(&m, sys, 1.0), smooth_iterate(&m, sys, 1.5));
+        residual(&m, sys, &u).unwrap();
+        let k = tangent(&m, sys, false).unwrap().values;
+        let report = sys.report();
+        assert!(
+            !contact || report.sticking + report.slipping > 0,
+            "{name}: no contact at the iterate"
+        );
+        let probed = probe_residual(&m, sys, &w).unwrap();
+        assert!(sys.iterate() == u.as_slice(), "{name}: the iterate moved");
+        let after: Vec<u64> = (tangent(&m, sys, false).unwrap().values.iter())
+            .map(|x| x.to_bits())
+            .collect();
+        let before: Vec<u64> = k.iter().map(|x| x.to_bits()).collect();
+        assert!(after == before, "{name}: the tangent changed");
+        assert_eq!(sys.report(), report, "{name}: the terms' state changed");
+        let evaluated = residual(&m, sys, &w).unwrap();
+        assert!(
+            bits(&probed) == bits(&evaluated),
+            "{name}: the probe differs from the residual"
+        );
+        println!(
+            "{name}: {} unknowns, probe = residual bit for bit",
+            sys.dofs.free
+        );
+    }
+}

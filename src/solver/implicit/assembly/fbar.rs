@@ -63,7 +63,11 @@ pub fn add_fbar_stiffness<const D: usize>(
 }
 
 /// β_p = (ΔJ̄_c / ΔJ_p)^{1/n} of each of the `particles`.
-fn scale_factors<const D: usize>(state: &FBarState, particles: usize, axisymmetric: bool) -> Vec<f64> {
+fn scale_factors<const D: usize>(
+    state: &FBarState,
+    particles: usize,
+    axisymmetric: bool,
+) -> Vec<f64> {
     let (cells, dj) = (&state.cells, &state.dj);
     (0..particles)
         .map(|q| {

@@ -196,12 +196,7 @@ pub trait StepTerm<const D: usize>: Debug + Send + Sync {
     /// linear domain stress), from the particles' stress measure `pk1` at u
     /// (`internal_force`'s), added into f_int before the inertia and the
     /// external force join it. Stateless.
-    fn add_internal_force(
-        &self,
-        _step: &StepView<'_, D>,
-        _pk1: &[Mat3],
-        _f_int: &mut [Vector<D>],
-    ) {
+    fn add_internal_force(&self, _step: &StepView<'_, D>, _pk1: &[Mat3], _f_int: &mut [Vector<D>]) {
     }
 
     /// At the iterate u: keep the term's state at u (what `add_tangent`,

@@ -219,13 +219,13 @@ impl<const D: usize> BodyContact<D> {
                 j.reference = j.meeting.outermost;
                 // Each side's outward normal: n for r, −n for s.
                 let outward = [j.meeting.normal, -j.meeting.normal];
-                for side in 0..2 {
+                for (side, outward) in outward.iter().enumerate() {
                     // How far the outermost particle lies beyond the reference.
                     let (now, then) = (j.meeting.outermost[side], carried.reference[side]);
                     let (Some(a), Some(b)) = (x.get(now as usize), x.get(then as usize)) else {
                         continue;
                     };
-                    let beyond = (a - b).dot(&outward[side]);
+                    let beyond = (a - b).dot(outward);
                     match beyond.abs() > OUTERMOST_SWITCH * h {
                         true => j.meeting.gap -= beyond,
                         false => j.reference[side] = then,

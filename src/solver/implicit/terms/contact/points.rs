@@ -158,7 +158,12 @@ impl<const D: usize> ContactPoints<D> {
 
     /// How far each contact point has moved under u, Σ N_I(c) u_I (None for a
     /// particle without one).
-    pub fn motion(&self, st: &Stencils<D>, map: &NodeMap, u: &[Vector<D>]) -> Vec<Option<Vector<D>>> {
+    pub fn motion(
+        &self,
+        st: &Stencils<D>,
+        map: &NodeMap,
+        u: &[Vector<D>],
+    ) -> Vec<Option<Vector<D>>> {
         (self.point.par_iter().enumerate())
             .with_min_len(MIN_PARALLEL_LEN)
             .map(|(q, point)| {

@@ -93,7 +93,12 @@ pub struct RigidContact<const D: usize> {
 impl<const D: usize> RigidContact<D> {
     /// The contact under `plan` of model m's deformable particles (each of
     /// `field`) with the rigid bodies `surfaces`, or None without any.
-    pub fn new(m: &Model<D>, plan: &ContactPlan, field: &[u32], surfaces: Vec<Surface>) -> Option<Self> {
+    pub fn new(
+        m: &Model<D>,
+        plan: &ContactPlan,
+        field: &[u32],
+        surfaces: Vec<Surface>,
+    ) -> Option<Self> {
         if surfaces.is_empty() {
             return None;
         }

@@ -75,7 +75,11 @@ pub fn write_points<const D: usize>(carried: &[CarriedPoint<D>]) -> Vec<f64> {
 /// particle or rigid body, or whose point is not finite, is left out: that
 /// particle's point is set on its domain, as for a particle that comes near a
 /// body.
-pub fn read_points<const D: usize>(values: &[f64], n: usize, bodies: usize) -> Vec<CarriedPoint<D>> {
+pub fn read_points<const D: usize>(
+    values: &[f64],
+    n: usize,
+    bodies: usize,
+) -> Vec<CarriedPoint<D>> {
     let mut carried = vec![None; n];
     let index =
         |v: f64, len: usize| (v >= 0.0 && v.fract() == 0.0 && v < len as f64).then_some(v as usize);
