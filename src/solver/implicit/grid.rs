@@ -3,10 +3,13 @@
 //!
 //! Without contact every particle is on the grid and the bodies share their
 //! nodes. With the implicit contact (`terms::contact`):
-//! - a rigid body's particles are not part of the grid problem: their
-//!   stencils are emptied (they touch no node, carry no mass and no unknown)
-//!   and they move at their velocity when a step is committed; the contact
-//!   sees the body through its `[[body]]` geometry;
+//! - the particles of a body that meets the grid through contact only (a
+//!   rigid body, `model::body::GridCoupling::ContactOnly`) are not part of
+//!   the grid problem: their stencils are emptied (they touch no node, carry
+//!   no mass and no unknown) and the committed step hands them the work their
+//!   kind declares (`StepGrid::advance_off_grid`: a prescribed rigid motion
+//!   moves them at their velocity); the contact sees the body through its
+//!   `[[body]]` geometry;
 //! - with contact between deformable bodies, every grid node that several
 //!   bodies' fields touch is split into one node per field
 //!   (`physics::contact::field_split`), so each body has its own displacement
@@ -15,10 +18,11 @@
 //!   bodies), and what the contact between the bodies finds its meetings on.
 //!
 //! This is the one place that decides which particles are off the grid
-//! (`StepGrid::for_contact`).
+//! (`StepGrid::for_contact`, from the body kinds) and the one place of the
+//! implicit step that advances them (`StepGrid::advance_off_grid`).
 
 use super::ties::NodeFields;
-use crate::model::particles::Particles;
+use crate::model::body::{Advance, GridCoupling};
 use crate::model::Model;
 use crate::physics::contact::field_split::FieldSplit;
 use crate::physics::shape::{ShapeFunction, Stencils};
@@ -29,8 +33,8 @@ use crate::scene::contact::ContactPlan;
 /// the bodies (module docs).
 #[derive(Clone, Debug, Default)]
 pub struct StepGrid {
-    /// Whether each particle belongs to a rigid body (left off the grid);
-    /// empty when every particle is on it.
+    /// Whether each particle's body meets the grid through contact only
+    /// (left off the grid); empty when every particle is on it.
     rigid: Vec<bool>,
     /// The fields of the deformable bodies in contact, each on nodes of its
     /// own where they meet (None: the bodies share nodes).
@@ -40,15 +44,18 @@ pub struct StepGrid {
 }
 
 impl StepGrid {
-    /// The grid of a scene with implicit contact under `plan`: the particles
-    /// `p` of rigid fields off it and, with `split`, every field on nodes of
-    /// its own where several meet.
-    pub fn for_contact<const D: usize>(plan: &ContactPlan, p: &Particles<D>, split: bool) -> Self {
+    /// The grid of model m with implicit contact under `plan`: the particles
+    /// of the bodies that meet the grid through contact only off it and, with
+    /// `split`, every field on nodes of its own where several meet.
+    pub fn for_contact<const D: usize>(m: &Model<D>, plan: &ContactPlan, split: bool) -> Self {
+        let p = &m.particles;
         let field: Vec<u32> = (p.body.iter())
             .map(|&b| plan.field_of_body[b as usize])
             .collect();
         StepGrid {
-            rigid: field.iter().map(|&f| plan.rigid[f as usize]).collect(),
+            rigid: (0..p.len())
+                .map(|q| m.kind_of(q).meets_grid() == GridCoupling::ContactOnly)
+                .collect(),
             split: split.then(|| FieldSplit::new(field)),
             nodes: None,
         }
@@ -96,10 +103,20 @@ impl StepGrid {
         self.nodes.as_ref()
     }
 
-    /// The converged step: the rigid bodies' particles move at their velocity.
-    pub fn move_rigid<const D: usize>(&self, p: &mut Particles<D>, dt: f64) {
+    /// The converged step hands each particle off the grid the work its
+    /// body's kind declares (`model::body::Advance`).
+    pub fn advance_off_grid<const D: usize>(&self, m: &mut Model<D>, dt: f64) {
         for q in (0..self.rigid.len()).filter(|&q| self.rigid[q]) {
-            p.x[q] += p.v[q] * dt;
+            match m.kind_of(q).advance() {
+                // x += v Δt: a prescribed rigid motion.
+                Advance::AtOwnVelocity => {
+                    let v = m.particles.v[q];
+                    m.particles.x[q] += v * dt;
+                }
+                // On the grid, so never here; a free rigid body is refused
+                // in implicit contact (`scene::validate`).
+                Advance::ByGrid | Advance::NewtonEuler => {}
+            }
         }
     }
 }

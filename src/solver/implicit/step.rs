@@ -444,7 +444,6 @@ impl StepSettings {
         for (x, d) in p.x.iter_mut().zip(&dx) {
             *x += d;
         }
-        sys.grid.move_rigid(p, dt);
         if self.dynamic() {
             let n = map.len();
             let (u_tilde, a_n) = (&sys.u_tilde, &sys.a_n);
@@ -462,6 +461,7 @@ impl StepSettings {
                 *a_q += interpolate(map, st, q, &da);
             }
         }
+        sys.grid.advance_off_grid(m, dt);
         work
     }
 }

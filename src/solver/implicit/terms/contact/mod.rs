@@ -49,7 +49,7 @@ pub fn of<const D: usize>(m: &Model<D>) -> Option<Contact<D>> {
         return None;
     }
     Some(Contact {
-        grid: StepGrid::for_contact(plan, p, bodies.is_some()),
+        grid: StepGrid::for_contact(m, plan, bodies.is_some()),
         rigid,
         bodies,
     })
