@@ -953,10 +953,10 @@ fn add_node_block<const D: usize>(
     block: &Tensor<D>,
 ) {
     for i in 0..D {
-        let rows = dofs.terms(a, i, D);
+        let rows = dofs.terms(a, i);
         for j in 0..D {
             for &(r, cr) in rows.as_slice() {
-                for &(c, cc) in dofs.terms(b, j, D).as_slice() {
+                for &(c, cc) in dofs.terms(b, j).as_slice() {
                     if k.storage == Storage::Full || r >= c {
                         let s = k.slot(r, c).expect("contact entry in the pattern");
                         k.values[s] += block[(i, j)] * cr * cc;

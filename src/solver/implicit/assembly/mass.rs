@@ -11,7 +11,7 @@ use crate::physics::transfer::NodeMap;
 pub fn add_lumped_mass<const D: usize>(k: &mut Tangent, dofs: &Dofs, mass: &[f64], inertia: f64) {
     for (node, m_i) in mass.iter().enumerate() {
         for d in 0..D {
-            let t = dofs.terms(node, d, D);
+            let t = dofs.terms(node, d);
             for &(r, cr) in t.as_slice() {
                 for &(c, cc) in t.as_slice() {
                     if k.storage == Storage::Full || r >= c {

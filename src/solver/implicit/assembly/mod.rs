@@ -26,4 +26,7 @@ pub mod stiffness;
 mod dofs;
 
 pub use dofs::{Dofs, Terms, Tie};
-pub use pattern::{Components, Pattern, Storage, Tangent};
+pub use pattern::layout::Storage;
+pub use pattern::scatter::{Components, Coupling};
+pub use pattern::tangent::Tangent;
+pub use pattern::Pattern;
