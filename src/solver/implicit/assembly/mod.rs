@@ -24,6 +24,8 @@ pub mod pattern;
 pub mod stiffness;
 
 mod dofs;
+#[cfg(test)]
+mod tests;
 
 pub use dofs::{Dofs, Terms, Tie};
 pub use pattern::layout::Storage;
