@@ -103,15 +103,28 @@ impl Dofs {
         self.per_node
     }
 
-    /// Number of active nodes.
-    pub fn nodes(&self) -> usize {
-        self.index.len().checked_div(self.per_node).unwrap_or(0)
-    }
-
     /// Equation of component c of node a, if it is an unknown.
     pub fn of(&self, a: usize, c: usize) -> Option<usize> {
         debug_assert!(c < self.per_node, "component {c} of {}", self.per_node);
-        match self.index[a * self.per_node + c] {
+        Self::equation(self.index[a * self.per_node + c])
+    }
+
+    /// The equations of the N components `first..first + N` of node a, if
+    /// they are unknowns (one look-up for a block of components).
+    pub fn block<const N: usize>(&self, a: usize, first: usize) -> [Option<usize>; N] {
+        debug_assert!(
+            first + N <= self.per_node,
+            "components {first}.. of {}",
+            self.per_node
+        );
+        let at = a * self.per_node + first;
+        let index: &[u32; N] = self.index[at..at + N].try_into().expect("N components");
+        index.map(Self::equation)
+    }
+
+    /// The equation of an entry of `index`, if it is an unknown.
+    fn equation(i: u32) -> Option<usize> {
+        match i {
             Self::NONE => None,
             i => Some(i as usize),
         }

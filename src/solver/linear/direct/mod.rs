@@ -9,11 +9,11 @@
 //! instead of a garbage solution; [`DirectSolver::factorize_and_solve`] solves a right-hand
 //! side together with the probe (one pass over the factor for both).
 //!
-//! The files, by concept: [`symbolic`] (the analysis and its cache, the
-//! matrix [`Structure`]), [`ordering`] (the fill-reducing ordering given to
-//! it), [`numeric`] (the factorizations and solves, their parallelism),
-//! [`check`] (the probe check), [`csc`] (the compressed-column input:
-//! products, triplets, the mirrored triangle) and [`error`]. Nothing here
+//! The files, by concept: `symbolic` (the analysis and its cache, the
+//! matrix [`Structure`]), `ordering` (the fill-reducing ordering given to
+//! it), `numeric` (the factorizations and solves, their parallelism),
+//! `check` (the probe check), `csc` (the compressed-column input:
+//! products, triplets, the mirrored triangle) and `error`. Nothing here
 //! knows of nodes: a node ordering comes in as a permutation.
 
 mod check;

@@ -55,11 +55,11 @@
 //! components together (`Transfer::fine_blocks`), which are the block-Jacobi
 //! blocks.
 //!
-//! The files, by concept: [`csr`] (compressed rows), [`lower`] (a symmetric
+//! The files, by concept: `csr` (compressed rows), `lower` (a symmetric
 //! matrix as its lower triangle, read by rows through the node graph),
-//! [`galerkin`] (the triple products), [`operator`] (the operator of a level),
-//! [`smoother`] (Chebyshev on block Jacobi, the eigenvalue estimate) and
-//! [`vcycle`] (the hierarchy's refresh, the coarse factorization and the
+//! `galerkin` (the triple products), `operator` (the operator of a level),
+//! `smoother` (Chebyshev on block Jacobi, the eigenvalue estimate) and
+//! `vcycle` (the hierarchy's refresh, the coarse factorization and the
 //! cycle).
 
 mod csr;

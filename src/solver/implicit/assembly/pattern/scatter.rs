@@ -189,6 +189,7 @@ impl Pattern {
     /// in the coupling's columns, j the position of a among b's m neighbours
     /// and `offsets[k·m + j]` the rows of the neighbours before it.
     #[allow(clippy::too_many_arguments)]
+    #[inline]
     fn add_column_terms<const D: usize, const R: usize, const C: usize>(
         &self,
         b: usize,
@@ -261,10 +262,8 @@ impl Pattern {
                     };
                     hint = j;
                     let lo = self.lists.first[a];
-                    for i in 0..R {
-                        let Some(r) = dofs.of(a, coupling.rows + i) else {
-                            continue;
-                        };
+                    for (i, r) in dofs.block::<R>(a, coupling.rows).into_iter().enumerate() {
+                        let Some(r) = r else { continue };
                         let coupled = match coupling.components {
                             Components::All => 0..C,
                             Components::Diagonal => i..i + 1,
