@@ -12,15 +12,17 @@
 //!   r_p,I  = Σ_p V_p [b S_Ip tr ε_p + c S_Ip p_p + k(p_p) ∇S_Ip · ∇p_p − S_Ip s],
 //!
 //! σ' = λ tr ε I + 2 μ ε, ε_p = sym Σ_J u_J ⊗ ∇S_Jp, p_p = Σ_J S_Jp p_J,
-//! k(p) = k₀ (1 + κ p²) (Coussy 2004, Poromechanics, §4: r_p is the storage
-//! and Darcy flow of one backward-Euler step, b the Biot coefficient, c the
-//! storage, k the permeability times Δt). Its tangent has the blocks
+//! k(p) = k₀ (1 + κ p²): Biot's consolidation (Biot 1941, J. Appl. Phys.
+//! 12:155–164) over one backward-Euler step, r_p the storage and Darcy flow
+//! of the step, b the Biot coefficient, c the storage, k the permeability
+//! times Δt (the pressure dependence only makes the tangent vary). Its
+//! tangent has the blocks
 //!
 //!   K_uu = Σ V ∇S_I A ∇S_J (the stiffness term of `stiffness`, A elastic),
 //!   K_up,(Ii)J = −Σ V b ∂_i S_I S_J,   K_pu,I(Jk) = Σ V b S_I ∂_k S_J,
 //!   K_pp,IJ = Σ V [c S_I S_J + k(p) ∇S_I·∇S_J + k'(p) S_J ∇S_I·∇p],
 //!
-//! unsymmetric (K_up = −K_puᵀ, and the k' term) but positive real.
+//! unsymmetric (K_up = −K_puᵀ, and the k' term).
 
 use super::stiffness::{add_stiffness, ParticleTangents};
 use super::{Components, Coupling, Dofs, Pattern, Storage, Tangent};
@@ -362,8 +364,9 @@ struct Solved<const N: usize> {
     newton_iterations: usize,
     /// ‖Tᵀ r‖ at the start and at the end.
     residuals: (f64, f64),
-    /// The most GMRES iterations of one correction, and the multigrid's levels.
+    /// The most GMRES iterations of one correction (multigrid).
     krylov: usize,
+    /// The multigrid's levels (0 with the direct solver).
     levels: usize,
 }
 
