@@ -50,25 +50,6 @@ impl<const D: usize> Coupling<D, D> {
 }
 
 impl Pattern {
-    /// [`Pattern::add_terms`] of a term of the displacements' D×D block
-    /// ([`Coupling::displacements`]): `column` fills
-    /// `block[(e1 − first entry of q)·D² + i·D + k]`.
-    #[allow(clippy::too_many_arguments)]
-    pub fn add_stencil_terms<const D: usize>(
-        &self,
-        values: &mut [f64],
-        col_ptr: &[Index],
-        storage: Storage,
-        map: &NodeMap,
-        st: &Stencils<D>,
-        dofs: &Dofs,
-        components: Components,
-        column: impl Fn(usize, usize, &[bool], &mut [f64]) -> bool + Sync,
-    ) {
-        let coupling = Coupling::<D, D>::displacements(components);
-        self.add_terms(values, col_ptr, storage, map, st, dofs, coupling, column);
-    }
-
     /// Adds the term of every particle q with `column(q, e2, needed, block)` true
     /// to the values of the pattern with `storage` (its column pointers
     /// `col_ptr`, [`Pattern::col_ptr`]): for each stencil entry e2 of q,

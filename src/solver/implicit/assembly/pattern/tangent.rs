@@ -1,6 +1,8 @@
 //! The assembled tangent: values in the step's pattern.
 
+use super::super::Dofs;
 use super::layout::{slot, Storage};
+use super::scatter::{Components, Coupling};
 use super::Pattern;
 use crate::solver::linear::direct::spmv;
 use crate::solver::linear::Index;
@@ -46,5 +48,36 @@ impl Tangent<'_> {
         let lists = &self.pattern.lists;
         let (a, b) = (lists.node_of(r), lists.node_of(c));
         lists.position(self.col_ptr, (a, r), (b, c), self.storage.lowest(c))
+    }
+
+    /// Adds a term between two active nodes beyond the stencils (a pair the
+    /// term listed in its couplings, `Pattern::new`'s `coupled`): K_ab +=
+    /// `block(i, k)` at (a, component `coupling.rows + i`) × (b, component
+    /// `coupling.cols + k`), spread onto the unknowns through the ties; rows
+    /// above the diagonal dropped with `Lower`.
+    pub fn add_node_block<const R: usize, const C: usize>(
+        &mut self,
+        dofs: &Dofs,
+        (a, b): (usize, usize),
+        coupling: Coupling<R, C>,
+        block: impl Fn(usize, usize) -> f64,
+    ) {
+        for i in 0..R {
+            let rows = dofs.terms(a, coupling.rows + i);
+            let coupled = match coupling.components {
+                Components::All => 0..C,
+                Components::Diagonal => i..i + 1,
+            };
+            for k in coupled {
+                for &(r, cr) in rows.as_slice() {
+                    for &(c, cc) in dofs.terms(b, coupling.cols + k).as_slice() {
+                        if self.storage == Storage::Full || r >= c {
+                            let s = self.slot(r, c).expect("node pair in the pattern");
+                            self.values[s] += block(i, k) * cr * cc;
+                        }
+                    }
+                }
+            }
+        }
     }
 }
