@@ -18,8 +18,10 @@
 //!                                            invertible; for p = 1 it is the identity, and P
 //!                                            is linear interpolation),
 //!
-//! and P = P_x ⊗ P_y (⊗ P_z), component by component. Every level reproduces
-//! any field the coarse space holds, in particular linear fields.
+//! and P = P_x ⊗ P_y (⊗ P_z), component by component: every component a node
+//! carries (`Dofs::per_node`: the D displacements, then any scalar fields) is
+//! prolongated alike. Every level reproduces any field the coarse space holds,
+//! in particular linear fields.
 //!
 //! Unknowns: level 0 has those of the step (`Dofs`: free components of untied
 //! active nodes). A tied node (`min_node_support`) has no unknowns: it follows
@@ -54,23 +56,33 @@ pub struct Level<const D: usize> {
     /// Its nodes (flat indices in the level's node layout, `cells + p` per
     /// direction, x fastest), ascending at coarse levels.
     pub nodes: Vec<usize>,
-    /// Per node and component: the unknown's number, `PRESCRIBED` or `ABSENT`.
-    index: Vec<[u32; D]>,
+    /// Components per node (those of the step's unknowns, `Dofs::per_node`).
+    pub components: usize,
+    /// Per node k and component c, at k·components + c: the unknown's
+    /// number, `PRESCRIBED` or `ABSENT`.
+    index: Vec<u32>,
     pub unknowns: usize,
 }
 
 impl<const D: usize> Level<D> {
-    /// The unknown of component d of node k, if it is one.
-    pub fn unknown(&self, k: usize, d: usize) -> Option<usize> {
-        (self.index[k][d] < PRESCRIBED).then_some(self.index[k][d] as usize)
+    /// The state of component c of node k.
+    fn state(&self, k: usize, c: usize) -> u32 {
+        self.index[k * self.components + c]
     }
 
-    /// The unknowns of each node that has some.
+    /// The unknown of component c of node k, if it is one.
+    pub fn unknown(&self, k: usize, c: usize) -> Option<usize> {
+        let i = self.state(k, c);
+        (i < PRESCRIBED).then_some(i as usize)
+    }
+
+    /// The unknowns of each node that has some: the smoother's blocks, all
+    /// the components of a node together.
     fn blocks(&self) -> Vec<Vec<usize>> {
         (0..self.nodes.len())
             .map(|k| {
-                (0..D)
-                    .filter_map(|d| self.unknown(k, d))
+                (0..self.components)
+                    .filter_map(|c| self.unknown(k, c))
                     .collect::<Vec<_>>()
             })
             .filter(|b| !b.is_empty())
@@ -117,10 +129,11 @@ pub fn hierarchy<const D: usize>(
     dofs: &Dofs,
     coarse_unknowns: usize,
 ) -> Hierarchy<D> {
-    let index: Vec<[u32; D]> = (0..active.len())
-        .map(|a| {
+    let components = dofs.per_node();
+    let index: Vec<u32> = (0..active.len())
+        .flat_map(|a| {
             let tied = dofs.ties.get(a).is_some_and(|t| t.is_some());
-            std::array::from_fn(|d| match dofs.of(a, d, D) {
+            (0..components).map(move |c| match dofs.of(a, c) {
                 Some(i) => i as u32,
                 None if tied => ABSENT,
                 None => PRESCRIBED,
@@ -131,6 +144,7 @@ pub fn hierarchy<const D: usize>(
         cells: grid.cells,
         h: std::array::from_fn(|d| grid.h[d]),
         nodes: active.iter().map(|&g| g as usize).collect(),
+        components,
         index,
         unknowns: dofs.free,
     }];
@@ -189,7 +203,6 @@ fn axis_prolongation(fine: usize, coarse: usize, p: usize) -> Vec<Vec<(usize, f6
 
 /// The next coarser level of `fine` and the transfer to it, or None when no
 /// direction can be coarsened.
-#[allow(clippy::needless_range_loop)] // d indexes several per-component arrays at once
 fn coarsen<const D: usize>(fine: &Level<D>, p: usize) -> Option<(Transfer, Level<D>)> {
     let cells: [usize; D] = std::array::from_fn(|d| fine.cells[d].div_ceil(2));
     if cells == fine.cells {
@@ -200,20 +213,22 @@ fn coarsen<const D: usize>(fine: &Level<D>, p: usize) -> Option<(Transfer, Level
     let axes: [Vec<Vec<(usize, f64)>>; D] =
         std::array::from_fn(|d| axis_prolongation(fine.cells[d], cells[d], p));
     let total: usize = coarse_nodes.iter().product();
-    let (mut referenced, mut prescribed) = (vec![[false; D]; total], vec![[false; D]; total]);
+    // Per coarse node j and component c, at j·n + c.
+    let n = fine.components;
+    let (mut referenced, mut prescribed) = (vec![false; total * n], vec![false; total * n]);
     for (k, &node) in fine.nodes.iter().enumerate() {
         let ijk = node_ijk(node, fine_nodes);
         if let Some(j) = coincident(&axes, ijk, coarse_nodes) {
-            for d in 0..D {
-                if fine.index[k][d] == PRESCRIBED {
-                    prescribed[j][d] = true;
+            for c in 0..n {
+                if fine.state(k, c) == PRESCRIBED {
+                    prescribed[j * n + c] = true;
                 }
             }
         }
-        if (0..D).any(|d| fine.unknown(k, d).is_some()) {
+        if (0..n).any(|c| fine.unknown(k, c).is_some()) {
             for_each_parent(&axes, ijk, coarse_nodes, |j, _| {
-                for d in 0..D {
-                    referenced[j][d] |= fine.unknown(k, d).is_some();
+                for c in 0..n {
+                    referenced[j * n + c] |= fine.unknown(k, c).is_some();
                 }
             });
         }
@@ -228,27 +243,29 @@ fn coarsen<const D: usize>(fine: &Level<D>, p: usize) -> Option<(Transfer, Level
             }
         }),
         nodes: Vec::new(),
+        components: n,
         index: Vec::new(),
         unknowns: 0,
     };
     let mut position = vec![u32::MAX; total];
     for j in 0..total {
-        if !(0..D).any(|d| referenced[j][d] || prescribed[j][d]) {
+        let (referenced, prescribed) = (&referenced[j * n..][..n], &prescribed[j * n..][..n]);
+        if !(0..n).any(|c| referenced[c] || prescribed[c]) {
             continue;
         }
         position[j] = coarse.nodes.len() as u32;
         coarse.nodes.push(j);
-        let index = std::array::from_fn(|d| {
-            if prescribed[j][d] {
+        for c in 0..n {
+            let state = if prescribed[c] {
                 PRESCRIBED
-            } else if referenced[j][d] {
+            } else if referenced[c] {
                 coarse.unknowns += 1;
                 coarse.unknowns as u32 - 1
             } else {
                 ABSENT
-            }
-        });
-        coarse.index.push(index);
+            };
+            coarse.index.push(state);
+        }
     }
     // P, row by row in the order of the fine unknowns (node by node).
     let mut prolongation = Csr {
@@ -261,22 +278,22 @@ fn coarsen<const D: usize>(fine: &Level<D>, p: usize) -> Option<(Transfer, Level
     let mut next_row = 0;
     for (k, &node) in fine.nodes.iter().enumerate() {
         let ijk = node_ijk(node, fine_nodes);
-        for d in 0..D {
-            let Some(u) = fine.unknown(k, d) else {
+        for c in 0..n {
+            let Some(u) = fine.unknown(k, c) else {
                 continue;
             };
             debug_assert_eq!(u, next_row, "unknowns numbered node by node");
             next_row += 1;
             row.clear();
             for_each_parent(&axes, ijk, coarse_nodes, |j, w| {
-                let c = coarse.index[position[j] as usize][d];
-                if c < PRESCRIBED {
-                    row.push((c, w));
+                let i = coarse.state(position[j] as usize, c);
+                if i < PRESCRIBED {
+                    row.push((i, w));
                 }
             });
-            row.sort_by_key(|&(c, _)| c);
-            for &(c, w) in &row {
-                prolongation.col.push(c);
+            row.sort_by_key(|&(i, _)| i);
+            for &(i, w) in &row {
+                prolongation.col.push(i);
                 prolongation.val.push(w);
             }
             prolongation.row_ptr.push(prolongation.col.len());
@@ -345,10 +362,16 @@ mod tests {
     }
 
     /// The active nodes of a body covering the cells with index < `body[d]`
-    /// (and the nodes of those cells), the base y = 0 prescribed if `fixed_base`,
-    /// and a few nodes on the body's top tied (to arbitrary masters: only their
-    /// having no unknowns matters here).
-    fn body<const D: usize>(g: &Grid<D>, body: [usize; D], fixed_base: bool) -> (Vec<u32>, Dofs) {
+    /// (and the nodes of those cells), N components per node, the
+    /// displacements' (components < D) prescribed on the base y = 0 if
+    /// `fixed_base` (a further scalar component is free there), and a few
+    /// nodes on the body's top tied (to arbitrary masters: only their having no
+    /// unknowns matters here).
+    fn body<const D: usize, const N: usize>(
+        g: &Grid<D>,
+        body: [usize; D],
+        fixed_base: bool,
+    ) -> (Vec<u32>, Dofs) {
         let p = g.degree;
         let active: Vec<u32> = (0..g.node_count())
             .filter(|&k| {
@@ -370,9 +393,9 @@ mod tests {
             .collect();
         let fixed = active.iter().map(|&k| {
             let ijk = g.node_ijk(k as usize);
-            [fixed_base && ijk[1] == 0; D]
+            std::array::from_fn(|c| fixed_base && ijk[1] == 0 && c < D)
         });
-        let dofs = Dofs::with_ties::<D>(fixed, ties);
+        let dofs = Dofs::with_ties::<N>(fixed, ties);
         (active, dofs)
     }
 
@@ -387,25 +410,28 @@ mod tests {
     }
 
     /// The linear field sampled at the unknowns of a level (its coefficients:
-    /// Σ N_I X_I = x).
+    /// Σ N_I X_I = x), the displacements vanishing on y = 0 if `vanish`.
     fn sample<const D: usize>(g: &Grid<D>, level: &Level<D>, vanish: bool) -> Vec<f64> {
         let mut v = vec![f64::NAN; level.unknowns];
         for k in 0..level.nodes.len() {
             let x = level.position(g, k);
-            for d in 0..D {
-                if let Some(u) = level.unknown(k, d) {
-                    v[u] = field(x, d, vanish);
+            for c in 0..level.components {
+                if let Some(u) = level.unknown(k, c) {
+                    v[u] = field(x, c, vanish && c < D);
                 }
             }
         }
         v
     }
 
-    fn check_linear_fields<const D: usize>(cells: [usize; D], body_cells: [usize; D]) {
+    fn check_linear_fields<const D: usize, const N: usize>(
+        cells: [usize; D],
+        body_cells: [usize; D],
+    ) {
         for degree in 1..=3 {
             for fixed_base in [false, true] {
                 let g = grid(cells, degree);
-                let (active, dofs) = body(&g, body_cells, fixed_base);
+                let (active, dofs) = body::<D, N>(&g, body_cells, fixed_base);
                 let h = hierarchy(&g, &active, &dofs, 8);
                 assert!(h.levels.len() >= 3, "{} levels", h.levels.len());
                 for (l, t) in h.transfers.iter().enumerate() {
@@ -420,8 +446,8 @@ mod tests {
                         .fold(0.0, f64::max);
                     assert!(
                         worst < 1e-12,
-                        "{D}D degree {degree}, fixed base {fixed_base}, level {l} → {}: \
-                         largest error {worst:.1e}",
+                        "{D}D, {N} components, degree {degree}, fixed base {fixed_base}, \
+                         level {l} → {}: largest error {worst:.1e}",
                         l + 1
                     );
                 }
@@ -432,11 +458,15 @@ mod tests {
     /// P reproduces linear fields exactly on every level, for the hats (linear,
     /// GIMP, CPDI grids) and the quadratic and cubic B-splines, over a body that
     /// covers part of the grid (odd and even cell counts), with tied nodes on
-    /// its top and with a prescribed base (fields vanishing there).
+    /// its top and with a prescribed base (fields vanishing there); with D
+    /// components per node, and with D + 1 (the further component free on the
+    /// base: it keeps the coarse unknowns there that the displacements lose).
     #[test]
     fn prolongation_reproduces_linear_fields_on_every_level() {
-        check_linear_fields([21, 14], [13, 9]);
-        check_linear_fields([9, 8, 7], [7, 5, 6]);
+        check_linear_fields::<2, 2>([21, 14], [13, 9]);
+        check_linear_fields::<2, 3>([21, 14], [13, 9]);
+        check_linear_fields::<3, 3>([9, 8, 7], [7, 5, 6]);
+        check_linear_fields::<3, 4>([9, 8, 7], [7, 5, 6]);
     }
 
     /// The vector Laplacian of bilinear elements on `n`×`n` cells, prescribed on
@@ -468,7 +498,7 @@ mod tests {
                         let na = local[&(g.node_index([ia, ja]) as u32)];
                         let nb = local[&(g.node_index([ib, jb]) as u32)];
                         for d in 0..2 {
-                            if let (Some(r), Some(s)) = (dofs.of(na, d, 2), dofs.of(nb, d, 2)) {
+                            if let (Some(r), Some(s)) = (dofs.of(na, d), dofs.of(nb, d)) {
                                 *rows[r].entry(s as u32).or_default() += c * ke(a, b);
                             }
                         }
@@ -496,7 +526,7 @@ mod tests {
     /// of `n`×`n` bilinear cells.
     fn pcg_iterations(n: usize, c_top: f64) -> usize {
         let g = grid([n, n], 1);
-        let (active, _) = body(&g, [n, n], true);
+        let (active, _) = body::<2, 2>(&g, [n, n], true);
         let dofs = Dofs::with_ties::<2>(
             active.iter().map(|&k| [g.node_ijk(k as usize)[1] == 0; 2]),
             Vec::new(),

@@ -5,7 +5,9 @@
 //! triangle, `symmetric`, when K is symmetric, else `general`) and
 //! `…_rhs.mtx` (−r); per step and cut-back attempt, `stepSSSSSS_cutC_unknowns.csv`:
 //! each unknown's grid node, component and node coordinates (for near-null
-//! spaces such as the rigid-body modes of smoothed-aggregation multigrid).
+//! spaces such as the rigid-body modes of smoothed-aggregation multigrid). The
+//! components are those of the step's unknowns (`Dofs::per_node`): 0..D the
+//! displacements, then any scalar fields.
 
 use super::assembly::Tangent;
 use super::failure::Failure;
@@ -75,7 +77,8 @@ impl Export {
         Ok(())
     }
 
-    /// unknown, node (global grid id), component, x, y(, z) of every unknown.
+    /// unknown, node (global grid id), component (`Dofs`: the displacements
+    /// first), x, y(, z) of every unknown.
     fn write_unknowns<const D: usize>(
         &self,
         m: &Model<D>,
@@ -89,9 +92,9 @@ impl Export {
         let mut rows: Vec<(usize, u32, usize)> = Vec::with_capacity(sys.dofs.free);
         for a in 0..sys.map.len() {
             let node = sys.map.grid_node(a) as u32;
-            for d in 0..D {
-                if let Some(i) = sys.dofs.of(a, d, D) {
-                    rows.push((i, node, d));
+            for c in 0..sys.dofs.per_node() {
+                if let Some(i) = sys.dofs.of(a, c) {
+                    rows.push((i, node, c));
                 }
             }
         }

@@ -381,7 +381,7 @@ impl KrylovState {
                 let mut diagonal = vec![0.0; dofs.free];
                 for (a, block) in blocks.iter().enumerate() {
                     for d in 0..D {
-                        if let Some(i) = dofs.of(a, d, D) {
+                        if let Some(i) = dofs.of(a, d) {
                             diagonal[i] = block[(d, d)];
                         }
                     }
@@ -394,7 +394,7 @@ impl KrylovState {
                 let mut values: Vec<Vec<f64>> = Vec::with_capacity(blocks.len());
                 for (a, block) in blocks.iter().enumerate() {
                     let free: Vec<(usize, usize)> = (0..D)
-                        .filter_map(|d| dofs.of(a, d, D).map(|i| (d, i)))
+                        .filter_map(|d| dofs.of(a, d).map(|i| (d, i)))
                         .collect();
                     values.push(
                         free.iter()

@@ -483,16 +483,10 @@ pub fn number_unknowns<const D: usize>(
         .map(|(a, _)| implicit_node_constraint(&m.grid, &m.faces, &m.friction, map.grid_node(a)))
         .collect();
     let support = nodal_support(map, st, &m.particles.volume, m.grid.cell_volume());
-    let weak = ties(
-        &m.grid,
-        map,
-        fields,
-        &support,
-        &constraint,
-        min_node_support,
-    );
+    let fixed: Vec<[bool; D]> = constraint.iter().map(|c| c.fixed).collect();
+    let weak = ties(&m.grid, map, fields, &support, &fixed, min_node_support);
     let natural = natural_end_ties(&m.grid, &m.faces, map, fields);
     let ties = merge(weak, natural, map.len());
-    let dofs = Dofs::with_ties(constraint.iter().map(|c| c.fixed), ties);
+    let dofs = Dofs::with_ties(fixed.into_iter(), ties);
     (constraint, dofs)
 }

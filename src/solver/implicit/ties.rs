@@ -25,7 +25,7 @@
 
 use super::assembly::Tie;
 use crate::dim::Vector;
-use crate::model::conditions::{Constraint, FaceCondition};
+use crate::model::conditions::FaceCondition;
 use crate::model::grid::Grid;
 use crate::physics::shape::Stencils;
 use crate::physics::transfer::NodeMap;
@@ -108,21 +108,24 @@ pub fn nodal_support<const D: usize>(
 /// Masters: the pair J = a + s, K = a + 2s (s a grid direction, axes first, then
 /// diagonals) with the largest smaller support, both at or above the threshold.
 /// A weak node with no such pair, or with a prescribed component, stays an
-/// unknown. Returns no ties at all when none are needed.
-pub fn ties<const D: usize>(
+/// unknown. `fixed[a]`: which of the N components of node a are prescribed
+/// (the unknowns' components, `Dofs::per_node`; a tie binds them all).
+/// Returns no ties at all when none are needed.
+pub fn ties<const D: usize, const N: usize>(
     grid: &Grid<D>,
     map: &NodeMap,
     fields: Option<&NodeFields>,
     support: &[f64],
-    constraint: &[Constraint<D>],
+    fixed: &[[bool; N]],
     threshold: f64,
 ) -> Vec<Option<Tie>> {
     let weak = |a: usize| support[a] < threshold;
+    let free = |a: usize| !fixed[a].iter().any(|&f| f);
     // A split node (one body's node where two bodies meet) on a face with a
     // prescribed component is tied too, to masters on that face with the same
     // prescribed components: the other body no longer shares its stiffness,
     // and its free components would be nearly singular.
-    let may_tie = |a: usize| constraint[a].is_free() || map.is_split(a);
+    let may_tie = |a: usize| free(a) || map.is_split(a);
     if threshold <= 0.0 || !(0..map.len()).any(|a| weak(a) && may_tie(a)) {
         return Vec::new();
     }
@@ -133,7 +136,7 @@ pub fn ties<const D: usize>(
             if !weak(a) || !may_tie(a) {
                 return None;
             }
-            let same_face = |b: usize| constraint[b].fixed == constraint[a].fixed;
+            let same_face = |b: usize| fixed[b] == fixed[a];
             let ijk = grid.node_ijk(map.grid_node(a));
             let mut best: Option<(usize, f64, usize, usize)> = None; // (|s|², score, J, K)
             for s in &directions {
@@ -148,7 +151,7 @@ pub fn ties<const D: usize>(
                     continue;
                 };
                 let prescribed_alike = same_face(j) && same_face(k);
-                if !(constraint[a].is_free() || prescribed_alike) {
+                if !(free(a) || prescribed_alike) {
                     continue;
                 }
                 let score = support[j].min(support[k]);

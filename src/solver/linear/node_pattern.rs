@@ -2,8 +2,9 @@
 //!
 //! The step's tangent couples all the unknowns of node b to all those of each
 //! neighbour a of b in the node graph, and numbers unknowns node by node (node
-//! a owns `first[a]..first[a + 1]`, fewer than D where components are
-//! prescribed or the node is tied). So column c of node b holds, neighbour
+//! a owns `first[a]..first[a + 1]`: its components, the D displacements and
+//! any scalar fields, fewer where components are prescribed or the node is
+//! tied). So column c of node b holds, neighbour
 //! after neighbour in ascending order, the rows `first[a]..first[a + 1]`, those
 //! below `lowest` dropped (`lowest = c` for a stored lower triangle, 0 for the
 //! whole matrix). The row of every entry follows from the graph and the column

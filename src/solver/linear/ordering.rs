@@ -2,9 +2,9 @@
 //!
 //! The tangent of a grid method couples whole nodes: all the unknowns of node a
 //! couple to all those of node b, so the fill of a Cholesky factor is decided by
-//! the node graph, and ordering that graph (D times smaller, D² times fewer
-//! edges) gives the same fill as ordering the scalar matrix at a fraction of the
-//! cost. The unknowns of a node then follow each other. Two orderings of the
+//! the node graph, and ordering that graph (n times smaller, n² times fewer
+//! edges, n the unknowns per node: D, or more with further nodal fields) gives
+//! the same fill as ordering the scalar matrix at a fraction of the cost. The unknowns of a node then follow each other. Two orderings of the
 //! node graph:
 //! - [`node_amd`]: approximate minimum degree (faer's AMD), the same fill as
 //!   AMD on the scalar matrix in 3–5× less time;

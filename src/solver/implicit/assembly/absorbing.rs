@@ -3,7 +3,7 @@
 //! v(u) = v* + rate · u, the springs through u, so each layer particle adds
 //! S_Ip S_Jp (rate C_p + K_p), diagonal in the components.
 
-use super::{Components, Dofs, Pattern, Tangent};
+use super::{Components, Coupling, Dofs, Pattern, Tangent};
 use crate::dim::Vector;
 use crate::physics::boundary::absorbing::AbsorbingStep;
 use crate::physics::shape::Stencils;
@@ -28,14 +28,14 @@ pub fn add_absorbing<const D: usize>(
         *coefficient[lp.q].get_or_insert_with(Vector::<D>::zeros) += c;
     }
     let (col_ptr, storage) = (k.col_ptr, k.storage);
-    pattern.add_stencil_terms(
+    pattern.add_terms(
         &mut k.values,
         col_ptr,
         storage,
         map,
         st,
         dofs,
-        Components::Diagonal,
+        Coupling::<D, D>::displacements(Components::Diagonal),
         |q, e2, _needed, block| {
             let Some(c) = coefficient[q] else {
                 return false;

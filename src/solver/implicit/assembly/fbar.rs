@@ -238,11 +238,11 @@ fn add_cell_products<const D: usize>(k: &mut Tangent, dofs: &Dofs, per_cell: &[C
     for (a_c, h_c) in per_cell {
         for (n1, av) in a_c {
             for i in 0..D {
-                let rows = dofs.terms(*n1, i, D);
+                let rows = dofs.terms(*n1, i);
                 for (n2, hv) in h_c {
                     for kk in 0..D {
                         for &(r, cr) in rows.as_slice() {
-                            for &(c, cc) in dofs.terms(*n2, kk, D).as_slice() {
+                            for &(c, cc) in dofs.terms(*n2, kk).as_slice() {
                                 let s = k.slot(r, c).expect("cell entry in the pattern");
                                 k.values[s] += av[i] * hv[kk] * cr * cc;
                             }

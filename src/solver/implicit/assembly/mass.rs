@@ -2,7 +2,7 @@
 //! lumped nodal mass m_I (2-24) or the consistent mass M_IJ = Σ_p m_p S_Ip S_Jp,
 //! diagonal in the components.
 
-use super::{Components, Dofs, Pattern, Storage, Tangent};
+use super::{Components, Coupling, Dofs, Pattern, Storage, Tangent};
 use crate::physics::shape::Stencils;
 use crate::physics::transfer::NodeMap;
 
@@ -11,7 +11,7 @@ use crate::physics::transfer::NodeMap;
 pub fn add_lumped_mass<const D: usize>(k: &mut Tangent, dofs: &Dofs, mass: &[f64], inertia: f64) {
     for (node, m_i) in mass.iter().enumerate() {
         for d in 0..D {
-            let t = dofs.terms(node, d, D);
+            let t = dofs.terms(node, d);
             for &(r, cr) in t.as_slice() {
                 for &(c, cc) in t.as_slice() {
                     if k.storage == Storage::Full || r >= c {
@@ -35,14 +35,14 @@ pub fn add_consistent_mass<const D: usize>(
     inertia: f64,
 ) {
     let (col_ptr, storage) = (k.col_ptr, k.storage);
-    pattern.add_stencil_terms(
+    pattern.add_terms(
         &mut k.values,
         col_ptr,
         storage,
         map,
         st,
         dofs,
-        Components::Diagonal,
+        Coupling::<D, D>::displacements(Components::Diagonal),
         |q, e2, _needed, block| {
             for (local, e1) in st.range(q).enumerate() {
                 let v = particle_mass[q] * st.weight(e1) * st.weight(e2) * inertia;

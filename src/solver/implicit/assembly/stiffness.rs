@@ -14,7 +14,7 @@
 //!
 //!   V_p [δ_i0 h_I A_θθkl ∂S_J/∂X_l + δ_k0 h_J ∂S_I/∂X_j A_ijθθ + δ_i0 δ_k0 h_I h_J A_θθθθ].
 
-use super::{Components, Dofs, Pattern, Tangent};
+use super::{Components, Coupling, Dofs, Pattern, Tangent};
 use crate::dim::{Mat3, Vector};
 use crate::material::driver::numerical_stress_derivative;
 use crate::material::{Increment, StressDerivative};
@@ -293,14 +293,14 @@ pub fn add_stiffness<const D: usize>(
 ) {
     let (col_ptr, storage) = (k.col_ptr, k.storage);
     let at = ParticleTangents::<D>::at;
-    pattern.add_stencil_terms(
+    pattern.add_terms(
         &mut k.values,
         col_ptr,
         storage,
         map,
         st,
         dofs,
-        Components::All,
+        Coupling::<D, D>::displacements(Components::All),
         |q, e2, needed, block| {
             // b_ijk = Σ_l A_ijkl ∂S_J/∂X_l, then V Σ_j ∂S_I/∂X_j b_ijk for each node I.
             let (ap, g2) = (a.of(q), &st.grad(e2));

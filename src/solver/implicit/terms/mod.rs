@@ -26,15 +26,27 @@
 //! `add_tangent`, `commit` and the reports, as the particles' stiffness reads
 //! only the trial state.
 //!
-//! **Unknowns of a term's own.** Today every unknown is a displacement
-//! component, D per active node (`assembly::Dofs`), and the terms see the
-//! nodal displacement increments `&[Vector<D>]` and add D-vectors per node to
-//! r. A term with unknowns of its own (a pore pressure per node, D + 1
-//! unknowns per node) would enter once `Dofs` numbers more than D unknowns per
-//! node: it would read its nodal values beside u in `evaluate` and `probe`,
-//! add its rows to r there, add its blocks to K through the same
-//! `Dofs::terms` spreading in `add_tangent`, and report in [`Couplings`] any
-//! node pairs its rows couple beyond the stencils.
+//! **Blocks.** A node carries the components the problem gives it
+//! (`assembly::Dofs::per_node`: the D displacements 0..D, then any scalar
+//! fields), and the pattern couples all of them between two coupled nodes. A
+//! term says which block of components it fills where it adds to K, with an
+//! `assembly::Coupling` (first row and column component, R×C, full or
+//! diagonal): `Pattern::add_terms` over the stencils, `Tangent::add_node_block`
+//! for the node pairs of its [`Couplings`]. The terms here all fill the
+//! displacements' D×D block (`Coupling::displacements`).
+//!
+//! **Unknowns of a term's own.** The step's unknowns are the displacements
+//! today (`super::step::number_unknowns` numbers D components per node) and
+//! the terms see the nodal displacement increments `&[Vector<D>]` and add
+//! D-vectors per node to r. A term with unknowns of its own (a pore pressure
+//! per node, D + 1 unknowns per node) enters once the step numbers D + 1
+//! components per node (`Dofs::with_ties` with `[bool; D + 1]` fixity) and
+//! its nodal vectors carry them: it reads its field beside u in `evaluate`
+//! and `probe`, adds its rows to r there, and adds its blocks (K_pp, K_up,
+//! K_pu) with their `Coupling` in `add_tangent`. The assembly, ties,
+//! multigrid, direct solver and export already take the components per node
+//! from `Dofs` (`assembly::tests`: a Biot-type system with D + 1 unknowns per
+//! node, through the direct solver and multigrid-preconditioned GMRES).
 
 pub mod absorbing;
 pub mod contact;
@@ -79,7 +91,9 @@ pub struct StepStart<'a, const D: usize> {
 }
 
 /// What a term couples in the tangent beyond the nodes of each particle's
-/// stencil (`assembly::Pattern`).
+/// stencil (`assembly::Pattern`): whole nodes, every component of one with
+/// every component of the other (the term fills its block of them,
+/// `Tangent::add_node_block`).
 #[derive(Clone, Debug)]
 pub struct Couplings<'a, const D: usize> {
     /// Pairs of active nodes (a < b) the term couples directly.

@@ -39,7 +39,7 @@ use crate::physics::rigid::surface::Inside;
 use crate::physics::shape::{evaluate, ShapeFunction};
 use crate::scene::contact::ContactPlan;
 use crate::solver::implicit::assembly::stiffness::ParticleTangents;
-use crate::solver::implicit::assembly::{Dofs, Storage, Tangent};
+use crate::solver::implicit::assembly::{Components, Coupling, Tangent};
 use crate::solver::implicit::terms::{
     Couplings, Restore, StepStart, StepTerm, StepView, TermReport,
 };
@@ -322,12 +322,14 @@ impl<const D: usize> StepTerm<D> for BodyContact<D> {
 
     /// K_ab −= c_a c_b ∂f over the nodes of the meetings in contact.
     fn add_tangent(&self, step: &StepView<'_, D>, _a: &ParticleTangents<D>, k: &mut Tangent) {
+        let displacements = Coupling::<D, D>::displacements(Components::All);
         for t in &self.at.touches {
             let d = &t.contact.derivative;
             let points = &self.joints[t.meeting].points;
             for &(a, ca) in points {
                 for &(b, cb) in points {
-                    add_node_block(k, step.dofs, a, b, &(d * (-ca * cb)));
+                    let block = d * (-ca * cb);
+                    k.add_node_block(step.dofs, (a, b), displacements, |i, j| block[(i, j)]);
                 }
             }
         }
@@ -400,30 +402,6 @@ impl<const D: usize> StepTerm<D> for BodyContact<D> {
     /// with contact has the `contact_f*` columns.
     fn add_particle_forces(&self, _forces: &mut [Vector<D>]) -> bool {
         true
-    }
-}
-
-/// K_ab += block over the unknowns of active nodes a and b (a tied node's
-/// terms going to its masters; the lower triangle only with `Lower`).
-fn add_node_block<const D: usize>(
-    k: &mut Tangent,
-    dofs: &Dofs,
-    a: usize,
-    b: usize,
-    block: &Tensor<D>,
-) {
-    for i in 0..D {
-        let rows = dofs.terms(a, i, D);
-        for j in 0..D {
-            for &(r, cr) in rows.as_slice() {
-                for &(c, cc) in dofs.terms(b, j, D).as_slice() {
-                    if k.storage == Storage::Full || r >= c {
-                        let s = k.slot(r, c).expect("contact entry in the pattern");
-                        k.values[s] += block[(i, j)] * cr * cc;
-                    }
-                }
-            }
-        }
     }
 }
 

@@ -36,7 +36,7 @@ use crate::physics::rigid::surface::{on_grid_boundary, Placement, Surface};
 use crate::physics::transfer::interpolate;
 use crate::scene::contact::ContactPlan;
 use crate::solver::implicit::assembly::stiffness::ParticleTangents;
-use crate::solver::implicit::assembly::{Components, Tangent};
+use crate::solver::implicit::assembly::{Components, Coupling, Tangent};
 use crate::solver::implicit::terms::{Restore, StepStart, StepTerm, StepView, TermReport};
 use crate::solver::stepper::SolverState;
 use rayon::prelude::*;
@@ -281,14 +281,14 @@ impl<const D: usize> StepTerm<D> for RigidContact<D> {
         let (map, st, dofs) = (step.map, step.stencils, step.dofs);
         let (pattern, col_ptr, storage) = (k.pattern, k.col_ptr, k.storage);
         let touches = &self.at.touches;
-        pattern.add_stencil_terms(
+        pattern.add_terms(
             &mut k.values,
             col_ptr,
             storage,
             map,
             st,
             dofs,
-            Components::All,
+            Coupling::<D, D>::displacements(Components::All),
             |q, e2, needed, block| {
                 let Ok(i) = touches.binary_search_by_key(&q, |t| t.particle) else {
                     return false;
