@@ -380,9 +380,15 @@ fn a_lagged_direct_restart_refactorizes_and_stays_within_the_tolerances() {
     let (a, b) = (read(whole.path()), read(again.path()));
     for column in ["x", "y", "syy"] {
         let scale = a.col(column).iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-        for (u, v) in a.col(column).iter().zip(b.col(column)) {
-            assert!((u - v).abs() <= 1e-6 * scale, "{column}: {u} against {v}");
-        }
+        let worst = (a.col(column).iter().zip(b.col(column)))
+            .fold(0.0_f64, |w, (u, v)| w.max((u - v).abs()));
+        // Measured 0, 1.8e-13, 2.0e-11: a floor at the Newton tolerance, which
+        // the refactorized preconditioner's other GMRES path may reach.
+        crate::common::assert_within(
+            &format!("{column}: restarted against whole, relative"),
+            worst / scale,
+            1e-9,
+        );
     }
 }
 
