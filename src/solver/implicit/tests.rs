@@ -281,14 +281,10 @@ fn tangent_with_rigid_contact_matches_finite_differences_of_the_residual() {
             "[[body]]\nname = \"block\"\nmaterial = \"m\"",
         )
         .replace("[[boundary]]", &format!("{RIGID_BODIES}[[boundary]]"));
-    for (shape, mu) in [
-        ("linear", 0.0),
-        ("linear", 0.3),
-        ("cpgimp", 0.3),
-        ("cpdi", 0.3),
-        ("cpbspline2", 0.3),
-        ("bspline2", 0.3),
-    ] {
+    // Frictionless with linear hats, with friction for every shape function.
+    use strum::IntoEnumIterator;
+    let every_shape = crate::scene::ShapeFunction::iter().map(|s| (s.name(), 0.3));
+    for (shape, mu) in std::iter::once(("linear", 0.0)).chain(every_shape) {
         let text = body.replace(
             "[solver]",
             &format!("[[contact]]\nfriction_coefficient = {mu}\n[solver]"),
