@@ -3,7 +3,8 @@
 //! recovery, and a clean stop when cut-backs are not allowed), and results that do
 //! not depend on the number of threads.
 
-use crate::common::{run_problem, Table};
+use crate::common::{assert_within, run_problem, shape_functions, Table};
+use mpm::scene::ShapeFunction;
 
 fn syy_errors(dir: &std::path::Path, l0: f64) -> Vec<(f64, f64)> {
     let p = Table::read(&dir.join("particles_final.csv")).unwrap();
@@ -14,12 +15,20 @@ fn syy_errors(dir: &std::path::Path, l0: f64) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// Linear, GIMP and CPDI keep every particle within ρ g h / 4 (= 100 Pa) of the
-/// exact stress across the 10⁶ jump; quadratic B-splines, whose support spans the
-/// interface, carry an error there (≈ 2.7 kPa of 8 kPa) but not away from it.
+/// The linear families (hats, GIMP, CPDI) keep every particle within about
+/// ρ g h / 4 (= 100 Pa; measured 112 Pa at most) of the exact stress across the
+/// 10⁶ jump; the B-splines, whose
+/// support spans the interface, carry an error there (≈ 2.7 kPa of 8 kPa,
+/// quadratic) but not away from it.
 #[test]
 fn stiffness_contrast_of_a_million() {
-    for shape in ["linear", "ugimp", "cpdi", "bspline2"] {
+    // Measured with cubic B-splines: 15.9 kPa next to the interface (2.0 times
+    // the base stress; quadratic 2.7 kPa), 2.5 kPa beyond 1 m, 1.0 kPa beyond
+    // 2 m, falling to 30 Pa at 4 m (a finding, not yet explained).
+    let cubic = "its error spreads beyond 1 m of the interface (2.5 kPa there)";
+    for shape in shape_functions(&[(ShapeFunction::Bspline3, cubic)]) {
+        let smooth = shape.degree() > 1;
+        let shape = shape.name();
         let (result, dir) = run_problem(
             "two_layer_column.toml",
             &[&format!("grid.shape_function={shape}")],
@@ -33,13 +42,16 @@ fn stiffness_contrast_of_a_million() {
             .map(|x| x.0)
             .fold(0.0, f64::max);
         println!("{shape}: max error {worst:.0} Pa, beyond 1 m of the interface {far:.0} Pa, {} Newton iterations", s.solver.newton_iterations.unwrap());
-        if shape == "bspline2" {
-            assert!(
-                far < 400.0,
-                "{shape}: error {far:.0} Pa away from the interface"
+        if smooth {
+            // Measured 297 Pa (quadratic, and averaged over the domains).
+            assert_within(
+                &format!("{shape}: error beyond 1 m of the interface (Pa)"),
+                far,
+                400.0,
             );
         } else {
-            assert!(worst < 120.0, "{shape}: max error {worst:.0} Pa");
+            // Twice ρ g h / 4 (measured 100 to 112 Pa).
+            assert_within(&format!("{shape}: max error (Pa)"), worst, 200.0);
         }
         assert!(
             s.solver.newton_iterations.unwrap() <= 40,
@@ -50,8 +62,8 @@ fn stiffness_contrast_of_a_million() {
 }
 
 /// ν = 0.49 (Hencky): uniaxial strain under lateral rollers; σ_yy is still
-/// −ρ g (l0 − Y). At 32 cells (h = 1.5625 m) every particle is within the linear
-/// basis' intrinsic ρ g h / 4 = 312 Pa of it at any ν (at ν = 0.49 the column barely
+/// −ρ g (l0 − Y). At 32 cells (h = 1.5625 m) every particle is within about the
+/// linear basis' intrinsic ρ g h / 4 = 312 Pa of it (measured 313 and 323 Pa) at any ν (at ν = 0.49 the column barely
 /// deforms, so all particles show that pattern; at ν = 0 the motion averages it
 /// down), and Newton converges as fast as at ν = 0.
 #[test]
@@ -77,10 +89,9 @@ fn nearly_incompressible_column() {
     let (w0, n0) = run("0.0");
     let (w49, n49) = run("0.49");
     println!("ν = 0: max error {w0:.0} Pa, {n0} Newton iterations; ν = 0.49: max error {w49:.0} Pa, {n49} iterations (ρgh/4 = {quarter_cell:.0} Pa)");
-    assert!(
-        w0 < 1.1 * quarter_cell && w49 < 1.1 * quarter_cell,
-        "max errors {w0:.0}, {w49:.0} Pa"
-    );
+    // Measured 323 and 313 Pa: bounded at twice ρ g h / 4.
+    assert_within("ν = 0: max error (Pa)", w0, 2.0 * quarter_cell);
+    assert_within("ν = 0.49: max error (Pa)", w49, 2.0 * quarter_cell);
     assert!(n49 <= n0, "ν = 0.49 needs {n49} Newton iterations vs {n0}");
 }
 
@@ -198,5 +209,6 @@ fn line_search_saves_newton_iterations() {
         .zip(&y_ls)
         .map(|(a, b)| (a - b).abs())
         .fold(0.0, f64::max);
-    assert!(dy < 1e-6, "the two paths reach states {dy} m apart");
+    // Measured 1.4e-14 m (3e-16 of the height): round-off, with a floor.
+    assert_within("the two paths' states apart (m)", dy, 1e-9);
 }

@@ -4,7 +4,9 @@
 //! Eisenstat–Walker forcing terms; a material without an analytic tangent; a
 //! Krylov failure handled like a Newton failure.
 
-use crate::common::{problem, read_newton, read_output, run_cli, run_problem, run_text, Table};
+use crate::common::{
+    assert_within, problem, read_newton, read_output, run_cli, run_problem, run_text, Table,
+};
 use mpm::run::summary::Summary;
 use mpm::run::RunError;
 
@@ -48,10 +50,7 @@ fn assert_same_state(direct: &Run, krylov: &Run, length: f64, fields: &[&str], t
         let scale = max_abs(direct.particles.col(f).iter().copied());
         worst = worst.max(max_diff(direct, krylov, f) / scale);
     }
-    assert!(
-        worst < tol,
-        "largest relative difference {worst:.2e} (tolerance {tol:.0e})"
-    );
+    assert_within("largest relative difference", worst, tol);
     worst
 }
 
@@ -80,8 +79,9 @@ const KRYLOV_CONFIGS: [&[&str]; 5] = [
 
 /// Quasi-static column (16 cells, 20 load steps, uGIMP): Newton stops at
 /// ‖r‖ ≤ 1e-9 of the reference force on both paths, so the states agree to about
-/// that times the conditioning; stated tolerance 1e-8 of the largest displacement
-/// (0.96 m) and of the largest stress (measured: 2e-10 or less).
+/// that times the conditioning; stated tolerance 1.5e-9 of the largest
+/// displacement (0.96 m) and of the largest stress (measured: 5.8e-10 with
+/// GMRES/block-Jacobi, 1.4e-10 or less with the others).
 #[test]
 fn column_same_state_as_direct() {
     let direct = run("column.toml", &[]);
@@ -95,7 +95,7 @@ fn column_same_state_as_direct() {
                 .zip(direct.particles.col("Y0")))
             .map(|(a, b)| a - b),
         );
-        let d = assert_same_state(&direct, &k, length, &["syy"], 1e-8);
+        let d = assert_same_state(&direct, &k, length, &["syy"], 1.5e-9);
         println!(
             "column {config:?}: difference {d:.1e}; {} (direct {})",
             counts(&k),
@@ -110,7 +110,9 @@ fn column_same_state_as_direct() {
 /// problems/cantilever.toml). Bending makes the tangent ill conditioned: GMRES(30)
 /// with a diagonal preconditioner stagnates here, so the checked configurations
 /// are CG, GMRES with a long restart, and the lagged direct preconditioner.
-/// Tolerance 1e-8 of the tip deflection (3.2 cm) and of the largest stress.
+/// Tolerance 4e-9 of the tip deflection (3.2 cm) and of the largest stress
+/// (measured: 1.7e-9 with CG and GMRES(200), 8.2e-11 or less preconditioned by
+/// the lagged tangent).
 #[test]
 fn cantilever_small_load_same_state_as_direct() {
     let small = ["load.0.force=[0,-100]", "solver.load_steps=1"];
@@ -141,7 +143,7 @@ fn cantilever_small_load_same_state_as_direct() {
     ] {
         let args: Vec<&str> = small.iter().chain(config).copied().collect();
         let k = run("cantilever.toml", &args);
-        let d = assert_same_state(&direct, &k, length, &["sxx", "sxy"], 1e-8);
+        let d = assert_same_state(&direct, &k, length, &["sxx", "sxy"], 4e-9);
         println!(
             "cantilever {config:?}: difference {d:.1e}; {} (direct {})",
             counts(&k),
@@ -152,8 +154,8 @@ fn cantilever_small_load_same_state_as_direct() {
 
 /// Trapezoidal Newmark bar over one period (100 steps): positions against the
 /// amplitude v0/ω = 0.159 m and velocities against v0 = 0.1 m/s; differences of
-/// the per-step Newton tolerance accumulate over the steps, so the stated
-/// tolerance is 1e-7 (measured: 5e-9 or less).
+/// the per-step Newton tolerance accumulate over the steps: stated tolerance
+/// 8e-9 (measured: 3.2e-9 or less).
 #[test]
 fn vibrating_bar_same_state_as_direct() {
     let period = ["solver.end_time=10"];
@@ -174,10 +176,8 @@ fn vibrating_bar_same_state_as_direct() {
             counts(&k),
             counts(&direct)
         );
-        assert!(
-            dx < 1e-7 && dv < 1e-7,
-            "position {dx:.2e}, velocity {dv:.2e}"
-        );
+        assert_within(&format!("bar {config:?}: position"), dx, 8e-9);
+        assert_within(&format!("bar {config:?}: velocity"), dv, 8e-9);
     }
 }
 
@@ -261,9 +261,9 @@ fn newton_stays_superlinear_with_forcing_terms() {
 /// The column in large deformation (E = 20 kPa: the top settles by 26 m of 50)
 /// with the compressible Ogden model, which has no analytic tangent, on GMRES:
 /// one term with α = 2, μ = E/2 is neo-Hookean, so it must reproduce the
-/// neo-Hookean run of the direct solver (tolerance 1e-7 of the settlement and of
-/// the base stress; measured about 1e-10). The direct solver refuses the Ogden scene with an error
-/// asking for a Krylov solver.
+/// neo-Hookean run of the direct solver (tolerance 2e-10 of the settlement and
+/// 5e-9 of the base stress; measured 8.0e-11 and 2.0e-9 at most). The direct
+/// solver refuses the Ogden scene with an error asking for a Krylov solver.
 #[test]
 fn material_without_tangent_runs_on_the_krylov_path() {
     let large = ["output.frames=0"];
@@ -311,7 +311,12 @@ fn material_without_tangent_runs_on_the_krylov_path() {
             settlement > 10.0,
             "large deformation expected, got {settlement}"
         );
-        assert!(dy < 1e-7 && ds < 1e-7, "differences {dy:.2e} / {ds:.2e}");
+        assert_within(
+            &format!("ogden {config:?}: settlement difference"),
+            dy,
+            2e-10,
+        );
+        assert_within(&format!("ogden {config:?}: stress difference"), ds, 5e-9);
     }
 
     let e = mpm::scene::Scene::parse("column.toml", &ogden, &[])

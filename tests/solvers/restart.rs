@@ -7,8 +7,10 @@
 use crate::common::problem;
 use mpm::run::checkpoint::VERSION;
 use mpm::run::summary::Summary;
+use mpm::scene::{Integrator, Scene, SolverKind};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+use strum::IntoEnumIterator;
 
 /// `mpm run problems/NAME --threads N --out DIR --set …` (and `--restart`).
 fn mpm(name: &str, threads: usize, out: &Path, sets: &[&str], restart: Option<&Path>) -> Output {
@@ -120,17 +122,6 @@ fn summary(dir: &Path) -> Summary {
     Summary::read(&dir.join("summary.json")).unwrap()
 }
 
-#[test]
-fn explicit_restart_is_byte_identical() {
-    let steps = restarts_are_exact(
-        "column_explicit.toml",
-        &["solver.end_time=2", "output.history_interval=0"],
-        0.8,
-        1,
-    );
-    assert!(steps[0] > 0 && steps[1] > steps[0], "{steps:?}");
-}
-
 /// The loads live on the particles (`Particles::load`, kept only by scenes that
 /// have loads): a restart in the middle of a traction pulse takes them from the
 /// checkpoint.
@@ -161,19 +152,43 @@ fn apic_restart_is_byte_identical() {
     );
 }
 
+/// Every solver kind, and every integrator of the implicit one, restarts
+/// byte-identically: a kind or integrator added to `SolverKind` or
+/// `Integrator` needs its scene here (the matches are exhaustive).
 #[test]
-fn quasi_static_restart_is_byte_identical() {
-    restarts_are_exact("column.toml", &[], 0.4, 1);
-}
-
-#[test]
-fn newmark_restart_is_byte_identical() {
-    restarts_are_exact(
-        "vibrating_bar_implicit.toml",
-        &["solver.end_time=3"],
-        1.2,
-        1,
-    );
+fn every_solver_kind_restarts_byte_identically() {
+    // The scene's own [solver] table: the kind and integrator the arm names.
+    let solver = |name: &str| {
+        let scene = Scene::load(&problem(name), &[]).unwrap();
+        let s = scene.config.solver.unwrap();
+        (s.kind, s.integrator)
+    };
+    for kind in SolverKind::iter() {
+        match kind {
+            SolverKind::Explicit => {
+                assert_eq!(solver("column_explicit.toml").0, kind);
+                let steps = restarts_are_exact(
+                    "column_explicit.toml",
+                    &["solver.end_time=2", "output.history_interval=0"],
+                    0.8,
+                    1,
+                );
+                assert!(steps[0] > 0 && steps[1] > steps[0], "{steps:?}");
+            }
+            SolverKind::Implicit => {
+                for integrator in Integrator::iter() {
+                    let (scene, sets, interval): (&str, &[&str], f64) = match integrator {
+                        Integrator::QuasiStatic => ("column.toml", &[], 0.4),
+                        Integrator::Newmark => {
+                            ("vibrating_bar_implicit.toml", &["solver.end_time=3"], 1.2)
+                        }
+                    };
+                    assert_eq!(solver(scene), (kind, Some(integrator)), "{scene}");
+                    restarts_are_exact(scene, sets, interval, 1);
+                }
+            }
+        }
+    }
 }
 
 #[test]
@@ -380,9 +395,15 @@ fn a_lagged_direct_restart_refactorizes_and_stays_within_the_tolerances() {
     let (a, b) = (read(whole.path()), read(again.path()));
     for column in ["x", "y", "syy"] {
         let scale = a.col(column).iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-        for (u, v) in a.col(column).iter().zip(b.col(column)) {
-            assert!((u - v).abs() <= 1e-6 * scale, "{column}: {u} against {v}");
-        }
+        let worst = (a.col(column).iter().zip(b.col(column)))
+            .fold(0.0_f64, |w, (u, v)| w.max((u - v).abs()));
+        // Measured 0, 1.8e-13, 2.0e-11: a floor at the Newton tolerance, which
+        // the refactorized preconditioner's other GMRES path may reach.
+        crate::common::assert_within(
+            &format!("{column}: restarted against whole, relative"),
+            worst / scale,
+            1e-9,
+        );
     }
 }
 

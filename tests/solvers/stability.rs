@@ -7,9 +7,11 @@
 //! while USL needs a step below h/c. A run past the limit stops with a message
 //! naming the step and the particle and keeps what it wrote.
 
-use crate::common::{run_problem, Table};
+use crate::common::{run_problem, schemes, Table};
 use mpm::run::summary::Status;
 use mpm::run::RunError;
+use mpm::scene::Scheme;
+use strum::IntoEnumIterator;
 
 fn runs(scheme: &str, factor: f64, end_time: f64) -> bool {
     let (result, _dir) = run_problem(
@@ -65,23 +67,25 @@ fn critical_step_is_h_over_c() {
 
 #[test]
 fn measured_stability_limits() {
-    for scheme in ["usf", "musl"] {
-        let t = threshold(scheme);
+    for scheme in Scheme::iter() {
+        let range = match scheme {
+            Scheme::Usf | Scheme::Musl => 1.0..2.0,
+            Scheme::Usl => 0.5..1.0,
+        };
+        let t = threshold(scheme.name());
         assert!(
-            (1.0..2.0).contains(&t),
-            "{scheme}: stability limit {t} h/c outside [1, 2)"
+            range.contains(&t),
+            "{}: stability limit {t} h/c outside {range:?}",
+            scheme.name()
         );
     }
-    let t = threshold("usl");
-    assert!(
-        (0.5..1.0).contains(&t),
-        "usl: stability limit {t} h/c outside [0.5, 1)"
-    );
 }
 
 #[test]
 fn runs_at_nine_tenths_of_the_critical_step() {
-    for scheme in ["usf", "musl"] {
+    let usl = "its limit lies below h/c (measured_stability_limits)";
+    for scheme in schemes(&[(Scheme::Usl, usl)]) {
+        let scheme = scheme.name();
         let (result, dir) = run_problem(
             "vibrating_bar.toml",
             &[

@@ -2,6 +2,8 @@
 //! 2 threads gives byte-identical outputs.
 
 use crate::common::{read_output, run_cli};
+use mpm::scene::Scheme;
+use strum::IntoEnumIterator;
 
 fn run(threads: usize, shape: &str, fbar: bool) -> (Vec<u8>, Vec<u8>) {
     let overrides = [
@@ -86,7 +88,7 @@ fn axisymmetric_runs_give_identical_results_on_one_and_two_threads() {
 /// Mohr–Coulomb with history and a friction base.
 #[test]
 fn scatter_runs_give_identical_results_on_one_and_two_threads() {
-    for scheme in ["usl", "usf", "musl"] {
+    for scheme in Scheme::iter().map(|s| s.name()) {
         let overrides = [
             format!("solver.scheme=\"{scheme}\""),
             "solver.end_time=0.004".to_string(),

@@ -7,55 +7,34 @@
 //! serves, and it refuses nothing silently: where it cannot serve, the node
 //! map runs and summary.json says so.
 
-use crate::common::{run_problem, run_text, Table};
+use crate::common::{face, face_with, run_problem, run_text, shape_functions, Block, Table};
 use mpm::run::summary::Summary;
+use mpm::scene::{Scheme, ShapeFunction};
 use mpm::solver::report::TransferPath;
+use strum::IntoEnumIterator;
 
 /// An elastic block thrown at a rough floor against a roller wall: gravity, a
 /// point load on its top corner, local damping, a PIC/FLIP blend.
-const BLOCK: &str = r#"dimension = 2
-gravity = [0.0, -9.81]
-[grid]
-min = [0.0, 0.0]
-max = [1.0, 0.5]
-cells = [40, 20]
-[[material]]
-name = "m"
-model = "neo_hookean"
-density = 1000.0
-youngs_modulus = 1.0e5
-poisson_ratio = 0.3
-[[body]]
-name = "b"
-material = "m"
-shape = "rectangle"
-min = [0.0, 0.0]
-max = [0.5, 0.25]
-particles_per_cell = 2
-velocity = [0.2, -0.05]
-[[boundary]]
-face = "xmin"
-condition = "roller"
-[[boundary]]
-face = "ymin"
-condition = "friction"
-friction_coefficient = 0.3
-[[load]]
-kind = "point"
-body = "b"
-region_min = [0.45, 0.2]
-region_max = [0.5, 0.25]
-force = [0.0, -20.0]
-[solver]
-kind = "explicit"
-end_time = 0.1
-cfl = 0.3
-flip = 0.95
-damping = 0.05
-[output]
-frames = 0
-history_interval = 0.01
-"#;
+const BLOCK: Block = Block {
+    gravity: Some([0.0, -9.81]),
+    grid_max: [1.0, 0.5],
+    cells: [40, 20],
+    model: "neo_hookean",
+    density: 1000.0,
+    youngs_modulus: 1.0e5,
+    poisson_ratio: 0.3,
+    body_max: [0.5, 0.25],
+    body_keys: "name = \"b\"\nparticles_per_cell = 2\nvelocity = [0.2, -0.05]",
+    faces: &[
+        face("xmin", "roller"),
+        face_with("ymin", "friction", "friction_coefficient = 0.3"),
+    ],
+    tables: "[[load]]\nkind = \"point\"\nbody = \"b\"\nregion_min = [0.45, 0.2]\n\
+             region_max = [0.5, 0.25]\nforce = [0.0, -20.0]",
+    solver: "kind = \"explicit\"\nend_time = 0.1\ncfl = 0.3\nflip = 0.95\ndamping = 0.05",
+    output: "frames = 0\nhistory_interval = 0.01",
+    ..Block::DEFAULT
+};
 
 /// The particle columns compared, and the largest difference between two runs
 /// in each relative to the column's largest magnitude.
@@ -98,56 +77,89 @@ fn agree(scene: &str, overrides: &[&str], tol: f64) {
     );
     let (gather, path) = run(scene, "gather", overrides);
     assert_eq!(path, TransferPath::Gather);
-    for (column, d) in differences(&scatter, &gather) {
+    let d = differences(&scatter, &gather);
+    let worst = d.iter().map(|c| c.1).fold(0.0, f64::max);
+    let name = if scene.ends_with(".toml") {
+        scene
+    } else {
+        "block"
+    };
+    println!("{name} {overrides:?}: scatter and gather differ by {worst:.1e} at most");
+    for (column, d) in d {
         assert!(
             d <= tol,
-            "{overrides:?}: {column} differs by {d:.2e} (relative)"
+            "{overrides:?}: {column} differs by {d:.2e} (relative; tolerance {tol:.0e}, a round-off floor)"
         );
+    }
+}
+
+/// The families the scatter serves on `BLOCK`, whose rollers and friction face
+/// prescribe velocities: the others run on the node map
+/// (`the_node_map_runs_where_the_scatter_does_not_serve` checks it).
+fn served_on_block() -> Vec<ShapeFunction> {
+    shape_functions(&[
+        (ShapeFunction::Cpdi, "not separable: no box of nodes"),
+        (
+            ShapeFunction::Bspline3,
+            "the mirror at faces with prescribed velocity needs the node map",
+        ),
+        (
+            ShapeFunction::Cpbspline2,
+            "the mirror at faces with prescribed velocity needs the node map",
+        ),
+    ])
+}
+
+/// `agree` on `block` for every family the scatter serves there and every
+/// scheme, but USF with a family that reads F (its second scatter would see
+/// the updated F: the node map runs, below).
+fn agree_for_every_scheme_and_served_family(block: &str, skip: &[(ShapeFunction, Scheme)]) {
+    for shape in served_on_block() {
+        for scheme in Scheme::iter() {
+            if (scheme == Scheme::Usf && shape.reads_deformation())
+                || skip.contains(&(shape, scheme))
+            {
+                continue;
+            }
+            let shape = format!("grid.shape_function=\"{}\"", shape.name());
+            let scheme = format!("solver.scheme=\"{}\"", scheme.name());
+            agree(block, &[&shape, &scheme], 1e-11);
+        }
     }
 }
 
 #[test]
 fn scatter_and_gather_agree_for_every_scheme_and_separable_family() {
     // Elastic, 159 steps: the differences stay at round-off (measured at most
-    // 2e-13 of each column's largest value).
-    for shape in ["linear", "ugimp", "cpgimp", "bspline2"] {
-        for scheme in ["usl", "usf", "musl"] {
-            if scheme == "usf" && shape == "cpgimp" {
-                continue; // the node map runs (below)
-            }
-            if scheme == "usl" && shape == "linear" {
-                // Hats with USL lose this block at step 48 on both paths alike
-                // (an inverted particle at the loaded corner, where a node
-                // holds a sliver of mass: the cell-crossing failure of USL).
-                continue;
-            }
-            let shape = format!("grid.shape_function=\"{shape}\"");
-            let scheme = format!("solver.scheme=\"{scheme}\"");
-            agree(BLOCK, &[&shape, &scheme], 1e-11);
-        }
-    }
+    // 2e-13 of each column's largest value). Hats with USL lose this block at
+    // step 48 on both paths alike (an inverted particle at the loaded corner,
+    // where a node holds a sliver of mass: the cell-crossing failure of USL).
+    agree_for_every_scheme_and_served_family(
+        &BLOCK.toml(),
+        &[(ShapeFunction::Linear, Scheme::Usl)],
+    );
 }
 
 #[test]
 fn scatter_and_gather_agree_with_apic() {
     // APIC's affine moments on the box (per-axis inertia) and on the node map
     // (the whole D_p): the block without its FLIP fraction, every scheme.
-    let block = BLOCK.replace("flip = 0.95\n", "velocity_transfer = \"apic\"\n");
-    for shape in ["ugimp", "bspline2"] {
-        for scheme in ["usl", "usf", "musl"] {
-            let shape = format!("grid.shape_function=\"{shape}\"");
-            let scheme = format!("solver.scheme=\"{scheme}\"");
-            agree(&block, &[&shape, &scheme], 1e-11);
-        }
-    }
+    // Hats lose this block with APIC and every scheme, on both paths alike (a
+    // particle inverts at step 113 with USF, 50 with USL, 173 with MUSL; with
+    // FLIP only USL loses it): a finding, not yet explained.
+    let block = BLOCK
+        .toml()
+        .replace("flip = 0.95\n", "velocity_transfer = \"apic\"\n");
+    let hats = Scheme::iter().map(|s| (ShapeFunction::Linear, s));
+    agree_for_every_scheme_and_served_family(&block, &hats.collect::<Vec<_>>());
 }
 
 #[test]
 fn scatter_and_gather_agree_for_a_collapsing_frictional_column() {
     // Mohr–Coulomb with history, the rough base of the collapse scene, 0.025 s
     // (measured: at most 9e-13 of each column's largest value at 0.05 s).
-    for scheme in ["usl", "musl"] {
-        let scheme = format!("solver.scheme=\"{scheme}\"");
+    for scheme in Scheme::iter() {
+        let scheme = format!("solver.scheme=\"{}\"", scheme.name());
         agree(
             "collapse.toml",
             &["solver.end_time=0.025", "output.frames=0", &scheme],
@@ -160,10 +172,23 @@ fn scatter_and_gather_agree_for_a_collapsing_frictional_column() {
 fn the_node_map_runs_where_the_scatter_does_not_serve() {
     for set in [
         ["grid.shape_function=\"cpgimp\"", "solver.scheme=\"usf\""],
+        [
+            "grid.shape_function=\"cpbspline2\"",
+            "solver.scheme=\"usf\"",
+        ],
         ["grid.shape_function=\"cpdi\"", "solver.scheme=\"usl\""],
+        ["grid.shape_function=\"bspline3\"", "solver.scheme=\"usl\""],
+        [
+            "grid.shape_function=\"cpbspline2\"",
+            "solver.scheme=\"musl\"",
+        ],
         ["solver.fbar=true", "solver.scheme=\"usl\""],
     ] {
-        let (_, path) = run(BLOCK, "auto", &[set[0], set[1], "solver.end_time=0.01"]);
+        let (_, path) = run(
+            &BLOCK.toml(),
+            "auto",
+            &[set[0], set[1], "solver.end_time=0.01"],
+        );
         assert_eq!(path, TransferPath::Gather, "{set:?}");
     }
 }

@@ -7,10 +7,12 @@
 //! W = A p0² T · 3/8 / (ρ c) of a pulse entering a semi-infinite rod. At the end
 //! time the tail of the pulse has passed the base and a reflection would have
 //! travelled half way back up, so the kinetic + strain energy left in the column
-//! is the reflected energy. The ratio E_left / W is ≤ 5 % with dashpots and close
-//! to 1 with a fixed base.
+//! is the reflected energy. The ratio E_left / W is ≤ 5 % with dashpots (the
+//! reference item's bound; measured 0.3 % to 0.7 %, asserted at 2–3 times
+//! that) and
+//! close to 1 with a fixed base.
 
-use crate::common::{problem, run_problem, run_text, Table};
+use crate::common::{assert_within, problem, run_problem, run_text, Table};
 use mpm::dim::Vector;
 use mpm::model::Model;
 use mpm::run::{kinetic_energy, strain_energy};
@@ -47,7 +49,11 @@ const RHO: f64 = 2000.0;
 const C_D: f64 = 173.205_080_756_887_7; // √(60 MPa / 2000)
 const C_S: f64 = 100.0; // √(20 MPa / 2000)
 
-fn check_column(scene: &str, c: f64, duration: f64, solver: &[&str]) {
+/// The incident work within 3 % of the closed form (measured 0.9 % at most),
+/// the reflected energy with dashpots below `reflected` (the reference item
+/// asks 5 %),
+/// and a fixed base keeping 95 %.
+fn check_column(scene: &str, c: f64, duration: f64, solver: &[&str], reflected: f64) {
     let w_exact = pulse_work(1000.0, duration, 0.25, RHO * c);
     let (w, absorbed) = reflection(scene, "absorbing", solver);
     let (w_fixed, fixed) = reflection(scene, "fixed", solver);
@@ -58,38 +64,48 @@ fn check_column(scene: &str, c: f64, duration: f64, solver: &[&str]) {
         (w / w_exact - 1.0).abs() < 0.03 && (w_fixed / w_exact - 1.0).abs() < 0.03,
         "{scene}: incident work {w:.4e} / {w_fixed:.4e}, closed form {w_exact:.4e}"
     );
-    assert!(absorbed <= 0.05, "{scene}: dashpots reflect {absorbed:.4}");
+    assert_within(
+        &format!("{scene} {solver:?}: reflected with dashpots"),
+        absorbed,
+        reflected,
+    );
     assert!(fixed >= 0.95, "{scene}: fixed base keeps only {fixed:.4}");
 }
 
 #[test]
 fn p_pulse_is_absorbed_explicit() {
-    check_column("wave_p.toml", C_D, 0.025, &[]);
+    // Measured 3.0e-3.
+    check_column("wave_p.toml", C_D, 0.025, &[], 1e-2);
 }
 
 #[test]
 fn s_pulse_is_absorbed_explicit() {
-    check_column("wave_s.toml", C_S, 0.04, &[]);
+    // Measured 5.2e-3.
+    check_column("wave_s.toml", C_S, 0.04, &[], 1.5e-2);
 }
 
 /// Trapezoidal Newmark at twice the explicit step (Δt = 0.56 h / c_d).
 #[test]
 fn p_pulse_is_absorbed_implicit() {
+    // Measured 6.3e-3.
     check_column(
         "wave_p.toml",
         C_D,
         0.025,
         &["solver.kind=implicit", "solver.dt=0.0008"],
+        1.5e-2,
     );
 }
 
 #[test]
 fn s_pulse_is_absorbed_implicit() {
+    // Measured 7.3e-3.
     check_column(
         "wave_s.toml",
         C_S,
         0.04,
         &["solver.kind=implicit", "solver.dt=0.0014"],
+        2e-2,
     );
 }
 
@@ -126,7 +142,9 @@ fn p_pulse_is_absorbed_in_3d() {
         "3D P column: reflected / incident: dashpots {:.4}, fixed {:.4}",
         ratio[0], ratio[1]
     );
-    assert!(ratio[0] <= 0.05 && ratio[1] >= 0.95, "{ratio:?}");
+    // Measured 3.0e-3 with dashpots.
+    assert_within("3D P column: reflected with dashpots", ratio[0], 1e-2);
+    assert!(ratio[1] >= 0.95, "fixed base keeps only {:.4}", ratio[1]);
 }
 
 /// Run an explicit scene step by step, recording the velocity of the particles
@@ -260,15 +278,19 @@ fn half_space_line_load_radiates_through_the_boundaries() {
             contrast = contrast.min(err_fix / err_abs);
         }
     }
-    assert!(worst < 0.15, "dashpots off by {worst:.4} (relative L2)");
-    assert!(
-        worst_peak < 0.12,
-        "dashpots off by {worst_peak:.4} of the peak"
+    // Measured 0.143 and 0.102: the dashpots' own error at oblique incidence.
+    assert_within("dashpots against the 25 m grid, relative L2", worst, 0.3);
+    assert_within(
+        "dashpots against the 25 m grid, of the peak",
+        worst_peak,
+        0.25,
     );
     assert!(contrast > 5.0, "fixed faces only {contrast:.2} × worse");
-    assert!(
-        (w_abs / w_ref - 1.0).abs() < 0.01,
-        "the load's work depends on the grid size"
+    // Measured −4.3e-15: round-off, with a floor.
+    assert_within(
+        "the load's work, 10 m against 25 m grid",
+        w_abs / w_ref - 1.0,
+        1e-12,
     );
     assert!(
         e_abs / w_abs < 0.05,
@@ -318,9 +340,10 @@ fn centre(dir: &std::path::Path) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
 /// the solver changes, the stencils at the settled positions shift the discrete
 /// equilibrium slightly: the column adjusts by less than 1e-4 of the settlement
 /// within a few transits, and then it does not drift: over the last 0.5 s
-/// (27 P-wave transits) the centre of mass moves by less than 1e-6 of the
-/// settlement, and its velocity stays below 1e-6 m/s (a residual ringing: at that
-/// speed for 0.5 s it would move by less than 1e-4 of the settlement).
+/// (27 P-wave transits) the centre of mass moves by less than 3e-9 of the
+/// settlement, and its velocity stays below 3e-7 m/s explicit, 1e-9 m/s Newmark
+/// (a residual ringing: at that speed for 0.5 s it would move by less than 3e-5
+/// of the settlement).
 #[test]
 fn gravity_on_spring_dashpot_base_keeps_static_equilibrium() {
     let expected = static_settlement();
@@ -347,17 +370,25 @@ fn gravity_on_spring_dashpot_base_keeps_static_equilibrium() {
             "settlement {settled:.6e} vs {expected:.6e}"
         );
         assert!(adjustment < 1e-4 * settled, "adjustment {adjustment:.3e} m");
-        assert!(drift < 1e-6 * settled, "drift {drift:.3e} m");
-        assert!(v_late < 1e-6, "velocity {v_late:.3e} m/s");
+        // Measured 1.1e-9 of the settlement; 1.1e-7 m/s explicit, 2.2e-10
+        // Newmark (a floor of 1e-9 m/s).
+        assert_within(
+            "drift over the last 0.5 s / settlement",
+            drift / settled,
+            3e-9,
+        );
+        let v_bound = if dynamics.is_empty() { 3e-7 } else { 1e-9 };
+        assert_within("largest |v| over the last 0.5 s (m/s)", v_late, v_bound);
     }
 }
 
 /// Gravity switched on at once over the spring–dashpot base (explicit): the
 /// column rings, radiates through the dashpots and settles at the static
-/// settlement (within 0.5 %, residual velocity < 1e-6 m/s after 1 s). Without
+/// settlement (within 0.5 %, residual velocity < 3e-8 m/s after 1 s). Without
 /// the springs the base cannot hold a static load: the column sinks at the
 /// velocity where the dashpot carries the weight, ρ c_d v = ρ g H, i.e.
-/// v = gH/c_d (within 2 %), which also checks the dashpot's coefficient.
+/// v = gH/c_d (within 5e-4; measured 1.7e-4), which also checks the dashpot's
+/// coefficient.
 #[test]
 fn sudden_gravity_settles_on_springs_and_creeps_on_dashpots_alone() {
     let (_, g, height, _, _, c_d, _) = ROCK;
@@ -376,7 +407,8 @@ fn sudden_gravity_settles_on_springs_and_creeps_on_dashpots_alone() {
         (settled / static_settlement() - 1.0).abs() < 0.005,
         "{settled:.6e}"
     );
-    assert!(v_end < 1e-6, "still moving at {v_end:.3e} m/s");
+    // Measured 1.1e-8 m/s.
+    assert_within("|v| at 1 s (m/s)", v_end, 3e-8);
 
     let dashpots_only = single.replace("spring_distance = 5.0\n", "");
     let (result, dir) = run_text(&dashpots_only, &["stage.0.end_time=0.1"]);
@@ -391,9 +423,11 @@ fn sudden_gravity_settles_on_springs_and_creeps_on_dashpots_alone() {
         "dashpots only: sinks at {creep:.4} m/s, gH/c_d = {:.4} m/s",
         g * height / c_d
     );
-    assert!(
-        (creep / (g * height / c_d) - 1.0).abs() < 0.02,
-        "creep {creep:.4}"
+    // Measured +1.7e-4.
+    assert_within(
+        "creep / (g H / c_d) − 1",
+        creep / (g * height / c_d) - 1.0,
+        5e-4,
     );
 }
 

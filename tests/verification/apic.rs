@@ -3,9 +3,10 @@
 //! momentum (x × m v plus the skew part of m B_p: Jiang et al. 2017) to
 //! round-off on both transfer paths, where FLIP and PIC do not.
 
+use crate::common::shape_functions;
 use mpm::dim::Vector;
 use mpm::model::Model;
-use mpm::scene::Scene;
+use mpm::scene::{Scene, ShapeFunction};
 use mpm::solver::stepper;
 
 /// A free elastic disk (R = 0.5 m, 10 cells across its radius) spinning at
@@ -86,18 +87,22 @@ fn spin(overrides: &[&str], steps: usize) -> (f64, f64, f64) {
 
 #[test]
 fn apic_keeps_a_spinning_disks_angular_momentum_to_round_off() {
-    for (transfer, shape, scheme) in [
-        ("auto", "bspline2", "usl"),
+    // Every family on the default path with USL (CPDI's is the node map), then
+    // the node map and the other schemes on a few.
+    let hats = "standard MPM loses the spinning disk: a particle inverts at step 52 \
+                (and with FLIP too: `mpm run` inverts one at step 194)";
+    let every_family = shape_functions(&[(ShapeFunction::Linear, hats)])
+        .into_iter()
+        .map(|s| ("auto", s.name(), "usl"));
+    let paths_and_schemes = [
         ("gather", "bspline2", "usl"),
         ("auto", "bspline2", "musl"),
         ("gather", "bspline2", "musl"),
         ("auto", "bspline2", "usf"),
-        ("auto", "ugimp", "usl"),
         ("gather", "ugimp", "usl"),
         ("auto", "cpgimp", "musl"),
-        ("auto", "bspline3", "usl"),
-        ("gather", "cpdi", "usl"),
-    ] {
+    ];
+    for (transfer, shape, scheme) in every_family.chain(paths_and_schemes) {
         let set_transfer = format!("solver.transfer=\"{transfer}\"");
         let set_shape = format!("grid.shape_function=\"{shape}\"");
         let set_scheme = format!("solver.scheme=\"{scheme}\"");

@@ -8,7 +8,7 @@
 //! against the runout laws at a = 1 and 2 on cells of d0/20
 //! (papers/granular_collapse, where a = 0.5 and 4 are the checks). CI runs the
 //! coarse grid (cells of d0/10) at a = 0.5 and a = 2: the squat column keeps its
-//! height within 10 %, the a = 2 runout is within 10 % of the law (measured
+//! height within 1 % (measured −0.2 %), the a = 2 runout is within 10 % of the law (measured
 //! −6.4 %; −1.3 % on the finer grid). With the former μ = tan φ = 0.36 it was
 //! −18.5 %, so the runout check can fail.
 //!
@@ -17,7 +17,7 @@
 //! shifted by the half particle spacing, so that the initial column measures
 //! d0 × h0); "final" is kinetic energy below 1 % of its peak.
 
-use crate::common::{run_problem, Table};
+use crate::common::{assert_within, run_problem, Table};
 use mpm::run::summary::Status;
 
 const D0: f64 = 0.2;
@@ -76,11 +76,8 @@ fn squat_column_keeps_its_height() {
         heap.height_ratio, heap.runout, heap.ke_ratio
     );
     assert!(heap.ke_ratio < 0.01, "not at rest: {}", heap.ke_ratio);
-    assert!(
-        (heap.height_ratio - 1.0).abs() < 0.1,
-        "h/h0 = {}",
-        heap.height_ratio
-    );
+    // Measured 0.998 (the law: 1).
+    assert_within("a = 0.5: h/h0 − 1", heap.height_ratio - 1.0, 1e-2);
     assert!(heap.runout > 0.0 && heap.runout < 3.25 * 0.65f64.powf(0.96));
 }
 

@@ -14,9 +14,12 @@
 //!   within the explicit method's own energy error of the initial energy.
 
 use crate::common::{
-    newton_order, problem, read_output, run_cli, run_problem, run_text, step_residuals, Table,
+    assert_within, newton_order, problem, read_output, run_cli, run_problem, run_text,
+    shape_functions, step_residuals, Table,
 };
 use mpm::run::summary::Status;
+use mpm::scene::ShapeFunction;
+use strum::IntoEnumIterator;
 
 const G: f64 = 9.81;
 
@@ -61,13 +64,13 @@ fn closed_form(theta_deg: f64, mu: f64, t: f64) -> f64 {
 
 #[test]
 fn block_slides_on_an_elastic_incline_as_the_closed_form() {
-    // Measured: +0.04 %, +0.13 %, +0.64 % (cpGIMP, 20 cells over the block).
-    for mu in [0.0, 0.3, 0.5] {
+    // Measured: +0.038 %, +0.128 %, +0.644 % (cpGIMP, 20 cells over the block);
+    // the issue's 1 % at μ = 0.5, where it is tighter than twice that.
+    for (mu, tolerance) in [(0.0, 1e-3), (0.3, 3e-3), (0.5, 1e-2)] {
         let (t, x, _) = slide(45.0, mu, &[]);
         let exact = closed_form(45.0, mu, t);
-        let err = (x / exact - 1.0).abs();
-        println!("mu {mu}: x = {x:.5} m, closed form {exact:.5} m, error {err:.2e}");
-        assert!(err < 0.01, "mu {mu}: x = {x}, exact {exact}");
+        println!("mu {mu}: x = {x:.5} m, closed form {exact:.5} m");
+        assert_within(&format!("mu {mu}: error"), x / exact - 1.0, tolerance);
     }
 }
 
@@ -95,11 +98,13 @@ fn contact_force_carries_the_block() {
         "mean force on the base: ({fx:.1}, {fy:.1}) N/m; m g cos θ = {weight:.1}, μ m g cos θ = {:.1}",
         0.3 * weight
     );
-    assert!(
-        (-fy / weight - 1.0).abs() < 0.05,
-        "normal {fy}, weight {weight}"
+    // Measured −0.14 % and −0.13 %.
+    assert_within("normal force / (m g cos θ) − 1", -fy / weight - 1.0, 4e-3);
+    assert_within(
+        "friction force / (μ m g cos θ) − 1",
+        fx / (0.3 * weight) - 1.0,
+        4e-3,
     );
-    assert!((fx / (0.3 * weight) - 1.0).abs() < 0.05, "friction {fx}");
 }
 
 #[test]
@@ -189,12 +194,12 @@ fn block_slides_and_sticks_near_the_limit_with_pic_and_gravity_raised() {
         "solver.gravity_ramp_time=0.3",
         "solver.end_time=1.0",
     ];
-    for mu in [0.7, 0.8] {
+    // Measured −0.017 % and +0.69 % (the issue's 1 % at μ = 0.8).
+    for (mu, tolerance) in [(0.7, 5e-4), (0.8, 1e-2)] {
         let (t, x, _) = slide(45.0, mu, &pic);
         let exact = closed_form_ramped(45.0, mu, t, 0.3);
-        let err = (x / exact - 1.0).abs();
-        println!("PIC, mu {mu}: x = {x:.5} m, closed form {exact:.5} m, error {err:.2e}");
-        assert!(err < 0.01, "mu {mu}: x = {x}, exact {exact}");
+        println!("PIC, mu {mu}: x = {x:.5} m, closed form {exact:.5} m");
+        assert_within(&format!("PIC, mu {mu}: error"), x / exact - 1.0, tolerance);
     }
     let (_, stuck, _) = slide(45.0, 1.2, &pic);
     println!("PIC, mu 1.2: x = {stuck:.2e} m");
@@ -443,12 +448,15 @@ fn roll(mu: f64, extra: &[&str]) -> (f64, f64) {
 
 #[test]
 fn slipping_cylinder_follows_the_closed_form() {
-    // Measured: +0.009 % (μ = 0), +0.06 % (μ = 0.1).
-    for mu in [0.0, 0.1] {
+    // Measured: −0.052 % (μ = 0), +0.084 % (μ = 0.1).
+    for (mu, tolerance) in [(0.0, 1.5e-3), (0.1, 2e-3)] {
         let (x, exact) = roll(mu, &[]);
-        let err = (x / exact - 1.0).abs();
-        println!("cylinder, mu {mu}: x = {x:.4} m, closed form {exact:.4} m, error {err:.2e}");
-        assert!(err < 0.01, "mu {mu}: x = {x}, exact {exact}");
+        println!("cylinder, mu {mu}: x = {x:.4} m, closed form {exact:.4} m");
+        assert_within(
+            &format!("cylinder, mu {mu}: error"),
+            x / exact - 1.0,
+            tolerance,
+        );
     }
 }
 
@@ -472,7 +480,8 @@ fn rolling_cylinder_converges_at_first_order() {
     let (polar, _) = roll(0.5, &["body.1.fill=\"polar\""]);
     let e3 = (polar / exact - 1.0).abs();
     println!("rolling cylinder, polar fill: error {e3:.3} (h = R/10)");
-    assert!(e3 < 0.14 && e3 < e1, "polar fill: {e3}");
+    assert!(e3 < e1, "polar fill: {e3} against {e1}");
+    assert_within("rolling cylinder, polar fill: error at R/10", e3, 0.24);
 }
 
 /// The cylinder of `problems/contact_cylinder.toml` as shipped (filled in rings,
@@ -684,9 +693,11 @@ fn rigid_plate_compresses_a_block_to_the_hencky_stress() {
         "mean syy {mean}, exact {exact}"
     );
     assert!(worst < 0.05, "the plate's force is {worst} off sigma A");
-    assert!(
-        (work / energy - 1.0).abs() < 2e-3,
-        "work {work}, energy {energy}"
+    // Measured 1.6e-4.
+    assert_within(
+        "plate work / (kinetic + strain) − 1",
+        work / energy - 1.0,
+        5e-4,
     );
     assert!(
         plate_moved < 1e-12,
@@ -769,16 +780,13 @@ fn contact_csv_holds_the_momentum_the_contact_passed() {
 fn adhesion_holds_the_block_in_shear() {
     // Frictionless with adhesion c on the 1 m long interface: the block slides with
     // a = g sin θ − c L / m (m = 500 kg/m) while c L < m g sin θ = 3468 N/m, and
-    // sticks above. Measured: −2.5 % at c = 2 kPa; 1.1 mm at c = 5 kPa.
+    // sticks above. Measured: +4.2 % at c = 2 kPa; 1.2 mm at c = 5 kPa.
     let (t, x, _) = slide(45.0, 0.0, &["contact.0.adhesion=2000"]);
     let a = G * 45f64.to_radians().sin() - 2000.0 / 500.0;
     let exact = 0.5 * a * t * t;
     let (_, stuck, _) = slide(45.0, 0.0, &["contact.0.adhesion=5000"]);
     println!("adhesion 2 kPa: x = {x:.4} m, closed form {exact:.4} m; 5 kPa: {stuck:.2e} m");
-    assert!(
-        (x / exact - 1.0).abs() < 0.05,
-        "x = {x}, closed form {exact}"
-    );
+    assert_within("adhesion 2 kPa: error", x / exact - 1.0, 0.1);
     assert!(stuck.abs() < 5e-3, "the adhesive block slid {stuck} m");
 }
 
@@ -844,8 +852,8 @@ history_interval = 0.01
 
 #[test]
 fn block_slides_on_an_elastic_incline_in_3d() {
-    // The same closed form as in 2D. Measured: +0.08 % (μ = 0), −0.11 % (μ = 0.3).
-    for mu in [0.0, 0.3] {
+    // The same closed form as in 2D. Measured: +0.082 % (μ = 0), −0.107 % (μ = 0.3).
+    for (mu, tolerance) in [(0.0, 2e-3), (0.3, 3e-3)] {
         let (result, dir) = run_text(
             INCLINE_3D,
             &[&format!("contact.0.friction_coefficient={mu}")],
@@ -855,9 +863,8 @@ fn block_slides_on_an_elastic_incline_in_3d() {
         let (t, x) = (h.col("t"), h.col("body1_x"));
         let (t, x) = (*t.last().unwrap(), x.last().unwrap() - x[0]);
         let exact = closed_form(45.0, mu, t);
-        let err = (x / exact - 1.0).abs();
-        println!("3D, mu {mu}: x = {x:.5} m, closed form {exact:.5} m, error {err:.2e}");
-        assert!(err < 0.01, "mu {mu}: x = {x}, exact {exact}");
+        println!("3D, mu {mu}: x = {x:.5} m, closed form {exact:.5} m");
+        assert_within(&format!("3D, mu {mu}: error"), x / exact - 1.0, tolerance);
     }
 }
 
@@ -889,7 +896,8 @@ fn rigid_plate_compresses_a_cylinder_in_axisymmetric_mode() {
         (mean / exact - 1.0).abs() < 0.01,
         "mean σ_zz {mean} vs {exact}"
     );
-    assert!(radial.abs() < 0.01 * exact.abs(), "mean σ_rr {radial}");
+    // Measured 2.5e-4 of σ_zz.
+    assert_within("mean σ_rr / |σ_zz|", radial / exact.abs(), 7.5e-4);
 }
 
 #[test]
@@ -1014,8 +1022,8 @@ fn free_rigid_body_spins_as_a_rigid_body() {
 #[test]
 fn rigid_cylinder_rolls_and_slips_as_the_closed_form_up_to_its_stepped_bottom() {
     // The lattice cylinder (LATTICE_CYLINDER) made a free rigid body (it now
-    // turns: Newton–Euler, physics::rigid::newton_euler). Slipping within 1.5 % (measured
-    // −1.3 % at μ = 0, −0.19 % at μ = 0.1); rolling lags like the elastic disk,
+    // turns: Newton–Euler, physics::rigid::newton_euler). Slipping: measured
+    // −1.34 % at μ = 0, −0.19 % at μ = 0.1; rolling lags like the elastic disk,
     // from the same stepped lattice bottom, at first order: −25.0 %, −11.7 %.
     let text = problem_with(
         "contact_cylinder.toml",
@@ -1034,18 +1042,23 @@ fn rigid_cylinder_rolls_and_slips_as_the_closed_form_up_to_its_stepped_bottom() 
         let (t, x) = (h.col("t"), h.col("body1_x"));
         (x.last().unwrap() - x[0], *t.last().unwrap())
     };
-    for mu in [0.0, 0.1] {
+    for (mu, tolerance) in [(0.0, 3e-2), (0.1, 5e-3)] {
         let (x, t) = run(mu, "[60, 28]");
         let exact = 0.5 * G * (th.sin() - mu * th.cos()) * t * t;
         println!("rigid cylinder, mu {mu}: x = {x:.4} m, closed form {exact:.4} m");
-        assert!((x / exact - 1.0).abs() < 0.015, "mu {mu}: {x} vs {exact}");
+        assert_within(
+            &format!("rigid cylinder, mu {mu}: error"),
+            x / exact - 1.0,
+            tolerance,
+        );
     }
     let (coarse, t) = run(0.5, "[60, 28]");
     let (fine, _) = run(0.5, "[120, 56]");
     let exact = 0.5 * 2.0 / 3.0 * G * th.sin() * t * t;
     let (e1, e2) = ((coarse / exact - 1.0).abs(), (fine / exact - 1.0).abs());
     println!("rigid rolling cylinder: error {e1:.3} (h = R/10), {e2:.3} (R/20)");
-    assert!(e2 < 0.13 && (e1 / e2).log2() > 0.8, "errors {e1}, {e2}");
+    assert_within("rigid rolling cylinder: error at R/20", e2, 0.25);
+    assert!((e1 / e2).log2() > 0.8, "errors {e1}, {e2}");
 }
 
 /// problems/rigid_disk_impact.toml with or without the rigid projection.
@@ -1210,7 +1223,9 @@ fn implicit_contact_takes_the_same_path_through_krylov_and_any_thread_count() {
     let (a, b) = (force(&direct), force(&krylov));
     let worst = (a.iter().zip(&b)).fold(0.0f64, |w, (x, y)| w.max((x / y - 1.0).abs()));
     println!("GMRES against direct: forces within {worst:.2e}");
-    assert!(a.len() >= 10 && worst < 1e-7, "{} rows, {worst}", a.len());
+    // Measured 2.5e-11 (GMRES to 1e-10).
+    assert!(a.len() >= 10, "{} rows", a.len());
+    assert_within("GMRES against direct: forces", worst, 1e-10);
 }
 
 /// q/c_u of `problems/contact_footing_implicit.toml` (contact force over B/2 =
@@ -1253,8 +1268,10 @@ fn implicit_contact_footing_converges_to_prandtl_at_first_order() {
         100.0 * e2,
         e1 / e2
     );
-    assert!(e1 > 0.0 && e1 < 0.09 && e2 > 0.0 && e2 < 0.05, "{e1} {e2}");
-    assert!(e1 / e2 > 1.7, "first order: ratio {}", e1 / e2);
+    assert!(e1 > 0.0 && e2 > 0.0, "{e1} {e2}: from above");
+    assert_within("q/c_u error at h = 0.25 m", e1, 0.16);
+    assert_within("q/c_u error at h = 0.125 m", e2, 0.09);
+    assert!(e1 / e2 > 1.6, "first order: ratio {}", e1 / e2);
     assert!(p1.abs() < 5e-3 && p2.abs() < 5e-3, "plateau {p1} {p2}");
     // Newton's cost: 442 and 576 rows with the contact points carried from step
     // to step; 750 and 1,662 (66 cut-backs at h = 0.125 m) when they were set
@@ -1270,10 +1287,8 @@ fn implicit_contact_footing_converges_to_prandtl_at_first_order() {
         "rough: q/c_u {q:.4} ({:+.2} %), plateau change {p:.1e}, Newton rows {n}",
         100.0 * e
     );
-    assert!(
-        e > e1 && e < 0.11 && p.abs() < 5e-3,
-        "rough {e}, plateau {p}"
-    );
+    assert!(e > e1 && p.abs() < 5e-3, "rough {e}, plateau {p}");
+    assert_within("rough: q/c_u error at h = 0.25 m", e, 0.19);
 }
 
 #[test]
@@ -1473,15 +1488,38 @@ fn staged_block_is_loaded_implicitly_and_handed_to_an_explicit_stage() {
     // contact points too: KE/SE 7.6e-10 and 1.3e-9, σ_yy −1.1e-4 and −5.8e-4
     // (rigid, elastic base); at the particle centres the rigid base's KE/SE
     // was 1.6e-2 and σ_yy +5.9e-3.
-    for shape in ["cpgimp", "linear"] {
+    //
+    // Every family the explicit contact takes (measured, rigid and elastic
+    // base): uGIMP KE/SE 2.1e-5 and 3.8e-3, CPDI 3.9e-6 and 8.6e-3 (the
+    // elastic base rings more with them than with cpGIMP: a finding, not yet
+    // explained), σ_yy within 2.0e-4. The contact force is the weight to the
+    // Newton tolerance's floor (1e-9 of the weight; measured 1.1e-10 at most).
+    let splines = "the explicit stage's contact refuses B-splines (supports of 3–4 cells)";
+    let families = shape_functions(&[
+        (ShapeFunction::Bspline2, splines),
+        (ShapeFunction::Bspline3, splines),
+        (ShapeFunction::Cpbspline2, splines),
+    ]);
+    for family in families {
+        let shape = family.name();
+        // KE/SE: 2–3 times the larger of the two bases' measured values.
+        let quiet = match family {
+            ShapeFunction::Linear => 4e-9,
+            ShapeFunction::Ugimp => 1e-2,
+            ShapeFunction::Cpgimp => 6e-4,
+            ShapeFunction::Cpdi => 2e-2,
+            _ => unreachable!("left out above"),
+        };
         for (base, name) in [("steel", "rigid"), ("elastic", "elastic")] {
             let (rows, force, ke, stress) = staged_block(base, shape);
             println!(
                 "{shape}, {name} base: {rows} Newton rows, contact force {force:.1e} off, \
                  KE/SE {ke:.2e}, σ_yy {stress:+.2e}"
             );
-            let quiet = if shape == "linear" { 1e-6 } else { 1e-3 };
-            assert!(rows <= 40 && force < 1e-7 && ke < quiet && stress.abs() < 1e-3);
+            assert!(rows <= 40, "{shape}, {name} base: {rows} Newton rows");
+            assert_within(&format!("{shape}, {name} base: contact force"), force, 1e-9);
+            assert_within(&format!("{shape}, {name} base: KE/SE"), ke, quiet);
+            assert_within(&format!("{shape}, {name} base: σ_yy"), stress, 1e-3);
         }
     }
 }
@@ -1753,8 +1791,8 @@ fn implicit_slide(mu: f64, extra: &[&str]) -> (f64, f64, tempfile::TempDir) {
 fn implicit_block_slides_on_a_deformable_incline_as_the_closed_form() {
     // Gravity raised linearly over T = 0.04 s (about one period of the block's
     // bounce on the base) and the rigid block's law for it, x = A (T²/6 +
-    // T (t − T)/2 + (t − T)²/2), A = g (sin θ − μ cos θ). Measured: −0.03 %,
-    // −0.04 %, +0.24 % at t = 0.5 s (Newmark, Δt = 5 ms, cpGIMP, 20 cells
+    // T (t − T)/2 + (t − T)²/2), A = g (sin θ − μ cos θ). Measured: −0.032 %,
+    // −0.044 %, +0.238 % at t = 0.5 s (Newmark, Δt = 5 ms, cpGIMP, 20 cells
     // over the block), 699, 660 and 767 rows of newton.csv. With gravity in
     // full from the first step the elastic block bounces: the normal force
     // swings between 0 and 2.6 times the weight's normal part (a suddenly
@@ -1765,18 +1803,16 @@ fn implicit_block_slides_on_a_deformable_incline_as_the_closed_form() {
     // with the base: it would not move.
     let ramp = 0.04;
     let ramp_key = format!("solver.gravity_ramp_time={ramp}");
-    for (mu, rows) in [(0.0, 750), (0.3, 800), (0.5, 1100)] {
+    for (mu, rows, tolerance) in [(0.0, 750, 1e-3), (0.3, 800, 1.2e-3), (0.5, 1100, 6e-3)] {
         let (t, x, dir) = implicit_slide(mu, &[&ramp_key]);
         let a = closed_form(45.0, mu, 1.0) * 2.0;
         let exact = a * (ramp * ramp / 6.0 + ramp * (t - ramp) / 2.0 + (t - ramp).powi(2) / 2.0);
-        let err = (x / exact - 1.0).abs();
         let newton = Table::read(&dir.path().join("newton.csv")).unwrap();
         let iterations = newton.col("iteration").len();
         println!(
-            "mu {mu}: x = {x:.5} m, closed form {exact:.5} m, error {err:.2e}, \
-             {iterations} rows of newton.csv"
+            "mu {mu}: x = {x:.5} m, closed form {exact:.5} m, {iterations} rows of newton.csv"
         );
-        assert!(err < 0.01, "mu {mu}: x = {x}, exact {exact}");
+        assert_within(&format!("mu {mu}: error"), x / exact - 1.0, tolerance);
         assert!(iterations < rows, "mu {mu}: {iterations} Newton rows");
     }
 }
@@ -1902,14 +1938,21 @@ fn implicit_contact_carries_a_deformable_block_resting_on_another_as_if_glued() 
     // 20 kN/m, to 3e-14 at every step; the penetration 1.5e-6 m = σ h / (α M).
     // σ_yy against the glued pair, relative to the exact ρ g (2 − y): linear
     // 4.5e-5 and quadratic B-splines 5.6e-5 (force at the meeting's nodes);
-    // cpGIMP 1.8e-3 and CPDI 1.3e-3 (force at the surfaces' points: at the
-    // nodes it was 1.7 %, docs/contact.md).
-    for (shape, tolerance) in [
-        ("linear", 1e-4),
-        ("bspline2", 1e-4),
-        ("cpgimp", 3e-3),
-        ("cpdi", 3e-3),
-    ] {
+    // uGIMP 1.5e-3, cpGIMP 1.8e-3 and CPDI 1.3e-3 (force at the surfaces'
+    // points: at the nodes it was 1.7 %, docs/contact.md); quadratic B-splines
+    // averaged over the domains 7.7e-3, with a penetration of 1.9e-6 m against
+    // 1.5e-6 m for the others (a finding, not yet explained).
+    for family in ShapeFunction::iter() {
+        let tolerance = match family {
+            ShapeFunction::Linear | ShapeFunction::Bspline2 => 1e-4,
+            ShapeFunction::Ugimp | ShapeFunction::Cpgimp | ShapeFunction::Cpdi => 3e-3,
+            ShapeFunction::Cpbspline2 => 2e-2,
+            // Left out: the scene check refuses implicit contact between bodies
+            // with cubic B-splines ("two blocks resting on each other came out
+            // wrong beside the interface").
+            ShapeFunction::Bspline3 => continue,
+        };
+        let shape = family.name();
         let shape_set = format!("grid.shape_function={shape}");
         let glued_text = STACKED.replace(
             "[[contact]]\nbodies = [\"base\", \"top\"]\nfriction_coefficient = 0.3\n",
@@ -1948,9 +1991,10 @@ fn implicit_contact_carries_a_deformable_block_resting_on_another_as_if_glued() 
                 "{} rows, force off by {force}",
                 t.len()
             );
-            assert!(
-                stress < tolerance,
-                "{shape}: σ_yy off the glued pair by {stress}"
+            assert_within(
+                &format!("{shape} mu {mu}: σ_yy off the glued pair"),
+                stress,
+                tolerance,
             );
             assert!(depth > 0.0 && depth < 1e-5, "penetration {depth}");
         }
@@ -2023,8 +2067,8 @@ fn implicit_contact_of_deformable_bodies_does_not_depend_on_the_number_of_thread
 fn implicit_contact_of_deformable_and_rigid_bodies_together_balances() {
     // The stacked blocks with a rigid plate pressed onto the top one (1 cm/s):
     // both kinds of implicit contact in one system. At every step the base
-    // carries the top block's weight plus the plate's force (measured 1e-11 of
-    // the force), in 4 Newton iterations a step.
+    // carries the top block's weight plus the plate's force (measured 1.9e-10
+    // of the force at most), in 4 Newton iterations a step.
     let plate = "[[material]]\nname = \"steel\"\nmodel = \"rigid\"\ndensity = 1000.0\n\
                  [[body]]\nname = \"plate\"\nmaterial = \"steel\"\nshape = \"rectangle\"\n\
                  min = [0.0, 2.0]\nmax = [1.0, 2.1]\nvelocity = [0.0, -0.01]\n\
@@ -2051,7 +2095,8 @@ fn implicit_contact_of_deformable_and_rigid_bodies_together_balances() {
             "t = {}: base–top {:.1} N/m, top–plate {:.1} N/m, balance {off:.1e}",
             t[k], fy[k], fy[j]
         );
-        assert!(off < 1e-8, "t = {}: {} against {expected}", t[k], fy[k]);
+        // Measured 1.9e-10 at most.
+        assert_within(&format!("t = {}: balance", t[k]), off, 5e-10);
         pressed += (fy[j] < -1.0) as usize;
     }
     assert!(pressed >= 2, "the plate pressed in {pressed} steps");

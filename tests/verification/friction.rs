@@ -11,7 +11,7 @@
 //! FLIP 0.99: pure FLIP with a one-sided wall gains energy slowly (the block
 //! hops on its base); a touch of PIC removes that.
 
-use crate::common::{run_problem, Table};
+use crate::common::{assert_within, run_problem, Table};
 use mpm::run::summary::Status;
 
 const G: f64 = 9.81;
@@ -40,14 +40,15 @@ fn closed_form(theta_deg: f64, mu: f64, t: f64) -> f64 {
 
 #[test]
 fn sliding_block_follows_the_closed_form() {
-    // (θ, μ): frictionless, and two sliding cases well above the threshold (near
-    // it, at θ = 45°, μ = 0.5, the ringing base pressure costs 2 %).
-    for (theta, mu) in [(30.0, 0.0), (30.0, 0.3), (45.0, 0.3)] {
+    // (θ, μ, tolerance): frictionless, and two sliding cases well above the
+    // threshold (near it, at θ = 45°, μ = 0.5, the ringing base pressure costs
+    // 2 %). Measured +0.043 %, +0.25 %, −0.11 %.
+    for (theta, mu, tolerance) in [(30.0, 0.0, 1e-3), (30.0, 0.3, 6e-3), (45.0, 0.3, 3e-3)] {
         let (t, x) = slide(theta, mu, 0.0);
         let exact = closed_form(theta, mu, t);
-        let err = (x / exact - 1.0).abs();
-        println!("theta {theta} mu {mu}: x = {x:.5} m, closed form {exact:.5} m, error {err:.2e}");
-        assert!(err < 0.02, "theta {theta} mu {mu}: x = {x}, exact {exact}");
+        println!("theta {theta} mu {mu}: x = {x:.5} m, closed form {exact:.5} m");
+        let what = format!("theta {theta} mu {mu}: error");
+        assert_within(&what, x / exact - 1.0, tolerance);
     }
 }
 

@@ -7,7 +7,9 @@
 //! strain) once the block has been compressed three times its yield strain.
 //! The quasi-static runs also check the Newton iterations of the plastic steps.
 
-use crate::common::{newton_order, problem, read_newton, run_text, step_residuals, Table};
+use crate::common::{
+    assert_within, newton_order, problem, read_newton, run_text, step_residuals, Table,
+};
 use mpm::run::summary::Status;
 
 const C: f64 = 1.0e4;
@@ -84,17 +86,20 @@ fn run(text: &str, overrides: &[&str]) -> (Result, tempfile::TempDir) {
     )
 }
 
-fn check(name: &str, r: &Result, tol: f64) {
+/// The mean σ_yy within `tol` of the strength, the mean |σ_xx| within
+/// `sxx_tol` of it.
+fn check(name: &str, r: &Result, tol: f64, sxx_tol: f64) {
     let limit = strength(r.j);
     let e = (r.syy - limit).abs() / limit.abs();
     eprintln!(
         "{name}: σ_yy = {:.5e} (plane-strain unconfined strength {limit:.5e} at J = {:.5}; {:.5e} at J = 1), rel. error {e:.1e}; mean |σ_xx| = {:.1e}, spread of σ_yy = {:.1e}",
         r.syy, r.j, strength(1.0), r.sxx, r.spread
     );
-    assert!(e < tol, "{name}: limit stress to {tol:e}, got {e:e}");
-    assert!(
-        r.sxx < tol * limit.abs(),
-        "{name}: σ_xx = 0 at the free side"
+    assert_within(&format!("{name}: σ_yy against the strength"), e, tol);
+    assert_within(
+        &format!("{name}: mean |σ_xx| (0 at the free side) / the strength"),
+        r.sxx / limit.abs(),
+        sxx_tol,
     );
 }
 
@@ -105,13 +110,15 @@ fn quasi_static_reaches_the_limit_with_quadratic_newton() {
     // 3 plastic), Drucker–Prager in 6 steps of 3.3e-3 (all plastic).
     let mc = ["solver.load_steps=3"];
     let dp = ["solver.load_steps=6", DP[0], DP[1], DP[2]];
+    // Measured: MC 3.1e-9 and 3.2e-9 (Newton's tolerance), DP 6.1e-5; mean
+    // |σ_xx| 6.1e-5 to 6.7e-5 of the strength.
     for (name, overrides, tol) in [
-        ("MC ψ = 10°", mc.to_vec(), 1e-3),
-        ("MC ψ = 0", vec![mc[0], "material.0.dilation_angle=0"], 1e-3),
-        ("DP plane strain ψ = 10°", dp.to_vec(), 1e-2),
+        ("MC ψ = 10°", mc.to_vec(), 1e-8),
+        ("MC ψ = 0", vec![mc[0], "material.0.dilation_angle=0"], 1e-8),
+        ("DP plane strain ψ = 10°", dp.to_vec(), 1.5e-4),
     ] {
         let (r, dir) = run(&text, &overrides);
-        check(&format!("quasi-static {name}"), &r, tol);
+        check(&format!("quasi-static {name}"), &r, tol, 1.5e-4);
         let newton = read_newton(&dir.path().join("newton.csv"));
         for s in [2.0, 3.0] {
             let r = step_residuals(&newton, s);
@@ -150,7 +157,8 @@ fn explicit_and_newmark_reach_the_limit() {
             }
             let overrides: Vec<&str> = base.iter().copied().chain(extra).collect();
             let (r, _dir) = run(text, &overrides);
-            check(&format!("{solver} {name}"), &r, 1e-2);
+            // Measured 1.3e-3 to 7.0e-3; mean |σ_xx| up to 2.5e-3 of the strength.
+            check(&format!("{solver} {name}"), &r, 1e-2, 1e-2);
         }
     }
 }
@@ -165,13 +173,13 @@ fn matrix_free_newton_krylov_reaches_the_limit() {
     let mc = ["solver.load_steps=3"];
     let dp = ["solver.load_steps=6", DP[0], DP[1], DP[2]];
     for (name, models, tol) in [
-        ("MC ψ = 10°", mc.to_vec(), 1e-3),
-        ("DP plane strain ψ = 10°", dp.to_vec(), 1e-2),
+        ("MC ψ = 10°", mc.to_vec(), 1e-8),
+        ("DP plane strain ψ = 10°", dp.to_vec(), 1.5e-4),
     ] {
         let (direct, _d) = run(&text, &models);
         let overrides: Vec<&str> = models.iter().chain(krylov.iter()).copied().collect();
         let (gmres, g) = run(&text, &overrides);
-        check(&format!("GMRES {name}"), &gmres, tol);
+        check(&format!("GMRES {name}"), &gmres, tol, 1.5e-4);
         let summary: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(g.path().join("summary.json")).unwrap())
                 .unwrap();
@@ -182,17 +190,8 @@ fn matrix_free_newton_krylov_reaches_the_limit() {
         let diff = (gmres.syy - direct.syy).abs() / direct.syy.abs();
         let dj = (gmres.j - direct.j).abs();
         eprintln!("   GMRES vs direct σ_yy: {diff:.1e}, V/V0: {dj:.1e}");
-        assert!(
-            dj < 1e-8,
-            "{name}: GMRES V/V0 {} vs direct {}",
-            gmres.j,
-            direct.j
-        );
-        assert!(
-            diff < 1e-6,
-            "{name}: GMRES σ_yy {} vs direct {}",
-            gmres.syy,
-            direct.syy
-        );
+        // Measured 2.2e-16 and 1.4e-14 at most: round-off, with floors.
+        assert_within(&format!("{name}: GMRES against direct, V/V0"), dj, 1e-12);
+        assert_within(&format!("{name}: GMRES against direct, σ_yy"), diff, 1e-10);
     }
 }

@@ -2,7 +2,9 @@
 //! the artificial bulk viscosity) and the Taylor bar against the measured final
 //! shape (Johnson & Holmquist 1988, review `002_…` Table 1).
 
-use crate::common::{read_output, run_cli, run_problem, run_text, Table};
+use crate::common::{
+    assert_within, face, face_with, read_output, run_cli, run_problem, run_text, Block, Table,
+};
 
 /// Copper Hugoniot at u_p = 500 m/s: U_s = c0 + S u_p, p_H = ρ0 U_s u_p.
 const U_P: f64 = 500.0;
@@ -137,8 +139,11 @@ fn taylor_bar_matches_the_measured_final_shape() {
         errors[0], errors[1], errors[2]
     );
     // MPM3D's mean error on this test is 0.031 (review Table 1): the same bar.
-    assert!(mean <= 0.03, "mean error {mean}");
-    assert!(errors.iter().all(|e| e.abs() <= 0.05), "{errors:?}");
+    // Measured: mean 0.005, L +1.1 %.
+    assert_within("mean error against the test", mean, 0.015);
+    for (name, e) in ["L", "D", "W"].iter().zip(errors) {
+        assert_within(&format!("{name} against the test"), e, 0.03);
+    }
 
     // Energy: kinetic + internal never exceeds the impact energy; the anvil
     // (nodal momentum zeroed at the face) and the bulk viscosity take the rest.
@@ -166,16 +171,17 @@ fn taylor_bar_matches_the_measured_final_shape() {
 
 #[test]
 fn axisymmetric_taylor_bar_matches_the_test_and_the_3d_quarter() {
-    // h = 0.38 mm: mean error ≤ 3 % against the test.
+    // h = 0.38 mm against the test.
     let (result, dir) = run_problem("taylor_bar_axisymmetric.toml", &[]);
     result.expect("the axisymmetric Taylor bar runs");
     let fine = taylor_shape(&Table::read(&dir.path().join("particles_final.csv")).unwrap());
     let (errors, mean) = taylor_errors(fine);
     println!("axisymmetric h = 0.38 mm: {fine:.2?}, errors {errors:.3?}, mean {mean:.3}");
-    assert!(
-        mean <= 0.03 && errors.iter().all(|e| e.abs() <= 0.05),
-        "{errors:?}"
-    );
+    // Measured: mean 0.003, D −0.5 %.
+    assert_within("axisymmetric: mean error against the test", mean, 0.01);
+    for (name, e) in ["L", "D", "W"].iter().zip(errors) {
+        assert_within(&format!("axisymmetric: {name} against the test"), e, 0.015);
+    }
     // h = 0.76 mm against the 3D quarter at the same cell size and particles per
     // cell direction: the same solid, so within 1 % (L) and 3 % (D, W).
     let (r_axi, d_axi) = run_problem("taylor_bar_axisymmetric.toml", &["grid.cells=[11,35]"]);
@@ -193,7 +199,7 @@ fn axisymmetric_taylor_bar_matches_the_test_and_the_3d_quarter() {
 #[test]
 fn axisymmetric_taylor_bar_with_cpdi_matches_the_test() {
     // CPDI in axisymmetric mode (plane r–z domain weights, the hoop terms at the
-    // particle's centre, as for GIMP): h = 0.38 mm, mean error ≤ 3 %.
+    // particle's centre, as for GIMP): h = 0.38 mm.
     let (result, dir) = run_problem(
         "taylor_bar_axisymmetric.toml",
         &["grid.shape_function=\"cpdi\""],
@@ -202,10 +208,19 @@ fn axisymmetric_taylor_bar_with_cpdi_matches_the_test() {
     let shape = taylor_shape(&Table::read(&dir.path().join("particles_final.csv")).unwrap());
     let (errors, mean) = taylor_errors(shape);
     println!("axisymmetric CPDI h = 0.38 mm: {shape:.2?}, errors {errors:.3?}, mean {mean:.3}");
-    assert!(
-        mean <= 0.03 && errors.iter().all(|e| e.abs() <= 0.05),
-        "{errors:?}"
+    // Measured: mean 0.004, D −0.5 %, W +0.5 %.
+    assert_within(
+        "axisymmetric CPDI: mean error against the test",
+        mean,
+        0.012,
     );
+    for (name, e) in ["L", "D", "W"].iter().zip(errors) {
+        assert_within(
+            &format!("axisymmetric CPDI: {name} against the test"),
+            e,
+            0.015,
+        );
+    }
 }
 
 #[test]
@@ -223,60 +238,37 @@ fn taylor_bar_does_not_depend_on_the_number_of_threads() {
 
 /// A Johnson–Cook block (no analytic tangent) compressed 5 % in uniaxial strain,
 /// implicit quasi-static through matrix-free GMRES, in 10 load steps.
-const JC_BLOCK: &str = r#"
-dimension = 2
-[grid]
-min = [0.0, 0.0]
-max = [1.0, 1.0]
-cells = [2, 2]
-shape_function = "linear"
-[[material]]
-name = "copper"
-model = "johnson_cook"
-density = 8930.0
-youngs_modulus = 117.0e9
-poisson_ratio = 0.35
-yield_stress = 90.0e6
-hardening_modulus = 292.0e6
-hardening_exponent = 0.31
-eos = "mie_gruneisen"
-sound_speed = 3940.0
-hugoniot_slope = 1.49
-gruneisen_gamma = 1.96
-[[body]]
-material = "copper"
-shape = "rectangle"
-min = [0.0, 0.0]
-max = [1.0, 1.0]
-[[boundary]]
-face = "xmin"
-condition = "roller"
-[[boundary]]
-face = "xmax"
-condition = "roller"
-[[boundary]]
-face = "ymin"
-condition = "roller"
-[[boundary]]
-face = "ymax"
-condition = "velocity"
-velocity = [0.0, -0.05]
-components = ["y"]
-[solver]
-kind = "implicit"
-integrator = "quasi_static"
-end_time = 1.0
-load_steps = 10
-linear_solver = "gmres"
-residual_tolerance = 1e-10
-[output]
-frames = 0
-"#;
+const JC_BLOCK: Block = Block {
+    cells: [2, 2],
+    shape_function: Some("linear"),
+    material_name: "copper",
+    model: "johnson_cook",
+    density: 8930.0,
+    youngs_modulus: 117.0e9,
+    poisson_ratio: 0.35,
+    material_keys:
+        "yield_stress = 90.0e6\nhardening_modulus = 292.0e6\nhardening_exponent = 0.31\n\
+                    eos = \"mie_gruneisen\"\nsound_speed = 3940.0\nhugoniot_slope = 1.49\n\
+                    gruneisen_gamma = 1.96",
+    faces: &[
+        face("xmin", "roller"),
+        face("xmax", "roller"),
+        face("ymin", "roller"),
+        face_with(
+            "ymax",
+            "velocity",
+            "velocity = [0.0, -0.05]\ncomponents = [\"y\"]",
+        ),
+    ],
+    solver: "kind = \"implicit\"\nintegrator = \"quasi_static\"\nend_time = 1.0\nload_steps = 10\n\
+             linear_solver = \"gmres\"\nresidual_tolerance = 1e-10",
+    ..Block::DEFAULT
+};
 
 #[test]
 fn johnson_cook_runs_implicitly_through_the_krylov_path() {
     use mpm::material::{driver, registry};
-    let (result, dir) = crate::common::run_text(JC_BLOCK, &[]);
+    let (result, dir) = crate::common::run_text(&JC_BLOCK.toml(), &[]);
     let summary = result.expect("the implicit Johnson-Cook block runs");
     assert!(
         summary.solver.krylov_iterations.unwrap_or(0) > 0,
@@ -301,17 +293,19 @@ fn johnson_cook_runs_implicitly_through_the_krylov_path() {
     let eps_p = point.history.last().unwrap()[0];
     assert!(eps_p > 0.01, "the point yields ({eps_p})");
     for (col, (i, j)) in [("sxx", (0, 0)), ("syy", (1, 1)), ("szz", (2, 2))] {
-        for (q, s) in t.col(col).iter().enumerate() {
-            let e = expected[(i, j)];
-            assert!((s / e - 1.0).abs() < 1e-6, "particle {q} {col}: {s} vs {e}");
-        }
+        let e = expected[(i, j)];
+        let worst = t
+            .col(col)
+            .iter()
+            .fold(0.0f64, |w, s| w.max((s / e - 1.0).abs()));
+        // Measured 4.8e-15: round-off, with a floor.
+        assert_within(&format!("{col} against the single point"), worst, 1e-9);
     }
-    for (q, e) in t.col("eps_p").iter().enumerate() {
-        assert!(
-            (e / eps_p - 1.0).abs() < 1e-6,
-            "particle {q}: ε̄p {e} vs {eps_p}"
-        );
-    }
+    let worst = t
+        .col("eps_p")
+        .iter()
+        .fold(0.0f64, |w, e| w.max((e / eps_p - 1.0).abs()));
+    assert_within("ε̄p against the single point", worst, 1e-9);
 }
 
 #[test]
@@ -421,11 +415,24 @@ fn taylor_bar_on_a_rigid_anvil_through_contact_matches_the_grid_face_anvil() {
     r_face.expect("runs");
     let face = taylor_shape(&Table::read(&d_face.path().join("particles_final.csv")).unwrap());
     println!("contact anvil {contact:.2?}, grid-face anvil {face:.2?}");
-    assert!((contact.0 / face.0 - 1.0).abs() < 0.02, "L");
-    assert!((contact.1 / face.1 - 1.0).abs() < 0.03, "D");
-    assert!((contact.2 / face.2 - 1.0).abs() < 0.03, "W");
+    // Measured +0.85 %, −1.84 %, +0.20 %; mean error 1.25 %.
+    assert_within(
+        "contact anvil: L / grid-face L − 1",
+        contact.0 / face.0 - 1.0,
+        0.02,
+    );
+    assert_within(
+        "contact anvil: D / grid-face D − 1",
+        contact.1 / face.1 - 1.0,
+        0.03,
+    );
+    assert_within(
+        "contact anvil: W / grid-face W − 1",
+        contact.2 / face.2 - 1.0,
+        6e-3,
+    );
     let (_, mean) = taylor_errors(contact);
-    assert!(mean <= 0.03, "mean error against the test {mean}");
+    assert_within("contact anvil: mean error against the test", mean, 0.03);
 }
 
 #[test]
@@ -457,43 +464,33 @@ fn axisymmetric_contact_with_a_rigid_anvil_matches_the_grid_face_anvil() {
     r_face.expect("runs");
     let face = taylor_shape(&Table::read(&d_face.path().join("particles_final.csv")).unwrap());
     println!("axisymmetric: contact anvil {contact:.2?}, grid-face anvil {face:.2?}");
-    assert!((contact.0 / face.0 - 1.0).abs() < 0.02, "L");
-    assert!((contact.1 / face.1 - 1.0).abs() < 0.03, "D");
-    assert!((contact.2 / face.2 - 1.0).abs() < 0.03, "W");
+    // Measured +0.72 %, −0.098 %, +0.093 %.
+    let what = |c: &str| format!("axisymmetric contact anvil: {c} / grid-face {c} − 1");
+    assert_within(&what("L"), contact.0 / face.0 - 1.0, 0.02);
+    assert_within(&what("D"), contact.1 / face.1 - 1.0, 3e-3);
+    assert_within(&what("W"), contact.2 / face.2 - 1.0, 3e-3);
 }
 
 /// A free elastic block flying at 10 m/s towards the x = 1 face of the grid
 /// (no boundary conditions, no gravity): it leaves the grid at t ≈ 0.05 s.
-const FLYING_BLOCK: &str = r#"dimension = 2
-[grid]
-min = [0.0, 0.0]
-max = [1.0, 1.0]
-cells = [10, 10]
-shape_function = "cpgimp"
-[[material]]
-name = "m"
-model = "linear_elastic"
-density = 1000.0
-youngs_modulus = 1.0e6
-poisson_ratio = 0.3
-[[body]]
-material = "m"
-shape = "rectangle"
-min = [0.3, 0.3]
-max = [0.5, 0.5]
-velocity = [10.0, 0.0]
-[solver]
-kind = "explicit"
-end_time = 0.1
-[output]
-frames = 0
-history_interval = 0.005
-"#;
+const FLYING_BLOCK: Block = Block {
+    cells: [10, 10],
+    shape_function: Some("cpgimp"),
+    density: 1000.0,
+    youngs_modulus: 1.0e6,
+    poisson_ratio: 0.3,
+    body_min: [0.3, 0.3],
+    body_max: [0.5, 0.5],
+    body_keys: "velocity = [10.0, 0.0]",
+    solver: "kind = \"explicit\"\nend_time = 0.1",
+    output: "frames = 0\nhistory_interval = 0.005",
+    ..Block::DEFAULT
+};
 
 #[test]
 fn particles_leaving_the_grid_stop_the_run_or_are_removed_with_their_mass_and_energy() {
     // Default: the first particle out stops the run, naming it.
-    let (result, _dir) = run_text(FLYING_BLOCK, &[]);
+    let (result, _dir) = run_text(&FLYING_BLOCK.toml(), &[]);
     let message = result.expect_err("a particle leaves the grid").to_string();
     assert!(message.contains("left the grid"), "{message}");
     // Implicit: the step that takes it out is committed, so the run stops
@@ -504,7 +501,7 @@ fn particles_leaving_the_grid_stop_the_run_or_are_removed_with_their_mass_and_en
         "solver.integrator=\"newmark\"",
         "solver.dt=0.005",
     ];
-    let (result, _dir) = run_text(FLYING_BLOCK, &implicit);
+    let (result, _dir) = run_text(&FLYING_BLOCK.toml(), &implicit);
     let message = result.expect_err("a particle leaves the grid").to_string();
     assert!(
         message.contains("left the grid")
@@ -516,7 +513,7 @@ fn particles_leaving_the_grid_stop_the_run_or_are_removed_with_their_mass_and_en
     // "remove": the run ends; every particle is out, frozen within one step's
     // travel of the face (v Δt < v h/(2(c + v)) = 0.011 m), with its velocity,
     // and history.csv counts all the mass and the kinetic energy as removed.
-    let (result, dir) = run_text(FLYING_BLOCK, &["grid.particles_outside=\"remove\""]);
+    let (result, dir) = run_text(&FLYING_BLOCK.toml(), &["grid.particles_outside=\"remove\""]);
     result.expect("the run ends");
     let p = Table::read(&dir.path().join("particles_final.csv")).unwrap();
     let (x, vx, mass) = (p.col("x"), p.col("vx"), p.col("mass"));

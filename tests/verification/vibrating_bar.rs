@@ -3,7 +3,8 @@
 //! The period comes from the zero crossings of the bar's mean velocity, the energy
 //! from history.csv (kinetic + strain; no external work).
 
-use crate::common::{run_problem, zero_crossings, Table};
+use crate::common::{assert_within, run_problem, schemes, shape_functions, zero_crossings, Table};
+use mpm::scene::{Scheme, ShapeFunction};
 
 struct Bar {
     period: f64,
@@ -77,20 +78,24 @@ fn initial_energy_matches_the_mode() {
     result.unwrap();
     let h = Table::read(&dir.path().join("history.csv")).unwrap();
     let k0 = h.col("kinetic")[0];
-    assert!(
-        (k0 / 0.0625 - 1.0).abs() < 2e-3,
-        "kinetic energy at t = 0: {k0} (expected 0.0625 to 0.2 %)"
+    assert_within(
+        "kinetic energy at t = 0 / 0.0625 − 1",
+        k0 / 0.0625 - 1.0,
+        1e-12, // measured 2.2e-16: round-off, with a floor
     );
 }
 
 #[test]
 fn usf_and_musl_period_within_one_percent_and_energy_conserved() {
-    for scheme in ["usf", "musl"] {
+    let usl = "it dissipates more (usl_dissipates_more_than_musl)";
+    for scheme in schemes(&[(Scheme::Usl, usl)]) {
+        let scheme = scheme.name();
         let b = bar(scheme, "linear", 0.5);
-        assert!(
-            (b.period / 10.0 - 1.0).abs() < 0.01,
-            "{scheme}: period {} s not within 1 % of 10 s",
-            b.period
+        // Measured +0.043 % (USF), +0.055 % (MUSL); the reference item asks 1 %.
+        assert_within(
+            &format!("{scheme}: period error"),
+            b.period / 10.0 - 1.0,
+            2e-3,
         );
         assert!(
             b.drift.abs() < 5e-3,
@@ -119,11 +124,8 @@ fn usf_and_musl_period_within_one_percent_and_energy_conserved() {
 fn usl_dissipates_more_than_musl() {
     let usl = bar("usl", "linear", 0.5);
     let musl = bar("musl", "linear", 0.5);
-    assert!(
-        (usl.period / 10.0 - 1.0).abs() < 0.01,
-        "usl period {}",
-        usl.period
-    );
+    // Measured +0.055 %.
+    assert_within("usl: period error", usl.period / 10.0 - 1.0, 2e-3);
     assert!(
         usl.drift < 0.0 && musl.drift < 0.0,
         "both lose energy: usl {:.3e}, musl {:.3e}",
@@ -138,14 +140,20 @@ fn usl_dissipates_more_than_musl() {
     );
 }
 
+/// Every other family: the period and the energy as with linear hats
+/// (measured, quadratic B-splines averaged over the particle domains: 10.005 s,
+/// drift −2.7e-3).
 #[test]
 fn every_shape_function_gets_the_period() {
-    for shape in ["ugimp", "cpgimp", "cpdi", "bspline2", "bspline3"] {
+    let linear = "usf_and_musl_period_within_one_percent_and_energy_conserved runs it";
+    for shape in shape_functions(&[(ShapeFunction::Linear, linear)]) {
+        let shape = shape.name();
         let b = bar("musl", shape, 0.5);
-        assert!(
-            (b.period / 10.0 - 1.0).abs() < 0.01,
-            "{shape}: period {} s",
-            b.period
+        // Measured +0.060 % (uGIMP) … +0.127 % (cubic B-splines).
+        assert_within(
+            &format!("{shape}: period error"),
+            b.period / 10.0 - 1.0,
+            3e-3,
         );
         assert!(
             b.drift.abs() < 1e-2,
@@ -155,19 +163,6 @@ fn every_shape_function_gets_the_period() {
     }
 }
 
-/// Quadratic B-splines averaged over the particle domains: the period and the
-/// energy as for the other shape functions (measured: 10.005 s, drift −2.7e-3).
-#[test]
-fn domain_averaged_bsplines_get_the_period() {
-    let b = bar("musl", "cpbspline2", 0.5);
-    assert!(
-        (b.period / 10.0 - 1.0).abs() < 0.01,
-        "period {} s",
-        b.period
-    );
-    assert!(b.drift.abs() < 1e-2, "energy drift {:.3e}", b.drift);
-}
-
 /// APIC (`solver.velocity_transfer = "apic"`) takes PIC's velocities with the
 /// particles' affine fields: the bar keeps its period and energy as FLIP does
 /// (measured, MUSL, drift over 9 periods: linear −2.9e-3, FLIP −3.1e-3;
@@ -175,14 +170,29 @@ fn domain_averaged_bsplines_get_the_period() {
 /// loses three quarters of it (−0.74, −0.83).
 #[test]
 fn apic_keeps_the_bars_energy_as_flip_does_and_pic_does_not() {
-    for shape in ["linear", "bspline2"] {
+    // Measured with cubic B-splines: APIC drift −0.137 (FLIP −3.0e-3); with
+    // quadratic B-splines averaged over the domains −8.1e-2: findings, not yet
+    // explained.
+    let cubic = "APIC loses 14 % of the bar's energy over 9 periods with them";
+    let averaged = "APIC loses 8 % of the bar's energy over 9 periods with them";
+    let excluded = [
+        (ShapeFunction::Bspline3, cubic),
+        (ShapeFunction::Cpbspline2, averaged),
+    ];
+    for shape in shape_functions(&excluded) {
+        let shape = shape.name();
         let apic = bar_with("musl", shape, 0.5, &["solver.velocity_transfer=\"apic\""]);
         let flip = bar_with("musl", shape, 0.5, &[]);
         let pic = bar_with("musl", shape, 0.5, &["solver.flip=0"]);
-        assert!(
-            (apic.period / 10.0 - 1.0).abs() < 0.01,
-            "{shape}: period {}",
-            apic.period
+        println!(
+            "{shape}: drift over 9 periods APIC {:+.3e}, FLIP {:+.3e}, PIC {:+.3e}",
+            apic.drift, flip.drift, pic.drift
+        );
+        // Measured +1.6e-4 (linear) to +4.9e-4 (quadratic B-splines).
+        assert_within(
+            &format!("{shape}: APIC period error"),
+            apic.period / 10.0 - 1.0,
+            1.5e-3,
         );
         assert!(
             apic.drift.abs() < 5e-3,
