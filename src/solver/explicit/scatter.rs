@@ -1,30 +1,33 @@
-//! The explicit step with particle-side transfers on a box of nodes
-//! (`solver::explicit::node_box`): the step of `solver::explicit` (USF, USL, MUSL; the
-//! PIC/FLIP blend, local damping, face conditions, friction faces, gravity and
-//! loads) without a node map or stored stencils. Each particle pass evaluates
-//! the particle's 1D factors again, which costs less than storing the tensor
+//! The box-scatter back-end of the explicit step (`solver::explicit::step`):
+//! particle-side transfers on a box of nodes (`solver::explicit::node_box`),
+//! without a node map or stored stencils. Each particle pass evaluates the
+//! particle's 1D factors again, which costs less than storing the tensor
 //! product and reading it back through a map.
 //!
-//! USL takes one scatter (mass, momentum, force), one pass over the nodes and
-//! one over the particles (G2P, ΔF = I + Δt L, the stress). USF and MUSL add a
-//! scatter and a particle pass each. `Explicit` chooses this path for the
-//! scenes it serves (`Explicit::scatter_serves`).
+//! The passes fuse what the scheme lets them: USL takes one scatter (mass,
+//! momentum, force), one pass over the nodes and one over the particles (G2P,
+//! ΔF = I + Δt L, the stress). USF and MUSL add a scatter and a particle pass
+//! each; MUSL maps the momentum back in its G2P pass and moves the particles
+//! in its last pass, which needs their stencils at the step start. No body
+//! that is not a continuum takes its own motion between them: rigid bodies
+//! come with contact, which needs the node map (`solver::explicit::features`).
 
 use crate::dim::{embed_deformation, Tensor, Vector};
 use crate::model::conditions::Constraint;
 use crate::model::particles::Particles;
 use crate::model::tensors::TensorsMut;
-use crate::model::{load_factor, Model};
+use crate::model::Model;
 use crate::parallel::{deterministic_sum, DisjointSlice, MIN_PARALLEL_LEN, SUM_CHUNK};
-use crate::physics::boundary::conditions::{friction_contact, node_constraint, node_friction};
+use crate::physics::boundary::conditions::{node_constraint, node_friction};
 use crate::physics::kinematics::deformation::{update_particle, ParticleState};
-use crate::physics::shape::{deformation_for, ShapeFunction};
-use crate::physics::transfer::{applied_force, applied_to, nodal_velocity};
-use crate::scene::Scheme;
+use crate::physics::shape::deformation_for;
+use crate::physics::transfer::nodal_velocity;
 use crate::solver::divergence::{inverted, sound, unsound, Divergence};
 use crate::solver::explicit::apic;
-use crate::solver::explicit::grid_update::{acceleration, TINY_MASS_FRACTION};
+use crate::solver::explicit::grid_update::{acceleration, updated_velocity, with_conditions};
+use crate::solver::explicit::motion::{blend, load_power};
 use crate::solver::explicit::node_box::{NodeBox, Points, Stencil};
+use crate::solver::explicit::step::{Backend, P2g, Start, Step, Then, Velocity};
 use rayon::prelude::*;
 
 /// Particles per task of a particle pass: the chunking of
@@ -51,18 +54,6 @@ impl<const D: usize> Node<D> {
     }
 }
 
-/// The settings of the step that the passes read.
-#[derive(Clone, Copy)]
-pub struct Settings<const D: usize> {
-    pub shape: ShapeFunction,
-    pub scheme: Scheme,
-    pub flip: f64,
-    /// APIC (`solver::explicit::apic`); `flip` is then 0.
-    pub apic: bool,
-    pub damping: f64,
-    pub gravity: Vector<D>,
-}
-
 /// The buffers of the scatter path, kept between steps.
 #[derive(Clone, Debug, Default)]
 pub struct ScatterStep<const D: usize> {
@@ -83,71 +74,85 @@ struct Conditions<const D: usize> {
     friction: Vec<u8>,
 }
 
-impl<const D: usize> ScatterStep<D> {
-    /// Advance the model from t to t + dt (`Stepper::step`); returns the work
-    /// of gravity and applied loads over the step.
-    pub fn step(
-        &mut self,
-        s: &Settings<D>,
-        m: &mut Model<D>,
-        t: f64,
-        dt: f64,
-        step: usize,
-    ) -> Result<f64, Divergence> {
+impl<const D: usize> Backend<D> for ScatterStep<D> {
+    fn locate(&mut self, m: &mut Model<D>, s: &Step<D>) {
         let p = &m.particles;
         self.nb.locate(s.shape, &m.grid, &p.x);
-        let scales = m.load_scales(t);
         if s.apic && p.affine.len() != p.len() {
-            self.initial_affine(s, m, &scales);
+            self.initial_affine(s, m);
         }
-        let p = &m.particles;
-        self.nodes.clear();
-        self.nodes.resize(self.nb.nodes(), Node::zero());
-        let tiny = TINY_MASS_FRACTION * p.mass.iter().cloned().fold(f64::INFINITY, f64::min);
-        // P2G: mass (2-24), momentum (2-25) and, but in USF, the force (2-51, 2-52).
-        match s.scheme {
-            Scheme::Usf if s.apic => self.scatter::<true, false, true>(s, m, &scales),
-            Scheme::Usf => self.scatter::<true, false, false>(s, m, &scales),
-            _ if s.apic => self.scatter::<true, true, true>(s, m, &scales),
-            _ => self.scatter::<true, true, false>(s, m, &scales),
-        }
-        let work = match s.scheme {
-            Scheme::Usl => {
-                self.node_pass(m, false, s.damping, tiny, dt);
-                self.particle_pass(s, m, t, dt, step, Pass::Full, &scales)?
-            }
-            Scheme::Usf => {
-                self.start_velocity(m);
-                self.particle_pass(s, m, t, dt, step, Pass::Stress, &scales)?;
-                self.scatter::<false, true, false>(s, m, &scales);
-                self.node_pass(m, true, s.damping, tiny, dt);
-                self.particle_pass(s, m, t, dt, step, Pass::Motion, &scales)?
-            }
-            Scheme::Musl => {
-                self.node_pass(m, false, s.damping, tiny, dt);
-                let work = self.velocity_and_remap(s, m, dt, &scales);
-                self.remapped_velocity(m);
-                self.particle_pass(s, m, t, dt, step, Pass::Remapped, &scales)?;
-                work
-            }
-        };
-        Ok(work)
     }
 
+    fn p2g(&mut self, m: &Model<D>, s: &Step<D>, what: P2g) {
+        if what != P2g::Force {
+            self.nodes.clear();
+            self.nodes.resize(self.nb.nodes(), Node::zero());
+        }
+        // P2G: mass (2-24), momentum (2-25) and the force (2-51, 2-52).
+        match what {
+            P2g::Motion if s.apic => self.scatter::<true, false, true>(s, m),
+            P2g::Motion => self.scatter::<true, false, false>(s, m),
+            P2g::MotionAndForce if s.apic => self.scatter::<true, true, true>(s, m),
+            P2g::MotionAndForce => self.scatter::<true, true, false>(s, m),
+            P2g::Force => self.scatter::<false, true, false>(s, m),
+        }
+    }
+
+    fn start_velocity(&mut self, m: &Model<D>, _: &Step<D>) {
+        self.start_velocity(m);
+    }
+
+    fn start_forces(&mut self, _: &Model<D>, _: &Step<D>) {
+        unreachable!("bulk viscosity and absorbing faces need the node map")
+    }
+
+    fn grid_update(&mut self, m: &Model<D>, s: &Step<D>, start: Start) {
+        self.node_pass(m, start == Start::Formed, s.damping, s.tiny, s.dt);
+    }
+
+    fn g2p(&mut self, m: &mut Model<D>, s: &Step<D>, then: Then) -> Result<f64, Divergence> {
+        match then {
+            Then::Stress => self.particle_pass(s, m, Pass::Full),
+            Then::Nothing => self.particle_pass(s, m, Pass::Motion),
+            Then::Remap => Ok(self.velocity_and_remap(s, m)),
+        }
+    }
+
+    fn remapped_velocity(&mut self, m: &Model<D>, _: &Step<D>) {
+        self.remapped_velocity(m);
+    }
+
+    fn update_stress(
+        &mut self,
+        m: &mut Model<D>,
+        s: &Step<D>,
+        from: Velocity,
+    ) -> Result<(), Divergence> {
+        let pass = match from {
+            Velocity::Start => Pass::Stress,
+            Velocity::Remapped => Pass::Remapped,
+        };
+        self.particle_pass(s, m, pass).map(|_| ())
+    }
+
+    /// The last particle pass checked every particle.
+    fn check(&self, _: &Model<D>, _: &Step<D>) -> Result<(), Divergence> {
+        Ok(())
+    }
+}
+
+impl<const D: usize> ScatterStep<D> {
     /// P2G into the nodes: mass and momentum (`MOTION`), the force
     /// f_ext − f_int = Σ S_I (m g + s f) − V σ ∇S_I (`FORCE`).
     fn scatter<const MOTION: bool, const FORCE: bool, const APIC: bool>(
         &mut self,
-        s: &Settings<D>,
+        s: &Step<D>,
         m: &Model<D>,
-        scales: &[f64],
     ) {
         let p = &m.particles;
         let source = |q: usize| {
             let applied = match FORCE {
-                true => applied_force(p, q, &s.gravity, &|q| {
-                    load_factor(&m.load_ramp_of, q, scales)
-                }),
+                true => s.applied(&m.load_ramp_of, &p.mass, &p.load, q),
                 false => Vector::<D>::zeros(),
             };
             let stress = crate::dim::restrict::<D>(&p.stress.get(q)) * p.volume[q];
@@ -185,10 +190,10 @@ impl<const D: usize> ScatterStep<D> {
 
     /// APIC's first step on the box (as `solver::explicit::apic::ensure` on the node
     /// map): B_p of the particles' velocities projected on the nodes.
-    fn initial_affine(&mut self, s: &Settings<D>, m: &mut Model<D>, scales: &[f64]) {
+    fn initial_affine(&mut self, s: &Step<D>, m: &mut Model<D>) {
         self.nodes.clear();
         self.nodes.resize(self.nb.nodes(), Node::zero());
-        self.scatter::<true, false, false>(s, m, scales);
+        self.scatter::<true, false, false>(s, m);
         let (nb, nodes, grid) = (&self.nb, &self.nodes, &m.grid);
         let p = &m.particles;
         let affine = (0..p.len())
@@ -212,20 +217,14 @@ impl<const D: usize> ScatterStep<D> {
     /// tile task owns its particles, so it may update them). Positions move in
     /// the last pass. Returns the work of the loads over the step, summed in the
     /// chunks of `deterministic_sum` from the per-particle terms.
-    fn velocity_and_remap(
-        &mut self,
-        s: &Settings<D>,
-        m: &mut Model<D>,
-        dt: f64,
-        scales: &[f64],
-    ) -> f64 {
+    fn velocity_and_remap(&mut self, s: &Step<D>, m: &mut Model<D>) -> f64 {
         let (nb, nodes) = (&self.nb, &self.nodes[..]);
         self.second.clear();
         self.second.resize(self.nodes.len(), Vector::<D>::zeros());
         let n = m.particles.len();
         self.work.clear();
         self.work.resize(n, 0.0);
-        let (grid, ramp_of) = (&m.grid, &m.load_ramp_of);
+        let (grid, ramp_of, dt) = (&m.grid, &m.load_ramp_of, s.dt);
         let Particles {
             x,
             v,
@@ -244,11 +243,8 @@ impl<const D: usize> ScatterStep<D> {
             // SAFETY: particle q belongs to this tile's task alone.
             let (v, w) = unsafe { (velocity.at(q), work.at(q)) };
             let v_old = *v;
-            *v = (v_old + a * dt) * s.flip + vp * (1.0 - s.flip);
-            let applied = applied_to(&s.gravity, mass[q], load, q, || {
-                load_factor(ramp_of, q, scales)
-            });
-            *w = applied.dot(&(v_old + *v)) * 0.5;
+            *v = blend(&v_old, &a, &vp, s.flip, dt);
+            *w = load_power(&s.applied(ramp_of, mass, load, q), &v_old, v);
             *v * mass[q]
         };
         let add = |n: &mut Vector<D>, s: &Vector<D>, w: f64, _: &Vector<D>| *n += s * w;
@@ -294,14 +290,10 @@ impl<const D: usize> ScatterStep<D> {
 
     /// v = p/m on a node with mass (2-25), with its conditions applied.
     fn velocity(m: &Model<D>, raw: &Vector<D>, c: &Option<Conditions<D>>) -> Vector<D> {
-        let mut v = *raw;
-        if let Some(c) = c {
-            c.constraint.apply_velocity(&mut v);
-            if !c.friction.is_empty() {
-                v = friction_contact(&m.friction, &c.friction, &c.constraint, &v);
-            }
+        match c {
+            Some(c) => with_conditions(raw, &c.constraint, &m.friction, &c.friction),
+            None => *raw,
         }
-        v
     }
 
     /// Calls `f(node, second, grid multi-index)` for every box node, in
@@ -344,13 +336,9 @@ impl<const D: usize> ScatterStep<D> {
             };
             let free = Constraint::free();
             let constraint = c.as_ref().map_or(&free, |c| &c.constraint);
-            let mut acc = acceleration(n.mass, &n.force, &v, &raw, constraint, damping, tiny, dt);
-            let mut v_new = raw + acc * dt;
-            if let Some(c) = c.as_ref().filter(|c| !c.friction.is_empty()) {
-                v_new = friction_contact(&m.friction, &c.friction, &c.constraint, &v_new);
-                acc = (v_new - raw) / dt;
-            }
-            (n.momentum, n.force) = (v_new, acc);
+            let acc = acceleration(n.mass, &n.force, &v, &raw, constraint, damping, tiny, dt);
+            let on: &[u8] = c.as_ref().map_or(&[], |c| &c.friction);
+            (n.momentum, n.force) = updated_velocity(&raw, &acc, constraint, &m.friction, on, dt);
         });
     }
 
@@ -373,17 +361,8 @@ impl<const D: usize> ScatterStep<D> {
 
     /// One pass over the particles (`Pass`), in fixed chunks; returns the work
     /// of the applied forces over the step (passes that move the particles).
-    #[allow(clippy::too_many_arguments)]
-    fn particle_pass(
-        &self,
-        s: &Settings<D>,
-        m: &mut Model<D>,
-        t: f64,
-        dt: f64,
-        step: usize,
-        pass: Pass,
-        scales: &[f64],
-    ) -> Result<f64, Divergence> {
+    fn particle_pass(&self, s: &Step<D>, m: &mut Model<D>, pass: Pass) -> Result<f64, Divergence> {
+        let (t, dt, step) = (s.t, s.dt, s.step);
         let (nb, nodes, second) = (&self.nb, &self.nodes[..], &self.second[..]);
         let (grid, materials, ramp_of) = (&m.grid, &m.materials, &m.load_ramp_of);
         let Particles {
@@ -404,11 +383,7 @@ impl<const D: usize> ScatterStep<D> {
         let (mass, volume0, half_length0, load, material) =
             (&*mass, &*volume0, &*half_length0, &*load, &*material);
         let affine = DisjointSlice::new(affine);
-        let applied = |q: usize| {
-            applied_to(&s.gravity, mass[q], load, q, || {
-                load_factor(ramp_of, q, scales)
-            })
-        };
+        let applied = |q: usize| s.applied(ramp_of, mass, load, q);
         // The last pass checks the state, as `check_state` does after a step.
         let checks = matches!(pass, Pass::Full | Pass::Motion | Pass::Remapped);
         let body = |q: usize, mut state: Moving<D>| -> (f64, bool, bool) {
@@ -444,8 +419,8 @@ impl<const D: usize> ScatterStep<D> {
             if matches!(pass, Pass::Full | Pass::Motion) {
                 // PIC/FLIP blend (2-27); the applied forces' work over the step.
                 let v_old = *state.v;
-                *state.v = (v_old + a * dt) * s.flip + vp * (1.0 - s.flip);
-                work = applied(q).dot(&(v_old + *state.v)) * 0.5;
+                *state.v = blend(&v_old, &a, &vp, s.flip, dt);
+                work = load_power(&applied(q), &v_old, state.v);
             }
             if matches!(pass, Pass::Full | Pass::Motion | Pass::Remapped) {
                 // x ← x + Δt v_PIC (2-26).
