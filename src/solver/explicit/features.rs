@@ -66,20 +66,20 @@ impl Feature {
             // Split nodes: a grid node holds one velocity per field, which a
             // box of one value per grid node cannot.
             Feature::Contact | Feature::RigidBodies => Serves::NodeMap,
-            // Its per-cell averages need every particle's ΔF before any update.
-            Feature::Fbar => Serves::NodeMap,
-            // Read the step-start velocity at the particles before the force.
-            Feature::BulkViscosity | Feature::AbsorbingFaces => Serves::NodeMap,
-            Feature::Axisymmetry => Serves::NodeMap,
             // The box's stencils are tensor products of 1D factors.
             Feature::NonSeparableShape => Serves::NodeMap,
-            Feature::RemovedParticles => Serves::NodeMap,
             // Lines of nodes normal to a face, through the node map's indices.
             Feature::Mirror => Serves::NodeMap,
-            // The scatter evaluates the stencils again: the second one would
-            // see the updated F.
+            // The box evaluates the stencils again for the force after the
+            // stress update: they would see the updated F.
             Feature::UsfReadingF => Serves::NodeMap,
-            Feature::Apic | Feature::FrictionFaces => Serves::Both,
+            Feature::Fbar
+            | Feature::BulkViscosity
+            | Feature::AbsorbingFaces
+            | Feature::Axisymmetry
+            | Feature::RemovedParticles
+            | Feature::Apic
+            | Feature::FrictionFaces => Serves::Both,
         }
     }
 

@@ -17,7 +17,7 @@ use crate::physics::contact::totals::PairTotal;
 use crate::physics::kinematics::deformation::Trial;
 use crate::physics::shape::{ShapeFunction, Stencils};
 use crate::physics::transfer::{
-    interpolate_two, mass_average, mass_momentum, nodal_force, stencils_and_nodes, NodeMap,
+    interpolate_two, mass_average, stencils_and_nodes, ExtraMomentum, NodeMap,
 };
 use crate::scene::Scheme;
 use crate::solver::divergence::{check_state, inverted, Divergence};
@@ -28,7 +28,8 @@ use crate::solver::explicit::grid_update::{
 };
 use crate::solver::explicit::mirror::Mirror;
 use crate::solver::explicit::motion::{blend, load_power};
-use crate::solver::explicit::step::{Backend, P2g, Start, Step, Then, Velocity};
+use crate::solver::explicit::p2g::{hoop_stress, Source};
+use crate::solver::explicit::step::{removed_particles, Backend, P2g, Start, Step, Then, Velocity};
 use rayon::prelude::*;
 
 /// The node map's state: what a step builds, kept between steps for its buffers.
@@ -45,6 +46,9 @@ pub struct NodeMapStep<const D: usize> {
     mirror: Mirror,
     /// APIC: the active nodes' positions.
     positions: Vec<Vector<D>>,
+    /// Per particle: removed from the transfers this step (`Model::removed` at
+    /// the step start; empty when the scene removes none).
+    removed: Vec<bool>,
     /// MUSL with APIC: the particles' positions at the step start.
     step_start_x: Option<Vec<Vector<D>>>,
     mass: Vec<f64>,
@@ -84,12 +88,99 @@ impl<const D: usize> NodeMapStep<D> {
         c.keep_out_of_rigid_bodies(m);
     }
 
-    /// Does particle q take a share of the loads' work? Not when it belongs to
-    /// a rigid body of prescribed motion: the motion takes the work done on it.
+    /// Does particle q take a share of the loads' work? Not when it is
+    /// removed, nor when it belongs to a rigid body of prescribed motion: the
+    /// motion takes the work done on it.
     fn takes_load_work(&self, q: usize) -> bool {
-        !(self.contact)
-            .as_ref()
-            .is_some_and(|c| c.is_prescribed_particle(q))
+        let prescribed = |c: &Contact<D>| c.is_prescribed_particle(q);
+        let removed = self.removed.get(q).is_some_and(|&r| r);
+        !removed && !self.contact.as_ref().is_some_and(prescribed)
+    }
+
+    /// APIC: the particles' affine moments B_p from the updated nodes, where
+    /// the particles are before they move.
+    fn affine_moments(&self, m: &mut Model<D>) {
+        let (st, map, velocity_new) = (&self.stencils, &self.map, &self.velocity_new);
+        let (mp, positions) = (&mut m.particles, &self.positions);
+        let x = &mp.x;
+        mp.affine = (0..mp.len())
+            .into_par_iter()
+            .with_min_len(MIN_PARALLEL_LEN)
+            .map(|q| apic::moment(map, st, q, &x[q], positions, velocity_new))
+            .collect();
+    }
+
+    /// G2P: the particles' velocity (PIC/FLIP blend, 2-27) and position
+    /// (2-26) from the updated nodes; returns their step-start velocities.
+    /// Removed particles (`physics::transfer::stencils` gave them no stencil)
+    /// keep theirs.
+    fn move_particles(&self, m: &mut Model<D>, s: &Step<D>) -> Vec<Vector<D>> {
+        let (st, map, removed) = (&self.stencils, &self.map, &self.removed);
+        let (accel, velocity_new) = (&self.accel, &self.velocity_new);
+        let mp = &mut m.particles;
+        let old_v = mp.v.clone();
+        mp.v.par_iter_mut()
+            .zip(mp.x.par_iter_mut())
+            .enumerate()
+            .with_min_len(MIN_PARALLEL_LEN)
+            .filter(|(q, _)| !removed.get(*q).is_some_and(|&r| r))
+            .for_each(|(q, (v, x))| {
+                let (a, v_pic) = interpolate_two(map, st, q, accel, velocity_new);
+                *v = blend(v, &a, &v_pic, s.flip, s.dt);
+                *x += v_pic * s.dt;
+            });
+        old_v
+    }
+
+    /// The work of the loads over the step on the particles that take a share
+    /// (`takes_load_work`), from their velocities at the step's start `old_v`
+    /// and end.
+    fn work_of_loads(&self, m: &Model<D>, s: &Step<D>, old_v: &[Vector<D>]) -> f64 {
+        let p = &m.particles;
+        let power = |q: usize| {
+            let applied = s.applied(&m.load_ramp_of, &p.mass, &p.load, q);
+            load_power(&applied, &old_v[q], &p.v[q])
+        };
+        let counted = |q: usize| match self.takes_load_work(q) {
+            true => power(q),
+            false => 0.0,
+        };
+        s.dt * deterministic_sum(p.len(), counted)
+    }
+
+    /// MUSL: the particles' updated momentum mapped back to the nodes (APIC:
+    /// with the affine part, where the particles were at the step start).
+    fn remap(&mut self, m: &Model<D>, s: &Step<D>) {
+        let (st, map, p) = (&self.stencils, &self.map, &m.particles);
+        let x = self.step_start_x.as_deref().unwrap_or(&p.x);
+        let affine = self.affine(m, x, s);
+        let term = affine.as_ref().map(|a| move |q, e, n| a.term(st, q, e, n));
+        let extra = term.as_ref().map(|t| t as _);
+        let sources = sources(m, s, false);
+        let nodes = gather_p2g::<D, true, false>(map, st, &sources, &[], extra);
+        self.momentum = nodes.iter().map(|n| n.1).collect();
+    }
+
+    /// The nodes' conditions this step: their constraints, the friction faces
+    /// of the nodes on some, and the mirror's lines.
+    fn node_conditions(&mut self, m: &Model<D>, s: &Step<D>) {
+        let map = &self.map;
+        self.constraint = (0..map.len())
+            .into_par_iter()
+            .with_min_len(MIN_PARALLEL_LEN)
+            .map(|a| node_constraint(&m.grid, &m.faces, map.grid_node(a)))
+            .collect();
+        self.friction = friction_nodes(m, map);
+        // Cubic and domain-averaged B-splines: the image problem's masses at faces
+        // with prescribed velocities. Point-sampled quadratic B-splines keep the
+        // clamped masses: the mirror removes their O(ε) stress error at the face
+        // too, but their knot-crossing quadrature error then dominates and makes the
+        // refinement sequence non-monotone (docs/accuracy.md); the suite's target
+        // for them (tests/verification/column_explicit.rs) stays as it was.
+        self.mirror = match s.shape {
+            ShapeFunction::Bspline2 => Mirror::default(),
+            _ => Mirror::build(&m.grid, &m.faces, map),
+        };
     }
 
     /// The stress update from nodal velocities `velocity` (2-31, 2-32): the
@@ -163,6 +254,7 @@ impl<const D: usize> Backend<D> for NodeMapStep<D> {
         if s.apic {
             apic::ensure(m, s.shape);
         }
+        self.removed = removed_particles(m);
         if let (None, Some(plan)) = (&self.contact, &m.contact) {
             self.contact = Some(Contact::new(plan.clone(), m));
         }
@@ -174,42 +266,41 @@ impl<const D: usize> Backend<D> for NodeMapStep<D> {
         if s.fbar {
             self.trial.use_fbar(&m.grid, &m.particles.x);
         }
-        let map = &self.map;
-        self.constraint = (0..map.len())
-            .into_par_iter()
-            .with_min_len(MIN_PARALLEL_LEN)
-            .map(|a| node_constraint(&m.grid, &m.faces, map.grid_node(a)))
-            .collect();
-        self.friction = friction_nodes(m, map);
-        // Cubic and domain-averaged B-splines: the image problem's masses at faces
-        // with prescribed velocities. Point-sampled quadratic B-splines keep the
-        // clamped masses: the mirror removes their O(ε) stress error at the face
-        // too, but their knot-crossing quadrature error then dominates and makes the
-        // refinement sequence non-monotone (docs/accuracy.md); the suite's target
-        // for them (tests/verification/column_explicit.rs) stays as it was.
-        self.mirror = match s.shape {
-            ShapeFunction::Bspline2 => Mirror::default(),
-            _ => Mirror::build(&m.grid, &m.faces, map),
-        };
+        self.node_conditions(m, s);
         self.positions = match s.apic {
-            true => apic::node_positions(map, &m.grid),
+            true => apic::node_positions(&self.map, &m.grid),
             false => Vec::new(),
         };
         self.step_start_x = (s.apic && s.scheme == Scheme::Musl).then(|| m.particles.x.clone());
     }
 
     fn p2g(&mut self, m: &Model<D>, s: &Step<D>, what: P2g) {
-        let (st, map, p) = (&self.stencils, &self.map, &m.particles);
+        let p = &m.particles;
+        let force = what != P2g::Motion;
+        let sources = sources(m, s, force);
+        let hoop: Vec<f64> = match force && m.axisymmetric {
+            true => (0..p.len()).map(|q| hoop_stress(p, q)).collect(),
+            false => Vec::new(),
+        };
+        // APIC: the affine part of the momentum.
+        let affine = (what != P2g::Force)
+            .then(|| self.affine(m, &p.x, s))
+            .flatten();
+        let st = &self.stencils;
+        let term = affine.as_ref().map(|a| move |q, e, n| a.term(st, q, e, n));
+        let extra = term.as_ref().map(|t| t as _);
+        let (map, sources) = (&self.map, &sources[..]);
+        let nodes = match what {
+            P2g::Motion => gather_p2g::<D, true, false>(map, st, sources, &hoop, extra),
+            P2g::Force => gather_p2g::<D, false, true>(map, st, sources, &hoop, extra),
+            P2g::MotionAndForce => gather_p2g::<D, true, true>(map, st, sources, &hoop, extra),
+        };
         if what != P2g::Force {
-            // APIC: the affine part of the momentum.
-            let affine = self.affine(m, &p.x, s);
-            let term = affine.as_ref().map(|a| move |q, e, n| a.term(st, q, e, n));
-            let (mass, momentum) = mass_momentum(map, st, p, term.as_ref().map(|t| t as _));
-            (self.mass, self.momentum) = (mass, momentum);
+            self.mass = nodes.iter().map(|n| n.0).collect();
+            self.momentum = nodes.iter().map(|n| n.1).collect();
         }
-        if what != P2g::Motion {
-            let load_factor = |q: usize| crate::model::load_factor(&m.load_ramp_of, q, &s.scales);
-            self.force = nodal_force(map, st, p, &s.gravity, &load_factor);
+        if force {
+            self.force = nodes.iter().map(|n| n.2).collect();
         }
     }
 
@@ -292,40 +383,12 @@ impl<const D: usize> Backend<D> for NodeMapStep<D> {
     }
 
     fn g2p(&mut self, m: &mut Model<D>, s: &Step<D>, then: Then) -> Result<f64, Divergence> {
-        let (st, map) = (&self.stencils, &self.map);
-        let (accel, velocity_new) = (&self.accel, &self.velocity_new);
-        let mp = &mut m.particles;
-        // APIC: the affine moment where the particles are before they move.
         if s.apic {
-            let (x, positions) = (&mp.x, &self.positions);
-            mp.affine = (0..mp.len())
-                .into_par_iter()
-                .with_min_len(MIN_PARALLEL_LEN)
-                .map(|q| apic::moment(map, st, q, &x[q], positions, velocity_new))
-                .collect();
+            self.affine_moments(m);
         }
-        // The particle velocity (PIC/FLIP blend, 2-27) and position (2-26).
-        let old_v = mp.v.clone();
-        mp.v.par_iter_mut()
-            .zip(mp.x.par_iter_mut())
-            .enumerate()
-            .with_min_len(MIN_PARALLEL_LEN)
-            .for_each(|(q, (v, x))| {
-                let (a, v_pic) = interpolate_two(map, st, q, accel, velocity_new);
-                *v = blend(v, &a, &v_pic, s.flip, s.dt);
-                *x += v_pic * s.dt;
-            });
+        let old_v = self.move_particles(m, s);
         self.rigid_bodies_own_motion(m, s);
-        let p = &m.particles;
-        let work = s.dt
-            * deterministic_sum(p.len(), |q| match self.takes_load_work(q) {
-                true => load_power(
-                    &s.applied(&m.load_ramp_of, &p.mass, &p.load, q),
-                    &old_v[q],
-                    &p.v[q],
-                ),
-                false => 0.0,
-            });
+        let work = self.work_of_loads(m, s, &old_v);
         match then {
             Then::Stress => {
                 let velocity_new = std::mem::take(&mut self.velocity_new);
@@ -333,16 +396,7 @@ impl<const D: usize> Backend<D> for NodeMapStep<D> {
                 self.velocity_new = velocity_new;
                 updated?;
             }
-            // Map the updated particle momentum back (APIC: with the affine
-            // part, where the particles were at the step start).
-            Then::Remap => {
-                let (st, map, p) = (&self.stencils, &self.map, &m.particles);
-                let x = self.step_start_x.as_deref().unwrap_or(&p.x);
-                let affine = self.affine(m, x, s);
-                let term = affine.as_ref().map(|a| move |q, e, n| a.term(st, q, e, n));
-                let (_, momentum) = mass_momentum(map, st, p, term.as_ref().map(|t| t as _));
-                self.momentum = momentum;
-            }
+            Then::Remap => self.remap(m, s),
             Then::Nothing => {}
         }
         Ok(work)
@@ -370,6 +424,67 @@ impl<const D: usize> Backend<D> for NodeMapStep<D> {
     fn check(&self, m: &Model<D>, s: &Step<D>) -> Result<(), Divergence> {
         check_state(m, s.step + 1, s.t + s.dt)
     }
+}
+
+/// The particles' P2G sources (`p2g::Source`), with their applied forces if
+/// the force is gathered (`force`).
+fn sources<const D: usize>(m: &Model<D>, s: &Step<D>, force: bool) -> Vec<Source<D>> {
+    let p = &m.particles;
+    (0..p.len())
+        .into_par_iter()
+        .with_min_len(MIN_PARALLEL_LEN)
+        .map(|q| {
+            let applied = match force {
+                true => s.applied(&m.load_ramp_of, &p.mass, &p.load, q),
+                false => Vector::<D>::zeros(),
+            };
+            Source::of(p, q, applied)
+        })
+        .collect()
+}
+
+/// P2G through the node map: at every active node, its entries in increasing
+/// particle order, the mass and momentum (`MOTION`; with the extra momentum
+/// of APIC, if given) and the force (`FORCE`; with the hoop force of `hoop`
+/// in axisymmetric mode, else empty) of the particles' `sources`.
+fn gather_p2g<const D: usize, const MOTION: bool, const FORCE: bool>(
+    map: &NodeMap,
+    st: &Stencils<D>,
+    sources: &[Source<D>],
+    hoop: &[f64],
+    extra: Option<ExtraMomentum<D>>,
+) -> Vec<(f64, Vector<D>, Vector<D>)> {
+    let owner = st.owner();
+    (0..map.len())
+        .into_par_iter()
+        .with_min_len(MIN_PARALLEL_LEN)
+        .map(|a| {
+            let (mut mass, mut momentum, mut force) =
+                (0.0, Vector::<D>::zeros(), Vector::<D>::zeros());
+            for &e in map.node_entries(a) {
+                let (q, e) = (owner.of(e), e as usize);
+                let s = &sources[q];
+                let (w, g) = match FORCE {
+                    true => st.value_at(q, e),
+                    false => (st.weight_at(q, e), Vector::<D>::zeros()),
+                };
+                if MOTION {
+                    mass += s.mass * w;
+                    momentum += s.momentum * w;
+                    if let Some(extra) = extra {
+                        momentum += extra(q, e, a);
+                    }
+                }
+                if FORCE {
+                    force += s.force_at(w, &g);
+                    if let Some(h) = hoop.get(q) {
+                        force[0] -= h * w;
+                    }
+                }
+            }
+            (mass, momentum, force)
+        })
+        .collect()
 }
 
 /// The active nodes on friction faces, with the faces each lies on.

@@ -19,6 +19,7 @@ pub mod grid_update;
 pub mod mirror;
 pub mod motion;
 pub mod node_box;
+pub mod p2g;
 pub mod scatter;
 pub mod step;
 
@@ -102,14 +103,6 @@ impl<const D: usize> Explicit<D> {
         }
     }
 
-    /// Does the step run on the box scatter (`solver::explicit::scatter`)? Where
-    /// the scene leaves the choice to the solver and no feature of the step
-    /// needs the node map (`solver::explicit::features`).
-    pub fn scatter_serves(&self, m: &Model<D>) -> bool {
-        let s = self.settings(m, 0.0, 0.0, 0);
-        self.transfer == Transfer::Auto && !needs_node_map(&s, m)
-    }
-
     /// Critical time step min_p h / (c_p + |v_p|) (2-45).
     pub fn critical_dt(m: &Model<D>) -> f64 {
         Self::critical_dt_with(m, None)
@@ -161,6 +154,8 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
     /// applied loads over the step.
     fn step(&mut self, m: &mut Model<D>, t: f64, dt: f64, step: usize) -> Result<f64, Divergence> {
         let s = self.settings(m, t, dt, step);
+        // The box scatter where the scene leaves the choice to the solver and
+        // no feature of the step needs the node map (`solver::explicit::features`).
         match self.transfer == Transfer::Auto && !needs_node_map(&s, m) {
             true => {
                 let scatter = self.scatter.get_or_insert_with(ScatterStep::default);

@@ -18,12 +18,14 @@
 use crate::dim::Vector;
 use crate::model::load_factor;
 use crate::model::Model;
+use crate::parallel::MIN_PARALLEL_LEN;
 use crate::physics::shape::ShapeFunction;
 use crate::physics::transfer::applied_to;
 use crate::scene::Scheme;
 use crate::solver::divergence::Divergence;
 use crate::solver::explicit::bulk_viscosity::BulkViscosity;
 use crate::solver::explicit::grid_update::TINY_MASS_FRACTION;
+use rayon::prelude::*;
 
 /// What one explicit step reads besides the model: the solver's settings, the
 /// loads at the step's start, and the step's time.
@@ -85,6 +87,21 @@ impl<const D: usize> Step<D> {
     /// viscosity, absorbing faces)?
     pub fn reads_start_velocity(&self, m: &Model<D>) -> bool {
         self.viscosity.is_some() || !m.absorbing.faces.is_empty()
+    }
+}
+
+/// Per particle: is it removed from the transfers this step (eroded, or
+/// outside the grid: `Model::removed`, at the step start)? Empty when the
+/// scene removes none. A removed particle touches no node, and keeps its
+/// position and velocity; no load does work on it.
+pub fn removed_particles<const D: usize>(m: &Model<D>) -> Vec<bool> {
+    match m.removes_particles() {
+        true => (0..m.particles.len())
+            .into_par_iter()
+            .with_min_len(MIN_PARALLEL_LEN)
+            .map(|q| m.removed(q))
+            .collect(),
+        false => Vec::new(),
     }
 }
 
