@@ -68,7 +68,7 @@ impl Material for Rigid {
     }
 
     /// No stress, so none changes (the implicit solver keeps a rigid body's
-    /// particles off the grid anyway, `solver::implicit::contact`).
+    /// particles off the grid anyway, `solver::implicit::grid`).
     fn stress_derivative(&self, _inc: &Increment) -> Option<StressDerivative> {
         Some(StressDerivative::zeros())
     }

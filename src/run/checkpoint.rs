@@ -28,8 +28,10 @@ use crate::dim::{Mat3, Tensor, Vector};
 use crate::model::particles::{History, Particles};
 use crate::model::tensors::{Layout, Tensors};
 use crate::output::atomic::write_atomically;
+use crate::run::error::RunError;
 use crate::run::recorders::RecorderState;
 use crate::run::summary::StageSummary;
+use crate::scene::Scene;
 use crate::solver::stepper::SolverState;
 use serde::{Deserialize, Serialize};
 use std::io::Write;
@@ -298,6 +300,53 @@ impl Kept {
             std::fs::remove_file(self.0.remove(0)).ok();
         }
     }
+}
+
+/// A checkpoint to continue from, and where it was read.
+pub(super) struct Resume {
+    pub checkpoint: Checkpoint,
+    pub path: PathBuf,
+}
+
+/// The checkpoint at `path`, if it was written by a run of this scene (the same
+/// text after overrides, hence the same dimension) and this build can read it.
+pub(super) fn matching_checkpoint(scene: &Scene, path: &Path) -> Result<Checkpoint, RunError> {
+    let ck = Checkpoint::read(path).map_err(RunError::Checkpoint)?;
+    let name = path.display();
+    if ck.dimension != scene.config.dimension.spatial() {
+        return Err(RunError::Checkpoint(format!(
+            "checkpoint {name} is of a {}D run, {} is {}D",
+            ck.dimension,
+            scene.file,
+            scene.config.dimension.spatial()
+        )));
+    }
+    if ck.scene_text != scene.text {
+        return Err(RunError::Checkpoint(format!(
+            "checkpoint {name} was written by a run of another scene ({}, or other --set \
+             overrides): restart with the scene text and overrides it was written with",
+            ck.scene_file
+        )));
+    }
+    Ok(ck)
+}
+
+/// The particles of a checkpoint, which must be as many as the scene builds.
+pub(super) fn restored_particles<const D: usize>(
+    ck: &Checkpoint,
+    path: &Path,
+    built: usize,
+) -> Result<crate::model::particles::Particles<D>, RunError> {
+    let name = path.display();
+    let p = (ck.particles.particles::<D>())
+        .map_err(|e| RunError::Checkpoint(format!("checkpoint {name}: {e}")))?;
+    if p.len() != built {
+        return Err(RunError::Checkpoint(format!(
+            "checkpoint {name} holds {} particles, the scene builds {built}",
+            p.len()
+        )));
+    }
+    Ok(p)
 }
 
 #[cfg(test)]

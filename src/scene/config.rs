@@ -408,7 +408,7 @@ pub struct ContactConfig {
     pub rigid_projection: bool,
     /// Implicit solver: the penalty ε_n = α M A_p / h of a particle against a
     /// rigid body is this α times the particle's P-wave modulus M, face area A_p
-    /// and 1/h (`crate::solver::implicit::contact`; default 100).
+    /// and 1/h (`crate::solver::implicit::terms::contact::rigid`; default 100).
     #[serde(default = "default_penalty_factor")]
     pub penalty_factor: f64,
 }

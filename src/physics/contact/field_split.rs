@@ -4,7 +4,7 @@
 //! that meets there gets a common normal, a nodal area and the gap between
 //! their surfaces (a [`Meeting`]). The explicit contact (`solver::explicit::contact`)
 //! corrects the fields' velocities at the meetings; the implicit one
-//! (`solver::implicit::contact`) puts a penalty between their displacements.
+//! (`solver::implicit::terms::contact::bodies`) puts a penalty between their displacements.
 //!
 //! **Split nodes.** A shared grid node is split: each field gets a node with an
 //! id past the grid's node count (`NodeMap::split`), and the stencil entries of
@@ -66,7 +66,7 @@ pub struct Meeting<const D: usize> {
     pub reach: [f64; 2],
     /// The particles of r and s whose centres lie farthest along n and −n
     /// among those that give the gap (`u32::MAX` where none does): the implicit
-    /// contact follows them from step to step (`solver::implicit::contact`).
+    /// contact follows them from step to step (`solver::implicit::terms::contact::bodies`).
     pub outermost: [u32; 2],
     /// The gap criterion D ≤ λ h holds.
     pub close: bool,

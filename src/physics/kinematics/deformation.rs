@@ -18,6 +18,7 @@ use crate::physics::shape::hoop::hoop_stretch;
 use crate::physics::shape::Stencils;
 use crate::physics::transfer::{gradient, NodeMap};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// The state the particles would reach under a displacement increment.
 ///
@@ -93,7 +94,7 @@ impl<const D: usize> Trial<D> {
         }
         let history_old = p.history.slots(&p.history.data);
         let mut history = p.history.slots_mut(&mut self.history);
-        let (u, fbar) = (&self.u, self.fbar.as_ref());
+        let (u, fbar) = (&self.u, self.fbar.as_ref().map(Dilatations::of));
         let inverted = (self.stress.par_iter_mut())
             .zip(self.volume.par_iter_mut())
             .zip(history.par_iter_mut())
@@ -116,7 +117,81 @@ impl<const D: usize> Trial<D> {
     /// ΔF_p of the last evaluation (ΔF̄_p with F-bar), formed as `evaluate`
     /// formed it.
     pub fn df(&self, st: &Stencils<D>, map: &NodeMap, q: usize) -> Mat3 {
-        df_of(&self.u, self.fbar.as_ref(), st, map, q)
+        df_of(&self.u, self.fbar.as_ref().map(Dilatations::of), st, map, q)
+    }
+
+    /// The nodal displacements u of the last evaluation.
+    pub fn displacements(&self) -> &[Vector<D>] {
+        &self.u
+    }
+
+    /// `measure(ΔF_p, σ_p)` of every particle under nodal displacements `u`,
+    /// with the ΔF_p (ΔF̄_p with F-bar) and the stress that `evaluate` would
+    /// leave (the same arithmetic; the stress packed and read back as `stress`
+    /// holds it), keeping nothing: the trial state stays that of the last
+    /// evaluation (an implicit solver's residual at a point that is not its
+    /// iterate, a difference product). Err(q): particle q inverts (det F ≤ 0).
+    #[allow(clippy::too_many_arguments)]
+    pub fn probe<T: Send>(
+        &self,
+        p: &Particles<D>,
+        materials: &[Box<dyn Material>],
+        st: &Stencils<D>,
+        map: &NodeMap,
+        u: &[Vector<D>],
+        dt: f64,
+        measure: impl Fn(&Mat3, &Mat3) -> T + Sync,
+    ) -> Result<Vec<T>, usize> {
+        let n = p.len();
+        let axisymmetric = !st.hoop.is_empty();
+        // F-bar: ΔF_p and ΔJ_p of every particle, then the cells' mean ΔJ̄_c.
+        let mut plain: (Vec<Mat3>, Vec<f64>, Vec<f64>) = Default::default();
+        if let Some(fbar) = &self.fbar {
+            let (df, dj, dj_bar) = &mut plain;
+            (0..n)
+                .into_par_iter()
+                .with_min_len(MIN_PARALLEL_LEN)
+                .map(|q| increment(st, map, q, u, axisymmetric))
+                .collect_into_vec(df);
+            dj.extend(df.iter().map(|f| f.determinant()));
+            if let Some(q) = dj.iter().position(|&j| j <= 0.0) {
+                return Err(q);
+            }
+            *dj_bar = fbar.cells.mean_dilatation(&p.volume, dj);
+        }
+        let fbar = (self.fbar.as_ref()).map(|f| Dilatations {
+            df: &plain.0,
+            dj: &plain.1,
+            dj_bar: &plain.2,
+            cell_of: &f.cells.of,
+        });
+        let history_old = p.history.slots(&p.history.data);
+        let inverted = AtomicUsize::new(usize::MAX);
+        let scratch = || {
+            (
+                Vec::new(),
+                Tensors::filled(Layout::stress(D), 1, &Mat3::zeros()),
+            )
+        };
+        let out = (0..n)
+            .into_par_iter()
+            .with_min_len(MIN_PARALLEL_LEN)
+            .map_init(scratch, |(hist, packed), q| {
+                let material = materials[p.material[q] as usize].as_ref();
+                hist.clear();
+                hist.extend_from_slice(history_old[q]);
+                let df = df_of(u, fbar, st, map, q);
+                let inc = Increment::new(p.f.get(q), df, dt, p.stress.get(q), history_old[q]);
+                let new = advance(material, &inc, p.volume0[q], hist);
+                inverted.fetch_min(new.inverted_at(q), Ordering::Relaxed);
+                packed.set(0, &new.stress);
+                measure(&df, &packed.get(0))
+            })
+            .collect();
+        match inverted.into_inner() {
+            usize::MAX => Ok(out),
+            q => Err(q),
+        }
     }
 
     /// The explicit step's update: the particles take the state of the
@@ -165,11 +240,32 @@ impl<const D: usize> Trial<D> {
     }
 }
 
+/// The plain ΔF_p, ΔJ_p and the cells' ΔJ̄_c of one F-bar evaluation.
+#[derive(Clone, Copy)]
+struct Dilatations<'a> {
+    df: &'a [Mat3],
+    dj: &'a [f64],
+    dj_bar: &'a [f64],
+    /// The cell of each particle.
+    cell_of: &'a [u32],
+}
+
+impl<'a> Dilatations<'a> {
+    fn of(f: &'a FBarState) -> Self {
+        Dilatations {
+            df: &f.df,
+            dj: &f.dj,
+            dj_bar: &f.dj_bar,
+            cell_of: &f.cells.of,
+        }
+    }
+}
+
 /// ΔF_p under the nodal displacements `u`; with F-bar, ΔF̄_p from the plain
 /// ΔF_p and dilatations that `fbar` holds.
 fn df_of<const D: usize>(
     u: &[Vector<D>],
-    fbar: Option<&FBarState>,
+    fbar: Option<Dilatations>,
     st: &Stencils<D>,
     map: &NodeMap,
     q: usize,
@@ -178,7 +274,7 @@ fn df_of<const D: usize>(
     let Some(fbar) = fbar else {
         return increment(st, map, q, u, axisymmetric);
     };
-    let (dj_bar, dj) = (fbar.dj_bar[fbar.cells.of[q] as usize], fbar.dj[q]);
+    let (dj_bar, dj) = (fbar.dj_bar[fbar.cell_of[q] as usize], fbar.dj[q]);
     // Axisymmetric: n = 3, the hoop stretch is scaled too.
     match axisymmetric {
         true => scaled::<3>(&fbar.df[q], scale_factor::<3>(dj_bar, dj)),

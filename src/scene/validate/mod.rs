@@ -188,7 +188,7 @@ fn linear_domain_stress(s: &SceneConfig) -> Check {
 
 /// Contact in explicit stages: node-based, not with B-splines. In implicit
 /// stages: a penalty against rigid bodies with a prescribed motion or between
-/// the split nodes of deformable bodies (`solver::implicit::contact`), not in
+/// the split nodes of deformable bodies (`solver::implicit::terms::contact`), not in
 /// axisymmetric mode.
 /// Implicit contact between two deformable bodies (`names`) splits their
 /// shared nodes: refused with what does not know split nodes.

@@ -47,7 +47,7 @@ use super::assembly::stiffness::{coupling, hoop_coupling, particle_tangents, Par
 use super::assembly::Dofs;
 use super::coarsening::hierarchy;
 use super::failure::Failure;
-use super::residual::{ordering, residual, tangent};
+use super::residual::{ordering, probe_residual, tangent};
 use super::step::StepSystem;
 use crate::dim::Vector;
 use crate::model::Model;
@@ -262,12 +262,13 @@ impl KrylovState {
     }
 
     /// δu with ‖r + J δu‖ ≤ η ‖r‖ by GMRES or CG on difference products at the
-    /// iterate `u` (whose residual `r_free` the trial state holds). `stop` is the
-    /// Newton tolerance on ‖r‖; `iteration` 0 starts a new forcing sequence.
+    /// step's iterate `u` (whose residual is `r_free`; the products leave the
+    /// iterate's state as it is). `stop` is the Newton tolerance on ‖r‖;
+    /// `iteration` 0 starts a new forcing sequence.
     pub fn correction<const D: usize>(
         &mut self,
         m: &Model<D>,
-        sys: &mut StepSystem<D>,
+        sys: &StepSystem<D>,
         u: &[Vector<D>],
         r_free: &[f64],
         stop: f64,
@@ -520,9 +521,10 @@ impl KrylovState {
 }
 
 /// (r(u + ε v) − r(u)) / ε over the free unknowns (2-39); `r_free` is r(u).
+/// r(u + ε v) is a probe: the step's iterate stays where it is.
 pub fn difference_product<const D: usize>(
     m: &Model<D>,
-    sys: &mut StepSystem<D>,
+    sys: &StepSystem<D>,
     u: &[Vector<D>],
     r_free: &[f64],
     v: &[f64],
@@ -530,7 +532,7 @@ pub fn difference_product<const D: usize>(
 ) -> Result<Vec<f64>, Failure> {
     let mut up = u.to_vec();
     sys.dofs.apply_correction(&mut up, v, eps);
-    let r = residual(m, sys, &up).map_err(|f| Failure {
+    let r = probe_residual(m, sys, &up).map_err(|f| Failure {
         particle: f.particle,
         message: format!("{} (in a finite-difference product, 2-39)", f.message),
     })?;
@@ -552,6 +554,7 @@ fn max_norm_free<const D: usize>(u: &[Vector<D>], dofs: &Dofs) -> f64 {
 mod tests {
     use super::*;
     use crate::scene::Scene;
+    use crate::solver::implicit::residual::residual;
     use crate::solver::implicit::tests::BLOCK;
     use crate::solver::implicit::Implicit;
 

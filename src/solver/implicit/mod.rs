@@ -11,23 +11,24 @@
 //! recomputed from the step-start state (`deformation::Trial`). A step whose Newton
 //! iteration fails is halved and retried, up to `max_cutbacks` times.
 //!
-//! The files follow the step: `step` prepares it (and commits it), `newton`
-//! iterates on `residual` r(u) with corrections from the tangent of `assembly` or
-//! from `krylov`; `ties` slaves weakly supported nodes, `newmark` integrates in
-//! time.
+//! The files follow the step: `step` prepares it (and commits it) on the
+//! step's `grid`, `newton` iterates on `residual` r(u) with corrections from the
+//! tangent of `assembly` or from `krylov`; `ties` slaves weakly supported nodes,
+//! `newmark` integrates in time. What is optional (absorbing faces, contact, a
+//! linear domain stress) enters the step as one of its `terms`.
 
 pub mod assembly;
 pub mod coarsening;
-pub mod contact;
 pub mod export;
 pub mod failure;
+pub mod grid;
 pub mod krylov;
 pub mod newmark;
 pub mod newton;
 pub mod residual;
-pub mod rigid_penalty;
 pub mod step;
 pub mod stress_gradient;
+pub mod terms;
 #[cfg(test)]
 mod tests;
 pub mod ties;
@@ -63,10 +64,10 @@ pub struct Implicit<const D: usize> {
     /// components exert on the body), nodes with a non-zero reaction only.
     pub reaction: Vec<(u32, Vector<D>)>,
     pub cutbacks: usize,
-    /// The contact's state from a checkpoint (`SolverState::contact_tangential`
-    /// and `contact_points`), restored before the first step sets up its
-    /// contact points from it.
-    restored_contact: Option<(Vec<f64>, Vec<f64>)>,
+    /// The state of a checkpoint, for the step's terms (their tangential
+    /// forces, contact points and meetings): restored once they are set up,
+    /// before the first step begins them.
+    restored: Option<SolverState>,
 }
 
 impl<const D: usize> Implicit<D> {
@@ -81,7 +82,7 @@ impl<const D: usize> Implicit<D> {
             accel: Vec::new(),
             reaction: Vec::new(),
             cutbacks: 0,
-            restored_contact: None,
+            restored: None,
         }
     }
 
@@ -162,11 +163,9 @@ impl<const D: usize> Implicit<D> {
 
     /// Set up the step t → t + dt (`step`).
     fn prepare(&mut self, m: &Model<D>, t: f64, dt: f64) {
-        if let Some((tangential, points)) = self.restored_contact.take() {
-            if let Some(contact) = self.system.contact_of(m) {
-                contact.restore_tangential(&tangential, &m.particles.x, m.grid.h_min());
-                contact.restore_carried_points(&points, m.particles.len());
-            }
+        self.system.set_up(m);
+        if let Some(state) = self.restored.take() {
+            self.system.restore_terms(&state);
         }
         self.settings
             .prepare(m, &mut self.system, &mut self.accel, t, dt);
@@ -178,9 +177,9 @@ impl<const D: usize> Implicit<D> {
 /// weakly supported nodes tied to their neighbours. `mpm bench` reports it.
 pub fn unknowns<const D: usize>(m: &Model<D>, shape: ShapeFunction, s: &SolverConfig) -> usize {
     let (mut st, mut map) = (Stencils::<D>::default(), NodeMap::default());
-    let mut contact = contact::PenaltyContact::new(m);
-    step::step_stencils(m, shape, contact.as_mut(), &mut st, &mut map);
-    number_unknowns(m, &st, &map, contact.as_ref(), s.min_node_support())
+    let (mut grid, _) = terms::list::step_terms(m);
+    grid.build(m, shape, &mut st, &mut map);
+    number_unknowns(m, &st, &map, grid.node_fields(), s.min_node_support())
         .1
         .free
 }
@@ -204,11 +203,11 @@ impl<const D: usize> Stepper<D> for Implicit<D> {
     }
 
     fn take_contact(&mut self) -> Vec<PairTotal<D>> {
-        (self.system.contact.as_mut()).map_or_else(Vec::new, |c| c.take_totals())
+        self.system.take_pair_totals()
     }
 
     fn contact_forces(&self, particles: usize) -> Option<Vec<Vector<D>>> {
-        (self.system.contact.as_ref()).map(|c| c.particle_forces(particles))
+        self.system.particle_forces(particles)
     }
 
     fn take_newton_rows(&mut self) -> Vec<NewtonRow> {
@@ -242,7 +241,7 @@ impl<const D: usize> Stepper<D> for Implicit<D> {
             }),
             beta: newmark.then_some(self.settings.newmark.beta),
             gamma: newmark.then_some(self.settings.newmark.gamma),
-            contact_penetration: self.system.contact.as_ref().map(|c| c.deepest),
+            contact_penetration: self.system.report().contact_penetration,
             multigrid: self.newton.krylov().and_then(|k| {
                 use PreconditionerKind::{LaggedMultigrid, Multigrid};
                 matches!(k.config.preconditioner, Multigrid | LaggedMultigrid)
@@ -251,12 +250,13 @@ impl<const D: usize> Stepper<D> for Implicit<D> {
         }
     }
 
-    /// The Newmark accelerations and the counts. The lagged_direct
-    /// preconditioner's factorization is not saved: a restarted solver factorizes
-    /// afresh at its first Krylov solve (docs/robustness.md).
+    /// The Newmark accelerations, the counts and what the step's terms carry.
+    /// The lagged_direct preconditioner's factorization is not saved: a
+    /// restarted solver factorizes afresh at its first Krylov solve
+    /// (docs/robustness.md).
     fn state(&self) -> SolverState {
         let krylov = self.newton.krylov();
-        SolverState {
+        let mut state = SolverState {
             acceleration: self.accel.iter().flat_map(|a| a.iter().copied()).collect(),
             newton_iterations: self.newton.iterations,
             cutbacks: self.cutbacks,
@@ -265,12 +265,12 @@ impl<const D: usize> Stepper<D> for Implicit<D> {
             direct: self
                 .direct_solver()
                 .map_or_else(Default::default, |d| d.statistics()),
-            contact_tangential: (self.system.contact.as_ref())
-                .map_or_else(Vec::new, |c| c.tangential_state()),
-            contact_points: (self.system.contact.as_ref())
-                .map_or_else(Vec::new, |c| c.carried_points()),
+            contact_tangential: Vec::new(),
+            contact_points: Vec::new(),
             multigrid: krylov.map_or_else(Default::default, |k| k.multigrid_counts),
-        }
+        };
+        self.system.save_terms(&mut state);
+        state
     }
 
     fn restore(&mut self, s: &SolverState) {
@@ -279,7 +279,7 @@ impl<const D: usize> Stepper<D> for Implicit<D> {
             .collect();
         self.newton.iterations = s.newton_iterations;
         self.cutbacks = s.cutbacks;
-        self.restored_contact = Some((s.contact_tangential.clone(), s.contact_points.clone()));
+        self.restored = Some(s.clone());
         match &mut self.newton.linear {
             newton::Linear::Krylov(k) => {
                 k.iterations = s.krylov_iterations;

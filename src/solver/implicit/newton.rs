@@ -148,7 +148,7 @@ impl Newton {
                 krylov_iterations: 0,
                 forcing: f64::NAN,
             };
-            let floor = sys.contact.as_ref().map_or(0.0, |c| c.residual_floor());
+            let floor = sys.residual_floor();
             if test.converged(iteration, r_norm, reference, floor) {
                 self.log.push(row);
                 return Ok(Converged { u, reaction });
@@ -158,7 +158,8 @@ impl Newton {
                 break;
             }
             // Correction K δu = −r (2-38): the assembled tangent (2-40) and the direct
-            // solver, or matrix-free Krylov (2-39) to the forcing term.
+            // solver, or matrix-free Krylov (2-39) to the forcing term, both at u.
+            debug_assert!(sys.iterate() == u.as_slice(), "the tangent is taken at u");
             let krylov_before = self.krylov_iterations();
             let correction = match &mut self.linear {
                 Linear::Direct(solver) => {
@@ -257,9 +258,9 @@ impl Convergence {
     }
 
     /// Has iteration `iteration`, whose residual norm is `r_norm`, converged?
-    /// `floor` is the round-off the residual cannot go below (the penalty
-    /// contact's, `PenaltyContact::residual_floor`): within `ROUND_OFF_MARGIN`
-    /// of it the residual counts as converged.
+    /// `floor` is the round-off the residual cannot go below (the step's
+    /// terms', `StepSystem::residual_floor`: the penalty contact's): within
+    /// `ROUND_OFF_MARGIN` of it the residual counts as converged.
     fn converged(&mut self, iteration: usize, r_norm: f64, reference: f64, floor: f64) -> bool {
         let tolerance = (self.residual_tolerance * reference).max(ROUND_OFF_MARGIN * floor);
         let residual_ok = r_norm <= tolerance || r_norm == 0.0;

@@ -1,19 +1,23 @@
 //! The residual of one implicit step and its derivative, at the active nodes:
 //!
-//!   r(u) = M (u − ũ)/(βΔt²) + f_int(u) − f_ext − f_abs(u)   (thesis 2-37)
+//!   r(u) = M (u − ũ)/(βΔt²) + f_int(u) − f_ext + Σ_terms r_term(u)   (thesis 2-37)
 //!
 //! with u the nodal displacement increments, M lumped or consistent (no inertia
 //! when quasi-static), f_int the internal force of the relative first
 //! Piola-Kirchhoff stress of the trial state at u on the step-start volumes (the
 //! stresses always recomputed from the step-start state, `Trial`), f_ext the
-//! external force at t + Δt and f_abs the dashpots and springs of absorbing faces
-//! (2-63). At the prescribed components r is the reaction. The consistent
-//! tangent K = ∂r/∂u (2-40) is assembled over the unknowns from the terms of
-//! `assembly`.
+//! external force at t + Δt, and the optional terms of the step
+//! (`super::terms`: the absorbing faces' dashpots and springs −f_abs(u) (2-63),
+//! contact; a linear domain stress is part of f_int). At the prescribed
+//! components r is the reaction. The consistent tangent K = ∂r/∂u (2-40) is
+//! assembled over the unknowns from the terms of `assembly` and the step's
+//! terms.
+//!
+//! [`residual`] makes u the step's iterate (the trial state and the terms'
+//! states are kept there, for the tangent and the commit); [`probe_residual`]
+//! evaluates r elsewhere (a difference product) and changes nothing.
 
-use super::assembly::absorbing::add_absorbing;
 use super::assembly::fbar::add_fbar_stiffness;
-use super::assembly::linear_stress::add_linear_stress_stiffness;
 use super::assembly::mass::{add_consistent_mass, add_lumped_mass};
 use super::assembly::stiffness::{
     add_stiffness, hoop_symmetric, major_symmetric, particle_tangents, relative_pk1,
@@ -22,7 +26,8 @@ use super::assembly::stiffness::{
 use super::assembly::{Pattern, Storage, Tangent};
 use super::failure::Failure;
 use super::step::StepSystem;
-use crate::dim::Vector;
+use super::terms::StepView;
+use crate::dim::{Mat3, Vector};
 use crate::model::conditions::Constraint;
 use crate::model::particles::Particles;
 use crate::model::Model;
@@ -32,7 +37,8 @@ use crate::scene::MassMatrix;
 use crate::solver::linear::direct::Ordering;
 use rayon::prelude::*;
 
-/// r(u) at the active nodes; evaluates the particles' trial state at u.
+/// r(u) at the active nodes, u made the step's iterate: the particles' trial
+/// state and every term's state are evaluated at u and kept.
 pub fn residual<const D: usize>(
     m: &Model<D>,
     sys: &mut StepSystem<D>,
@@ -41,36 +47,85 @@ pub fn residual<const D: usize>(
     let p = &m.particles;
     let (st, map) = (&sys.stencils, &sys.map);
     if let Some(q) = sys.trial.evaluate(p, &m.materials, st, map, u, sys.dt) {
-        return Err(Failure {
-            particle: Some(q),
-            message: "inverted (det F ≤ 0) in a Newton iterate".into(),
-        });
+        return Err(inverted(q));
     }
     let pk1: Vec<_> = (0..p.len())
         .into_par_iter()
         .with_min_len(MIN_PARALLEL_LEN)
         .map(|q| relative_pk1(&sys.trial.df(st, map, q), &sys.trial.stress.get(q)))
         .collect();
-    let mut f_int = internal_force(map, st, &p.volume, &pk1);
-    // A stress linear within each particle domain (`solver::implicit::stress_gradient`).
-    if let Some(linear) = &sys.linear_stress {
-        let f_linear = linear.force(map, st, &p.volume, &pk1);
-        f_int.iter_mut().zip(f_linear).for_each(|(f, g)| *f += g);
+    let mut r = material_residual(m, sys, u, &pk1);
+    let StepSystem {
+        stencils,
+        map,
+        dofs,
+        grid,
+        dt,
+        terms,
+        ..
+    } = sys;
+    let step = StepView {
+        m,
+        stencils,
+        map,
+        dofs,
+        grid,
+        dt: *dt,
+    };
+    for t in terms.iter_mut() {
+        t.evaluate(&step, u, &mut r);
+    }
+    Ok(r)
+}
+
+/// r(u) at a u that is not the iterate (a difference product, 2-39): the
+/// trial state and the terms' states stay at the iterate.
+pub fn probe_residual<const D: usize>(
+    m: &Model<D>,
+    sys: &StepSystem<D>,
+    u: &[Vector<D>],
+) -> Result<Vec<Vector<D>>, Failure> {
+    let p = &m.particles;
+    let (st, map) = (&sys.stencils, &sys.map);
+    let pk1 = (sys.trial)
+        .probe(p, &m.materials, st, map, u, sys.dt, relative_pk1)
+        .map_err(inverted)?;
+    let mut r = material_residual(m, sys, u, &pk1);
+    let step = sys.view(m);
+    for t in &sys.terms {
+        t.probe(&step, u, &mut r);
+    }
+    Ok(r)
+}
+
+/// The failure of an iterate at which particle q inverts.
+fn inverted(q: usize) -> Failure {
+    Failure {
+        particle: Some(q),
+        message: "inverted (det F ≤ 0) in a Newton iterate".into(),
+    }
+}
+
+/// M (u − ũ)/(βΔt²) + f_int − f_ext from the particles' stress measure `pk1`
+/// at u: the residual but the terms' parts outside the internal force.
+fn material_residual<const D: usize>(
+    m: &Model<D>,
+    sys: &StepSystem<D>,
+    u: &[Vector<D>],
+    pk1: &[Mat3],
+) -> Vec<Vector<D>> {
+    let p = &m.particles;
+    let (st, map) = (&sys.stencils, &sys.map);
+    let mut f_int = internal_force(map, st, &p.volume, pk1);
+    let step = sys.view(m);
+    for t in &sys.terms {
+        t.add_internal_force(&step, pk1, &mut f_int);
     }
     let w: Vec<Vector<D>> = u.iter().zip(&sys.u_tilde).map(|(a, b)| a - b).collect();
     let f_inertia = inertial_force(p, sys, &w);
-    let mut r: Vec<Vector<D>> = (0..u.len())
+    (0..u.len())
         .map(|a| f_inertia[a] + f_int[a] - sys.f_ext[a])
-        .collect();
-    // Absorbing faces: − f_boundary(u), dashpots through v_{n+1}(u) (2-63).
-    sys.absorbing.add_residual(map, st, p, u, &mut r);
-    // Contact: r_I −= S_Ip f_p with rigid bodies, r_a −= c_a f between the
-    // surfaces of deformable bodies (`super::contact`).
-    if let Some(contact) = sys.contact.as_mut() {
-        contact.evaluate(m, st, map, u);
-        contact.add_residual(map, st, &mut r);
-    }
-    Ok(r)
+        .collect()
 }
 
 /// M w / (βΔt²) at the active nodes (lumped or consistent M; zero when
@@ -104,11 +159,11 @@ pub fn reactions<const D: usize>(constraint: &[Constraint<D>], r: &[Vector<D>]) 
         .collect()
 }
 
-/// K = ∂r/∂u at the trial state over the unknowns (2-40): the stiffness of the
-/// particles (2-41, 2-42; with F-bar if on), the absorbing faces' dashpots and
-/// springs, and the inertia; and whether K is symmetric. `numerical` lets
-/// materials without an analytic tangent use a numerical one (Krylov
-/// preconditioners only).
+/// K = ∂r/∂u at the step's iterate over the unknowns (2-40): the stiffness of
+/// the particles at the trial state (2-41, 2-42; with F-bar if on), the step's
+/// terms at their states (`super::terms`), and the inertia; and whether K is
+/// symmetric. `numerical` lets materials without an analytic tangent use a
+/// numerical one (Krylov preconditioners only).
 pub fn tangent<'s, const D: usize>(
     m: &Model<D>,
     sys: &'s StepSystem<D>,
@@ -119,11 +174,9 @@ pub fn tangent<'s, const D: usize>(
     let a = particle_tangents(m, &sys.trial, &sys.stencils, &sys.map, numerical)?;
     let fbar = sys.trial.fbar.as_ref();
     let pattern = step_pattern(sys);
-    // Symmetric unless F-bar or a non-associated material breaks it.
-    let contact = sys.contact.as_ref();
+    // Symmetric unless F-bar, a non-associated material or a term breaks it.
     let symmetric = fbar.is_none()
-        && sys.linear_stress.is_none()
-        && contact.is_none_or(|c| c.symmetric())
+        && sys.terms.iter().all(|t| t.symmetric())
         && (a.values)
             .par_chunks(ParticleTangents::<D>::LEN)
             .enumerate()
@@ -150,13 +203,10 @@ pub fn tangent<'s, const D: usize>(
         None => add_stiffness(&mut k, pattern, map, st, dofs, &p.volume, &a),
         Some(state) => add_fbar_stiffness(&mut k, pattern, map, st, dofs, &p.volume, state, &a),
     }
-    // Absorbing faces: Σ S_I S_J (γ/(βΔt) C + K), symmetric.
-    if let Some(linear) = &sys.linear_stress {
-        add_linear_stress_stiffness(&mut k, pattern, map, st, dofs, &p.volume, &a, linear);
-    }
-    add_absorbing(&mut k, &sys.absorbing, pattern, map, st, dofs);
-    if let Some(contact) = contact {
-        contact.add_tangent(&mut k, pattern, map, st, dofs);
+    // The step's terms (absorbing faces, contact, a linear domain stress).
+    let step = sys.view(m);
+    for t in &sys.terms {
+        t.add_tangent(&step, &a, &mut k);
     }
     if sys.inertia > 0.0 {
         match sys.mass_matrix {
@@ -173,10 +223,11 @@ pub fn tangent<'s, const D: usize>(
 /// step, or kept from the previous step).
 pub fn step_pattern<const D: usize>(sys: &StepSystem<D>) -> &Pattern {
     let cells = sys.trial.fbar.as_ref().map(|f| &f.cells);
-    let fit = sys.linear_stress.as_ref().map(|l| &l.fit);
-    let coupled = (sys.contact.as_ref()).map_or_else(Vec::new, |c| c.coupled_nodes());
-    (sys.pattern)
-        .get_or_init(|| Pattern::new(&sys.map, &sys.stencils, &sys.dofs, cells, fit, &coupled))
+    (sys.pattern).get_or_init(|| {
+        let c = sys.couplings();
+        let (map, st, dofs) = (&sys.map, &sys.stencils, &sys.dofs);
+        Pattern::new(map, st, dofs, cells, c.neighbours, &c.node_pairs)
+    })
 }
 
 /// The fill-reducing ordering for the factorization of the tangent `k` of

@@ -1,35 +1,38 @@
 //! One implicit step around its Newton iteration (thesis §2.2.2).
 //!
 //! [`StepSettings::prepare`] sets up everything of the step t → t + Δt that does
-//! not depend on the iterate: the shape functions at the step-start positions
-//! (updated Lagrangian), the conditions and unknowns of the active nodes (weakly
-//! supported nodes tied to their neighbours and the natural end condition of cubic
-//! B-splines at faces with prescribed velocities, `super::ties`), the lumped mass, the
-//! external force at t + Δt, the Newmark predictor ũ (2-36) and the absorbing
-//! faces of the step. Quasi-static steps scale gravity and loads with the load
+//! not depend on the iterate: the step's grid at the step-start positions
+//! (updated Lagrangian; `super::grid`), the conditions and unknowns of the active
+//! nodes (weakly supported nodes tied to their neighbours and the natural end
+//! condition of cubic B-splines at faces with prescribed velocities,
+//! `super::ties`), the lumped mass, the external force at t + Δt, the Newmark
+//! predictor ũ (2-36), and then every optional term of the step
+//! (`super::terms`). Quasi-static steps scale gravity and loads with the load
 //! factor λ = (t − t_start) / duration and have no inertia. Newmark starts from
 //! the particle accelerations of M a = f_ext − f_int at the first step.
 //! [`StepSettings::commit`] makes the converged increment the particles' state.
 
 use super::assembly::{Dofs, Pattern};
-use super::contact::PenaltyContact;
+use super::grid::StepGrid;
 use super::newmark::Newmark;
-use super::ties::{merge, natural_end_ties, nodal_support, ties};
+use super::terms::list::step_terms;
+use super::terms::{Couplings, Restore, StepStart, StepTerm, StepView, TermReport};
+use super::ties::{merge, natural_end_ties, nodal_support, ties, NodeFields};
 use crate::dim::Vector;
 use crate::model::conditions::Constraint;
 use crate::model::loads::LoadTime;
 use crate::model::{load_factor, Model};
 use crate::parallel::MIN_PARALLEL_LEN;
-use crate::physics::boundary::absorbing::{self, AbsorbingStep};
 use crate::physics::boundary::conditions::implicit_node_constraint;
+use crate::physics::contact::totals::PairTotal;
 use crate::physics::kinematics::deformation::Trial;
-use crate::physics::shape::{domain_corner_mean, ShapeFunction, Stencils};
+use crate::physics::shape::{ShapeFunction, Stencils};
 use crate::physics::transfer::{
     applied_force, external_force, interpolate, mass_average, mass_momentum, mass_weighted,
-    nodal_force, stencils, NodeMap,
+    nodal_force, NodeMap,
 };
 use crate::scene::{DirectOrdering, Integrator, MassMatrix, SolverConfig};
-use crate::solver::implicit::stress_gradient::LinearStress;
+use crate::solver::stepper::SolverState;
 use rayon::prelude::*;
 use std::sync::OnceLock;
 
@@ -56,10 +59,12 @@ pub struct StepSettings {
 }
 
 /// One step's nonlinear system r(u) = 0 (2-37): the parts that do not depend on
-/// the iterate u, and the particles' trial state at the latest iterate (which
-/// the residual evaluates). The solver keeps it between steps so that the
-/// stencils, the node map and the trial state reuse their buffers; the rest is
-/// set anew by `prepare`.
+/// the iterate u, and the evaluation at the iterate, the u of the last
+/// `residual` call (`StepSystem::iterate`): the particles' trial state there
+/// and every term's state (`super::terms`, the rule). The solver keeps it
+/// between steps so that the stencils, the node map, the trial state and the
+/// terms reuse their buffers and carry their state; the rest is set anew by
+/// `prepare`.
 #[derive(Clone, Debug)]
 pub struct StepSystem<const D: usize> {
     /// The step t → t + dt.
@@ -82,23 +87,24 @@ pub struct StepSystem<const D: usize> {
     pub u_tilde: Vec<Vector<D>>,
     /// 1/(βΔt²), or 0 when quasi-static.
     pub inertia: f64,
-    /// Absorbing faces within the step (empty when the scene has none).
-    pub absorbing: AbsorbingStep<D>,
     /// Load factors at the end of the step: gravity, and each load ramp.
     pub g_new: f64,
     pub scales_new: Vec<f64>,
-    /// The particles' state at the latest iterate.
+    /// The particles' state at the iterate.
     pub trial: Trial<D>,
     /// The fill-reducing ordering of the direct factorizations.
     pub direct_ordering: DirectOrdering,
     /// The tangent's sparsity pattern (built at the step's first assembly, kept
     /// for the next step if it fits).
     pub pattern: OnceLock<Pattern>,
-    /// Contact with rigid bodies (None in a scene without).
-    pub contact: Option<PenaltyContact<D>>,
-    /// The linear domain stress of the step-start configuration (None unless
-    /// `[grid] domain_stress = "linear"`).
-    pub linear_stress: Option<LinearStress<D>>,
+    /// Which particles the step's grid carries and which nodes the bodies
+    /// share (set up with the terms).
+    pub grid: StepGrid,
+    /// The optional terms of r and K, in the order they add in (set up at the
+    /// first `prepare`, `terms::list`).
+    pub terms: Vec<Box<dyn StepTerm<D>>>,
+    /// Whether the grid and the terms are set up.
+    set_up: bool,
 }
 
 impl<const D: usize> StepSystem<D> {
@@ -117,23 +123,94 @@ impl<const D: usize> StepSystem<D> {
             a_n: Vec::new(),
             u_tilde: Vec::new(),
             inertia: 0.0,
-            absorbing: AbsorbingStep::default(),
             g_new: 0.0,
             scales_new: Vec::new(),
             trial: Trial::default(),
             direct_ordering: DirectOrdering::Auto,
             pattern: OnceLock::new(),
-            contact: None,
-            linear_stress: None,
+            grid: StepGrid::default(),
+            terms: Vec::new(),
+            set_up: false,
         }
     }
 
-    /// The contact of model m, set up on first use (None in a scene without).
-    pub fn contact_of(&mut self, m: &Model<D>) -> Option<&mut PenaltyContact<D>> {
-        if self.contact.is_none() && m.contact.is_some() {
-            self.contact = PenaltyContact::new(m);
+    /// Set up the step's grid and terms for model m, once.
+    pub fn set_up(&mut self, m: &Model<D>) {
+        if !self.set_up {
+            (self.grid, self.terms) = step_terms(m);
+            self.set_up = true;
         }
-        self.contact.as_mut()
+    }
+
+    /// The step as the terms see it.
+    pub fn view<'a>(&'a self, m: &'a Model<D>) -> StepView<'a, D> {
+        StepView {
+            m,
+            stencils: &self.stencils,
+            map: &self.map,
+            dofs: &self.dofs,
+            grid: &self.grid,
+            dt: self.dt,
+        }
+    }
+
+    /// The iterate: the nodal displacement increments u of the last
+    /// `residual` call, at which the trial state and the terms' states are.
+    pub fn iterate(&self) -> &[Vector<D>] {
+        self.trial.displacements()
+    }
+
+    /// What the terms couple beyond the stencils, together.
+    pub fn couplings(&self) -> Couplings<'_, D> {
+        let mut all = Couplings::default();
+        for c in self.terms.iter().map(|t| t.couplings()) {
+            all.node_pairs.extend(c.node_pairs);
+            if let Some(n) = c.neighbours {
+                assert!(all.neighbours.is_none(), "two terms with neighbour lists");
+                all.neighbours = Some(n);
+            }
+        }
+        all
+    }
+
+    /// The round-off floor of ‖r‖ at the iterate: the terms' in quadrature.
+    pub fn residual_floor(&self) -> f64 {
+        (self.terms.iter()).fold(0.0, |floor, t| floor.hypot(t.residual_floor()))
+    }
+
+    /// What the terms report.
+    pub fn report(&self) -> TermReport {
+        let mut report = TermReport::default();
+        self.terms.iter().for_each(|t| t.report(&mut report));
+        report
+    }
+
+    /// The terms' pair totals since the last call (contact.csv; empty
+    /// without contact).
+    pub fn take_pair_totals(&mut self) -> Vec<PairTotal<D>> {
+        let mut totals = Vec::new();
+        (self.terms.iter_mut()).for_each(|t| t.take_pair_totals(&mut totals));
+        totals
+    }
+
+    /// The terms' contact force on each of `n` particles at the iterate, if
+    /// any term has such forces.
+    pub fn particle_forces(&self, n: usize) -> Option<Vec<Vector<D>>> {
+        let mut forces = vec![Vector::<D>::zeros(); n];
+        let any =
+            (self.terms.iter()).fold(false, |any, t| t.add_particle_forces(&mut forces) | any);
+        any.then_some(forces)
+    }
+
+    /// What the terms carry across steps, into a checkpoint's `state`.
+    pub fn save_terms(&self, state: &mut SolverState) {
+        self.terms.iter().for_each(|t| t.save(state));
+    }
+
+    /// Continue the terms from a checkpoint's `state` (after `set_up`).
+    pub fn restore_terms(&mut self, state: &SolverState) {
+        let mut from = Restore::new(state);
+        self.terms.iter_mut().for_each(|t| t.restore(&mut from));
     }
 }
 
@@ -186,27 +263,18 @@ impl StepSettings {
         dt: f64,
     ) {
         let p = &m.particles;
-        sys.contact_of(m);
-        let contact = sys.contact.as_mut();
-        step_stencils(m, self.shape, contact, &mut sys.stencils, &mut sys.map);
-        if let Some(contact) = sys.contact.as_mut() {
-            contact.start_step(m, self.shape, &sys.stencils, &sys.map, dt);
-        }
+        sys.set_up(m);
+        sys.grid
+            .build(m, self.shape, &mut sys.stencils, &mut sys.map);
         if self.fbar {
             sys.trial.use_fbar(&m.grid, &p.x);
         }
         if self.dynamic() && accel.len() != p.len() {
-            *accel = self.initial_acceleration(m, &sys.stencils, &sys.map);
+            *accel = self.initial_acceleration(m, sys);
         }
-        sys.linear_stress = m
-            .linear_domain_stress
-            .then(|| LinearStress::new(self.shape, &m.grid, p, &sys.stencils));
         let (st, map) = (&sys.stencils, &sys.map);
-        let contact = sys.contact.as_ref();
-        let (constraint, dofs) = number_unknowns(m, st, map, contact, self.min_node_support);
-        if let Some(contact) = sys.contact.as_mut() {
-            contact.drop_tied_meetings(&dofs);
-        }
+        let fields = sys.grid.node_fields();
+        let (constraint, dofs) = number_unknowns(m, st, map, fields, self.min_node_support);
         let n = map.len();
 
         // External force at the end of the step; inertia terms: the Newmark
@@ -234,7 +302,6 @@ impl StepSettings {
         } else {
             (vec![Vector::<D>::zeros(); n], vec![Vector::<D>::zeros(); n])
         };
-        sys.absorbing = self.absorbing_step(m, &u_tilde, &a_n, dt);
         sys.inertia = if self.dynamic() {
             self.newmark.inertia(dt)
         } else {
@@ -243,18 +310,6 @@ impl StepSettings {
         sys.t = t;
         sys.dt = dt;
         sys.constraint = constraint;
-        // The previous step's pattern, ordering and (in the direct solver) symbolic
-        // factorization serve again when no stencil, constraint or tie changed.
-        let cells = sys.trial.fbar.as_ref().map(|f| &f.cells);
-        let fit = sys.linear_stress.as_ref().map(|l| &l.fit);
-        let coupled = (sys.contact.as_ref()).map_or_else(Vec::new, |c| c.coupled_nodes());
-        let kept = std::mem::take(&mut sys.pattern)
-            .into_inner()
-            .filter(|pattern| pattern.fits(st, &dofs, cells, fit, &coupled));
-        sys.pattern = OnceLock::new();
-        if let Some(pattern) = kept {
-            let _ = sys.pattern.set(pattern);
-        }
         sys.dofs = dofs;
         sys.direct_ordering = self.direct_ordering;
         sys.mass = mass;
@@ -263,40 +318,69 @@ impl StepSettings {
         sys.u_tilde = u_tilde;
         sys.g_new = g_new;
         sys.scales_new = scales_new;
+        self.begin_terms(m, sys);
+        // The previous step's pattern, ordering and (in the direct solver) symbolic
+        // factorization serve again when no stencil, constraint, tie or coupling
+        // changed.
+        let last = std::mem::take(&mut sys.pattern).into_inner();
+        let cells = sys.trial.fbar.as_ref().map(|f| &f.cells);
+        let couplings = sys.couplings();
+        let (st, dofs, neighbours) = (&sys.stencils, &sys.dofs, couplings.neighbours);
+        let kept =
+            last.filter(|pattern| pattern.fits(st, dofs, cells, neighbours, &couplings.node_pairs));
+        if let Some(pattern) = kept {
+            let _ = sys.pattern.set(pattern);
+        }
     }
 
-    /// The particles' displacements over the step: Σ_I S_Ip u_I; with a linear
-    /// domain stress, the mean of u at the corners of the step-start domain,
-    /// as CPDI moves its particles, so that the domains keep tiling the body
-    /// (the domain average moves a domain's centre by δ²u''/24 off its
-    /// corners' mean, which opens gaps and overlaps of O(h²) at the faces;
-    /// docs/accuracy.md).
+    /// Begin every term of the step (its stencils, unknowns and predictor are
+    /// set).
+    fn begin_terms<const D: usize>(&self, m: &Model<D>, sys: &mut StepSystem<D>) {
+        let StepSystem {
+            stencils,
+            map,
+            dofs,
+            grid,
+            dt,
+            u_tilde,
+            a_n,
+            terms,
+            ..
+        } = sys;
+        let step = StepView {
+            m,
+            stencils,
+            map,
+            dofs,
+            grid,
+            dt: *dt,
+        };
+        let start = StepStart {
+            shape: self.shape,
+            newmark: self.dynamic().then_some(&self.newmark),
+            u_tilde,
+            a_n,
+        };
+        terms.iter_mut().for_each(|t| t.begin_step(&step, &start));
+    }
+
+    /// The particles' displacements over the step: Σ_I S_Ip u_I, or as a term
+    /// moves them (a linear domain stress).
     fn particle_displacements<const D: usize>(
         &self,
         m: &Model<D>,
         sys: &StepSystem<D>,
         u: &[Vector<D>],
     ) -> Vec<Vector<D>> {
-        let (p, map, st) = (&m.particles, &sys.map, &sys.stencils);
-        (0..p.len())
+        let step = sys.view(m);
+        if let Some(dx) = (sys.terms.iter()).find_map(|t| t.particle_displacements(&step, u)) {
+            return dx;
+        }
+        let (map, st) = (&sys.map, &sys.stencils);
+        (0..m.particles.len())
             .into_par_iter()
             .with_min_len(crate::parallel::MIN_PARALLEL_LEN)
-            .map(|q| match sys.linear_stress.is_some() && st.count[q] > 0 {
-                false => interpolate(map, st, q, u),
-                true => {
-                    let value = |n: u32| u[map.local[n as usize] as usize];
-                    let shape = self.shape;
-                    domain_corner_mean(
-                        shape,
-                        &m.grid,
-                        &p.x[q],
-                        &p.half_length0[q],
-                        &p.f.get(q),
-                        value,
-                    )
-                    .expect("a linear domain stress on a box domain")
-                }
-            })
+            .map(|q| interpolate(map, st, q, u))
             .collect()
     }
 
@@ -304,16 +388,17 @@ impl StepSettings {
     fn initial_acceleration<const D: usize>(
         &self,
         m: &Model<D>,
-        st: &Stencils<D>,
-        map: &NodeMap,
+        sys: &StepSystem<D>,
     ) -> Vec<Vector<D>> {
-        let p = &m.particles;
+        let (p, st, map) = (&m.particles, &sys.stencils, &sys.map);
         let (g, scales) = self.load_factors(m, self.t_start);
         let load = |q: usize| load_factor(&m.load_ramp_of, q, &scales);
         let mut force = nodal_force(map, st, p, &(m.gravity * g), &load);
         let (mass, momentum) = mass_momentum(map, st, p, None);
         let v = mass_average(&mass, &momentum);
-        absorbing::add_force(&m.absorbing, &m.grid, p, map, st, &v, &mut force);
+        for t in &sys.terms {
+            t.add_initial_force(m, st, map, &v, &mut force);
+        }
         let a: Vec<Vector<D>> = force
             .iter()
             .zip(&mass)
@@ -322,42 +407,11 @@ impl StepSettings {
         (0..p.len()).map(|q| interpolate(map, st, q, &a)).collect()
     }
 
-    /// The absorbing faces of this step: layer particles at the step start, and
-    /// their velocity as a function of u through Newmark (none when quasi-static).
-    fn absorbing_step<const D: usize>(
-        &self,
-        m: &Model<D>,
-        u_tilde: &[Vector<D>],
-        a_n: &[Vector<D>],
-        dt: f64,
-    ) -> AbsorbingStep<D> {
-        let layer = absorbing::layer(&m.absorbing, &m.grid, &m.particles);
-        if layer.is_empty() {
-            return AbsorbingStep::default();
-        }
-        let n = a_n.len();
-        let nm = &self.newmark;
-        let (velocity_offset, rate) = if self.dynamic() {
-            (
-                (0..n)
-                    .map(|a| nm.end_velocity(dt, &Vector::<D>::zeros(), &u_tilde[a], &a_n[a]))
-                    .collect(),
-                nm.velocity_rate(dt),
-            )
-        } else {
-            (vec![Vector::<D>::zeros(); n], 0.0)
-        };
-        AbsorbingStep {
-            layer,
-            velocity_offset,
-            rate,
-        }
-    }
-
     /// Make the converged increment u the particles' state: the stresses of the
-    /// converged iterate (the last residual evaluation), positions, and the Newmark
-    /// update of velocities and accelerations. Returns the work of gravity and
-    /// applied loads over the step.
+    /// converged iterate (`StepSystem::iterate`, which is u), positions, the
+    /// terms' carried state, and the Newmark update of velocities and
+    /// accelerations. Returns the work of gravity and applied loads over the
+    /// step.
     pub fn commit<const D: usize>(
         &self,
         m: &mut Model<D>,
@@ -365,11 +419,18 @@ impl StepSettings {
         u: &[Vector<D>],
         accel: &mut [Vector<D>],
     ) -> f64 {
+        debug_assert!(sys.iterate() == u, "the converged u is the iterate");
         let dt = sys.dt;
         let (g_old, scales_old) = self.load_factors(m, sys.t);
         let load_old = |q: usize| load_factor(&m.load_ramp_of, q, &scales_old);
         let load_new = |q: usize| load_factor(&m.load_ramp_of, q, &sys.scales_new);
         let dx = self.particle_displacements(m, sys, u);
+        // The terms keep what they carry, seeing the step-start model (taken
+        // out of `sys` while the view borrows it).
+        let mut terms = std::mem::take(&mut sys.terms);
+        let step = sys.view(m);
+        terms.iter_mut().for_each(|t| t.commit(&step, u));
+        sys.terms = terms;
         let p = &mut m.particles;
         sys.trial.commit(p, &sys.stencils, &sys.map);
         let (map, st) = (&sys.map, &sys.stencils);
@@ -383,9 +444,7 @@ impl StepSettings {
         for (x, d) in p.x.iter_mut().zip(&dx) {
             *x += d;
         }
-        if let Some(contact) = sys.contact.as_mut() {
-            contact.commit(p, dt);
-        }
+        sys.grid.move_rigid(p, dt);
         if self.dynamic() {
             let n = map.len();
             let (u_tilde, a_n) = (&sys.u_tilde, &sys.a_n);
@@ -407,32 +466,13 @@ impl StepSettings {
     }
 }
 
-/// The particles' stencils at the step start and the active nodes they touch;
-/// with contact, rigid bodies' particles stay off the grid and deformable
-/// bodies in contact get nodes of their own (`PenaltyContact::stencils`).
-pub fn step_stencils<const D: usize>(
-    m: &Model<D>,
-    shape: ShapeFunction,
-    contact: Option<&mut PenaltyContact<D>>,
-    st: &mut Stencils<D>,
-    map: &mut NodeMap,
-) {
-    match contact {
-        Some(contact) => contact.stencils(m, shape, st, map),
-        None => {
-            stencils(m, shape, st);
-            map.build(st, m.grid.node_count());
-        }
-    }
-}
-
 /// The conditions at the active nodes and the numbering of the unknowns: the
 /// free components, weakly supported nodes tied to their neighbours.
 pub fn number_unknowns<const D: usize>(
     m: &Model<D>,
     st: &Stencils<D>,
     map: &NodeMap,
-    contact: Option<&PenaltyContact<D>>,
+    fields: Option<&NodeFields>,
     min_node_support: f64,
 ) -> (Vec<Constraint<D>>, Dofs) {
     let constraint: Vec<Constraint<D>> = map
@@ -443,7 +483,6 @@ pub fn number_unknowns<const D: usize>(
         .map(|(a, _)| implicit_node_constraint(&m.grid, &m.faces, &m.friction, map.grid_node(a)))
         .collect();
     let support = nodal_support(map, st, &m.particles.volume, m.grid.cell_volume());
-    let fields = contact.and_then(|c| c.node_fields());
     let weak = ties(
         &m.grid,
         map,

@@ -75,7 +75,8 @@ fn tangent_error_of<const D: usize>(
     );
     solver.prepare(&m, 0.0, 0.01);
     let sys = &mut solver.system;
-    assert_eq!(sys.absorbing.is_empty(), !absorbing);
+    let layer = crate::physics::boundary::absorbing::layer(&m.absorbing, &m.grid, &m.particles);
+    assert_eq!(layer.is_empty(), !absorbing);
     // A smooth, finite-strain iterate (strains of a few per cent).
     let nodes: Vec<usize> = (0..sys.map.len()).map(|a| sys.map.grid_node(a)).collect();
     let mut u: Vec<Vector<D>> = nodes
@@ -93,8 +94,7 @@ fn tangent_error_of<const D: usize>(
         .collect();
     // With contact between deformable bodies, the nodes of the second body are
     // pushed into the first (`SHIFT`).
-    let contact = sys.contact.as_ref();
-    if let Some(fields) = contact.and_then(|c| c.node_fields()) {
+    if let Some(fields) = sys.grid.node_fields() {
         let shift = SHIFT.with(|s| s.get());
         for (a, u_a) in u.iter_mut().enumerate() {
             if fields.field(a) > 0 {
@@ -115,9 +115,9 @@ fn tangent_error_of<const D: usize>(
     let n = dofs.free;
     let mut k = vec![0.0; n * n];
     let kt = tangent(&m, sys, false).unwrap();
-    if let Some(c) = &sys.contact {
-        let (stick, slip) = c.stick_and_slip();
-        CONTACTS.with(|x| x.set((stick, slip)));
+    let report = sys.report();
+    if report.contact_penetration.is_some() {
+        CONTACTS.with(|x| x.set((report.sticking, report.slipping)));
     }
     let km = kt.matrix();
     for c in 0..n {
@@ -230,7 +230,7 @@ fn global_tangent_matches_finite_differences_of_the_residual() {
 }
 
 /// Two rigid bodies pressed into the block: a disk on its top and a box at its
-/// right side, moving with prescribed velocities (`super::contact`).
+/// right side, moving with prescribed velocities (`super::terms::contact::rigid`).
 const RIGID_BODIES: &str = r#"[[material]]
 name = "steel"
 model = "rigid"
@@ -364,7 +364,7 @@ fn tangent_with_deformable_contact_matches_finite_differences_of_the_residual() 
         .replace("min = [0.5, 1.5]", "min = [0.5, 1.25]");
     let on_node = STACK.to_string();
     // μ = 0.03: a meeting slips once its tangential trial force ε_t |Δ| exceeds
-    // μ ε_n g; with ε_t = ε_n/10 (`contact::TANGENTIAL_PENALTY`) μ = 0.3 left
+    // μ ε_n g; with ε_t = ε_n/10 (`terms::contact::bodies::TANGENTIAL_PENALTY`) μ = 0.3 left
     // every meeting sticking at this iterate, 0.03 leaves 1–2 sticking and 5–9
     // slipping.
     let cases = [
@@ -824,4 +824,113 @@ fn a_pattern_is_kept_only_while_it_fits() {
     m.particles.x[0][0] += 1.0;
     solver.prepare(&m, 0.02, 0.01);
     assert!(solver.system.pattern.get().is_none(), "dropped");
+}
+
+/// A smooth iterate of a step, `scale` times a field of strains of about a
+/// per cent, zero at the prescribed components, tied nodes following their
+/// masters.
+fn smooth_iterate(m: &Model<2>, sys: &StepSystem<2>, scale: f64) -> Vec<Vector<2>> {
+    let mut u: Vec<Vector<2>> = (0..sys.map.len())
+        .zip(&sys.constraint)
+        .map(|(a, c)| {
+            let x = m.grid.node_position(m.grid.node_ijk(sys.map.grid_node(a)));
+            let mut v = Vector::<2>::new(0.02 * (0.7 * x[1]).sin(), -0.01 * x[0] * x[1] / 4.0);
+            for d in 0..2 {
+                if c.fixed[d] {
+                    v[d] = 0.0;
+                }
+            }
+            v * scale
+        })
+        .collect();
+    sys.dofs.follow_ties(&mut u);
+    u
+}
+
+/// The bits of nodal vectors, to compare them exactly.
+fn bits(v: &[Vector<2>]) -> Vec<u64> {
+    v.iter()
+        .flat_map(|x| x.iter().map(|c| c.to_bits()))
+        .collect()
+}
+
+/// A residual away from the iterate (`probe_residual`, the Krylov solver's
+/// difference products) has the bits of `residual` at the same point, and
+/// leaves the step's iterate where it was: after a probe the tangent and the
+/// terms' report are those before it, bit for bit (`terms`, the iterate).
+/// With F-bar, a linear domain stress, absorbing faces, friction against
+/// rigid bodies and between two deformable bodies (contacts at the iterate).
+#[test]
+fn a_probe_is_the_residual_and_leaves_the_iterate() {
+    use super::residual::probe_residual;
+    let rigid = BLOCK
+        .replace(
+            "[[body]]\nmaterial = \"m\"",
+            "[[body]]\nname = \"block\"\nmaterial = \"m\"",
+        )
+        .replace("[[boundary]]", &format!("{RIGID_BODIES}[[boundary]]"))
+        .replace(
+            "[solver]",
+            "[[contact]]\nfriction_coefficient = 0.3\n[solver]",
+        );
+    let absorbing = BLOCK.replace("[solver]", &format!("{ABSORBING}[solver]"));
+    let cases: [(&str, &str, Vec<&str>, bool); 5] = [
+        ("F-bar", BLOCK, vec!["solver.fbar=true"], false),
+        (
+            "linear domain stress",
+            BLOCK,
+            vec!["grid.shape_function=cpgimp", "grid.domain_stress=linear"],
+            false,
+        ),
+        ("absorbing faces", &absorbing, vec![], false),
+        (
+            "rigid bodies",
+            &rigid,
+            vec!["grid.shape_function=cpgimp"],
+            true,
+        ),
+        (
+            "two deformable bodies",
+            STACK,
+            vec![
+                "grid.shape_function=cpgimp",
+                "contact.0.friction_coefficient=0.03",
+            ],
+            true,
+        ),
+    ];
+    for (name, text, overrides, contact) in cases {
+        let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+        let scene = Scene::parse("block.toml", text, &overrides).unwrap();
+        let m = Model::<2>::build(&scene).unwrap();
+        let stage = scene.config.stages()[0];
+        let mut solver = Implicit::<2>::new(scene.config.grid.shape_function, stage, 0.0);
+        solver.prepare(&m, 0.0, 0.01);
+        let sys = &mut solver.system;
+        let (u, w) = (smooth_iterate(&m, sys, 1.0), smooth_iterate(&m, sys, 1.5));
+        residual(&m, sys, &u).unwrap();
+        let k = tangent(&m, sys, false).unwrap().values;
+        let report = sys.report();
+        assert!(
+            !contact || report.sticking + report.slipping > 0,
+            "{name}: no contact at the iterate"
+        );
+        let probed = probe_residual(&m, sys, &w).unwrap();
+        assert!(sys.iterate() == u.as_slice(), "{name}: the iterate moved");
+        let after: Vec<u64> = (tangent(&m, sys, false).unwrap().values.iter())
+            .map(|x| x.to_bits())
+            .collect();
+        let before: Vec<u64> = k.iter().map(|x| x.to_bits()).collect();
+        assert!(after == before, "{name}: the tangent changed");
+        assert_eq!(sys.report(), report, "{name}: the terms' state changed");
+        let evaluated = residual(&m, sys, &w).unwrap();
+        assert!(
+            bits(&probed) == bits(&evaluated),
+            "{name}: the probe differs from the residual"
+        );
+        println!(
+            "{name}: {} unknowns, probe = residual bit for bit",
+            sys.dofs.free
+        );
+    }
 }

@@ -1,5 +1,7 @@
-//! Penalty contact of a deformable particle with a rigid body (the implicit
-//! solver's contact, `solver::implicit::contact`).
+//! The penalty law of the implicit contact (`super`): a deformable particle
+//! against a rigid body (`super::rigid`), and with the same law one deformable
+//! body's surface against another's at a meeting of their split nodes
+//! (`super::bodies`).
 //!
 //! The node-based contact of `solver::explicit::contact` corrects grid velocities, which
 //! has no residual to put into a Newton iteration. Here the particle is the
@@ -63,6 +65,15 @@ pub struct ParticleContact<const D: usize> {
     /// The work friction dissipated over the step: the slip (|h| − μ ε_n g)/ε_t
     /// times the mean of |f_t⁰| and |f_t| (trapezoidal; zero when it sticks).
     pub dissipation: f64,
+}
+
+impl<const D: usize> ParticleContact<D> {
+    /// Whether the derivative is symmetric, to round-off (plane faces, no
+    /// slip).
+    pub fn is_symmetric(&self) -> bool {
+        let d = &self.derivative;
+        (d - d.transpose()).amax() <= 1e-10 * d.amax()
+    }
 }
 
 /// The penalty force on a particle that reaches into a body (`inside`: nearest

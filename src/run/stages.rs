@@ -1,0 +1,321 @@
+//! The stage loop of a run: each stage's stepper built from its settings and
+//! driven step by step to the stage's end, recording as it goes and writing a
+//! checkpoint when one is due or a signal asks for it.
+
+use crate::dim::Vector;
+use crate::model::Model;
+use crate::output::Progress;
+use crate::run::checkpoint::{self, Checkpoint, Kept, ParticleState};
+use crate::run::interrupt;
+use crate::run::recorders::{Moment, Recorders};
+use crate::run::summary::StageSummary;
+use crate::scene::{Integrator, LinearSystems, Scene, SolverConfig, SolverKind};
+use crate::solver::divergence::{check_state, Divergence};
+use crate::solver::report::SolverReport;
+use crate::solver::stepper::Stepper;
+use std::path::Path;
+use std::time::Instant;
+
+/// The run's course: where it is (time, step, the work done so far) and what it
+/// writes as it goes.
+pub(super) struct Timeline {
+    pub t: f64,
+    pub step: usize,
+    pub external_work: f64,
+    /// The run's total time (the time tolerance is relative to it).
+    pub total_time: f64,
+    pub recorders: Recorders,
+    pub progress: Option<Progress>,
+    /// The signal that stopped the run at the end of a step, if one did.
+    pub interrupted: Option<i32>,
+    pub checkpoints: Checkpoints,
+}
+
+/// When checkpoints are due and which ones are kept.
+pub(super) struct Checkpoints {
+    /// Simulation time between checkpoints, and when the next is due.
+    pub interval: Option<f64>,
+    pub next: f64,
+    /// Wall-clock seconds between checkpoints, and when the last was written.
+    pub wall_seconds: Option<f64>,
+    pub last_written: Instant,
+    pub kept: Kept,
+}
+
+/// What a checkpoint records about the stage under way and the run around it.
+struct StageContext<'a> {
+    scene: &'a Scene,
+    index: usize,
+    start: f64,
+    first_step: usize,
+    done: &'a [StageSummary],
+    /// The stage's duration when it is quasi-static (its load factor is reported).
+    quasi_static: Option<f64>,
+    strength_factor: f64,
+    dt_critical: f64,
+}
+
+impl<'a> StageContext<'a> {
+    fn quasi_static(sc: &SolverConfig) -> Option<f64> {
+        (sc.kind == SolverKind::Implicit && sc.integrator() == Integrator::QuasiStatic)
+            .then_some(sc.end_time)
+    }
+}
+
+impl Timeline {
+    pub(super) fn moment<'a, const D: usize>(&self, model: &'a Model<D>) -> Moment<'a, D> {
+        Moment {
+            model,
+            t: self.t,
+            external_work: self.external_work,
+        }
+    }
+
+    /// Advance the stage of `ctx`, of length `duration`, from where it is (its
+    /// last step `last_dt`, 0 at its start): step, record, write a checkpoint
+    /// when one is due, repeat. Returns how the stage ended and its last step;
+    /// the outer error is an output failure.
+    fn stage<const D: usize>(
+        &mut self,
+        ctx: &StageContext,
+        model: &mut Model<D>,
+        stepper: &mut dyn Stepper<D>,
+        duration: f64,
+        mut last_dt: f64,
+    ) -> std::io::Result<(Result<(), Divergence>, f64)> {
+        let end = ctx.start + duration;
+        while self.t < end - 1e-12 * self.total_time {
+            let dt = stepper.dt(model).min(end - self.t);
+            last_dt = dt;
+            // A step too small to move the clock would never end the stage.
+            if !(dt > 0.0 && self.t + dt > self.t) {
+                return Ok((Err(stalled(self.step, self.t, dt)), last_dt));
+            }
+            let result = stepper.step(model, self.t, dt, self.step);
+            self.recorders.newton(&stepper.take_newton_rows())?;
+            self.recorders.contact(&stepper.take_contact());
+            match result {
+                Ok(work) => self.external_work += work,
+                Err(d) => return Ok((Err(d), last_dt)),
+            }
+            self.t += dt;
+            self.step += 1;
+            self.recorders
+                .footing(model, self.t, dt, stepper.reaction())?;
+            self.recorders.state(&self.moment(model), false)?;
+            if let Some(p) = &self.progress {
+                p.set(self.t, self.step);
+            }
+            let signal = interrupt::requested();
+            if signal.is_some() || self.checkpoint_due() {
+                self.checkpoint(ctx, model, stepper, last_dt)?;
+            }
+            if let Some(signal) = signal {
+                self.interrupted = Some(signal);
+                return Ok((Ok(()), last_dt));
+            }
+        }
+        self.t = end;
+        Ok((Ok(()), last_dt))
+    }
+
+    /// Whether a checkpoint is due now (by simulation time or wall clock); the
+    /// next one by time is then set past now.
+    fn checkpoint_due(&mut self) -> bool {
+        let c = &mut self.checkpoints;
+        let tolerance = 1e-12 * self.total_time;
+        let by_time = match c.interval {
+            Some(interval) if self.t >= c.next - tolerance => {
+                while c.next <= self.t + tolerance {
+                    c.next += interval;
+                }
+                true
+            }
+            _ => false,
+        };
+        let by_clock = c
+            .wall_seconds
+            .is_some_and(|s| c.last_written.elapsed().as_secs_f64() >= s);
+        by_time || by_clock
+    }
+
+    /// Write the checkpoint of this moment into the output directory, keeping
+    /// the last two.
+    fn checkpoint<const D: usize>(
+        &mut self,
+        ctx: &StageContext,
+        model: &Model<D>,
+        stepper: &dyn Stepper<D>,
+        last_dt: f64,
+    ) -> std::io::Result<()> {
+        let ck = Checkpoint {
+            scene_file: ctx.scene.file.clone(),
+            scene_text: ctx.scene.text.clone(),
+            dimension: D,
+            stage: ctx.index,
+            stage_start: ctx.start,
+            stage_first_step: ctx.first_step,
+            stages_done: ctx.done.to_vec(),
+            time: self.t,
+            step: self.step,
+            dt: last_dt,
+            load_factor: ctx
+                .quasi_static
+                .map(|d| ((self.t - ctx.start) / d).clamp(0.0, 1.0)),
+            strength_factor: ctx.strength_factor,
+            external_work: self.external_work,
+            dt_critical: ctx.dt_critical,
+            next_checkpoint: self.checkpoints.next,
+            particles: ParticleState::of(&model.particles),
+            solver: stepper.state(),
+            recorders: self.recorders.saved()?,
+        };
+        let path = (self.recorders.directory()).join(checkpoint::file_name(self.step));
+        ck.write(&path)?;
+        self.checkpoints.kept.push(path);
+        self.checkpoints.last_written = Instant::now();
+        Ok(())
+    }
+}
+
+fn stalled(step: usize, time: f64, dt: f64) -> Divergence {
+    Divergence {
+        step,
+        time,
+        particle: None,
+        message: format!("the time step {dt:e} no longer advances the time"),
+    }
+}
+
+/// How the stages went: the outcome, each stage's summary, the last stage's
+/// solver report, step and active nodes, its per-particle contact forces
+/// (implicit contact only), and an output that could not be written.
+pub(super) struct Ran<const D: usize> {
+    pub outcome: Result<(), Divergence>,
+    pub stages: Vec<StageSummary>,
+    pub last: Option<(SolverReport, f64, usize)>,
+    pub contact_forces: Option<Vec<Vector<D>>>,
+    pub failure: Option<std::io::Error>,
+}
+
+/// The run's stages from the first (or the one a checkpoint `ck` was written
+/// in) to the end: the model's initial state checked and recorded, then each
+/// stage's stepper built and driven ([`Timeline::stage`]). The error is an
+/// output that could not be written before the stepping began (the initial
+/// state, the linear systems' folder); one that fails while stepping ends the
+/// stages with `Ran::failure`.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn run_stages<const D: usize>(
+    scene: &Scene,
+    out: &Path,
+    model: &mut Model<D>,
+    line: &mut Timeline,
+    strength_factor: &mut f64,
+    dt_critical: f64,
+    ck: Option<&Checkpoint>,
+) -> std::io::Result<Ran<D>> {
+    let cfg = &scene.config;
+    let mut outcome = check_state(model, 0, 0.0);
+    if outcome.is_ok() && ck.is_none() {
+        line.recorders.state(&line.moment(model), true)?;
+    }
+    let first_stage = ck.map_or(0, |c| c.stage);
+    let mut stages = ck.map_or_else(Vec::new, |c| c.stages_done.clone());
+    let mut last: Option<(SolverReport, f64, usize)> = None;
+    // The last stage's per-particle contact forces (implicit contact only).
+    let mut contact_forces: Option<Vec<Vector<D>>> = None;
+    // An output that cannot be written ends the run as failed.
+    let mut failure: Option<std::io::Error> = None;
+    for (k, sc) in cfg.stages().into_iter().enumerate().skip(first_stage) {
+        if outcome.is_err() {
+            break;
+        }
+        // The stage a checkpoint was written in continues where it was.
+        let resumed = ck.filter(|c| c.stage == k);
+        if let Some(f) = sc
+            .strength_reduction_factor
+            .filter(|&f| f != *strength_factor)
+        {
+            model.reduce_strength(f);
+            *strength_factor = f;
+        }
+        let (mut stepper, start, steps_before, last_dt) =
+            stage_stepper(scene, out, sc, resumed, model, line)?;
+        let stage_clock = Instant::now();
+        let ctx = StageContext {
+            scene,
+            index: k,
+            start,
+            first_step: steps_before,
+            done: &stages,
+            quasi_static: StageContext::quasi_static(sc),
+            strength_factor: *strength_factor,
+            dt_critical,
+        };
+        let ended = line.stage(&ctx, model, stepper.as_mut(), sc.end_time, last_dt);
+        let (result, dt) = match ended {
+            Ok(ended) => ended,
+            Err(e) => {
+                failure = Some(e);
+                break;
+            }
+        };
+        outcome = result;
+        let report = stepper.report();
+        stages.push(StageSummary {
+            name: sc.name.clone().unwrap_or_else(|| format!("stage{k}")),
+            start_time: start,
+            end_time: line.t,
+            steps: line.step - steps_before,
+            dt,
+            wall_seconds: stage_clock.elapsed().as_secs_f64(),
+            active_nodes_last_step: stepper.active_nodes(),
+            solver: report.clone(),
+            strength_reduction_factor: sc.strength_reduction_factor.map(|_| *strength_factor),
+        });
+        last = Some((report, dt, stepper.active_nodes()));
+        contact_forces = stepper.contact_forces(model.particles.len());
+        if line.interrupted.is_some() {
+            break;
+        }
+    }
+    Ok(Ran {
+        outcome,
+        stages,
+        last,
+        contact_forces,
+        failure,
+    })
+}
+
+/// The stepper of stage `sc` and where the stage starts: its start time, its
+/// first step and the last Δt taken (those of the checkpoint `resumed` it
+/// continues, else now and 0). APIC's affine moments belong to the APIC
+/// stages: a stage without them drops them, and an APIC stage after it forms
+/// them anew.
+fn stage_stepper<const D: usize>(
+    scene: &Scene,
+    out: &Path,
+    sc: &SolverConfig,
+    resumed: Option<&Checkpoint>,
+    model: &mut Model<D>,
+    line: &Timeline,
+) -> std::io::Result<(Box<dyn Stepper<D>>, f64, usize, f64)> {
+    let cfg = &scene.config;
+    let (start, steps_before, last_dt) = resumed.map_or((line.t, line.step, 0.0), |c| {
+        (c.stage_start, c.stage_first_step, c.dt)
+    });
+    if !sc.apic() {
+        model.particles.affine = Vec::new();
+    }
+    let mut stepper = crate::solver::stepper::<D>(cfg.grid.shape_function, sc, start);
+    if let Some(c) = resumed {
+        stepper.restore(&c.solver);
+    }
+    if cfg.output.linear_systems != LinearSystems::None {
+        let dir = out.join("linear_systems");
+        std::fs::create_dir_all(&dir)?;
+        stepper.export_linear_systems(&dir, cfg.output.linear_systems);
+    }
+    Ok((stepper, start, steps_before, last_dt))
+}
