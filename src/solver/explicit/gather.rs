@@ -9,7 +9,7 @@
 
 use crate::dim::Vector;
 use crate::model::conditions::Constraint;
-use crate::model::Model;
+use crate::model::{load_factor, Model};
 use crate::parallel::{deterministic_sum, MIN_PARALLEL_LEN};
 use crate::physics::boundary::absorbing;
 use crate::physics::boundary::conditions::{node_constraint, node_friction};
@@ -17,7 +17,7 @@ use crate::physics::contact::totals::PairTotal;
 use crate::physics::kinematics::deformation::Trial;
 use crate::physics::shape::{ShapeFunction, Stencils};
 use crate::physics::transfer::{
-    interpolate_two, mass_average, stencils_and_nodes, ExtraMomentum, NodeMap,
+    interpolate_two, mass_average, mass_momentum, nodal_force, stencils_and_nodes, NodeMap,
 };
 use crate::scene::Scheme;
 use crate::solver::divergence::{check_state, inverted, Divergence};
@@ -28,7 +28,6 @@ use crate::solver::explicit::grid_update::{
 };
 use crate::solver::explicit::mirror::Mirror;
 use crate::solver::explicit::motion::{blend, load_power};
-use crate::solver::explicit::p2g::{hoop_stress, Source};
 use crate::solver::explicit::step::{removed_particles, Backend, P2g, Start, Step, Then, Velocity};
 use rayon::prelude::*;
 
@@ -155,10 +154,7 @@ impl<const D: usize> NodeMapStep<D> {
         let x = self.step_start_x.as_deref().unwrap_or(&p.x);
         let affine = self.affine(m, x, s);
         let term = affine.as_ref().map(|a| move |q, e, n| a.term(st, q, e, n));
-        let extra = term.as_ref().map(|t| t as _);
-        let sources = sources(m, s, false);
-        let nodes = gather_p2g::<D, true, false>(map, st, &sources, &[], extra);
-        self.momentum = nodes.iter().map(|n| n.1).collect();
+        (_, self.momentum) = mass_momentum(map, st, p, term.as_ref().map(|t| t as _));
     }
 
     /// The nodes' conditions this step: their constraints, the friction faces
@@ -274,33 +270,20 @@ impl<const D: usize> Backend<D> for NodeMapStep<D> {
         self.step_start_x = (s.apic && s.scheme == Scheme::Musl).then(|| m.particles.x.clone());
     }
 
+    /// P2G through the node map's gathers (`physics::transfer`, which the
+    /// implicit step shares): at every active node its entries in increasing
+    /// particle order.
     fn p2g(&mut self, m: &Model<D>, s: &Step<D>, what: P2g) {
-        let p = &m.particles;
-        let force = what != P2g::Motion;
-        let sources = sources(m, s, force);
-        let hoop: Vec<f64> = match force && m.axisymmetric {
-            true => (0..p.len()).map(|q| hoop_stress(p, q)).collect(),
-            false => Vec::new(),
-        };
-        // APIC: the affine part of the momentum.
-        let affine = (what != P2g::Force)
-            .then(|| self.affine(m, &p.x, s))
-            .flatten();
-        let st = &self.stencils;
-        let term = affine.as_ref().map(|a| move |q, e, n| a.term(st, q, e, n));
-        let extra = term.as_ref().map(|t| t as _);
-        let (map, sources) = (&self.map, &sources[..]);
-        let nodes = match what {
-            P2g::Motion => gather_p2g::<D, true, false>(map, st, sources, &hoop, extra),
-            P2g::Force => gather_p2g::<D, false, true>(map, st, sources, &hoop, extra),
-            P2g::MotionAndForce => gather_p2g::<D, true, true>(map, st, sources, &hoop, extra),
-        };
+        let (st, map, p) = (&self.stencils, &self.map, &m.particles);
         if what != P2g::Force {
-            self.mass = nodes.iter().map(|n| n.0).collect();
-            self.momentum = nodes.iter().map(|n| n.1).collect();
+            // APIC: the affine part of the momentum.
+            let affine = self.affine(m, &p.x, s);
+            let term = affine.as_ref().map(|a| move |q, e, n| a.term(st, q, e, n));
+            (self.mass, self.momentum) = mass_momentum(map, st, p, term.as_ref().map(|t| t as _));
         }
-        if force {
-            self.force = nodes.iter().map(|n| n.2).collect();
+        if what != P2g::Motion {
+            let factor = |q: usize| load_factor(&m.load_ramp_of, q, &s.scales);
+            self.force = nodal_force(map, st, p, &s.gravity, &factor);
         }
     }
 
@@ -424,67 +407,6 @@ impl<const D: usize> Backend<D> for NodeMapStep<D> {
     fn check(&self, m: &Model<D>, s: &Step<D>) -> Result<(), Divergence> {
         check_state(m, s.step + 1, s.t + s.dt)
     }
-}
-
-/// The particles' P2G sources (`p2g::Source`), with their applied forces if
-/// the force is gathered (`force`).
-fn sources<const D: usize>(m: &Model<D>, s: &Step<D>, force: bool) -> Vec<Source<D>> {
-    let p = &m.particles;
-    (0..p.len())
-        .into_par_iter()
-        .with_min_len(MIN_PARALLEL_LEN)
-        .map(|q| {
-            let applied = match force {
-                true => s.applied(&m.load_ramp_of, &p.mass, &p.load, q),
-                false => Vector::<D>::zeros(),
-            };
-            Source::of(p, q, applied)
-        })
-        .collect()
-}
-
-/// P2G through the node map: at every active node, its entries in increasing
-/// particle order, the mass and momentum (`MOTION`; with the extra momentum
-/// of APIC, if given) and the force (`FORCE`; with the hoop force of `hoop`
-/// in axisymmetric mode, else empty) of the particles' `sources`.
-fn gather_p2g<const D: usize, const MOTION: bool, const FORCE: bool>(
-    map: &NodeMap,
-    st: &Stencils<D>,
-    sources: &[Source<D>],
-    hoop: &[f64],
-    extra: Option<ExtraMomentum<D>>,
-) -> Vec<(f64, Vector<D>, Vector<D>)> {
-    let owner = st.owner();
-    (0..map.len())
-        .into_par_iter()
-        .with_min_len(MIN_PARALLEL_LEN)
-        .map(|a| {
-            let (mut mass, mut momentum, mut force) =
-                (0.0, Vector::<D>::zeros(), Vector::<D>::zeros());
-            for &e in map.node_entries(a) {
-                let (q, e) = (owner.of(e), e as usize);
-                let s = &sources[q];
-                let (w, g) = match FORCE {
-                    true => st.value_at(q, e),
-                    false => (st.weight_at(q, e), Vector::<D>::zeros()),
-                };
-                if MOTION {
-                    mass += s.mass * w;
-                    momentum += s.momentum * w;
-                    if let Some(extra) = extra {
-                        momentum += extra(q, e, a);
-                    }
-                }
-                if FORCE {
-                    force += s.force_at(w, &g);
-                    if let Some(h) = hoop.get(q) {
-                        force[0] -= h * w;
-                    }
-                }
-            }
-            (mass, momentum, force)
-        })
-        .collect()
 }
 
 /// The active nodes on friction faces, with the faces each lies on.

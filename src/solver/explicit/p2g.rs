@@ -1,11 +1,13 @@
-//! The rules of P2G at one particle and node, which every transfer back-end
-//! applies (`solver::explicit::step`): what a particle gives a node of weight
-//! S_I and gradient ∇S_I, its mass m S_I (2-24), momentum m v S_I (2-25) and
-//! force S_I (m g + s f) − V σ ∇S_I (2-51, 2-52), and in axisymmetric mode the
+//! What a particle gives the nodes in the box scatter's P2G
+//! (`solver::explicit::scatter`), formed once per particle: its mass m S_I
+//! (2-24), momentum m v S_I (2-25) and force S_I (m g + s f) − V σ ∇S_I (2-51,
+//! 2-52, `physics::transfer::force_at_node`, the rule the node map's
+//! `physics::transfer::nodal_force` applies too), and in axisymmetric mode the
 //! hoop part − V σ_θθ S_I / r_p of the radial force (`physics::shape::hoop`).
 
 use crate::dim::{restrict, Tensor, Vector};
 use crate::model::particles::Particles;
+use crate::physics::transfer::force_at_node;
 
 /// What particle q gives the nodes, formed once per P2G.
 #[derive(Clone, Copy, Debug)]
@@ -32,10 +34,11 @@ impl<const D: usize> Source<D> {
     }
 
     /// The force on a node of weight S_I = `w` and gradient ∇S_I = `g`:
-    /// S_I (m g + s f) − V σ ∇S_I (2-51, 2-52).
+    /// S_I (m g + s f) − V σ ∇S_I (2-51, 2-52), V σ formed here once (so V = 1
+    /// in the shared rule).
     #[inline(always)]
     pub fn force_at(&self, w: f64, g: &Vector<D>) -> Vector<D> {
-        self.applied * w - self.stress * g
+        force_at_node(&self.applied, w, &self.stress, g, 1.0)
     }
 }
 
