@@ -128,7 +128,7 @@ fn scatter_benches<const D: usize>(
         &shape,
         |b, &shape| {
             b.iter(|| {
-                nb.locate(shape, grid, &p.x);
+                nb.locate(shape, grid, &p.x, &[]);
                 nodes.clear();
                 nodes.resize(
                     nb.nodes(),
@@ -154,7 +154,7 @@ fn scatter_benches<const D: usize>(
             })
         },
     );
-    nb.locate(shape, grid, &p.x);
+    nb.locate(shape, grid, &p.x, &[]);
     let nodal: Vec<Vector<D>> = (0..nb.nodes())
         .map(|b| Vector::<D>::repeat(b as f64 * 1e-3))
         .collect();

@@ -399,13 +399,28 @@ pub fn nodal_force<const D: usize>(
     map.gather(st.stride, Vector::<D>::zeros(), |q, e| {
         let s = &sources[q];
         let (weight, grad) = st.value_at(q, e);
-        let mut f = s.applied * weight - s.stress * grad * s.volume;
+        let mut f = force_at_node(&s.applied, weight, &s.stress, &grad, s.volume);
         if let Some(h) = hoop_at(st, e) {
             // f_Ir −= V_p σ_θθ S_Ip / r_p (the hoop term of the internal force).
             f[0] -= s.hoop_stress * h * s.volume;
         }
         f
     })
+}
+
+/// The force a particle gives node I of weight S_I and gradient ∇S_I:
+/// S_I (m g + s f) − V σ ∇S_I (2-51, 2-52), for the applied force m g + s f,
+/// the in-plane Cauchy stress σ and the current volume V. (A caller that
+/// forms V σ once per particle passes it with V = 1, which is exact.)
+#[inline(always)]
+pub fn force_at_node<const D: usize>(
+    applied: &Vector<D>,
+    weight: f64,
+    stress: &Tensor<D>,
+    grad: &Vector<D>,
+    volume: f64,
+) -> Vector<D> {
+    applied * weight - stress * grad * volume
 }
 
 /// Force applied to particle q: m_q g + s_q f_q (gravity and its scaled load).

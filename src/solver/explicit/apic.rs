@@ -322,7 +322,7 @@ mod tests {
             let grid = grid::<D>(shape);
             let mut p = particles(&grid);
             let mut nb = NodeBox::<D>::default();
-            nb.locate(shape, &grid, &p.x);
+            nb.locate(shape, &grid, &p.x, &[]);
             let position = |b: usize| grid.node_position(nb.grid_ijk(b));
             let nodal: Vec<Vector<D>> = (0..nb.nodes()).map(|b| field(&position(b))).collect();
             for q in 0..p.len() {

@@ -45,6 +45,22 @@ impl BulkViscosity {
         l / (q + (q * q + c * c).sqrt())
     }
 
+    /// q_p V_p of particle q at the volumetric rate `rate`, l the cell size:
+    /// what its viscous pressure gives a node per unit ∇S_Ip.
+    pub fn pressure_volume<const D: usize>(
+        &self,
+        p: &Particles<D>,
+        materials: &[Box<dyn Material>],
+        q: usize,
+        l: f64,
+        rate: f64,
+    ) -> f64 {
+        let material = &materials[p.material[q] as usize];
+        let rho = p.mass[q] / p.volume[q];
+        let c = material.wave_speed(p.f.get(q).determinant(), p.history.get(q));
+        self.pressure(rho, c, l, rate) * p.volume[q]
+    }
+
     /// ε̇_v = tr L_p of every particle under the nodal velocities `v` (in
     /// axisymmetric mode with the hoop rate v_r/r_p = Σ_I v_Ir S_Ip/r_p).
     pub fn volumetric_rates<const D: usize>(
@@ -87,12 +103,7 @@ impl BulkViscosity {
         let qv: Vec<f64> = (0..p.len())
             .into_par_iter()
             .with_min_len(MIN_PARALLEL_LEN)
-            .map(|q| {
-                let mat = &materials[p.material[q] as usize];
-                let rho = p.mass[q] / p.volume[q];
-                let c = mat.wave_speed(p.f.get(q).determinant(), p.history.get(q));
-                self.pressure(rho, c, l, rates[q]) * p.volume[q]
-            })
+            .map(|q| self.pressure_volume(p, materials, q, l, rates[q]))
             .collect();
         // −(−q I) : ∇S V, with the hoop part q V S_Ip/r_p on the radial component.
         let viscous = map.gather(st.stride, Vector::<D>::zeros(), |q, e| {

@@ -1,9 +1,12 @@
-//! Rules of the explicit grid update that both transfer paths apply
-//! (`solver::explicit`, `solver::explicit::scatter`): local damping of the nodal
-//! force, and no acceleration on nodes too light to carry one.
+//! The rules of the explicit grid update at one node, which every transfer
+//! back-end applies (`solver::explicit::step`): the conditions on the
+//! step-start velocity, local damping of the nodal force, no acceleration on
+//! nodes too light to carry one, and the updated velocity with the friction
+//! faces.
 
 use crate::dim::Vector;
-use crate::model::conditions::Constraint;
+use crate::model::conditions::{Constraint, FrictionFace};
+use crate::physics::boundary::conditions::friction_contact;
 
 /// Nodes lighter than this fraction of the lightest particle get no acceleration:
 /// f_I/m_I is ill-conditioned there (f_I need not vanish with m_I), while the
@@ -49,4 +52,43 @@ pub fn acceleration<const D: usize>(
         acc[d] = (constraint.value[d] - raw[d]) / dt;
     }
     acc
+}
+
+/// A node's velocity `raw` = p/m with its conditions: the prescribed
+/// components, then the friction faces `on` (indices into `faces`) it lies on.
+#[inline(always)]
+pub fn with_conditions<const D: usize>(
+    raw: &Vector<D>,
+    constraint: &Constraint<D>,
+    faces: &[FrictionFace],
+    on: &[u8],
+) -> Vector<D> {
+    let mut v = *raw;
+    constraint.apply_velocity(&mut v);
+    if !on.is_empty() {
+        v = friction_contact(faces, on, constraint, &v);
+    }
+    v
+}
+
+/// A node's updated velocity v = v_raw + Δt a (2-29) and its acceleration:
+/// the friction faces `on` act on the updated velocity, and the acceleration
+/// follows from what they leave.
+#[inline(always)]
+pub fn updated_velocity<const D: usize>(
+    raw: &Vector<D>,
+    acc: &Vector<D>,
+    constraint: &Constraint<D>,
+    faces: &[FrictionFace],
+    on: &[u8],
+    dt: f64,
+) -> (Vector<D>, Vector<D>) {
+    let v = raw + acc * dt;
+    match on.is_empty() {
+        true => (v, *acc),
+        false => {
+            let v = friction_contact(faces, on, constraint, &v);
+            (v, (v - raw) / dt)
+        }
+    }
 }

@@ -1,7 +1,7 @@
-//! Particle-side transfers on a dense box of nodes, for the explicit step of
-//! scenes that need nothing of the node map (`physics::transfer::NodeMap`):
-//! separable shape functions (linear, GIMP, B-splines), no contact, no F-bar,
-//! no mirror, no absorbing faces, no removed particles, plane strain or 3D.
+//! Particle-side transfers on a dense box of nodes, for the explicit step's
+//! box-scatter back-end (`solver::explicit::scatter`): separable shape
+//! functions (linear, GIMP, B-splines); what else it serves the features
+//! declare (`solver::explicit::features`).
 //!
 //! The nodes that the particles can touch form a box (their cells' range,
 //! widened by the family's reach). P2G is a scatter: each particle evaluates
@@ -244,9 +244,16 @@ impl<const D: usize> NodeBox<D> {
         self.len[0]
     }
 
-    /// Set the box and the tiles for the particles at `x` (those outside the
-    /// grid touch no node, as in `Stencils::compute`).
-    pub fn locate(&mut self, shape: ShapeFunction, grid: &Grid<D>, x: &[Vector<D>]) {
+    /// Set the box and the tiles for the particles at `x`. Those outside the
+    /// grid touch no node (as in `Stencils::compute`), nor do those that
+    /// `removed` marks (empty: none; `Model::removed`).
+    pub fn locate(
+        &mut self,
+        shape: ShapeFunction,
+        grid: &Grid<D>,
+        x: &[Vector<D>],
+        removed: &[bool],
+    ) {
         let reach = Reach::of(shape).expect("a separable family");
         let cell = |xq: &Vector<D>| -> [usize; D] {
             std::array::from_fn(|d| cell_index(cell_coordinate(grid, xq, d), grid.cells[d]))
@@ -306,6 +313,9 @@ impl<const D: usize> NodeBox<D> {
                     };
                 }
             });
+        for (k, _) in key.iter_mut().zip(removed).filter(|(_, &r)| r) {
+            *k = NO_BUCKET;
+        }
         let n_tiles = self.tiles.iter().product();
         bucket_sort(&self.key, n_tiles, &mut self.start, &mut self.order);
     }
@@ -495,7 +505,7 @@ mod tests {
                 let mut nb = NodeBox::<D>::default();
                 let mut nodes = Vec::new();
                 crate::parallel::on_threads(threads, || {
-                    nb.locate(shape, &grid, &p.x);
+                    nb.locate(shape, &grid, &p.x, &[]);
                     nodes = vec![(0.0, Vector::<D>::zeros()); nb.nodes()];
                     nb.scatter(
                         shape,
