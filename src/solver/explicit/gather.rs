@@ -8,6 +8,7 @@
 //! prescribed velocities, USF with the families that read F.
 
 use crate::dim::Vector;
+use crate::model::body::Advance;
 use crate::model::conditions::Constraint;
 use crate::model::{load_factor, Model};
 use crate::parallel::{deterministic_sum, MIN_PARALLEL_LEN};
@@ -69,15 +70,23 @@ impl<const D: usize> NodeMapStep<D> {
             .map_or_else(Vec::new, |c| c.take_totals())
     }
 
-    /// The bodies that are no continuum take their own motion after G2P: free
-    /// rigid bodies by Newton–Euler under the step's contact impulses and the
-    /// applied forces (`physics::rigid::newton_euler`), and the deformable
-    /// particles that entered a rigid body are put back on its surface.
-    fn rigid_bodies_own_motion(&mut self, m: &mut Model<D>, s: &Step<D>) {
+    /// After G2P, the one place of the explicit step that hands each body
+    /// kind its work (`model::body::Advance`): continuum bodies moved with the
+    /// grid in G2P, and so did a prescribed rigid body (its nodes move at its
+    /// velocity); free rigid bodies advance by Newton–Euler under the step's
+    /// contact impulses and the applied forces (`physics::rigid::newton_euler`).
+    /// Then the deformable particles that entered a rigid body are put back on
+    /// its surface. Bodies other than continua meet the rest through contact
+    /// only, so a scene without contact has none (`scene::validate`).
+    fn advance_bodies(&mut self, m: &mut Model<D>, s: &Step<D>) {
         let Some(c) = &mut self.contact else {
             return;
         };
-        if let Some(free) = c.free_bodies() {
+        let newton_euler = (m.bodies.iter()).any(|b| match b.kind.advance() {
+            Advance::ByGrid | Advance::AtOwnVelocity => false,
+            Advance::NewtonEuler => true,
+        });
+        if let (true, Some(free)) = (newton_euler, c.free_bodies()) {
             let p = &m.particles;
             let force: Vec<Vector<D>> = (free.particles())
                 .map(|q| s.applied(&m.load_ramp_of, &p.mass, &p.load, q))
@@ -88,12 +97,15 @@ impl<const D: usize> NodeMapStep<D> {
     }
 
     /// Does particle q take a share of the loads' work? Not when it is
-    /// removed, nor when it belongs to a rigid body of prescribed motion: the
-    /// motion takes the work done on it.
-    fn takes_load_work(&self, q: usize) -> bool {
-        let prescribed = |c: &Contact<D>| c.is_prescribed_particle(q);
+    /// removed, nor when its body moves at its own velocity (a prescribed
+    /// rigid motion takes the work done on it).
+    fn takes_load_work(&self, m: &Model<D>, q: usize) -> bool {
         let removed = self.removed.get(q).is_some_and(|&r| r);
-        !removed && !self.contact.as_ref().is_some_and(prescribed)
+        let own_motion = match m.kind_of(q).advance() {
+            Advance::ByGrid | Advance::NewtonEuler => false,
+            Advance::AtOwnVelocity => true,
+        };
+        !removed && !own_motion
     }
 
     /// APIC: the particles' affine moments B_p from the updated nodes, where
@@ -140,7 +152,7 @@ impl<const D: usize> NodeMapStep<D> {
             let applied = s.applied(&m.load_ramp_of, &p.mass, &p.load, q);
             load_power(&applied, &old_v[q], &p.v[q])
         };
-        let counted = |q: usize| match self.takes_load_work(q) {
+        let counted = |q: usize| match self.takes_load_work(m, q) {
             true => power(q),
             false => 0.0,
         };
@@ -370,7 +382,7 @@ impl<const D: usize> Backend<D> for NodeMapStep<D> {
             self.affine_moments(m);
         }
         let old_v = self.move_particles(m, s);
-        self.rigid_bodies_own_motion(m, s);
+        self.advance_bodies(m, s);
         let work = self.work_of_loads(m, s, &old_v);
         match then {
             Then::Stress => {
