@@ -6,9 +6,6 @@
 
 use super::parameters::{KeyError, Parameters};
 
-/// The keys of the erosion criteria.
-pub const KEYS: [&str; 2] = ["erosion", "erosion_plastic_strain"];
-
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Erosion {
     /// Erode at D = 1.

@@ -13,14 +13,14 @@
 //! registers it, so a new model is a new file, one line in that list and its keys
 //! in docs/scene.md.
 
-pub mod deviatoric;
+pub(crate) mod deviatoric;
 pub mod driver;
-pub mod eos;
-pub mod erosion;
-pub mod parameters;
+pub(crate) mod eos;
+pub(crate) mod erosion;
+pub(crate) mod parameters;
 pub mod registry;
 pub mod return_mapping;
-pub mod spectral;
+pub(crate) mod spectral;
 #[cfg(test)]
 mod testing;
 

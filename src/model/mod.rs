@@ -2,16 +2,16 @@
 //! loads and the bodies (their geometry and kind, `body.rs`), built once from a
 //! validated scene (`build.rs`) and then independent of it.
 
-pub mod axisymmetry;
-pub mod body;
+pub(crate) mod axisymmetry;
+pub(crate) mod body;
 mod build;
-pub mod conditions;
+pub(crate) mod conditions;
 pub mod geometry;
 pub mod grid;
-pub mod loads;
-pub mod memory;
+pub(crate) mod loads;
+pub(crate) mod memory;
 pub mod particles;
-pub mod tensors;
+pub(crate) mod tensors;
 
 pub use loads::{load_factor, LoadTime};
 

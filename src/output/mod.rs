@@ -9,8 +9,8 @@
 //! Files written whole (summary.json, particles_final.csv, frames) are replaced
 //! atomically (`atomic.rs`).
 
-pub mod atomic;
-pub mod csv_file;
+pub(crate) mod atomic;
+pub(crate) mod csv_file;
 mod history;
 pub mod matrix_market;
 mod particles_csv;

@@ -9,10 +9,10 @@
 //! only one solver uses lives under that solver (`solver::explicit`,
 //! `solver::implicit`).
 
-pub mod boundary;
-pub mod contact;
+pub(crate) mod boundary;
+pub(crate) mod contact;
 pub mod geostatic;
-pub mod kinematics;
-pub mod rigid;
+pub(crate) mod kinematics;
+pub(crate) mod rigid;
 pub mod shape;
 pub mod transfer;

@@ -8,14 +8,14 @@
 
 pub mod checkpoint;
 mod checks;
-pub mod contact;
-pub mod energy;
-pub mod error;
+pub(crate) mod contact;
+pub(crate) mod energy;
+pub(crate) mod error;
 mod finish;
-pub mod footing;
+pub(crate) mod footing;
 pub mod interrupt;
-pub mod options;
-pub mod recorders;
+pub(crate) mod options;
+pub(crate) mod recorders;
 mod setup;
 mod stages;
 pub mod summary;

@@ -11,14 +11,14 @@ mod body_kind;
 mod config;
 pub mod contact;
 mod error;
-pub mod expr;
+pub(crate) mod expr;
 mod grid;
 mod material;
-pub mod overrides;
+pub(crate) mod overrides;
 mod solver;
 #[cfg(test)]
 pub(crate) mod testing;
-pub mod validate;
+pub(crate) mod validate;
 
 pub use config::*;
 pub use error::{SceneError, Source};

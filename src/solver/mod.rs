@@ -2,7 +2,7 @@
 //! the implicit Newmark / quasi-static Newton solver, with the linear solvers of
 //! the Newton corrections. The run drives either through `Stepper`.
 
-pub mod divergence;
+pub(crate) mod divergence;
 pub mod explicit;
 pub mod implicit;
 pub mod linear;

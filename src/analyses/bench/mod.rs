@@ -6,10 +6,10 @@
 //! ran and its outputs) and PNG plots. docs/bench.md describes the command, the
 //! `[bench]` keys and the columns.
 
-pub mod child;
-pub mod configurations;
+pub(crate) mod child;
+pub(crate) mod configurations;
 mod plots;
-pub mod row;
+pub(crate) mod row;
 
 use crate::analyses::reference;
 use crate::analyses::strength_reduction::SearchSummary;

@@ -55,6 +55,7 @@ pub struct Edge {
 
 /// `n` cell boundaries on [0, 1] in geometric progression, the first cell `ratio`
 /// times smaller than the last (ratio 1: uniform).
+#[cfg(test)]
 pub fn graded(n: usize, ratio: f64) -> Vec<f64> {
     assert!(n >= 1 && ratio > 0.0);
     let q = if n > 1 {

@@ -13,11 +13,11 @@
 //!
 //! Sign convention: tension positive, compression negative.
 
-pub mod cone;
+pub(crate) mod cone;
 pub mod config;
 pub mod lower_bound;
-pub mod mesh;
-pub mod model;
+pub(crate) mod mesh;
+pub(crate) mod model;
 pub mod reduction;
 pub mod run;
 pub mod upper_bound;

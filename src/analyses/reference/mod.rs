@@ -7,10 +7,10 @@
 //! same functions.
 
 pub mod bar;
-pub mod cantilever;
+pub(crate) mod cantilever;
 pub mod column;
 pub mod elastica;
-pub mod measure;
+pub(crate) mod measure;
 
 pub use measure::{ErrorMeasure, KeyError};
 

@@ -2,5 +2,5 @@
 //! (`conditions`), and the dashpots and springs of absorbing faces
 //! (`absorbing`).
 
-pub mod absorbing;
-pub mod conditions;
+pub(crate) mod absorbing;
+pub(crate) mod conditions;

@@ -5,5 +5,5 @@
 //! (momentum correction at the meetings) and `solver::implicit::terms::contact`
 //! (penalty).
 
-pub mod field_split;
-pub mod totals;
+pub(crate) mod field_split;
+pub(crate) mod totals;

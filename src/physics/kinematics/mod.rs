@@ -2,5 +2,5 @@
 //! incremental deformation gradient from nodal displacements and the material
 //! update (`deformation`), and F-bar against volumetric locking (`fbar`).
 
-pub mod deformation;
-pub mod fbar;
+pub(crate) mod deformation;
+pub(crate) mod fbar;

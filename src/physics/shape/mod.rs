@@ -5,11 +5,11 @@
 //! special case χ_p = V_p δ(x − x_p), 2-55). All families satisfy the partition of
 //! unity Σ_I S_Ip = 1 and Σ_I ∇S_Ip = 0 and reproduce linear fields.
 
-pub mod bspline;
-pub mod cpdi;
-pub mod gimp;
-pub mod hoop;
-pub mod linear;
+pub(crate) mod bspline;
+pub(crate) mod cpdi;
+pub(crate) mod gimp;
+pub(crate) mod hoop;
+pub(crate) mod linear;
 
 pub use linear::{AxisFactors, MAX_PER_AXIS};
 

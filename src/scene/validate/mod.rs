@@ -14,7 +14,7 @@ mod materials;
 mod solver;
 
 pub use analyses::bench;
-pub use check::{Check, KeyError};
+pub use check::Check;
 
 use crate::scene::contact::ContactPlan;
 use crate::scene::{

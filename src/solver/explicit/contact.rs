@@ -121,12 +121,6 @@ impl<const D: usize> Contact<D> {
         }
     }
 
-    /// Whether particle q belongs to a rigid body of prescribed motion.
-    pub fn is_prescribed_particle(&self, q: usize) -> bool {
-        let k = self.field[q] as usize;
-        self.plan.rigid[k] && !self.plan.free[k]
-    }
-
     /// The free rigid bodies, if the scene has any.
     pub fn free_bodies(&mut self) -> Option<&mut FreeBodies<D>> {
         self.free.as_mut()
@@ -278,10 +272,6 @@ impl<const D: usize> Contact<D> {
             t.dissipation = 0.0;
         }
         out
-    }
-
-    pub fn plan(&self) -> &ContactPlan {
-        &self.plan
     }
 }
 

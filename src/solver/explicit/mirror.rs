@@ -105,10 +105,6 @@ impl Mirror {
         Mirror { lines, degree: p }
     }
 
-    pub fn is_empty(&self) -> bool {
-        self.lines.is_empty()
-    }
-
     fn odd(&self) -> &[f64] {
         &ODD[self.degree - 2][..self.degree]
     }

@@ -10,18 +10,18 @@
 //! `motion`); the features have their own modules (`apic`, `bulk_viscosity`,
 //! `contact`, `mirror`).
 
-pub mod apic;
-pub mod bulk_viscosity;
-pub mod contact;
+pub(crate) mod apic;
+pub(crate) mod bulk_viscosity;
+pub(crate) mod contact;
 pub mod features;
-pub mod gather;
-pub mod grid_update;
-pub mod mirror;
-pub mod motion;
+pub(crate) mod gather;
+pub(crate) mod grid_update;
+pub(crate) mod mirror;
+pub(crate) mod motion;
 pub mod node_box;
-pub mod p2g;
-pub mod scatter;
-pub mod step;
+pub(crate) mod p2g;
+pub(crate) mod scatter;
+pub(crate) mod step;
 
 use crate::model::loads::LoadTime;
 use crate::model::Model;

@@ -92,6 +92,9 @@ impl<const D: usize> Level<D> {
 
 /// The grid levels (finest first) and the transfers between them.
 pub struct Hierarchy<const D: usize> {
+    /// The levels themselves: the prolongations are all a solve needs; the
+    /// tests check the levels' nodes and components against them.
+    #[cfg_attr(not(test), allow(dead_code))]
     pub levels: Vec<Level<D>>,
     pub transfers: Vec<Transfer>,
 }
@@ -110,8 +113,9 @@ fn flat<const D: usize>(ijk: [usize; D], nodes: [usize; D]) -> usize {
 }
 
 impl<const D: usize> Level<D> {
-    /// Position of node k: its Greville abscissa on the level's knots, from the
+    /// Position of node k (the tests' check of the prolongations): its Greville abscissa on the level's knots, from the
     /// grid's min corner.
+    #[cfg(test)]
     pub fn position(&self, grid: &Grid<D>, k: usize) -> [f64; D] {
         let nodes: [usize; D] = std::array::from_fn(|d| self.cells[d] + grid.degree);
         let ijk = node_ijk(self.nodes[k], nodes);

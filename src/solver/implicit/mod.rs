@@ -18,20 +18,20 @@
 //! linear domain stress) enters the step as one of its `terms`.
 
 pub mod assembly;
-pub mod coarsening;
-pub mod export;
-pub mod failure;
-pub mod grid;
-pub mod krylov;
-pub mod newmark;
+pub(crate) mod coarsening;
+pub(crate) mod export;
+pub(crate) mod failure;
+pub(crate) mod grid;
+pub(crate) mod krylov;
+pub(crate) mod newmark;
 pub mod newton;
 pub mod residual;
 pub mod step;
-pub mod stress_gradient;
-pub mod terms;
+pub(crate) mod stress_gradient;
+pub(crate) mod terms;
 #[cfg(test)]
 mod tests;
-pub mod ties;
+pub(crate) mod ties;
 
 use crate::dim::Vector;
 use crate::model::Model;

@@ -7,11 +7,11 @@
 /// error.
 pub type Index = u32;
 
-pub mod cg;
+pub(crate) mod cg;
 pub mod direct;
-pub mod gmres;
-pub mod iterative;
-pub mod multigrid;
-pub mod node_pattern;
+pub(crate) mod gmres;
+pub(crate) mod iterative;
+pub(crate) mod multigrid;
+pub(crate) mod node_pattern;
 pub mod ordering;
-pub mod preconditioner;
+pub(crate) mod preconditioner;

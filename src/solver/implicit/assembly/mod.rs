@@ -22,11 +22,11 @@
 //! A term of another block adds itself with `Pattern::add_terms` and the
 //! block's `Coupling` (the tests: a scalar field with D + 1 unknowns per node).
 
-pub mod absorbing;
-pub mod fbar;
-pub mod linear_stress;
-pub mod mass;
-pub mod pattern;
+pub(crate) mod absorbing;
+pub(crate) mod fbar;
+pub(crate) mod linear_stress;
+pub(crate) mod mass;
+pub(crate) mod pattern;
 pub mod stiffness;
 
 mod dofs;

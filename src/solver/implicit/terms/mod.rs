@@ -48,10 +48,10 @@
 //! from `Dofs` (`assembly::tests`: a Biot-type system with D + 1 unknowns per
 //! node, through the direct solver and multigrid-preconditioned GMRES).
 
-pub mod absorbing;
-pub mod contact;
-pub mod linear_stress;
-pub mod list;
+pub(crate) mod absorbing;
+pub(crate) mod contact;
+pub(crate) mod linear_stress;
+pub(crate) mod list;
 
 use super::assembly::stiffness::ParticleTangents;
 use super::assembly::{Dofs, Tangent};

@@ -8,16 +8,11 @@ use rayon::prelude::*;
 /// A square matrix read row by row, each row's columns ascending: what the
 /// Galerkin triple product needs of an operator.
 pub trait Rows: Sync {
-    fn rows(&self) -> usize;
     /// f(j, a_ij) for the stored entries of row i, j ascending.
     fn for_each_in_row(&self, i: usize, f: impl FnMut(u32, f64));
 }
 
 impl Rows for Csr {
-    fn rows(&self) -> usize {
-        self.rows
-    }
-
     fn for_each_in_row(&self, i: usize, mut f: impl FnMut(u32, f64)) {
         let (c, v) = self.row(i);
         c.iter().zip(v).for_each(|(&j, &a)| f(j, a));

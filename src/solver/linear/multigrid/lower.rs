@@ -295,10 +295,6 @@ impl<'a> LowerRows<'a> {
 }
 
 impl Rows for LowerRows<'_> {
-    fn rows(&self) -> usize {
-        self.a.rows()
-    }
-
     fn for_each_in_row(&self, i: usize, mut f: impl FnMut(u32, f64)) {
         let (g, values, col_ptr) = (self.graph, &self.a.values, &self.a.col_ptr);
         let node = g.node_of(i);

@@ -70,11 +70,15 @@ mod smoother;
 mod vcycle;
 
 pub use csr::Csr;
-pub use galerkin::{galerkin, Rows};
-pub use lower::{LowerRows, LowerSymmetric};
-pub use operator::{Fine, Operator};
-pub use smoother::{EIGEN_RATIO, ESTIMATE_STEPS, SMOOTHING_STEPS};
-pub use vcycle::{Multigrid, Shape, Transfer, COARSE_SHIFT};
+pub use operator::Fine;
+pub use vcycle::{Multigrid, Transfer};
+#[cfg(test)]
+use {
+    galerkin::{galerkin, Rows},
+    lower::LowerRows,
+    operator::Operator,
+    vcycle::COARSE_SHIFT,
+};
 
 #[cfg(test)]
 mod tests;

@@ -154,6 +154,7 @@ impl Multigrid {
     }
 
     /// Levels in use (with the coarsest).
+    #[cfg(test)]
     pub fn depth(&self) -> usize {
         self.operators.len()
     }

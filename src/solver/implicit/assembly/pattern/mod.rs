@@ -22,10 +22,10 @@
 //! particle order), so every value is the same sum in the same order for any
 //! number of threads.
 
-pub mod graph;
-pub mod layout;
-pub mod scatter;
-pub mod tangent;
+pub(crate) mod graph;
+pub(crate) mod layout;
+pub(crate) mod scatter;
+pub(crate) mod tangent;
 
 use super::Dofs;
 use crate::physics::kinematics::fbar::Cells;

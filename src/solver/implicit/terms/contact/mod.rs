@@ -13,11 +13,11 @@
 //! rigid body's particles off it, deformable bodies on split nodes) is the
 //! step's grid, `super::super::grid::StepGrid`, set up here with the terms.
 
-pub mod bodies;
-pub mod penalty;
-pub mod points;
-pub mod rigid;
-pub mod state;
+pub(crate) mod bodies;
+pub(crate) mod penalty;
+pub(crate) mod points;
+pub(crate) mod rigid;
+pub(crate) mod state;
 
 use crate::model::Model;
 use crate::physics::rigid::surface::rigid_surfaces;
