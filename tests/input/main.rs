@@ -9,6 +9,7 @@ mod axisymmetric;
 mod bench;
 mod body_kinds;
 mod contact;
+mod documented;
 mod domain_stress;
 mod fuzz;
 mod impact;

@@ -131,6 +131,16 @@ impl TermReport {
         let deepest = self.contact_penetration.map_or(depth, |d| d.max(depth));
         self.contact_penetration = Some(deepest);
     }
+
+    /// Count the contacts that slip and those that stick.
+    pub fn contacts(&mut self, slips: impl Iterator<Item = bool>) {
+        for slip in slips {
+            match slip {
+                true => self.slipping += 1,
+                false => self.sticking += 1,
+            }
+        }
+    }
 }
 
 /// A checkpoint's solver state read back by the terms, in the order of the

@@ -386,12 +386,7 @@ impl<const D: usize> StepTerm<D> for BodyContact<D> {
 
     fn report(&self, report: &mut TermReport) {
         report.penetration(self.deepest);
-        for t in &self.at.touches {
-            match t.contact.slips {
-                true => report.slipping += 1,
-                false => report.sticking += 1,
-            }
-        }
+        report.contacts(self.at.touches.iter().map(|t| t.contact.slips));
     }
 
     fn take_pair_totals(&mut self, totals: &mut Vec<PairTotal<D>>) {
