@@ -10,7 +10,7 @@
 //!   only. A rigid body's particles mark out a velocity field of its own whose
 //!   nodes move with the body and have infinite mass in the contact
 //!   (`solver::explicit::contact`), or they stay off the grid and the body's
-//!   geometry is the master surface of a penalty (`solver::implicit::contact`).
+//!   geometry is the master surface of a penalty (`solver::implicit::terms::contact`).
 //!
 //! | kind              | advanced           | meets the grid |
 //! |-------------------|--------------------|----------------|
@@ -35,11 +35,14 @@
 //! 3. its answers to `advance` and `meets_grid`, with a new `Advance` or
 //!    `GridCoupling` where no existing one says what it does;
 //! 4. its work at each solver's one site that hands every kind its work (the
-//!    explicit step after G2P, the implicit step at commit) and at the sites
-//!    that ask how it meets the grid (the stencils of particles that stay off
-//!    the grid, the contact fields: today `ContactPlan::rigid` and `free`,
-//!    filled from the kinds, in `solver::explicit::contact`,
-//!    `solver::implicit::contact` and `physics::rigid`);
+//!    explicit step after G2P, `NodeMapStep::advance_bodies` and
+//!    `takes_load_work` in `solver/explicit/gather.rs`; the implicit step at
+//!    commit, `StepGrid::advance_off_grid`), which match on `Advance`
+//!    exhaustively, and at the sites that ask how it meets the grid (the
+//!    implicit step's particles off the grid, `StepGrid::for_contact`; the
+//!    contact fields: `ContactPlan::rigid` and `free`, filled from the kinds,
+//!    read in `solver::explicit::contact`, `solver::implicit::terms::contact`
+//!    and `physics::rigid`);
 //! 5. the material its particles carry, where its table's constitutive model
 //!    should not act (`SceneConfig::particle_materials`), and whether it
 //!    carries stress (`carries_stress`: K0 states).

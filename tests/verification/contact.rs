@@ -1860,7 +1860,7 @@ fn implicit_cylinder_slips_down_a_deformable_incline_with_the_rigid_cylinder_s_s
     // the one behind stayed shut, so the normal force acted behind the centre
     // and spun the disk (frictionless −0.676 rad/s at 0.5 s, at μ = 0.1 +33 %).
     // With the gap following the outermost particles at the node
-    // (solver::implicit::contact, `Fields::assign_history`), measured: centre
+    // (solver::implicit::terms::contact::bodies, `assign_history`), measured: centre
     // −0.47 %, spin −1.1 % (frictionless +0.082 rad/s; rolling at μ = 0.5 centre
     // −0.41 %, spin −2.2 %).
     let text = problem_with(
