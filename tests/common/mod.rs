@@ -378,3 +378,13 @@ impl Block {
         t
     }
 }
+
+/// `text` is rejected with an error that names `key`, and its text holds every one of `parts`.
+pub fn rejected_at(text: &str, key: &str, parts: &[&str]) {
+    let e = Scene::parse("scene.toml", text, &[]).expect_err("must be rejected");
+    assert_eq!(e.key.as_deref(), Some(key), "{e}");
+    let s = e.to_string();
+    for part in parts {
+        assert!(s.contains(part), "`{part}` not in: {s}");
+    }
+}

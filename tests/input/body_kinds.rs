@@ -2,6 +2,7 @@
 //! and the old one (a material with `model = "rigid"`) read as the same body;
 //! every mistake is named by its key.
 
+use crate::common::rejected_at;
 use mpm::scene::{BodyKindName, Scene};
 
 /// problems/rigid_disk_impact.toml: body 0 (`left`) is a free rigid disk of
@@ -32,16 +33,6 @@ fn at_line(text: &str, line: &str, n: usize) -> String {
         .unwrap()
         .0;
     format!("scene.toml:{}:", l + 1)
-}
-
-/// The error names `key`, and its text holds every one of `parts`.
-fn rejected(text: &str, key: &str, parts: &[&str]) {
-    let e = Scene::parse("scene.toml", text, &[]).expect_err("must be rejected");
-    assert_eq!(e.key.as_deref(), Some(key), "{e}");
-    let s = e.to_string();
-    for part in parts {
-        assert!(s.contains(part), "`{part}` not in: {s}");
-    }
 }
 
 #[test]
@@ -83,15 +74,15 @@ fn a_rigid_body_of_any_material_takes_its_density_only() {
 fn an_unknown_kind_is_named() {
     let bad = impact().replace("kind = \"rigid\"", "kind = \"rigd\"");
     let line = at_line(&bad, "kind = \"rigd\"", 0);
-    rejected(&bad, "body.0.kind", &[&line, "rigd", "continuum", "rigid"]);
+    rejected_at(&bad, "body.0.kind", &[&line, "rigd", "continuum", "rigid"]);
 }
 
 #[test]
 fn an_unknown_motion_on_the_body_or_the_old_form_material_is_named() {
     let bad = impact().replace("motion = \"free\"", "motion = \"spinning\"");
-    rejected(&bad, "body.0.motion", &["scene.toml:", "spinning"]);
+    rejected_at(&bad, "body.0.motion", &["scene.toml:", "spinning"]);
     let bad = old_form(&impact()).replace("motion = \"free\"", "motion = \"spinning\"");
-    rejected(&bad, "material.1.motion", &["scene.toml:", "spinning"]);
+    rejected_at(&bad, "material.1.motion", &["scene.toml:", "spinning"]);
 }
 
 #[test]
@@ -101,14 +92,14 @@ fn a_motion_on_a_continuum_body_is_rejected() {
         "motion = \"free\"\nmaterial = \"elastic\"",
     );
     let line = at_line(&bad, "motion = \"free\"", 1);
-    rejected(
+    rejected_at(
         &bad,
         "body.1.motion",
         &[&line, "does not apply to a continuum body"],
     );
     let bad = impact().replace("kind = \"rigid\"\n", "kind = \"continuum\"\n");
     let line = at_line(&bad, "kind = \"continuum\"", 0);
-    rejected(&bad, "body.0.kind", &[&line, "has model = \"rigid\""]);
+    rejected_at(&bad, "body.0.kind", &[&line, "has model = \"rigid\""]);
 }
 
 #[test]
@@ -117,7 +108,7 @@ fn a_motion_given_twice_is_rejected() {
         "model = \"rigid\"\ndensity",
         "model = \"rigid\"\nmotion = \"free\"\ndensity",
     );
-    rejected(&bad, "body.0.motion", &["scene.toml:", "give it once"]);
+    rejected_at(&bad, "body.0.motion", &["scene.toml:", "give it once"]);
 }
 
 #[test]
@@ -130,7 +121,7 @@ fn a_material_shared_by_a_rigid_and_a_continuum_body_is_rejected() {
         )
         .replace("material = \"elastic\"", "material = \"steel\"");
     let line = at_line(&shared, "material = \"steel\"", 0);
-    rejected(
+    rejected_at(
         &shared,
         "body.0.material",
         &[&line, "also the material of continuum body 1"],
@@ -140,12 +131,12 @@ fn a_material_shared_by_a_rigid_and_a_continuum_body_is_rejected() {
 #[test]
 fn a_rigid_body_without_contact_is_named_at_the_key_that_makes_it_rigid() {
     let without = |text: &str| text.replace("[[contact]]\nfriction_coefficient = 0.3\n", "");
-    rejected(
+    rejected_at(
         &without(&impact()),
         "body.0.kind",
         &["a rigid body meets other bodies only through contact"],
     );
-    rejected(
+    rejected_at(
         &without(&old_form(&impact())),
         "body.0.material",
         &["a rigid body meets other bodies only through contact"],

@@ -1,6 +1,7 @@
 //! `[[contact]]` tables: every mistake is named by its key, with the line and
 //! column of the file (issue 14 item 4).
 
+use crate::common::rejected_at;
 use mpm::scene::Scene;
 
 /// problems/contact_disks.toml with `contact` as its contact table(s).
@@ -8,16 +9,6 @@ fn scene(contact: &str) -> String {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/problems/contact_disks.toml");
     let text = std::fs::read_to_string(path).unwrap();
     text.replace("[[contact]]\nfriction_coefficient = 0.3\n", contact)
-}
-
-/// The error names `key`, and its text holds every one of `parts`.
-fn rejected(text: &str, key: &str, parts: &[&str]) {
-    let e = Scene::parse("scene.toml", text, &[]).expect_err("must be rejected");
-    assert_eq!(e.key.as_deref(), Some(key), "{e}");
-    let s = e.to_string();
-    for part in parts {
-        assert!(s.contains(part), "`{part}` not in: {s}");
-    }
 }
 
 #[test]
@@ -28,7 +19,7 @@ fn the_contact_scenes_are_valid() {
 
 #[test]
 fn an_unknown_body_is_named() {
-    rejected(
+    rejected_at(
         &scene("[[contact]]\nbodies = [\"left\", \"rigth\"]\n"),
         "contact.0.bodies.1",
         &["scene.toml:44:", "no body is named `rigth`"],
@@ -37,7 +28,7 @@ fn an_unknown_body_is_named() {
 
 #[test]
 fn a_body_paired_with_itself_is_rejected() {
-    rejected(
+    rejected_at(
         &scene("[[contact]]\nbodies = [\"left\", \"left\"]\n"),
         "contact.0.bodies",
         &["scene.toml:44:", "pairs body `left` with itself"],
@@ -46,7 +37,7 @@ fn a_body_paired_with_itself_is_rejected() {
 
 #[test]
 fn a_pair_needs_two_bodies() {
-    rejected(
+    rejected_at(
         &scene("[[contact]]\nbodies = [\"left\"]\n"),
         "contact.0.bodies",
         &["scene.toml:44:", "names two bodies, has 1"],
@@ -55,17 +46,17 @@ fn a_pair_needs_two_bodies() {
 
 #[test]
 fn negative_friction_and_adhesion_and_a_zero_gap_factor_are_rejected() {
-    rejected(
+    rejected_at(
         &scene("[[contact]]\nfriction_coefficient = -0.1\n"),
         "contact.0.friction_coefficient",
         &["scene.toml:44:", "must be a finite number ≥ 0"],
     );
-    rejected(
+    rejected_at(
         &scene("[[contact]]\nadhesion = -5.0\n"),
         "contact.0.adhesion",
         &["scene.toml:44:", "must be a finite number ≥ 0"],
     );
-    rejected(
+    rejected_at(
         &scene("[[contact]]\ngap_factor = 0.0\n"),
         "contact.0.gap_factor",
         &["scene.toml:44:", "must be a finite number > 0"],
@@ -74,7 +65,7 @@ fn negative_friction_and_adhesion_and_a_zero_gap_factor_are_rejected() {
 
 #[test]
 fn a_rigid_projection_that_is_not_a_bool_is_named() {
-    rejected(
+    rejected_at(
         &scene("[[contact]]\nrigid_projection = \"yes\"\n"),
         "contact.0.rigid_projection",
         &["scene.toml:44:", "expected a boolean"],
@@ -83,12 +74,12 @@ fn a_rigid_projection_that_is_not_a_bool_is_named() {
 
 #[test]
 fn an_unknown_normal_and_an_unknown_key_are_named() {
-    rejected(
+    rejected_at(
         &scene("[[contact]]\nnormal = \"mass_gradient\"\n"),
         "contact.0.normal",
         &["scene.toml:44:", "unknown variant `mass_gradient`"],
     );
-    rejected(
+    rejected_at(
         &scene("[[contact]]\nfriction = 0.3\n"),
         "contact.0.friction",
         &["unknown field `friction`"],
@@ -97,7 +88,7 @@ fn an_unknown_normal_and_an_unknown_key_are_named() {
 
 #[test]
 fn a_pair_declared_twice_is_rejected() {
-    rejected(
+    rejected_at(
         &scene("[[contact]]\nbodies = [\"left\", \"right\"]\n\n[[contact]]\nbodies = [\"right\", \"left\"]\n"),
         "contact.1",
         &["scene.toml:46:", "declares the contact of bodies 0 and 1 again (also in contact.0)"],
@@ -112,7 +103,7 @@ fn implicit_contact_of_deformable_bodies_refusals_and_explicit_contact_no_b_spli
             &format!("kind = \"implicit\"\ndt = 0.1\n{extra}"),
         )
     };
-    rejected(
+    rejected_at(
         &implicit("linear_solver = \"cg\"\npreconditioner = \"multigrid\""),
         "contact",
         &[
@@ -121,7 +112,7 @@ fn implicit_contact_of_deformable_bodies_refusals_and_explicit_contact_no_b_spli
             "multigrid coarsens the grid's nodes only",
         ],
     );
-    rejected(
+    rejected_at(
         &implicit("fbar = true"),
         "contact",
         &[
@@ -129,12 +120,12 @@ fn implicit_contact_of_deformable_bodies_refusals_and_explicit_contact_no_b_spli
             "F-bar averages the dilation",
         ],
     );
-    rejected(
+    rejected_at(
         &implicit("").replace("\"cpgimp\"", "\"bspline3\""),
         "grid.shape_function",
         &["between bodies 0 and 1 is not implemented with cubic B-splines"],
     );
-    rejected(
+    rejected_at(
         &scene("[[contact]]\n").replace("\"cpgimp\"", "\"bspline2\""),
         "grid.shape_function",
         &[
@@ -142,7 +133,7 @@ fn implicit_contact_of_deformable_bodies_refusals_and_explicit_contact_no_b_spli
             "contact in the explicit solver works with linear, ugimp, cpgimp and cpdi",
         ],
     );
-    rejected(
+    rejected_at(
         &scene("[[contact]]\npenalty_factor = 0.0\n"),
         "contact.0.penalty_factor",
         &["must be a finite number > 0"],
@@ -155,7 +146,7 @@ fn glued_bodies_cannot_also_be_in_contact() {
     let third = "[[body]]\nname = \"third\"\nmaterial = \"elastic\"\nshape = \"rectangle\"\nmin = [0.1, 0.8]\nmax = [0.3, 0.9]\n\n";
     let text = scene("[[contact]]\nbodies = [\"left\", \"right\"]\n")
         .replace("\n[[contact]]\n", &format!("\n{third}[[contact]]\n"));
-    rejected(
+    rejected_at(
         &text,
         "contact.0",
         &["are declared in contact, but other bodies"],
@@ -179,7 +170,7 @@ fn more_than_64_velocity_fields_are_refused() {
     let first = text.find("[[body]]").unwrap();
     let contact = text.find("\n[[contact]]\n").unwrap();
     let text = format!("{}{bodies}{}", &text[..first], &text[contact + 1..]);
-    rejected(&text, "contact", &["65 velocity fields; at most 64"]);
+    rejected_at(&text, "contact", &["65 velocity fields; at most 64"]);
 }
 
 #[test]
@@ -195,7 +186,7 @@ fn a_rigid_body_needs_contact_with_every_other_body() {
             )
     };
     Scene::parse("scene.toml", &with_rigid("[[contact]]\n"), &[]).unwrap();
-    rejected(
+    rejected_at(
         &with_rigid(""),
         "body.1.material",
         &["a rigid body meets other bodies only through contact"],
@@ -211,5 +202,5 @@ fn a_rigid_motion_other_than_prescribed_or_free_is_named() {
     .unwrap();
     Scene::parse("scene.toml", &text, &[]).unwrap();
     let bad = text.replace("motion = \"free\"", "motion = \"spinning\"");
-    rejected(&bad, "body.0.motion", &["scene.toml:", "spinning"]);
+    rejected_at(&bad, "body.0.motion", &["scene.toml:", "spinning"]);
 }

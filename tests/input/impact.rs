@@ -2,21 +2,12 @@
 //! equation of state, the bulk viscosity or a cylinder body is named by its key
 //! with line and column.
 
+use crate::common::rejected_at;
 use mpm::scene::Scene;
 
 fn taylor() -> String {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/problems/taylor_bar.toml");
     std::fs::read_to_string(path).unwrap()
-}
-
-/// The error names `key`, and its text holds every one of `parts`.
-fn rejected(text: &str, key: &str, parts: &[&str]) {
-    let e = Scene::parse("scene.toml", text, &[]).expect_err("must be rejected");
-    assert_eq!(e.key.as_deref(), Some(key), "{e}");
-    let s = e.to_string();
-    for part in parts {
-        assert!(s.contains(part), "`{part}` not in: {s}");
-    }
 }
 
 fn replaced(from: &str, to: &str) -> String {
@@ -34,7 +25,7 @@ fn the_impact_scenes_are_valid() {
 
 #[test]
 fn equation_of_state_mistakes_are_named() {
-    rejected(
+    rejected_at(
         &replaced("eos = \"mie_gruneisen\"", "eos = \"gruneisen\""),
         "material.0.eos",
         &[
@@ -43,12 +34,12 @@ fn equation_of_state_mistakes_are_named() {
             "mie_gruneisen",
         ],
     );
-    rejected(
+    rejected_at(
         &replaced("sound_speed = 3940.0\n", ""),
         "material.0.sound_speed",
         &["is required for eos = \"mie_gruneisen\""],
     );
-    rejected(
+    rejected_at(
         &replaced(
             "eos = \"mie_gruneisen\"",
             "eos = \"polynomial\"\nk1 = 1.0e11",
@@ -56,7 +47,7 @@ fn equation_of_state_mistakes_are_named() {
         "material.0.sound_speed",
         &["does not apply to eos = \"polynomial\""],
     );
-    rejected(
+    rejected_at(
         &replaced("hugoniot_slope = 1.49", "hugoniot_slope = -1.0"),
         "material.0.hugoniot_slope",
         &["must lie in [0, 10)"],
@@ -65,12 +56,12 @@ fn equation_of_state_mistakes_are_named() {
 
 #[test]
 fn johnson_cook_mistakes_are_named() {
-    rejected(
+    rejected_at(
         &replaced("yield_stress = 157.0e6", "yield_stress = -1.0"),
         "material.0.yield_stress",
         &["must be a number ≥ 0"],
     );
-    rejected(
+    rejected_at(
         &replaced(
             "hardening_exponent = 1.0",
             "hardening_exponent = 1.0\nmelting_temperature = 1356.0",
@@ -78,7 +69,7 @@ fn johnson_cook_mistakes_are_named() {
         "material.0.thermal_exponent",
         &["is required for thermal softening"],
     );
-    rejected(
+    rejected_at(
         &replaced(
             "hardening_exponent = 1.0",
             "hardening_exponent = 1.0\ntaylor_quinney = 0.9",
@@ -86,7 +77,7 @@ fn johnson_cook_mistakes_are_named() {
         "material.0.taylor_quinney",
         &["applies only with melting_temperature"],
     );
-    rejected(
+    rejected_at(
         &replaced(
             "hardening_exponent = 1.0",
             "hardening_exponent = 1.0\ndamage_d1 = 0.5",
@@ -94,7 +85,7 @@ fn johnson_cook_mistakes_are_named() {
         "material.0.damage_d2",
         &["is required for Johnson–Cook damage"],
     );
-    rejected(
+    rejected_at(
         &replaced(
             "hardening_exponent = 1.0",
             "hardening_exponent = 1.0\nhel_strength = 1.0",
@@ -113,19 +104,19 @@ fn ceramic_and_concrete_mistakes_are_named() {
         let end = text.find("[[body]]").unwrap();
         format!("{}{body}\n{}", &text[..start], &text[end..])
     };
-    rejected(
+    rejected_at(
         &material(jh2),
         "material.0.rate_form",
         &["unknown variant `sometimes`"],
     );
     let hjc = "model = \"hjc\"\ndensity = 2.44e-3\nshear_modulus = 14.86e3\nintact_coefficient = 0.79\ncompressive_strength = 48.0\ntensile_strength = 4.0\ndamage_d1 = 0.04\ncrush_pressure = 16.0\ncrush_strain = 0.001\nlock_pressure = 10.0\nk1 = 85.0e3\n";
-    rejected(
+    rejected_at(
         &material(hjc),
         "material.0.lock_pressure",
         &["must exceed crush_pressure = 16"],
     );
     let unreachable = hjc.replace("lock_pressure = 10.0", "lock_pressure = 800.0\nk2 = -1.0e7");
-    rejected(
+    rejected_at(
         &material(&unreachable),
         "material.0.k1",
         &["must rise to lock_pressure"],
@@ -134,7 +125,7 @@ fn ceramic_and_concrete_mistakes_are_named() {
 
 #[test]
 fn bulk_viscosity_and_cylinder_mistakes_are_named() {
-    rejected(
+    rejected_at(
         &replaced(
             "bulk_viscosity_linear = 0.06",
             "bulk_viscosity_linear = -0.06",
@@ -147,17 +138,17 @@ fn bulk_viscosity_and_cylinder_mistakes_are_named() {
         "kind = \"implicit\"\nlinear_solver = \"gmres\"",
     );
     let implicit = implicit.replace("cfl = 0.5\n", "");
-    rejected(
+    rejected_at(
         &implicit,
         "solver.bulk_viscosity_quadratic",
         &["does not apply"],
     );
-    rejected(
+    rejected_at(
         &replaced("height = 25.4e-3", "height = 0.0"),
         "body.0.height",
         &["must be a positive number"],
     );
-    rejected(
+    rejected_at(
         &replaced("height = 25.4e-3\n", ""),
         "body.0.height",
         &["required"],
@@ -167,5 +158,5 @@ fn bulk_viscosity_and_cylinder_mistakes_are_named() {
         "face = \"xmin\"\ncondition = \"roller\"",
         "face = \"xmin\"\ncondition = \"fixed\"",
     );
-    rejected(&text, "body.0.shape", &["outside the grid", "roller"]);
+    rejected_at(&text, "body.0.shape", &["outside the grid", "roller"]);
 }
