@@ -35,10 +35,12 @@ use crate::solver::explicit::p2g::{hoop_stress, Source};
 use crate::solver::explicit::step::{removed_particles, Backend, P2g, Start, Step, Then, Velocity};
 use rayon::prelude::*;
 
-/// Particles per task of a particle pass: the chunking of
-/// `parallel::deterministic_sum`, so the work of the loads sums the same on
-/// any number of threads.
-const CHUNK: usize = SUM_CHUNK;
+/// Particles per task of a particle pass: small enough that a scene of a few
+/// thousand particles keeps every thread busy. The work of the loads is summed
+/// afterwards in the chunks of `parallel::deterministic_sum` (`SUM_CHUNK`, a
+/// multiple of it), so it sums the same on any number of threads.
+const TASK: usize = MIN_PARALLEL_LEN;
+const _: () = assert!(SUM_CHUNK % TASK == 0);
 
 /// What a box node gathers. After the node pass: `momentum` holds the updated
 /// velocity and `force` the acceleration.
@@ -743,11 +745,11 @@ struct Parts<'a, const D: usize> {
     history: &'a mut History,
 }
 
-/// `body(q, state)` for every particle, in parallel over chunks of `CHUNK`
+/// `body(q, state)` for every particle, in parallel over tasks of `TASK`
 /// particles; `body` returns the particle's work term, whether it inverted
-/// and whether it is unsound. Returns the summed work (in the chunks of
-/// `parallel::deterministic_sum`), the first inverted and the first unsound
-/// particle.
+/// and whether it is unsound. Returns the summed work (in particle order
+/// within each chunk of `parallel::deterministic_sum`, then over the chunks),
+/// the first inverted and the first unsound particle.
 #[inline(always)]
 fn over_particles<const D: usize>(
     parts: Parts<D>,
@@ -761,14 +763,16 @@ fn over_particles<const D: usize>(
         volume,
         history,
     } = parts;
+    let mut works = vec![0.0; x.len()];
     let chunk = |c: usize,
+                 ws: &mut [f64],
                  xs: &mut [Vector<D>],
                  vs: &mut [Vector<D>],
                  mut fs: TensorsMut,
                  mut ss: TensorsMut,
                  vols: &mut [f64],
                  mut hs: Option<&mut [&mut [f64]]>| {
-        let (mut work, mut first_inverted, mut bad) = (0.0, usize::MAX, usize::MAX);
+        let (mut first_inverted, mut bad) = (usize::MAX, usize::MAX);
         for i in 0..xs.len() {
             let history: &mut [f64] = match &mut hs {
                 Some(hs) => hs[i],
@@ -784,9 +788,9 @@ fn over_particles<const D: usize>(
                     history,
                 },
             };
-            let q = c * CHUNK + i;
+            let q = c * TASK + i;
             let (w, inverts, unsound) = body(q, state);
-            work += w;
+            ws[i] = w;
             if inverts {
                 first_inverted = first_inverted.min(q);
             }
@@ -794,33 +798,52 @@ fn over_particles<const D: usize>(
                 bad = bad.min(q);
             }
         }
-        (work, first_inverted, bad)
+        (first_inverted, bad)
     };
-    let chunks = (x.par_chunks_mut(CHUNK))
-        .zip(v.par_chunks_mut(CHUNK))
-        .zip(f.par_chunks_mut(CHUNK))
-        .zip(stress.par_chunks_mut(CHUNK))
-        .zip(volume.par_chunks_mut(CHUNK))
+    let chunks = (works.par_chunks_mut(TASK))
+        .zip(x.par_chunks_mut(TASK))
+        .zip(v.par_chunks_mut(TASK))
+        .zip(f.par_chunks_mut(TASK))
+        .zip(stress.par_chunks_mut(TASK))
+        .zip(volume.par_chunks_mut(TASK))
         .enumerate();
-    let per_chunk: Vec<(f64, usize, usize)> = match history.data.is_empty() {
+    let per_task: Vec<(usize, usize)> = match history.data.is_empty() {
         true => chunks
-            .map(|(c, ((((xs, vs), fs), ss), vols))| chunk(c, xs, vs, fs, ss, vols, None))
+            .map(|(c, (((((ws, xs), vs), fs), ss), vols))| chunk(c, ws, xs, vs, fs, ss, vols, None))
             .collect(),
         false => {
             let mut slots = history.own_slots_mut();
             chunks
-                .zip(slots.par_chunks_mut(CHUNK))
-                .map(|((c, ((((xs, vs), fs), ss), vols)), hs)| {
-                    chunk(c, xs, vs, fs, ss, vols, Some(hs))
+                .zip(slots.par_chunks_mut(TASK))
+                .map(|((c, (((((ws, xs), vs), fs), ss), vols)), hs)| {
+                    chunk(c, ws, xs, vs, fs, ss, vols, Some(hs))
                 })
                 .collect()
         }
     };
-    let work: f64 = per_chunk.iter().map(|c| c.0).sum();
-    let first = |k: fn(&(f64, usize, usize)) -> usize| {
-        per_chunk.iter().map(k).min().filter(|&q| q != usize::MAX)
+    (
+        chunked_sum(&works),
+        first(per_task.iter().map(|t| t.0)),
+        first(per_task.iter().map(|t| t.1)),
+    )
+}
+
+/// Σ w in particle order within each chunk of `SUM_CHUNK`, then over the
+/// chunks: the sum `parallel::deterministic_sum` forms.
+fn chunked_sum(works: &[f64]) -> f64 {
+    let chunk_sum = |c: &[f64]| {
+        let mut sum = 0.0;
+        for w in c {
+            sum += w;
+        }
+        sum
     };
-    (work, first(|c| c.1), first(|c| c.2))
+    works.chunks(SUM_CHUNK).map(chunk_sum).sum()
+}
+
+/// The least particle index of `qs` (usize::MAX: none).
+fn first(qs: impl Iterator<Item = usize>) -> Option<usize> {
+    qs.min().filter(|&q| q != usize::MAX)
 }
 
 /// What one particle pass does.
