@@ -78,19 +78,11 @@ impl<const D: usize> Trial<D> {
         self.history.clone_from(&p.history.data);
         let axisymmetric = !st.hoop.is_empty();
         if let Some(fbar) = &mut self.fbar {
-            // ΔF̄_p = (ΔJ̄_c / ΔJ_p)^{1/n} ΔF_p (Coombs et al. 2018); needs ΔJ_p > 0.
-            fbar.df.clear();
-            (0..n)
-                .into_par_iter()
-                .with_min_len(MIN_PARALLEL_LEN)
-                .map(|q| increment(st, map, q, u, axisymmetric))
-                .collect_into_vec(&mut fbar.df);
-            fbar.dj.clear();
-            fbar.dj.extend(fbar.df.iter().map(|f| f.determinant()));
-            if let Some(q) = fbar.dj.iter().position(|&j| j <= 0.0) {
-                return Some(q);
+            let (df, dj) = (&mut fbar.df, &mut fbar.dj);
+            match dilatations(st, map, u, axisymmetric, &fbar.cells, &p.volume, df, dj) {
+                Ok(dj_bar) => fbar.dj_bar = dj_bar,
+                Err(q) => return Some(q),
             }
-            fbar.dj_bar = fbar.cells.mean_dilatation(&p.volume, &fbar.dj);
         }
         let history_old = p.history.slots(&p.history.data);
         let mut history = p.history.slots_mut(&mut self.history);
@@ -148,16 +140,7 @@ impl<const D: usize> Trial<D> {
         let mut plain: (Vec<Mat3>, Vec<f64>, Vec<f64>) = Default::default();
         if let Some(fbar) = &self.fbar {
             let (df, dj, dj_bar) = &mut plain;
-            (0..n)
-                .into_par_iter()
-                .with_min_len(MIN_PARALLEL_LEN)
-                .map(|q| increment(st, map, q, u, axisymmetric))
-                .collect_into_vec(df);
-            dj.extend(df.iter().map(|f| f.determinant()));
-            if let Some(q) = dj.iter().position(|&j| j <= 0.0) {
-                return Err(q);
-            }
-            *dj_bar = fbar.cells.mean_dilatation(&p.volume, dj);
+            *dj_bar = dilatations(st, map, u, axisymmetric, &fbar.cells, &p.volume, df, dj)?;
         }
         let fbar = (self.fbar.as_ref()).map(|f| Dilatations {
             df: &plain.0,
@@ -322,6 +305,34 @@ fn advance(
 }
 
 /// ΔF_p = I + Σ_I u_I ⊗ ∇S_Ip; axisymmetric: ΔF_θθ = 1 + Σ_I u_Ir S_Ip / r_p.
+/// F-bar's measures under nodal displacements u: ΔF_p and ΔJ_p = det ΔF_p of
+/// every particle (into `df`, `dj`), and the cells' mean dilatation ΔJ̄_c, from
+/// which ΔF̄_p = (ΔJ̄_c / ΔJ_p)^{1/n} ΔF_p (Coombs et al. 2018). Err(q): ΔJ_q ≤ 0.
+#[allow(clippy::too_many_arguments)]
+fn dilatations<const D: usize>(
+    st: &Stencils<D>,
+    map: &NodeMap,
+    u: &[Vector<D>],
+    axisymmetric: bool,
+    cells: &Cells,
+    volume: &[f64],
+    df: &mut Vec<Mat3>,
+    dj: &mut Vec<f64>,
+) -> Result<Vec<f64>, usize> {
+    df.clear();
+    (0..volume.len())
+        .into_par_iter()
+        .with_min_len(MIN_PARALLEL_LEN)
+        .map(|q| increment(st, map, q, u, axisymmetric))
+        .collect_into_vec(df);
+    dj.clear();
+    dj.extend(df.iter().map(|f| f.determinant()));
+    if let Some(q) = dj.iter().position(|&j| j <= 0.0) {
+        return Err(q);
+    }
+    Ok(cells.mean_dilatation(volume, dj))
+}
+
 fn increment<const D: usize>(
     st: &Stencils<D>,
     map: &NodeMap,

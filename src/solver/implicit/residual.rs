@@ -26,7 +26,6 @@ use super::assembly::stiffness::{
 use super::assembly::{Pattern, Storage, Tangent};
 use super::failure::Failure;
 use super::step::StepSystem;
-use super::terms::StepView;
 use crate::dim::{Mat3, Vector};
 use crate::model::conditions::Constraint;
 use crate::model::particles::Particles;
@@ -55,26 +54,7 @@ pub fn residual<const D: usize>(
         .map(|q| relative_pk1(&sys.trial.df(st, map, q), &sys.trial.stress.get(q)))
         .collect();
     let mut r = material_residual(m, sys, u, &pk1);
-    let StepSystem {
-        stencils,
-        map,
-        dofs,
-        grid,
-        dt,
-        terms,
-        ..
-    } = sys;
-    let step = StepView {
-        m,
-        stencils,
-        map,
-        dofs,
-        grid,
-        dt: *dt,
-    };
-    for t in terms.iter_mut() {
-        t.evaluate(&step, u, &mut r);
-    }
+    sys.for_each_term(m, |step, t| t.evaluate(step, u, &mut r));
     Ok(r)
 }
 
@@ -200,8 +180,8 @@ pub fn tangent<'s, const D: usize>(
         storage,
     };
     match fbar {
-        None => add_stiffness(&mut k, pattern, map, st, dofs, &p.volume, &a),
-        Some(state) => add_fbar_stiffness(&mut k, pattern, map, st, dofs, &p.volume, state, &a),
+        None => add_stiffness(&mut k, map, st, dofs, &p.volume, &a),
+        Some(state) => add_fbar_stiffness(&mut k, map, st, dofs, &p.volume, state, &a),
     }
     // The step's terms (absorbing faces, contact, a linear domain stress).
     let step = sys.view(m);
@@ -212,7 +192,7 @@ pub fn tangent<'s, const D: usize>(
         match sys.mass_matrix {
             MassMatrix::Lumped => add_lumped_mass::<D>(&mut k, dofs, &sys.mass, sys.inertia),
             MassMatrix::Consistent => {
-                add_consistent_mass(&mut k, pattern, map, st, dofs, &p.mass, sys.inertia)
+                add_consistent_mass(&mut k, map, st, dofs, &p.mass, sys.inertia)
             }
         }
     }

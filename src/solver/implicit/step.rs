@@ -154,6 +154,21 @@ impl<const D: usize> StepSystem<D> {
         }
     }
 
+    /// `f` on every term, in order, with the step's view (the terms taken out
+    /// of the system while the view borrows it).
+    pub fn for_each_term(
+        &mut self,
+        m: &Model<D>,
+        mut f: impl FnMut(&StepView<'_, D>, &mut dyn StepTerm<D>),
+    ) {
+        let mut terms = std::mem::take(&mut self.terms);
+        let step = self.view(m);
+        for t in terms.iter_mut() {
+            f(&step, t.as_mut());
+        }
+        self.terms = terms;
+    }
+
     /// The iterate: the nodal displacement increments u of the last
     /// `residual` call, at which the trial state and the terms' states are.
     pub fn iterate(&self) -> &[Vector<D>] {
@@ -336,32 +351,16 @@ impl StepSettings {
     /// Begin every term of the step (its stencils, unknowns and predictor are
     /// set).
     fn begin_terms<const D: usize>(&self, m: &Model<D>, sys: &mut StepSystem<D>) {
-        let StepSystem {
-            stencils,
-            map,
-            dofs,
-            grid,
-            dt,
-            u_tilde,
-            a_n,
-            terms,
-            ..
-        } = sys;
-        let step = StepView {
-            m,
-            stencils,
-            map,
-            dofs,
-            grid,
-            dt: *dt,
-        };
+        let mut terms = std::mem::take(&mut sys.terms);
+        let step = sys.view(m);
         let start = StepStart {
             shape: self.shape,
             newmark: self.dynamic().then_some(&self.newmark),
-            u_tilde,
-            a_n,
+            u_tilde: &sys.u_tilde,
+            a_n: &sys.a_n,
         };
         terms.iter_mut().for_each(|t| t.begin_step(&step, &start));
+        sys.terms = terms;
     }
 
     /// The particles' displacements over the step: Σ_I S_Ip u_I, or as a term
@@ -421,16 +420,12 @@ impl StepSettings {
     ) -> f64 {
         debug_assert!(sys.iterate() == u, "the converged u is the iterate");
         let dt = sys.dt;
+        let dx = self.particle_displacements(m, sys, u);
+        // The terms keep what they carry, seeing the step-start model.
+        sys.for_each_term(m, |step, t| t.commit(step, u));
         let (g_old, scales_old) = self.load_factors(m, sys.t);
         let load_old = |q: usize| load_factor(&m.load_ramp_of, q, &scales_old);
         let load_new = |q: usize| load_factor(&m.load_ramp_of, q, &sys.scales_new);
-        let dx = self.particle_displacements(m, sys, u);
-        // The terms keep what they carry, seeing the step-start model (taken
-        // out of `sys` while the view borrows it).
-        let mut terms = std::mem::take(&mut sys.terms);
-        let step = sys.view(m);
-        terms.iter_mut().for_each(|t| t.commit(&step, u));
-        sys.terms = terms;
         let p = &mut m.particles;
         sys.trial.commit(p, &sys.stencils, &sys.map);
         let (map, st) = (&sys.map, &sys.stencils);

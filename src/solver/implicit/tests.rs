@@ -168,7 +168,7 @@ fn lower_equals_full_stiffness<const D: usize>(m: &Model<D>, sys: &StepSystem<D>
             storage,
         };
         let (map, st, dofs) = (&sys.map, &sys.stencils, &sys.dofs);
-        add_stiffness(&mut t, pattern, map, st, dofs, &m.particles.volume, &a);
+        add_stiffness(&mut t, map, st, dofs, &m.particles.volume, &a);
         t
     };
     let (lower, full) = (assemble(Storage::Lower), assemble(Storage::Full));

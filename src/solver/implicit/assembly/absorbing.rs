@@ -3,7 +3,7 @@
 //! v(u) = v* + rate · u, the springs through u, so each layer particle adds
 //! S_Ip S_Jp (rate C_p + K_p), diagonal in the components.
 
-use super::{Components, Coupling, Dofs, Pattern, Tangent};
+use super::{Components, Coupling, Dofs, Tangent};
 use crate::dim::Vector;
 use crate::physics::boundary::absorbing::AbsorbingStep;
 use crate::physics::shape::Stencils;
@@ -14,7 +14,6 @@ use crate::physics::transfer::NodeMap;
 pub fn add_absorbing<const D: usize>(
     k: &mut Tangent,
     step: &AbsorbingStep<D>,
-    pattern: &Pattern,
     map: &NodeMap,
     st: &Stencils<D>,
     dofs: &Dofs,
@@ -27,11 +26,7 @@ pub fn add_absorbing<const D: usize>(
         let c = lp.damping * step.rate + lp.stiffness;
         *coefficient[lp.q].get_or_insert_with(Vector::<D>::zeros) += c;
     }
-    let (col_ptr, storage) = (k.col_ptr, k.storage);
-    pattern.add_terms(
-        &mut k.values,
-        col_ptr,
-        storage,
+    k.add_terms(
         map,
         st,
         dofs,

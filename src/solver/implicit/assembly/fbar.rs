@@ -14,7 +14,7 @@
 //! which couples each particle to the nodes of every particle in its cell.
 
 use super::stiffness::{add_stiffness, indices, ParticleTangents};
-use super::{Dofs, Pattern, Tangent};
+use super::{Dofs, Tangent};
 use crate::dim::{Mat3, Vector};
 use crate::parallel::MIN_PARALLEL_LEN;
 use crate::physics::kinematics::fbar::{scale_factor, FBarState};
@@ -29,7 +29,6 @@ use rayon::prelude::*;
 #[allow(clippy::too_many_arguments)]
 pub fn add_fbar_stiffness<const D: usize>(
     k: &mut Tangent,
-    pattern: &Pattern,
     map: &NodeMap,
     st: &Stencils<D>,
     dofs: &Dofs,
@@ -48,7 +47,7 @@ pub fn add_fbar_stiffness<const D: usize>(
         .collect();
     let m = contractions(a, &state.df, volume.len(), axisymmetric);
     let a_tilde = scaled_tangents(a, &beta, &m, &inv_t, n, axisymmetric);
-    add_stiffness(k, pattern, map, st, dofs, volume, &a_tilde);
+    add_stiffness(k, map, st, dofs, volume, &a_tilde);
     let cells = CellTerms {
         map,
         st,

@@ -2,7 +2,7 @@
 //! lumped nodal mass m_I (2-24) or the consistent mass M_IJ = Σ_p m_p S_Ip S_Jp,
 //! diagonal in the components.
 
-use super::{Components, Coupling, Dofs, Pattern, Storage, Tangent};
+use super::{Components, Coupling, Dofs, Storage, Tangent};
 use crate::physics::shape::Stencils;
 use crate::physics::transfer::NodeMap;
 
@@ -27,18 +27,13 @@ pub fn add_lumped_mass<const D: usize>(k: &mut Tangent, dofs: &Dofs, mass: &[f64
 /// Adds Σ_p m_p S_Ip S_Jp · inertia.
 pub fn add_consistent_mass<const D: usize>(
     k: &mut Tangent,
-    pattern: &Pattern,
     map: &NodeMap,
     st: &Stencils<D>,
     dofs: &Dofs,
     particle_mass: &[f64],
     inertia: f64,
 ) {
-    let (col_ptr, storage) = (k.col_ptr, k.storage);
-    pattern.add_terms(
-        &mut k.values,
-        col_ptr,
-        storage,
+    k.add_terms(
         map,
         st,
         dofs,

@@ -14,7 +14,7 @@
 //!
 //!   V_p [δ_i0 h_I A_θθkl ∂S_J/∂X_l + δ_k0 h_J ∂S_I/∂X_j A_ijθθ + δ_i0 δ_k0 h_I h_J A_θθθθ].
 
-use super::{Components, Coupling, Dofs, Pattern, Tangent};
+use super::{Components, Coupling, Dofs, Tangent};
 use crate::dim::{Mat3, Vector};
 use crate::material::driver::numerical_stress_derivative;
 use crate::material::{Increment, StressDerivative};
@@ -284,19 +284,14 @@ pub fn indices<const D: usize>() -> impl Iterator<Item = (usize, usize, usize, u
 /// axisymmetric mode, to the tangent `k`.
 pub fn add_stiffness<const D: usize>(
     k: &mut Tangent,
-    pattern: &Pattern,
     map: &NodeMap,
     st: &Stencils<D>,
     dofs: &Dofs,
     volume: &[f64],
     a: &ParticleTangents<D>,
 ) {
-    let (col_ptr, storage) = (k.col_ptr, k.storage);
     let at = ParticleTangents::<D>::at;
-    pattern.add_terms(
-        &mut k.values,
-        col_ptr,
-        storage,
+    k.add_terms(
         map,
         st,
         dofs,

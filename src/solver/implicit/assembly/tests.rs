@@ -208,7 +208,7 @@ fn tangent<'p, const D: usize, const N: usize>(
     };
     // K_uu: the code's stiffness term, into the displacements' D×D block.
     let a = elastic_tangents::<D>(volume.len(), c);
-    add_stiffness(&mut k, pattern, map, st, dofs, volume, &a);
+    add_stiffness(&mut k, map, st, dofs, volume, &a);
     let fields: Vec<(f64, Vector<D>)> = (0..volume.len())
         .map(|q| {
             let (_, p, dp) = particle_fields(s, w, q);
@@ -221,75 +221,48 @@ fn tangent<'p, const D: usize, const N: usize>(
         cols: D,
         components: Components::All,
     };
-    pattern.add_terms(
-        &mut k.values,
-        col_ptr,
-        storage,
-        map,
-        st,
-        dofs,
-        up,
-        |q, e2, _, block| {
-            for (local, e1) in st.range(q).enumerate() {
-                let g1 = st.grad(e1);
-                for i in 0..D {
-                    block[local * D + i] = -volume[q] * c.biot * g1[i] * st.weight(e2);
-                }
+    k.add_terms(map, st, dofs, up, |q, e2, _, block| {
+        for (local, e1) in st.range(q).enumerate() {
+            let g1 = st.grad(e1);
+            for i in 0..D {
+                block[local * D + i] = -volume[q] * c.biot * g1[i] * st.weight(e2);
             }
-            true
-        },
-    );
+        }
+        true
+    });
     // K_pu (rows: the scalar field, columns: the displacements).
     let pu = Coupling::<1, D> {
         rows: D,
         cols: 0,
         components: Components::All,
     };
-    pattern.add_terms(
-        &mut k.values,
-        col_ptr,
-        storage,
-        map,
-        st,
-        dofs,
-        pu,
-        |q, e2, _, block| {
-            let g2 = st.grad(e2);
-            for (local, e1) in st.range(q).enumerate() {
-                for kk in 0..D {
-                    block[local * D + kk] = volume[q] * c.biot * st.weight(e1) * g2[kk];
-                }
+    k.add_terms(map, st, dofs, pu, |q, e2, _, block| {
+        let g2 = st.grad(e2);
+        for (local, e1) in st.range(q).enumerate() {
+            for kk in 0..D {
+                block[local * D + kk] = volume[q] * c.biot * st.weight(e1) * g2[kk];
             }
-            true
-        },
-    );
+        }
+        true
+    });
     // K_pp: storage and the nonlinear Darcy term.
     let pp = Coupling::<1, 1> {
         rows: D,
         cols: D,
         components: Components::Diagonal,
     };
-    pattern.add_terms(
-        &mut k.values,
-        col_ptr,
-        storage,
-        map,
-        st,
-        dofs,
-        pp,
-        |q, e2, _, block| {
-            let (p, dp) = &fields[q];
-            let (g2, w2) = (st.grad(e2), st.weight(e2));
-            for (local, e1) in st.range(q).enumerate() {
-                let (g1, w1) = (st.grad(e1), st.weight(e1));
-                block[local] = volume[q]
-                    * (c.storage * w1 * w2
-                        + c.permeability(*p) * g1.dot(&g2)
-                        + c.permeability_slope(*p) * w2 * g1.dot(dp));
-            }
-            true
-        },
-    );
+    k.add_terms(map, st, dofs, pp, |q, e2, _, block| {
+        let (p, dp) = &fields[q];
+        let (g2, w2) = (st.grad(e2), st.weight(e2));
+        for (local, e1) in st.range(q).enumerate() {
+            let (g1, w1) = (st.grad(e1), st.weight(e1));
+            block[local] = volume[q]
+                * (c.storage * w1 * w2
+                    + c.permeability(*p) * g1.dot(&g2)
+                    + c.permeability_slope(*p) * w2 * g1.dot(dp));
+        }
+        true
+    });
     k
 }
 

@@ -90,7 +90,6 @@ impl<const D: usize> StepTerm<D> for AbsorbingFaces<D> {
 
     /// Σ_p S_Ip S_Jp (rate C_p + K_p), symmetric.
     fn add_tangent(&self, step: &StepView<'_, D>, _a: &ParticleTangents<D>, k: &mut Tangent) {
-        let pattern = k.pattern;
-        add_absorbing(k, &self.step, pattern, step.map, step.stencils, step.dofs);
+        add_absorbing(k, &self.step, step.map, step.stencils, step.dofs);
     }
 }

@@ -4,6 +4,8 @@ use super::super::Dofs;
 use super::layout::{slot, Storage};
 use super::scatter::{Components, Coupling};
 use super::Pattern;
+use crate::physics::shape::Stencils;
+use crate::physics::transfer::NodeMap;
 use crate::solver::linear::direct::spmv;
 use crate::solver::linear::Index;
 use faer::sparse::SparseColMatRef;
@@ -48,6 +50,29 @@ impl Tangent<'_> {
         let lists = &self.pattern.lists;
         let (a, b) = (lists.node_of(r), lists.node_of(c));
         lists.position(self.col_ptr, (a, r), (b, c), self.storage.lowest(c))
+    }
+
+    /// Adds the particles' stencil-pair terms of one `coupling` to the values
+    /// (`Pattern::add_terms`, the one scatter into the step's pattern).
+    pub fn add_terms<const D: usize, const R: usize, const C: usize>(
+        &mut self,
+        map: &NodeMap,
+        st: &Stencils<D>,
+        dofs: &Dofs,
+        coupling: Coupling<R, C>,
+        column: impl Fn(usize, usize, &[bool], &mut [f64]) -> bool + Sync,
+    ) {
+        let (pattern, col_ptr, storage) = (self.pattern, self.col_ptr, self.storage);
+        pattern.add_terms(
+            &mut self.values,
+            col_ptr,
+            storage,
+            map,
+            st,
+            dofs,
+            coupling,
+            column,
+        );
     }
 
     /// Adds a term between two active nodes beyond the stencils (a pair the

@@ -279,12 +279,8 @@ impl<const D: usize> StepTerm<D> for RigidContact<D> {
             return;
         }
         let (map, st, dofs) = (step.map, step.stencils, step.dofs);
-        let (pattern, col_ptr, storage) = (k.pattern, k.col_ptr, k.storage);
         let touches = &self.at.touches;
-        pattern.add_terms(
-            &mut k.values,
-            col_ptr,
-            storage,
+        k.add_terms(
             map,
             st,
             dofs,
