@@ -54,6 +54,7 @@ pub(super) fn summary<const D: usize>(
         message: None,
         divergence: None,
         solver: run_totals(solver, &ran.stages, implicit),
+        warnings: ran.stages.iter().flat_map(|s| s.warnings.clone()).collect(),
         stages: std::mem::take(&mut ran.stages),
         footing: line.recorders.footing_summary(model),
         monitor_particle: monitor,
@@ -134,7 +135,7 @@ fn final_outputs<const D: usize>(
     contact_forces: Option<&[crate::dim::Vector<D>]>,
 ) -> std::io::Result<()> {
     let (model, line): (&Model<D>, _) = (&run.model, &mut run.line);
-    line.recorders.state(&line.moment(model), true)?;
+    line.recorders.state(&line.moment(model), None, true)?;
     let eps_p = model.plastic_strain();
     let mut extra: Vec<(&str, &[f64])> = eps_p.iter().map(|e| ("eps_p", e.as_slice())).collect();
     let components: Vec<Vec<f64>> = (contact_forces.iter())

@@ -10,6 +10,8 @@ use crate::physics::contact::totals::PairTotal;
 use crate::run::contact::{ContactLog, ContactState};
 use crate::run::energy::{kinetic_energy, strain_energy};
 use crate::run::footing::FootingCurve;
+use crate::run::particle_dumps::{DumpState, ParticleDumps};
+use crate::run::schedule::Schedule;
 use crate::run::summary::FootingSummary;
 use crate::scene::{SceneConfig, SolverKind};
 use crate::solver::report::NewtonRow;
@@ -36,6 +38,8 @@ pub const NEWTON_COLUMNS: [&str; 11] = [
 pub struct Moment<'a, const D: usize> {
     pub model: &'a Model<D>,
     pub t: f64,
+    /// The steps taken so far.
+    pub step: usize,
     /// Work of gravity and applied loads since the start.
     pub external_work: f64,
 }
@@ -46,6 +50,7 @@ pub struct Moment<'a, const D: usize> {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct RecorderState {
     pub history_csv: String,
+    /// The next output time of history.csv not yet taken.
     pub next_history: f64,
     /// Time of the last history row (none before the first).
     pub last_history: Option<f64>,
@@ -60,15 +65,19 @@ pub struct RecorderState {
     /// contact.csv and the totals since its last rows, when the scene has contact.
     #[serde(default)]
     pub contact: Option<ContactState>,
+    /// particles_NNNN.csv, when the scene asks for them.
+    #[serde(default)]
+    pub particle_dumps: Option<DumpState>,
 }
 
 /// The output files that grow during a run.
 pub struct Recorders {
     out: PathBuf,
     history: HistoryWriter,
-    history_interval: f64,
-    next_history: f64,
+    history_times: Schedule,
     last_history: f64,
+    /// particles_NNNN.csv at the scene's particle_times / particle_interval.
+    dumps: Option<ParticleDumps>,
     frames: FrameWriter,
     /// Time between frames (None: no frames at all).
     frame_interval: Option<f64>,
@@ -112,9 +121,9 @@ impl Recorders {
                     &[]
                 },
             )?,
-            history_interval: cfg.output.history_interval,
-            next_history: 0.0,
+            history_times: Schedule::interval(cfg.output.history_interval),
             last_history: f64::NAN,
+            dumps: ParticleDumps::create(out, &cfg.output, end_time)?,
             frames: FrameWriter::new(out, "particles")?,
             frame_interval: (cfg.output.frames > 0).then(|| end_time / cfg.output.frames as f64),
             next_frame: 0.0,
@@ -166,7 +175,7 @@ impl Recorders {
             extra,
             &saved.history_csv,
         )?;
-        r.next_history = saved.next_history;
+        r.history_times.resume_at(saved.next_history);
         r.last_history = saved.last_history.unwrap_or(f64::NAN);
         r.next_frame = saved.next_frame;
         r.last_frame = saved.last_frame.unwrap_or(f64::NAN);
@@ -181,6 +190,9 @@ impl Recorders {
             }
         }
         r.frames = FrameWriter::resume(out, "particles", saved.frames)?;
+        if let (Some(dumps), Some(state)) = (&mut r.dumps, &saved.particle_dumps) {
+            dumps.resume(state, (!same_directory(out, from)).then_some(from))?;
+        }
         if let (Some(_), Some(state)) = (&r.contact, &saved.contact) {
             r.contact = Some(ContactLog::resume(&out.join("contact.csv"), state)?);
         }
@@ -221,9 +233,13 @@ impl Recorders {
             Some(log) => Some(log.saved(&self.out.join("contact.csv"))?),
             None => None,
         };
+        let particle_dumps = match &mut self.dumps {
+            Some(dumps) => Some(dumps.saved()?),
+            None => None,
+        };
         Ok(RecorderState {
             history_csv: read("history.csv")?,
-            next_history: self.next_history,
+            next_history: self.history_times.next_time().unwrap_or(0.0),
             last_history: Some(self.last_history).filter(|t| !t.is_nan()),
             frames: self.frames.frames().to_vec(),
             next_frame: self.next_frame,
@@ -233,14 +249,25 @@ impl Recorders {
             footing_rows,
             footing_settlement,
             contact,
+            particle_dumps,
         })
     }
 
-    /// A history row and a frame when they are due (or `force`d, at the start
-    /// and the end), never twice at the same time.
-    pub fn state<const D: usize>(&mut self, now: &Moment<D>, force: bool) -> io::Result<()> {
+    /// The records of the state `now`, the next step taking `next_dt` (none at
+    /// the run's start and end): a history row and a particle file when it is
+    /// the state nearest one of their output times (`run::schedule`; a history
+    /// row also when `force`d, at the start and the end), a frame at the first
+    /// state at or after its time; never twice at the same time.
+    pub fn state<const D: usize>(
+        &mut self,
+        now: &Moment<D>,
+        next_dt: Option<f64>,
+        force: bool,
+    ) -> io::Result<()> {
         let (m, t) = (now.model, now.t);
-        if (force || t >= self.next_history) && t != self.last_history {
+        let tolerance = 1e-12 * self.end_time;
+        let due = self.history_times.take(t, next_dt, tolerance);
+        if (force || due) && t != self.last_history {
             self.last_history = t;
             let (com, vcom) = body_centres(&m.particles, self.n_bodies);
             let (kinetic, strain) = (kinetic_energy(m), strain_energy(m));
@@ -251,12 +278,13 @@ impl Recorders {
             if let Some(log) = &mut self.contact {
                 log.rows(t)?;
             }
-            self.next_history = t + self.history_interval;
+        }
+        if let Some(dumps) = &mut self.dumps {
+            dumps.at(m, t, now.step, next_dt, tolerance)?;
         }
         let Some(interval) = self.frame_interval else {
             return Ok(());
         };
-        let tolerance = 1e-12 * self.end_time;
         if (force || t >= self.next_frame - tolerance) && t != self.last_frame {
             self.last_frame = t;
             let eps_p = m.plastic_strain();

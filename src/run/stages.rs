@@ -67,14 +67,18 @@ impl Timeline {
         Moment {
             model,
             t: self.t,
+            step: self.step,
             external_work: self.external_work,
         }
     }
 
     /// Advance the stage of `ctx`, of length `duration`, from where it is (its
-    /// last step `last_dt`, 0 at its start): step, record, write a checkpoint
-    /// when one is due, repeat. Returns how the stage ended and its last step;
-    /// the outer error is an output failure.
+    /// last step `last_dt`, 0 at its start): record, step, write a checkpoint
+    /// when one is due, repeat. The state before a step is recorded knowing the
+    /// step's length, so that each output time is taken at its nearest step
+    /// (`run::schedule`). Returns how the stage ended and the last step the
+    /// stepper asked for (the last one taken may be shortened to end the stage
+    /// there); the outer error is an output failure.
     fn stage<const D: usize>(
         &mut self,
         ctx: &StageContext,
@@ -84,13 +88,16 @@ impl Timeline {
         mut last_dt: f64,
     ) -> std::io::Result<(Result<(), Divergence>, f64)> {
         let end = ctx.start + duration;
-        while self.t < end - 1e-12 * self.total_time {
-            let dt = stepper.dt(model).min(end - self.t);
-            last_dt = dt;
+        let tolerance = 1e-12 * self.total_time;
+        while self.t < end - tolerance {
+            let asked = stepper.dt(model);
+            let (dt, last) = fit_to_end(asked, end - self.t, tolerance);
+            last_dt = asked;
             // A step too small to move the clock would never end the stage.
             if !(dt > 0.0 && self.t + dt > self.t) {
                 return Ok((Err(stalled(self.step, self.t, dt)), last_dt));
             }
+            self.recorders.state(&self.moment(model), Some(dt), false)?;
             let result = stepper.step(model, self.t, dt, self.step);
             self.recorders.newton(&stepper.take_newton_rows())?;
             self.recorders.contact(&stepper.take_contact());
@@ -98,11 +105,10 @@ impl Timeline {
                 Ok(work) => self.external_work += work,
                 Err(d) => return Ok((Err(d), last_dt)),
             }
-            self.t += dt;
+            self.t = if last { end } else { self.t + dt };
             self.step += 1;
             self.recorders
                 .footing(model, self.t, dt, stepper.reaction())?;
-            self.recorders.state(&self.moment(model), false)?;
             if let Some(p) = &self.progress {
                 p.set(self.t, self.step);
             }
@@ -178,6 +184,25 @@ impl Timeline {
     }
 }
 
+/// A step shorter than this fraction of the one asked for is merged into the
+/// step before it, which then ends the stage at most 0.1 % longer than asked
+/// (a fixed Δt that does not divide the stage leaves, after Σ Δt's round-off,
+/// a sliver step of 1e-12 s; issue 56).
+const SLIVER: f64 = 1e-3;
+
+/// The step `asked` fitted to the `left` of the stage, and whether it ends the
+/// stage: one that reaches the end (within the clock's `tolerance`), passes
+/// it, or would leave less than a sliver of it, ends exactly there.
+fn fit_to_end(asked: f64, left: f64, tolerance: f64) -> (f64, bool) {
+    if left - asked <= tolerance {
+        (asked.min(left), true)
+    } else if left - asked < SLIVER * asked {
+        (left, true)
+    } else {
+        (asked, false)
+    }
+}
+
 fn stalled(step: usize, time: f64, dt: f64) -> Divergence {
     Divergence {
         step,
@@ -217,7 +242,7 @@ pub(super) fn run_stages<const D: usize>(
     let cfg = &scene.config;
     let mut outcome = check_state(model, 0, 0.0);
     if outcome.is_ok() && ck.is_none() {
-        line.recorders.state(&line.moment(model), true)?;
+        line.recorders.state(&line.moment(model), None, true)?;
     }
     let first_stage = ck.map_or(0, |c| c.stage);
     let mut stages = ck.map_or_else(Vec::new, |c| c.stages_done.clone());
@@ -241,6 +266,8 @@ pub(super) fn run_stages<const D: usize>(
         }
         let (mut stepper, start, steps_before, last_dt) =
             stage_stepper(scene, out, sc, resumed, model, line)?;
+        let name = sc.name.clone().unwrap_or_else(|| format!("stage{k}"));
+        let warnings = stage_warnings(scene, &name, stepper.as_ref(), model);
         let stage_clock = Instant::now();
         let ctx = StageContext {
             scene,
@@ -263,7 +290,7 @@ pub(super) fn run_stages<const D: usize>(
         outcome = result;
         let report = stepper.report();
         stages.push(StageSummary {
-            name: sc.name.clone().unwrap_or_else(|| format!("stage{k}")),
+            name,
             start_time: start,
             end_time: line.t,
             steps: line.step - steps_before,
@@ -272,6 +299,7 @@ pub(super) fn run_stages<const D: usize>(
             active_nodes_last_step: stepper.active_nodes(),
             solver: report.clone(),
             strength_reduction_factor: sc.strength_reduction_factor.map(|_| *strength_factor),
+            warnings,
         });
         last = Some((report, dt, stepper.active_nodes()));
         contact_forces = stepper.contact_forces(model.particles.len());
@@ -286,6 +314,28 @@ pub(super) fn run_stages<const D: usize>(
         contact_forces,
         failure,
     })
+}
+
+/// What stage `name` warns of at its start (`Stepper::step_warning`; named
+/// when the scene has [[stage]]s), said on stderr at once and kept for
+/// summary.json.
+fn stage_warnings<const D: usize>(
+    scene: &Scene,
+    name: &str,
+    stepper: &dyn Stepper<D>,
+    model: &Model<D>,
+) -> Vec<String> {
+    let staged = !scene.config.stages.is_empty();
+    let warnings: Vec<String> = (stepper.step_warning(model).into_iter())
+        .map(|w| match staged {
+            true => format!("stage {name}: {w}"),
+            false => w,
+        })
+        .collect();
+    for w in &warnings {
+        eprintln!("warning: {}: {w}", scene.file);
+    }
+    warnings
 }
 
 /// The stepper of stage `sc` and where the stage starts: its start time, its

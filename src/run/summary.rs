@@ -69,6 +69,9 @@ pub struct Summary {
     /// `particle_steps_per_second` then count this run's part only).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub resumed_from: Option<ResumedFrom>,
+    /// The stages' warnings, each naming its stage.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
 }
 
 /// Where a restarted run began.
@@ -102,6 +105,10 @@ pub struct StageSummary {
     /// The strengths' divisor from this stage on, when the stage sets one.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub strength_reduction_factor: Option<f64>,
+    /// What the stage warned of at its start (an explicit fixed Δt above the
+    /// critical step).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
 }
 
 /// The load–settlement curve of a footing, summarised.

@@ -522,6 +522,12 @@ pub struct OutputConfig {
     /// Time between rows of history.csv (0: every step).
     #[serde(default)]
     pub history_interval: f64,
+    /// Times at which particles_NNNN.csv is written (none: no such files).
+    #[serde(default)]
+    pub particle_times: Option<Vec<f64>>,
+    /// Time between particles_NNNN.csv files, from t = 0 (none: no such files).
+    #[serde(default)]
+    pub particle_interval: Option<f64>,
     /// Simulation time between checkpoints (none: no checkpoints by time).
     #[serde(default)]
     pub checkpoint_interval: Option<f64>,
@@ -556,6 +562,8 @@ impl Default for OutputConfig {
         OutputConfig {
             frames: default_frames(),
             history_interval: 0.0,
+            particle_times: None,
+            particle_interval: None,
             checkpoint_interval: None,
             checkpoint_wall_seconds: None,
             linear_systems: LinearSystems::None,

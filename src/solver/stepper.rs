@@ -51,6 +51,13 @@ pub trait Stepper<const D: usize> {
     /// Active grid nodes of the last step.
     fn active_nodes(&self) -> usize;
 
+    /// A warning about the steps the stage will take, from the state `m` at
+    /// its start: an explicit fixed Δt above the critical step (it runs as
+    /// asked, for stability studies).
+    fn step_warning(&self, _m: &Model<D>) -> Option<String> {
+        None
+    }
+
     /// Reactions of the last converged step: (grid node, force the prescribed
     /// components exert on the body); `None` when the stepper computes none.
     fn reaction(&self) -> Option<&[(u32, Vector<D>)]> {

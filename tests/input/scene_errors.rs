@@ -677,3 +677,32 @@ fn a_flip_fraction_with_apic_is_refused() {
         "{e}"
     );
 }
+
+#[test]
+fn particle_output_times_outside_the_run_or_too_dense() {
+    let with = |o: &str| format!("{GOOD}\n[output]\n{o}\n");
+    rejected(
+        &with("particle_times = [0.5, 1.5]"),
+        &[
+            "scene.toml:27:",
+            "key `output.particle_times.1`",
+            "between 0 and its end 1e0",
+        ],
+    );
+    rejected(
+        &with("particle_times = [-0.1]"),
+        &["key `output.particle_times.0`"],
+    );
+    rejected(
+        &with("particle_interval = 0.0"),
+        &["key `output.particle_interval`", "must be > 0"],
+    );
+    rejected(
+        &with("particle_interval = 1e-6"),
+        &[
+            "key `output.particle_interval`",
+            "would write 1000001 particle files",
+        ],
+    );
+    Scene::parse("scene.toml", &with("particle_times = [0.0, 1.0]"), &[]).unwrap();
+}

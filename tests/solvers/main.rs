@@ -17,4 +17,5 @@ mod restart;
 mod signals;
 mod stability;
 mod threads;
+mod timeline;
 mod transfers;

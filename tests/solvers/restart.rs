@@ -506,3 +506,11 @@ fn implicit_deformable_contact_restart_keeps_the_meetings_gaps_and_friction() {
         2,
     );
 }
+
+/// particles_NNNN.csv and particle_times.csv go on after a restart as they do
+/// in the uninterrupted run (the checkpoint keeps which times were taken).
+#[test]
+fn particle_files_restart_byte_identically() {
+    let sets = ["solver.end_time=0.1", "output.particle_interval=0.02"];
+    restarts_are_exact("sliding_block.toml", &sets, 0.03, 1);
+}

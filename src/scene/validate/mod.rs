@@ -18,7 +18,8 @@ pub use check::Check;
 
 use crate::scene::contact::ContactPlan;
 use crate::scene::{
-    DomainStress, LinearSolver, LinearSystems, SceneConfig, ShapeFunction, SolverConfig, SolverKind,
+    DomainStress, LinearSolver, LinearSystems, OutputConfig, SceneConfig, ShapeFunction,
+    SolverConfig, SolverKind,
 };
 use analyses::{geostatic, strength_reduction};
 use axisymmetry::axisymmetry;
@@ -101,6 +102,7 @@ pub fn validate(s: &SceneConfig) -> Check {
         "output.history_interval",
         "must be ≥ 0",
     )?;
+    particle_output_times(&s.output, s.total_time())?;
     for (key, value) in [
         ("checkpoint_interval", s.output.checkpoint_interval),
         ("checkpoint_wall_seconds", s.output.checkpoint_wall_seconds),
@@ -130,6 +132,37 @@ pub fn validate(s: &SceneConfig) -> Check {
     }
     if let Some(b) = &s.bench {
         bench(b, "bench")?;
+    }
+    Ok(())
+}
+
+/// The most particle files `particle_interval` may ask for.
+const MAX_PARTICLE_FILES: f64 = 100_000.0;
+
+/// `particle_times` within the run (0 ≤ t ≤ its end), `particle_interval` > 0
+/// and not so small that it floods the output directory.
+fn particle_output_times(o: &OutputConfig, end: f64) -> Check {
+    for (i, &t) in o.particle_times.iter().flatten().enumerate() {
+        ensure(
+            t.is_finite() && (0.0..=end * (1.0 + 1e-12)).contains(&t),
+            format!("output.particle_times.{i}"),
+            format!("must be a time of the run, between 0 and its end {end:e}"),
+        )?;
+    }
+    if let Some(interval) = o.particle_interval {
+        ensure(
+            interval > 0.0 && interval.is_finite(),
+            "output.particle_interval",
+            "must be > 0",
+        )?;
+        ensure(
+            end / interval < MAX_PARTICLE_FILES,
+            "output.particle_interval",
+            format!(
+                "would write {:.0} particle files over the run's {end:e}; at most {MAX_PARTICLE_FILES:.0}",
+                (end / interval).floor() + 1.0
+            ),
+        )?;
     }
     Ok(())
 }

@@ -168,6 +168,21 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
         }
     }
 
+    /// A fixed Δt above the critical step min h/(c + |v|) (with bulk viscosity,
+    /// its stable step) of the stage's starting state.
+    fn step_warning(&self, m: &Model<D>) -> Option<String> {
+        let dt = self.fixed_dt?;
+        let critical = Self::critical_dt_with(m, self.viscosity.as_ref());
+        (dt > critical).then(|| {
+            format!(
+                "the fixed time step dt = {dt:e} is {:.3} × the critical step {critical:.6e} \
+                 (min over particles of h_min/(c + |v|) at the stage's start): explicit \
+                 integration is unstable above it",
+                dt / critical
+            )
+        })
+    }
+
     fn active_nodes(&self) -> usize {
         match &self.scatter {
             Some(s) => s.active,
