@@ -9,8 +9,14 @@ use crate::solver::explicit::Explicit;
 
 /// What a run checks before it allocates and steps: the memory estimate, then the
 /// model's build (a body that holds no particle, an absorbing face with no
-/// material, …). `mpm check` calls it, so it rejects what `mpm run` would.
+/// material, …). `mpm check` calls it, so it rejects what `mpm run` would; an
+/// error that an override causes names the override (`Scene::blame`).
 pub fn set_up_check(scene: &Scene, opts: &RunOptions) -> Result<(), SceneError> {
+    before_steps(scene, opts).map_err(|e| scene.blame(e, |s| before_steps(s, opts)))
+}
+
+/// [`set_up_check`] without naming the override an error comes from.
+pub(super) fn before_steps(scene: &Scene, opts: &RunOptions) -> Result<(), SceneError> {
     check_memory(scene, opts)?;
     match scene.config.dimension.spatial() {
         2 => check_steps(scene, &Model::<2>::build(scene)?),

@@ -29,14 +29,24 @@ pub use options::RunOptions;
 
 use crate::scene::Scene;
 use checkpoint::{matching_checkpoint, Resume};
-use checks::check_memory;
+use checks::{before_steps, check_memory};
 use setup::SetUp;
 use std::path::Path;
 use std::time::Instant;
 use summary::Summary;
 
-/// Run a scene, writing its outputs into `out`.
+/// Run a scene, writing its outputs into `out`. A scene error that an override
+/// causes names the override (`Scene::blame`, replaying the checks before the
+/// first step).
 pub fn run(scene: &Scene, out: &Path, opts: &RunOptions) -> Result<Summary, RunError> {
+    run_as_given(scene, out, opts).map_err(|e| match e {
+        RunError::Scene(e) => RunError::Scene(scene.blame(e, |s| before_steps(s, opts))),
+        e => e,
+    })
+}
+
+/// [`run`] without naming the override a scene error comes from.
+fn run_as_given(scene: &Scene, out: &Path, opts: &RunOptions) -> Result<Summary, RunError> {
     check_memory(scene, opts)?;
     let resume = match &opts.restart {
         Some(path) => Some(Resume {

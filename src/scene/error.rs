@@ -4,10 +4,11 @@
 //! [`Source`] is what an error is located in: the file's text, the text after the
 //! overrides and the overrides themselves. An error at a key path points at the
 //! override that set the key (its value is not in the file), else at the key's
-//! line and column in the file. Deserialisation runs through
-//! `serde_path_to_error`, which records the key path of a failing value (type
-//! errors, unknown enum values, untagged-enum mismatches) while the TOML
-//! deserialiser keeps its span.
+//! line and column in the file; [`blame`] then names the override that causes an
+//! error at another key, found by replaying the checks with fewer overrides.
+//! Deserialisation runs through `serde_path_to_error`, which records the key
+//! path of a failing value (type errors, unknown enum values, untagged-enum
+//! mismatches) while the TOML deserialiser keeps its span.
 
 use serde::de::DeserializeOwned;
 use std::fmt;
@@ -20,7 +21,7 @@ pub struct SceneError {
     /// 1-based line and column.
     pub position: Option<(usize, usize)>,
     /// The `--set KEY=VALUE` override the error comes from (then there is no
-    /// position: the value is not in the file).
+    /// position: the error is not in the file).
     pub set: Option<String>,
     pub message: String,
 }
@@ -148,6 +149,34 @@ impl<'a> Source<'a> {
     }
 }
 
+/// `e`, an error found with the `overrides` applied, naming the override that
+/// causes it: the first one after which `replay` (the same parse and checks on
+/// the file with the first overrides only) gives the same error, the same key
+/// and message. An error at a key that no override set may come from an
+/// override at another key (`--set body.0.max=…` takes the body out of the
+/// grid: key `body.0.shape`), and only the replay tells. An error that the
+/// file gives without overrides, or that no replay gives again, is left as it
+/// is.
+pub fn blame<T>(
+    e: SceneError,
+    overrides: &[String],
+    replay: impl Fn(&[String]) -> Result<T, SceneError>,
+) -> SceneError {
+    if e.set.is_some() {
+        return e;
+    }
+    let gives_e =
+        |k: usize| replay(&overrides[..k]).is_err_and(|f| f.key == e.key && f.message == e.message);
+    match (0..=overrides.len()).find(|&k| gives_e(k)) {
+        Some(k) if k > 0 => SceneError {
+            set: Some(overrides[k - 1].clone()),
+            position: None,
+            ..e
+        },
+        _ => e,
+    }
+}
+
 /// The dotted key of an override `KEY=VALUE`.
 fn override_key(o: &str) -> &str {
     o.split_once('=').map_or(o, |(k, _)| k).trim()
@@ -220,4 +249,41 @@ fn locate(text: &str, path: &str) -> Option<(usize, usize)> {
         }
     }
     span.map(|s| line_col(text, s.start))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn at(key: &str) -> SceneError {
+        SceneError {
+            key: Some(key.into()),
+            position: Some((3, 1)),
+            ..SceneError::plain("s.toml", "wrong")
+        }
+    }
+
+    /// The error blamed by a replay that gives it from the first `from`
+    /// overrides on (0: the file gives it; more than there are: no replay does).
+    fn blamed(from: usize) -> SceneError {
+        let overrides = ["grid.cells=[2,2]", "body.0.max=[9,9]", "x=1"].map(String::from);
+        blame(at("body.0.shape"), &overrides, |o| match o.len() >= from {
+            true => Err(at("body.0.shape")),
+            false => Ok(()),
+        })
+    }
+
+    #[test]
+    fn the_first_override_that_gives_the_error_is_named() {
+        let e = blamed(2);
+        assert_eq!(e.set.as_deref(), Some("body.0.max=[9,9]"));
+        assert_eq!((e.key.as_deref(), e.position), (Some("body.0.shape"), None));
+    }
+
+    #[test]
+    fn an_error_of_the_file_or_of_no_replay_is_left_as_it_is() {
+        for from in [0, 4] {
+            assert_eq!(blamed(from), at("body.0.shape"), "{from}");
+        }
+    }
 }

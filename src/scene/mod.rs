@@ -3,9 +3,10 @@
 //! `Scene::load` reads a file, applies `--set KEY=VALUE` overrides (dotted TOML
 //! paths, values in TOML syntax), deserialises, and validates physical ranges.
 //! Every error names the file and the key path and, where the TOML gives it, the
-//! line and column; an error at a key set by `--set` names the override instead
-//! (`error.rs`). The keys are documented in `docs/scene.md`. What each body is
-//! (its `kind`, or the old form of a rigid body) is read in `body_kind.rs`.
+//! line and column; an error that a `--set` override causes names the override
+//! instead (`error.rs`). The keys are documented in `docs/scene.md`. What each
+//! body is (its `kind`, or the old form of a rigid body) is read in
+//! `body_kind.rs`.
 
 mod body_kind;
 mod config;
@@ -21,7 +22,7 @@ pub(crate) mod testing;
 pub(crate) mod validate;
 
 pub use config::*;
-pub use error::{SceneError, Source};
+pub use error::{blame, SceneError, Source};
 pub use grid::*;
 pub use material::MaterialConfig;
 pub use solver::*;
@@ -48,8 +49,15 @@ impl Scene {
         Scene::parse(&file, &text, overrides)
     }
 
-    /// Parse scene text (`file` names it in errors).
+    /// Parse scene text (`file` names it in errors); an error that an override
+    /// causes names the override (`error::blame`).
     pub fn parse(file: &str, text: &str, overrides: &[String]) -> Result<Scene, SceneError> {
+        Scene::parse_as_given(file, text, overrides)
+            .map_err(|e| error::blame(e, overrides, |o| Scene::parse_as_given(file, text, o)))
+    }
+
+    /// Parse scene text, an error at a key naming an override only if it set the key.
+    fn parse_as_given(file: &str, text: &str, overrides: &[String]) -> Result<Scene, SceneError> {
         let applied = overrides::apply(file, text, overrides)?;
         let source = Source::new(file, text, &applied, overrides);
         let config: SceneConfig = source.deserialize()?;
@@ -66,6 +74,19 @@ impl Scene {
     /// An error at a dotted key path of this scene (found after parsing).
     pub fn at_key(&self, path: &str, message: impl Into<String>) -> SceneError {
         Source::new(&self.file, &self.original, &self.text, &self.overrides).at_key(path, message)
+    }
+
+    /// `e`, an error that `check` found in this scene, naming the override that
+    /// causes it (`error::blame`: `check` is replayed on the scene with fewer
+    /// overrides).
+    pub fn blame<T>(
+        &self,
+        e: SceneError,
+        check: impl Fn(&Scene) -> Result<T, SceneError>,
+    ) -> SceneError {
+        error::blame(e, &self.overrides, |o| {
+            Scene::parse_as_given(&self.file, &self.original, o).and_then(|s| check(&s))
+        })
     }
 }
 

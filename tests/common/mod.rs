@@ -118,6 +118,26 @@ pub fn run_cli<S: AsRef<str>>(name: &str, threads: usize, overrides: &[S]) -> te
     dir
 }
 
+/// `mpm check FILE ARGS` and `mpm run FILE ARGS --out DIR` through the program:
+/// each must refuse the scene (exit code 2). Returns each command with its stderr.
+pub fn refusals(file: &Path, args: &[&str]) -> Vec<(&'static str, String)> {
+    let dir = tempfile::tempdir().unwrap();
+    ["check", "run"]
+        .into_iter()
+        .map(|command| {
+            let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_mpm"));
+            cmd.arg(command).arg(file).args(args);
+            if command == "run" {
+                cmd.arg("--out").arg(dir.path().join("out"));
+            }
+            let out = cmd.output().unwrap();
+            let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+            assert_eq!(out.status.code(), Some(2), "mpm {command}: {stderr}");
+            (command, stderr)
+        })
+        .collect()
+}
+
 /// The bytes of an output file.
 pub fn read_output(dir: &tempfile::TempDir, file: &str) -> Vec<u8> {
     std::fs::read(dir.path().join(file)).unwrap()

@@ -4,6 +4,9 @@
 //! override, not a line of the file; a file that is not UTF-8 gets the byte offset.
 
 use mpm::scene::Scene;
+use std::path::{Path, PathBuf};
+
+use crate::common::{problem, refusals};
 
 const GOOD: &str = r#"dimension = 2
 
@@ -193,6 +196,125 @@ fn an_error_in_the_file_keeps_its_line_when_overrides_add_keys() {
     assert_eq!(e.key.as_deref(), Some("stage.1.dt"), "{e}");
     assert_eq!(e.position, Some((29, 6)), "{e}");
     assert!(e.set.is_none(), "{e}");
+}
+
+/// `mpm check` and `mpm run` on `file` with `--set` each of `sets` refuse it with
+/// an error that starts with `start` (after `error: `) and holds `words`.
+fn refused_with(file: &Path, sets: &[&str], start: &str, words: &str) {
+    let args: Vec<&str> = sets.iter().flat_map(|s| ["--set", *s]).collect();
+    for (command, stderr) in refusals(file, &args) {
+        assert!(
+            stderr.starts_with(&format!("error: {start}")) && stderr.contains(words),
+            "mpm {command} {args:?}: `{start}` … `{words}` expected, got: {stderr}"
+        );
+    }
+}
+
+/// problems/column.toml with `from` replaced by `to`, in a temporary directory.
+fn column_with(from: &str, to: &str) -> (tempfile::TempDir, PathBuf) {
+    let text = std::fs::read_to_string(problem("column.toml")).unwrap();
+    assert!(text.contains(from), "`{from}` not in column.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("column.toml");
+    std::fs::write(&file, text.replacen(from, to, 1)).unwrap();
+    (dir, file)
+}
+
+/// An override that makes another key wrong (a body that leaves the grid is
+/// reported at `body.0.shape`, a Δt beside the file's load_steps at
+/// `solver.load_steps`) names the override and the key, not the key's line in
+/// the file; the unrelated override given before it is not named.
+#[test]
+fn an_override_that_makes_another_key_wrong_is_named() {
+    let file = problem("column.toml");
+    for (set, key, words) in [
+        ("body.0.max=[1.0, 60.0]", "body.0.shape", "outside the grid"),
+        ("grid.max=[1.0, 40.0]", "body.0.shape", "outside the grid"),
+        (
+            "solver.dt=0.01",
+            "solver.load_steps",
+            "give either load_steps or dt",
+        ),
+        ("dimension=3", "gravity", "needs 3 components"),
+        (
+            "material.0.model=mohr_coulomb",
+            "material.0.cohesion",
+            "is required",
+        ),
+        ("reference.kind=cantilever", "load", "point load"),
+    ] {
+        let start = format!("{}: override `--set {set}`: key `{key}`: ", file.display());
+        refused_with(&file, &["grid.cells=[1, 32]", set], &start, words);
+    }
+}
+
+/// A value out of range or of the wrong type given by `--set`, at the key or in
+/// a table that the override gives whole, names the override.
+#[test]
+fn a_bad_value_given_by_an_override_is_named() {
+    let file = problem("column.toml");
+    let grid = "grid={min=[0.0, 0.0], max=[1.0, 50.0], cells=[1, \"16\"]}";
+    for (set, key, words) in [
+        (
+            "material.0.youngs_modulus=-1",
+            "material.0.youngs_modulus",
+            "must be a positive number",
+        ),
+        (
+            "material.0.density=\"x\"",
+            "material.0.density",
+            "invalid type",
+        ),
+        (grid, "grid.cells.1", "invalid type"),
+    ] {
+        let start = format!("{}: override `--set {set}`: key `{key}`: ", file.display());
+        refused_with(&file, &["solver.load_steps=10", set], &start, words);
+    }
+}
+
+/// An error that the model's build finds (an initial velocity expression that is
+/// not finite where the override moved the body) names the override too.
+#[test]
+fn a_build_error_caused_by_an_override_is_named() {
+    let (_dir, file) = column_with(
+        "particles_per_cell = 2\n",
+        "particles_per_cell = 2\nvelocity_expr = [\"0\", \"sqrt(50.5 - y)\"]\n",
+    );
+    let set = "body.0.max=[1.0, 60.0]";
+    let start = format!(
+        "{}: override `--set {set}`: key `body.0.velocity_expr.1`: ",
+        file.display()
+    );
+    refused_with(
+        &file,
+        &["grid.max=[1.0, 60.0]", set],
+        &start,
+        "is not finite",
+    );
+}
+
+/// An error in the file keeps its line and names no override when an unrelated
+/// override is given, for a value out of range and for a body outside the grid.
+#[test]
+fn an_error_in_the_file_is_not_blamed_on_an_unrelated_override() {
+    for (from, to, at, words) in [
+        (
+            "youngs_modulus = 1.0e6",
+            "youngs_modulus = -1.0",
+            "28:18: key `material.0.youngs_modulus`",
+            "must be a positive number",
+        ),
+        (
+            "max = [1.0, 50.0]\nparticles",
+            "max = [1.0, 60.0]\nparticles",
+            "34:9: key `body.0.shape`",
+            "outside the grid",
+        ),
+    ] {
+        let (_dir, file) = column_with(from, to);
+        let start = format!("{}:{at}: ", file.display());
+        refused_with(&file, &["grid.cells=[1, 32]"], &start, words);
+    }
 }
 
 #[test]

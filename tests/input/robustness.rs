@@ -7,23 +7,15 @@
 use mpm::scene::Scene;
 use std::process::Command;
 
-use crate::common::GOOD;
+use crate::common::{refusals, GOOD};
 
-/// `mpm check` (and, where `run`, `mpm run`) on `text` with `args`: exit code 2
-/// and stderr naming `key` and containing `words`.
+/// `mpm check` and `mpm run` on `text` with `args`: exit code 2 and stderr naming
+/// `key` and containing `words`.
 fn refused(text: &str, args: &[&str], key: &str, words: &str) {
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("scene.toml");
     std::fs::write(&file, text).unwrap();
-    for command in ["check", "run"] {
-        let mut cmd = Command::new(env!("CARGO_BIN_EXE_mpm"));
-        cmd.arg(command).arg(&file).args(args);
-        if command == "run" {
-            cmd.arg("--out").arg(dir.path().join("out"));
-        }
-        let out = cmd.output().unwrap();
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "mpm {command}: {stderr}");
+    for (command, stderr) in refusals(&file, args) {
         assert!(
             stderr.contains(&format!("key `{key}`")) && stderr.contains(words),
             "mpm {command}: {stderr}"

@@ -4,7 +4,7 @@
 
 use super::cone::MohrCoulomb;
 use super::model::{MeshSize, Model, SlopeGeometry};
-use crate::scene::{SceneError, Source};
+use crate::scene::{blame, SceneError, Source};
 use serde::Deserialize;
 use std::path::Path;
 
@@ -226,7 +226,18 @@ impl LimitScene {
         LimitScene::parse(&file, &text, overrides)
     }
 
+    /// Parse the text; an error that an override causes names the override
+    /// (`scene::blame`).
     pub fn parse(file: &str, text: &str, overrides: &[String]) -> Result<LimitScene, SceneError> {
+        LimitScene::parse_as_given(file, text, overrides)
+            .map_err(|e| blame(e, overrides, |o| LimitScene::parse_as_given(file, text, o)))
+    }
+
+    fn parse_as_given(
+        file: &str,
+        text: &str,
+        overrides: &[String],
+    ) -> Result<LimitScene, SceneError> {
         let applied = crate::scene::overrides::apply(file, text, overrides)?;
         let source = Source::new(file, text, &applied, overrides);
         let config: LimitConfig = source.deserialize()?;

@@ -37,10 +37,19 @@ pub fn from_scene(s: &SceneConfig) -> Result<Option<Box<dyn ErrorMeasure>>, KeyE
 
 /// A parsed scene whose `[reference]`, if any, fits it (the check that the scene
 /// validation cannot make: it needs the reference kinds of this layer). `mpm run`,
-/// `mpm check` and `mpm bench` load scenes through it.
+/// `mpm check` and `mpm bench` load scenes through it. An error that an override
+/// causes names the override (`Scene::blame`).
 pub fn checked(scene: Scene) -> Result<Scene, SceneError> {
+    match fits(&scene) {
+        Ok(()) => Ok(scene),
+        Err(e) => Err(scene.blame(e, fits)),
+    }
+}
+
+/// The scene's `[reference]` fits it; an error names the scene key.
+fn fits(scene: &Scene) -> Result<(), SceneError> {
     match from_scene(&scene.config) {
-        Ok(_) => Ok(scene),
+        Ok(_) => Ok(()),
         Err((key, m)) => Err(scene.at_key(&key, m)),
     }
 }
