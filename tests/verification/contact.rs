@@ -79,13 +79,15 @@ fn contact_force_carries_the_block() {
     // Sliding at μ = 0.3: the block presses on the base with its weight's normal
     // part m g cos θ and drags it with μ times that. contact.csv holds the mean
     // force on the base (the pair's first body) between rows; averaged over the
-    // slide after the first 0.1 s (the weight comes on suddenly and rings).
+    // slide after the first 0.1 s (the weight comes on suddenly and rings), from
+    // the row of 0.1 s on (rows every 0.01 s, each within half a step of its
+    // time). The mean moves by 1 % when the start moves by 0.01 s (the ringing).
     let (_, _, dir) = slide(45.0, 0.3, &[]);
     let c = Table::read(&dir.path().join("contact.csv")).unwrap();
     let (t, fx, fy) = (c.col("t"), c.col("fx"), c.col("fy"));
     let (mut ix, mut iy, mut span) = (0.0, 0.0, 0.0);
     for k in 1..t.len() {
-        if t[k - 1] >= 0.1 {
+        if t[k - 1] >= 0.1 - 0.005 {
             let dt = t[k] - t[k - 1];
             ix += fx[k] * dt;
             iy += fy[k] * dt;
@@ -98,7 +100,8 @@ fn contact_force_carries_the_block() {
         "mean force on the base: ({fx:.1}, {fy:.1}) N/m; m g cos θ = {weight:.1}, μ m g cos θ = {:.1}",
         0.3 * weight
     );
-    // Measured −0.14 % and −0.13 %.
+    // Measured +0.08 % and +0.08 % (−0.14 % and −0.13 % from a row at 0.101 s
+    // when the rows drifted late, issue 56).
     assert_within("normal force / (m g cos θ) − 1", -fy / weight - 1.0, 4e-3);
     assert_within(
         "friction force / (μ m g cos θ) − 1",
