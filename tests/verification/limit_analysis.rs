@@ -213,6 +213,11 @@ fn bad_scenes_are_rejected_with_file_line_and_column() {
     );
     let e = error(&FOOTING.replace("problem = \"footing\"", "problem = \"slope\""));
     assert!(e.contains("key `footing`"), "{e}");
+    let e = error(&format!("{FOOTING}\n[solver]\nmax_iterations = 0\n"));
+    assert!(
+        e.starts_with("limit.toml:17:18: key `solver.max_iterations`"),
+        "{e}"
+    );
     // The CLI exits with 2 and prints the same message.
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("bad.toml");
