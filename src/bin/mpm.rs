@@ -353,12 +353,13 @@ fn limit(scene: &std::path::Path, out: &std::path::Path, overrides: &[String]) -
     };
     match run_limit(&scene, out, true) {
         Ok(s) => {
+            let finest = s.finest.expect("a run that did not fail solved a level");
             println!(
                 "{}: {} between {:.5} and {:.5}; outputs in {}",
                 scene.file,
                 s.quantity,
-                s.lower_bound,
-                s.upper_bound,
+                finest.lower_bound,
+                finest.upper_bound,
                 out.display()
             );
             ExitCode::SUCCESS

@@ -19,7 +19,8 @@ pub enum Status {
     /// A signal (SIGINT, SIGTERM) stopped it at the end of a step; a checkpoint
     /// lets it go on (`message` says where).
     Interrupted,
-    /// It could not go on: an output could not be written (`message`).
+    /// It could not go on: an output could not be written (`message`); for
+    /// `mpm limit`, a refinement level could not be solved.
     Failed,
 }
 

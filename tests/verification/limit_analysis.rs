@@ -3,19 +3,13 @@
 //! small enough for CI. The refinement study with finer meshes is in
 //! papers/limit_analysis/.
 
+use crate::common::problem;
 use mpm::analyses::limit_analysis::config::LimitScene;
 use mpm::analyses::limit_analysis::lower_bound::lower_bound;
 use mpm::analyses::limit_analysis::reduction::factor_of_safety;
 use mpm::analyses::limit_analysis::upper_bound::upper_bound;
 use std::f64::consts::PI;
-use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn problem(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("problems")
-        .join(name)
-}
+use std::process::{Command, Output};
 
 fn scene(name: &str, overrides: &[&str]) -> LimitScene {
     let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
@@ -124,29 +118,37 @@ fn slope_factor_of_safety_bounds() {
     );
 }
 
+/// `mpm limit problems/NAME --out DIR --set O …`: its output and DIR.
+fn limit_cli(name: &str, overrides: &[&str]) -> (Output, tempfile::TempDir) {
+    let dir = tempfile::tempdir().unwrap();
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_mpm"));
+    cmd.arg("limit")
+        .arg(problem(name))
+        .arg("--out")
+        .arg(dir.path());
+    for o in overrides {
+        cmd.args(["--set", o]);
+    }
+    (cmd.output().unwrap(), dir)
+}
+
+fn read_summary(dir: &tempfile::TempDir) -> serde_json::Value {
+    let text = std::fs::read_to_string(dir.path().join("summary.json")).unwrap();
+    serde_json::from_str(&text).unwrap()
+}
+
 #[test]
 fn cli_writes_the_summary_with_both_bounds() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_mpm"))
-        .args(["limit"])
-        .arg(problem("limit_footing_tresca.toml"))
-        .arg("--out")
-        .arg(dir.path())
-        .args([
-            "--set",
-            "mesh.fine_size=0.25",
-            "--set",
-            "mesh.refinements=[0]",
-        ])
-        .output()
-        .unwrap();
+    let (out, dir) = limit_cli(
+        "limit_footing_tresca.toml",
+        &["mesh.fine_size=0.25", "mesh.refinements=[0]"],
+    );
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let text = std::fs::read_to_string(dir.path().join("summary.json")).unwrap();
-    let s: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let s = read_summary(&dir);
     let (lb, ub) = (
         s["lower_bound"].as_f64().unwrap(),
         s["upper_bound"].as_f64().unwrap(),
@@ -156,6 +158,67 @@ fn cli_writes_the_summary_with_both_bounds() {
     assert_eq!(s["bearing_capacity_factor_lower"].as_f64().unwrap(), lb);
     let csv = std::fs::read_to_string(dir.path().join("refinement.csv")).unwrap();
     assert_eq!(csv.lines().count(), 2);
+}
+
+/// Uniform 1-unit cells, levels 0 (128 triangles) and 2 (2048). Measured with
+/// `solver.max_iterations`: level 0 is solved (or near enough to be kept) with
+/// 16 iterations and not with 14; level 2 with 22 and not with 20.
+const COARSE_THEN_FINE: [&str; 3] = [
+    "mesh.fine_size=1.0",
+    "mesh.max_size=1.0",
+    "mesh.refinements=[0, 2]",
+];
+
+/// A level the conic solver fails (issue 56): exit 1 naming the level and the
+/// solver's status; summary.json says `failed` with the same message and keeps
+/// the level before it, as does refinement.csv.
+#[test]
+fn a_level_the_solver_fails_fails_the_run_and_keeps_the_levels_before_it() {
+    let mut overrides = COARSE_THEN_FINE.to_vec();
+    overrides.push("solver.max_iterations=18");
+    let (out, dir) = limit_cli("limit_footing_mc.toml", &overrides);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    let failure = "lower bound at refinement level 2 (2048 triangles): the conic solver \
+                   (clarabel) stopped with status MaxIterations after 18 iterations";
+    assert!(stderr.contains(failure), "{stderr}");
+    let s = read_summary(&dir);
+    assert_eq!(s["status"], "failed");
+    assert_eq!(s["message"], failure);
+    let levels = s["levels"].as_array().unwrap();
+    assert_eq!(levels.len(), 1, "{levels:?}");
+    assert_eq!(levels[0]["refinements"], 0);
+    assert_eq!(levels[0]["elements"], 128);
+    // The finished level is the headline, as if it had been the last.
+    for key in ["lower_bound", "upper_bound", "relative_gap", "elements"] {
+        assert_eq!(s[key], levels[0][key], "{key}");
+    }
+    assert!(s["lower_bound"].as_f64().unwrap() < prandtl(20.0));
+    let csv = std::fs::read_to_string(dir.path().join("refinement.csv")).unwrap();
+    let rows: Vec<&str> = csv.lines().collect();
+    assert_eq!(rows.len(), 2, "{csv}");
+    assert!(rows[1].starts_with("0,128,"), "{csv}");
+}
+
+/// A failure at the first level still writes summary.json: `failed`, no
+/// levels and no bounds.
+#[test]
+fn a_failure_at_the_first_level_writes_a_failed_summary() {
+    let mut overrides = COARSE_THEN_FINE.to_vec();
+    overrides.push("solver.max_iterations=5");
+    let (out, dir) = limit_cli("limit_footing_mc.toml", &overrides);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    let s = read_summary(&dir);
+    assert_eq!(s["status"], "failed");
+    let message = s["message"].as_str().unwrap();
+    assert!(
+        message.starts_with("lower bound at refinement level 0 (128 triangles)")
+            && message.contains("MaxIterations after 5 iterations"),
+        "{message}"
+    );
+    assert_eq!(s["levels"].as_array().map(Vec::len), Some(0));
+    assert!(s.get("lower_bound").is_none(), "{s}");
 }
 
 fn error(text: &str) -> String {
@@ -213,6 +276,11 @@ fn bad_scenes_are_rejected_with_file_line_and_column() {
     );
     let e = error(&FOOTING.replace("problem = \"footing\"", "problem = \"slope\""));
     assert!(e.contains("key `footing`"), "{e}");
+    let e = error(&format!("{FOOTING}\n[solver]\nmax_iterations = 0\n"));
+    assert!(
+        e.starts_with("limit.toml:17:18: key `solver.max_iterations`"),
+        "{e}"
+    );
     // The CLI exits with 2 and prints the same message.
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("bad.toml");

@@ -18,6 +18,9 @@ use clarabel::solver::{
 };
 use std::fmt;
 
+/// Clarabel's iteration limit unless the scene sets `solver.max_iterations`.
+pub const MAX_ITERATIONS: u32 = 300;
+
 /// Plane-strain Mohr–Coulomb strength: cohesion c ≥ 0, friction angle φ in radians.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MohrCoulomb {
@@ -141,8 +144,9 @@ impl ConicProgram {
         self.cones.len()
     }
 
-    /// Solve with clarabel (direct KKT factorisation, default tolerances 1e-8).
-    pub fn solve(&self) -> Result<ConicSolution, SolverFailure> {
+    /// Solve with clarabel (direct KKT factorisation, default tolerances 1e-8)
+    /// in at most `max_iterations` interior-point iterations.
+    pub fn solve(&self, max_iterations: u32) -> Result<ConicSolution, SolverFailure> {
         let n = self.variables;
         let (mut rows, mut cols, mut vals, mut b) = (vec![], vec![], vec![], vec![]);
         for (r, (row, rhs)) in self.equalities.iter().enumerate() {
@@ -181,7 +185,7 @@ impl ConicProgram {
         // thousand triangles.
         let settings = DefaultSettingsBuilder::default()
             .verbose(false)
-            .max_iter(300)
+            .max_iter(max_iterations)
             .presolve_enable(false)
             .static_regularization_constant(1e-7)
             .build()
@@ -288,7 +292,7 @@ mod tests {
         );
         p.equal(vec![(0, 1.0), (1, 1.0)], 0.0);
         p.objective = vec![(2, -1.0)];
-        let s = p.solve().unwrap();
+        let s = p.solve(MAX_ITERATIONS).unwrap();
         assert!((s.x[2] - 2.0).abs() < 1e-6, "{:?}", s.x);
     }
 }

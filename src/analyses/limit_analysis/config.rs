@@ -2,7 +2,7 @@
 //! in `docs/limit_analysis.md`; errors name the file, the key and its line and
 //! column like the MPM scene files.
 
-use super::cone::MohrCoulomb;
+use super::cone::{MohrCoulomb, MAX_ITERATIONS};
 use super::model::{MeshSize, Model, SlopeGeometry};
 use crate::scene::{blame, SceneError, Source};
 use serde::Deserialize;
@@ -23,6 +23,8 @@ pub struct LimitConfig {
     pub footing: Option<FootingConfig>,
     pub slope: Option<SlopeConfig>,
     pub mesh: MeshConfig,
+    #[serde(default)]
+    pub solver: SolverConfig,
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -76,6 +78,27 @@ pub struct MeshConfig {
     pub max_size: f64,
     #[serde(default = "default_refinements")]
     pub refinements: Vec<u32>,
+}
+
+/// The conic solver (clarabel).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolverConfig {
+    /// Interior-point iterations for each bound.
+    #[serde(default = "default_max_iterations")]
+    pub max_iterations: u32,
+}
+
+impl Default for SolverConfig {
+    fn default() -> Self {
+        SolverConfig {
+            max_iterations: default_max_iterations(),
+        }
+    }
+}
+
+fn default_max_iterations() -> u32 {
+    MAX_ITERATIONS
 }
 
 fn default_growth() -> f64 {
@@ -202,6 +225,11 @@ fn validate(c: &LimitConfig) -> Check {
         "mesh.refinements",
         "must list one or more refinement levels, each between 0 and 5",
     )?;
+    ensure(
+        c.solver.max_iterations >= 1,
+        "solver.max_iterations",
+        "must be at least 1",
+    )?;
     let cells = match c.problem {
         Problem::Footing => {
             let f = c.footing.as_ref().unwrap();
@@ -269,7 +297,7 @@ impl LimitScene {
     pub fn model(&self, refinements: u32) -> Model {
         let c = &self.config;
         let size = self.mesh_size(refinements);
-        match c.problem {
+        let model = match c.problem {
             Problem::Footing => {
                 let f = c.footing.as_ref().expect("validated");
                 Model::footing(
@@ -296,6 +324,10 @@ impl LimitScene {
                     size,
                 )
             }
+        };
+        Model {
+            max_iterations: c.solver.max_iterations,
+            ..model
         }
     }
 }

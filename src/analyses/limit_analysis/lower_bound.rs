@@ -131,7 +131,7 @@ pub fn program(model: &Model) -> ConicProgram {
 /// Solve the lower-bound problem.
 pub fn lower_bound(model: &Model) -> Result<Bound, SolverFailure> {
     let p = program(model);
-    let s = p.solve()?;
+    let s = p.solve(model.max_iterations)?;
     let ne = model.mesh.triangles.len();
     Ok(Bound {
         multiplier: s.x[9 * ne] * model.multiplier_unit,

@@ -6,7 +6,7 @@
 //! a reference length, stresses over a reference stress); `multiplier_unit`
 //! converts the solver's multiplier back.
 
-use super::cone::MohrCoulomb;
+use super::cone::{MohrCoulomb, MAX_ITERATIONS};
 use super::mesh::{refine, reversed, spacing, Block, Edge, Mesh, Point};
 
 /// What a boundary edge imposes.
@@ -45,6 +45,9 @@ pub struct Model {
     pub load: Load,
     /// Physical value of a unit multiplier (a stress for a footing, 1 for gravity).
     pub multiplier_unit: f64,
+    /// Clarabel's iteration limit for each bound (scene key
+    /// `solver.max_iterations`).
+    pub max_iterations: u32,
 }
 
 /// Mesh density: smallest cell at the singular point (footing edge, slope toe),
@@ -104,6 +107,7 @@ impl Model {
             strength,
             load,
             multiplier_unit,
+            max_iterations: MAX_ITERATIONS,
         }
     }
 

@@ -1,5 +1,6 @@
 //! `mpm limit`: solve the lower and upper bounds at each refinement level and
-//! write summary.json and refinement.csv.
+//! write summary.json and refinement.csv. A level that cannot be solved ends the
+//! run: summary.json then has status `failed`, the message and the levels before.
 //!
 //! Footing: the bounds are on the limit pressure q (average footing pressure at
 //! collapse) and on q/c. Slope: the bounds are on the strength-reduction factor
@@ -14,6 +15,7 @@ use super::reduction::{factor_of_safety, FactorOfSafety, ReductionError};
 use super::upper_bound::upper_bound;
 use super::Bound;
 use crate::output::{write_json, CsvWriter, Field};
+use crate::run::summary::Status;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 use std::time::Instant;
@@ -42,8 +44,12 @@ impl Level {
 
 #[derive(Debug, thiserror::Error)]
 pub enum LimitError {
-    #[error("{0}")]
-    Solve(String),
+    /// A level could not be solved; summary.json (written) says so.
+    #[error("{message}")]
+    Solve {
+        message: String,
+        summary: Box<LimitSummary>,
+    },
     #[error("cannot write {path}: {source}")]
     Io {
         path: String,
@@ -58,14 +64,13 @@ fn io(path: &Path) -> impl FnOnce(std::io::Error) -> LimitError + '_ {
     }
 }
 
-fn solve_level(scene: &LimitScene, refinements: u32) -> Result<Level, LimitError> {
+/// The bounds at one refinement level, or why they could not be found (the
+/// bound, the level and the solver's status).
+fn solve_level(scene: &LimitScene, refinements: u32) -> Result<Level, String> {
     let model: Model = scene.model(refinements);
     let elements = model.mesh.triangles.len();
     let what = |bound: &str, e: &dyn std::fmt::Display| {
-        LimitError::Solve(format!(
-            "{}: {bound} bound at refinement level {refinements} ({elements} triangles): {e}",
-            scene.file
-        ))
+        format!("{bound} bound at refinement level {refinements} ({elements} triangles): {e}")
     };
     match scene.config.problem {
         Problem::Footing => {
@@ -106,22 +111,36 @@ fn solve_level(scene: &LimitScene, refinements: u32) -> Result<Level, LimitError
     }
 }
 
-/// summary.json of `mpm limit`: the bounds of the finest level (the headline)
-/// and every level.
+/// summary.json of `mpm limit`: the bounds of the finest level solved (the
+/// headline) and every level solved.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LimitSummary {
     pub scene: String,
     pub problem: Problem,
     /// What is bounded: `limit_pressure` or `factor_of_safety`.
     pub quantity: String,
+    /// `failed` when a level could not be solved; absent when every level was.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub status: Option<Status>,
+    /// Why it failed: the bound, the level and the solver's status.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub message: Option<String>,
+    /// Absent when the first level failed.
+    #[serde(flatten, default, skip_serializing_if = "Option::is_none")]
+    pub finest: Option<Finest>,
+    pub levels: Vec<LevelSummary>,
+    pub wall_seconds: f64,
+}
+
+/// The bounds of the finest level solved.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Finest {
     pub lower_bound: f64,
     pub upper_bound: f64,
     pub relative_gap: f64,
     pub elements: usize,
     #[serde(flatten)]
     pub headline: Headline,
-    pub levels: Vec<LevelSummary>,
-    pub wall_seconds: f64,
 }
 
 /// The bounds of the finest level in the units of the problem.
@@ -214,8 +233,80 @@ fn level_summary(scene: &LimitScene, l: &Level) -> LevelSummary {
     }
 }
 
+/// The columns of refinement.csv, one row per level solved.
+const CSV_COLUMNS: [&str; 7] = [
+    "refinements",
+    "elements",
+    "lower_bound",
+    "upper_bound",
+    "relative_gap",
+    "lower_seconds",
+    "upper_seconds",
+];
+
+fn csv_row(l: &Level) -> [Field<'static>; 7] {
+    [
+        Field::from(l.refinements),
+        l.elements.into(),
+        l.lower.into(),
+        l.upper.into(),
+        l.relative_gap().into(),
+        l.lower_seconds.into(),
+        l.upper_seconds.into(),
+    ]
+}
+
+fn print_level(scene: &LimitScene, l: &Level) {
+    println!(
+        "level {}: {} triangles, {} ≤ {:.5} … {:.5} (gap {:.2} %), solver {:.2} s + {:.2} s",
+        l.refinements,
+        l.elements,
+        match scene.config.problem {
+            Problem::Footing => "q",
+            Problem::Slope => "F",
+        },
+        l.lower,
+        l.upper,
+        100.0 * l.relative_gap(),
+        l.lower_seconds,
+        l.upper_seconds
+    );
+}
+
+/// summary.json of the levels solved; `failure` is why the next one was not.
+fn limit_summary(
+    scene: &LimitScene,
+    levels: &[Level],
+    failure: Option<String>,
+    wall_seconds: f64,
+) -> LimitSummary {
+    let quantity = match scene.config.problem {
+        Problem::Footing => "limit_pressure",
+        Problem::Slope => "factor_of_safety",
+    };
+    LimitSummary {
+        scene: scene.file.clone(),
+        problem: scene.config.problem,
+        quantity: quantity.into(),
+        status: failure.as_ref().map(|_| Status::Failed),
+        message: failure,
+        finest: levels.last().map(|last| Finest {
+            lower_bound: last.lower,
+            upper_bound: last.upper,
+            relative_gap: last.relative_gap(),
+            elements: last.elements,
+            headline: level_summary(scene, last).headline,
+        }),
+        levels: levels.iter().map(|l| level_summary(scene, l)).collect(),
+        wall_seconds,
+    }
+}
+
 /// Solve every refinement level and write summary.json (the last level is the
 /// headline) and refinement.csv into `out`. `progress` prints one line per level.
+/// A level that cannot be solved ends the run with [`LimitError::Solve`] after
+/// summary.json (status `failed`) and refinement.csv are written with the
+/// levels before it.
 pub fn run_limit(
     scene: &LimitScene,
     out: &Path,
@@ -223,70 +314,42 @@ pub fn run_limit(
 ) -> Result<LimitSummary, LimitError> {
     std::fs::create_dir_all(out).map_err(io(out))?;
     let start = Instant::now();
-    let mut levels = Vec::new();
     let csv_path = out.join("refinement.csv");
-    let columns = [
-        "refinements",
-        "elements",
-        "lower_bound",
-        "upper_bound",
-        "relative_gap",
-        "lower_seconds",
-        "upper_seconds",
-    ];
-    let mut csv = CsvWriter::create(&csv_path, &columns).map_err(io(&csv_path))?;
+    let mut csv = CsvWriter::create(&csv_path, &CSV_COLUMNS).map_err(io(&csv_path))?;
     let mut refinements = scene.config.mesh.refinements.clone();
     refinements.sort_unstable();
     refinements.dedup();
+    let mut levels = Vec::new();
+    let mut failure = None;
     for r in refinements {
-        let l = solve_level(scene, r)?;
-        csv.row([
-            Field::from(l.refinements),
-            l.elements.into(),
-            l.lower.into(),
-            l.upper.into(),
-            l.relative_gap().into(),
-            l.lower_seconds.into(),
-            l.upper_seconds.into(),
-        ])
-        .and_then(|_| csv.flush())
-        .map_err(io(&csv_path))?;
+        let l = match solve_level(scene, r) {
+            Ok(l) => l,
+            Err(message) => {
+                failure = Some(message);
+                break;
+            }
+        };
+        csv.row(csv_row(&l))
+            .and_then(|_| csv.flush())
+            .map_err(io(&csv_path))?;
         if progress {
-            println!(
-                "level {}: {} triangles, {} ≤ {:.5} … {:.5} (gap {:.2} %), solver {:.2} s + {:.2} s",
-                l.refinements,
-                l.elements,
-                match scene.config.problem {
-                    Problem::Footing => "q",
-                    Problem::Slope => "F",
-                },
-                l.lower,
-                l.upper,
-                100.0 * l.relative_gap(),
-                l.lower_seconds,
-                l.upper_seconds
-            );
+            print_level(scene, &l);
         }
         levels.push(l);
     }
-    let last = levels.last().expect("at least one level");
-    let quantity = match scene.config.problem {
-        Problem::Footing => "limit_pressure",
-        Problem::Slope => "factor_of_safety",
-    };
-    let summary = LimitSummary {
-        scene: scene.file.clone(),
-        problem: scene.config.problem,
-        quantity: quantity.into(),
-        lower_bound: last.lower,
-        upper_bound: last.upper,
-        relative_gap: last.relative_gap(),
-        elements: last.elements,
-        headline: level_summary(scene, last).headline,
-        levels: levels.iter().map(|l| level_summary(scene, l)).collect(),
-        wall_seconds: start.elapsed().as_secs_f64(),
-    };
+    let wall_seconds = start.elapsed().as_secs_f64();
+    let summary = limit_summary(scene, &levels, failure.clone(), wall_seconds);
     let path = out.join("summary.json");
     write_json(&path, &summary).map_err(io(&path))?;
-    Ok(summary)
+    match failure {
+        None => Ok(summary),
+        Some(message) => Err(LimitError::Solve {
+            message: format!(
+                "{}: {message}; summary.json (status failed) and the levels solved so far are in {}",
+                scene.file,
+                out.display()
+            ),
+            summary: Box::new(summary),
+        }),
+    }
 }

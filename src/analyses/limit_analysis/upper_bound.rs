@@ -204,7 +204,7 @@ pub fn program(model: &Model) -> (ConicProgram, VelocityMap, Vec<f64>) {
 /// node (vertices, then mid-side nodes), normalised by its largest component.
 pub fn upper_bound(model: &Model) -> Result<Bound, SolverFailure> {
     let (p, map, load) = program(model);
-    let s = p.solve()?;
+    let s = p.solve(model.max_iterations)?;
     let ne = model.mesh.triangles.len();
     let y = &s.equality_duals;
     // Orient the mechanism so that the load does positive work on it.
