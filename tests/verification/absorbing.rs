@@ -375,12 +375,15 @@ fn gravity_on_spring_dashpot_base_keeps_static_equilibrium() {
             "settlement {settled:.6e} vs {expected:.6e}"
         );
         assert!(adjustment < 1e-4 * settled, "adjustment {adjustment:.3e} m");
-        // Measured 1.1e-9 of the settlement; 1.1e-7 m/s explicit, 2.2e-10
+        // Measured 3.2e-9 of the settlement explicit between the rows nearest
+        // 1.5 s and 2 s (1.1e-9 between rows that had drifted a few steps late
+        // before issue 56: the drift samples the residual oscillation of ~1e-7
+        // m/s, so it moves with the rows' times); 1.1e-7 m/s explicit, 2.2e-10
         // Newmark (a floor of 1e-9 m/s).
         assert_within(
             "drift over the last 0.5 s / settlement",
             drift / settled,
-            3e-9,
+            1e-8,
         );
         let v_bound = if dynamics.is_empty() { 3e-7 } else { 1e-9 };
         assert_within("largest |v| over the last 0.5 s (m/s)", v_late, v_bound);
