@@ -46,7 +46,7 @@ history_interval = 0.0
 "#,
         gx = length + 0.002,
         gy = width + 0.002,
-        end = 0.4 * length / (70e9f64 / 2700.0).sqrt(),
+        end = 0.7 * length / (70e9f64 / 2700.0).sqrt(),
     )
 }
 
@@ -70,9 +70,11 @@ fn the_bar_wave_speed_is_the_elastic_one_to_the_surface_error() {
     let h = Table::read(&dir.path().join("history.csv")).unwrap();
     let quarter = first_minimum(h.col("t"), h.col("kinetic"));
     let c = length / (2.0 * quarter);
-    // Bond-based with free surfaces: the bonds missing within δ of the bar's
-    // four faces make it softer than E (no surface correction in this slice).
-    assert_within("bar wave speed c/c0 − 1", c / c0 - 1.0, 0.10);
+    // Bond-based, m = 3, no surface or partial-volume correction: the lattice
+    // interior is stiffer than E (+6.5 % in energy, `pmb` unit test), the bonds
+    // missing within δ of the faces softer; measured +0.93 % (0.1 m × 10 mm,
+    // Δx = 0.5 mm, 157 steps).
+    assert_within("bar wave speed c/c0 − 1", c / c0 - 1.0, 0.03);
     // The mode is elastic: it lost no bond.
     let p = Table::read(&dir.path().join("particles_final.csv")).unwrap();
     assert!(p.col("damage").iter().all(|&d| d == 0.0));
@@ -86,17 +88,21 @@ fn the_notched_plate_cracks_from_its_notch() {
     let p = Table::read(&dir.path().join("particles_final.csv")).unwrap();
     let (x, y, d) = (p.col("X0"), p.col("Y0"), p.col("damage"));
     let max = d.iter().cloned().fold(0.0, f64::max);
-    // Damage across the bottom half of the ligament below the notch (x within
-    // 2δ of the middle), and none far from it in the corners.
-    let band = |q: usize| (x[q] - 0.02).abs() < 0.003;
-    let cracked = (0..d.len())
-        .filter(|&q| band(q) && y[q] < 0.008 && d[q] > 0.3)
+    // The crack: every row of particles below the notch tip (y < 15 mm) has a
+    // particle with φ > 1/2 within 3 mm of the middle (a particle a crack
+    // passes by loses about half its bonds); far from the middle (|x − 20 mm|
+    // > 12 mm) none has (measured there: φ ≤ 0.29, edge particles' bonds).
+    let rows = 30;
+    let row = |q: usize| (y[q] / 5e-4) as usize;
+    let cracked = (0..rows)
+        .filter(|&r| (0..d.len()).any(|q| row(q) == r && (x[q] - 0.02).abs() < 0.003 && d[q] > 0.5))
         .count();
-    let corners = (0..d.len())
-        .filter(|&q| (x[q] - 0.02).abs() > 0.012 && d[q] > 0.3)
-        .count();
-    println!("max damage {max:.3}, cracked below the notch {cracked}, in the corners {corners}");
-    assert!(cracked > 0 && corners == 0);
+    let far = (0..d.len())
+        .filter(|&q| (x[q] - 0.02).abs() > 0.012)
+        .map(|q| d[q])
+        .fold(0.0, f64::max);
+    println!("max damage {max:.3}; rows cracked below the notch {cracked} of {rows}; max φ far from it {far:.3}");
+    assert!(cracked == rows && far < 0.5);
 }
 
 const BODY: &str = r#"
