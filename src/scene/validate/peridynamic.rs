@@ -91,17 +91,18 @@ fn material(i: usize, s: &SceneConfig) -> Check {
     let space = s.peridynamic_space(i);
     let nu = (m.parameters.get("poisson_ratio")).and_then(|v| v.as_float());
     let want = space.poisson_ratio();
-    let name = match space {
-        Space::ThreeD => "3D",
-        Space::PlaneStrain => "plane strain",
-        Space::PlaneStress => "plane stress",
+    let (name, fraction) = match space {
+        Space::ThreeD => ("3D", "1/4"),
+        Space::PlaneStrain => ("plane strain", "1/4"),
+        Space::PlaneStress => ("plane stress", "1/3"),
     };
+    let got = nu.map_or("none".to_string(), |nu| nu.to_string());
     ensure(
         nu.is_some_and(|nu| (nu - want).abs() <= 1e-4),
         format!("material.{k}.poisson_ratio"),
         format!(
-            "the bond-based (PMB) peridynamic body {i} has ν = {want:.6} in {name} \
-             (one micromodulus fixes it); got {nu:?}: set poisson_ratio = {want:.6} \
+            "the bond-based (PMB) peridynamic body {i} has ν = {fraction} in {name} \
+             (one micromodulus fixes it); got {got}: set poisson_ratio = {want:.6} \
              (or, in 2D, the other `plane`)"
         ),
     )?;
