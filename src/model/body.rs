@@ -17,6 +17,15 @@
 //! | continuum         | by the grid        | integrated     |
 //! | rigid, prescribed | at its velocity    | contact only   |
 //! | rigid, free       | by Newton–Euler    | contact only   |
+//! | peridynamic       | by its bonds       | contact only   |
+//!
+//! A peridynamic body (`physics::peridynamics`) is advanced by the forces of
+//! its bonds, gravity and loads, by central differences, in the explicit step
+//! (`NodeMapStep::advance_bodies`); its particles carry the zero-stress
+//! `Rigid` with its material's density, so the grid adds no internal force to
+//! them. In this slice it is alone in its scene, on explicit stages
+//! (`scene::validate::peridynamic`), so it meets no other body; its particles'
+//! mass and momentum still go to the nodes, which nothing reads back.
 //!
 //! The scene gives the kind: `[[body]] kind` and `motion`, or the old form, a
 //! material with `model = "rigid"` (`SceneConfig::body_kind`, `rigid_motion`).
@@ -76,6 +85,8 @@ pub enum BodyKind {
     Continuum,
     /// Rigid, meeting the other bodies through contact only.
     Rigid { motion: Motion },
+    /// Bond-based peridynamic (`physics::peridynamics`).
+    Peridynamic,
 }
 
 /// How a kind's particles are advanced over a step.
@@ -90,6 +101,9 @@ pub enum Advance {
     /// As one rigid body under the contact impulses, gravity and loads
     /// (`physics::rigid::newton_euler`).
     NewtonEuler,
+    /// By the forces of their bonds, gravity and loads, by central
+    /// differences (`physics::peridynamics::PdBody::advance`).
+    ByBonds,
 }
 
 /// How a kind's particles meet the grid.
@@ -110,6 +124,7 @@ impl BodyKind {
             BodyKindName::Rigid => BodyKind::Rigid {
                 motion: c.rigid_motion(i),
             },
+            BodyKindName::Peridynamic => BodyKind::Peridynamic,
         }
     }
 
@@ -122,13 +137,14 @@ impl BodyKind {
             BodyKind::Rigid {
                 motion: Motion::Free,
             } => Advance::NewtonEuler,
+            BodyKind::Peridynamic => Advance::ByBonds,
         }
     }
 
     pub fn meets_grid(self) -> GridCoupling {
         match self {
             BodyKind::Continuum => GridCoupling::Integrated,
-            BodyKind::Rigid { .. } => GridCoupling::ContactOnly,
+            BodyKind::Rigid { .. } | BodyKind::Peridynamic => GridCoupling::ContactOnly,
         }
     }
 
@@ -173,5 +189,9 @@ mod tests {
             (AtOwnVelocity, ContactOnly, false, true)
         );
         assert_eq!(declared(free), (NewtonEuler, ContactOnly, false, true));
+        assert_eq!(
+            declared(BodyKind::Peridynamic),
+            (ByBonds, ContactOnly, false, false)
+        );
     }
 }

@@ -7,13 +7,15 @@
 
 use crate::dim::Vector;
 use crate::material::Material;
-use crate::model::body::Body;
+use crate::model::body::{Body, BodyKind};
 use crate::model::conditions::{Absorbing, Constraint, FaceCondition, Footing, FrictionFace};
 use crate::model::geometry::Geometry;
 use crate::model::grid::Grid;
 use crate::model::loads::Loads;
 use crate::model::particles::Particles;
 use crate::model::{axisymmetry, Model};
+use crate::physics::peridynamics::{PdBody, Peridynamics};
+use crate::scene::SceneConfig;
 use crate::scene::{
     axis, expr, BodyConfig, BoundaryConfig, Condition, DomainStress, Face, Fill, ParticlesOutside,
     Scene, SceneError,
@@ -68,6 +70,7 @@ impl<const D: usize> Model<D> {
                 return Err(err((format!("body.{i}.shape"), "the body holds no particle centre: refine the grid or raise particles_per_cell".into())));
             }
         }
+        let peridynamics = peridynamic_bodies(c, &bodies, &particles);
         // The velocity conditions, with the index of their [[boundary]] table.
         let velocity: Vec<(usize, &BoundaryConfig)> = (c.boundaries.iter().enumerate())
             .filter(|(_, b)| b.condition.prescribes_velocity())
@@ -124,8 +127,28 @@ impl<const D: usize> Model<D> {
             load_ramps: loads.ramps,
             load_ramp_of: loads.ramp_of,
             axisymmetric,
+            peridynamics,
         })
     }
+}
+
+/// The peridynamic bodies with their bonds (`physics::peridynamics`), built
+/// from the particles' reference positions and volumes; None without one.
+fn peridynamic_bodies<const D: usize>(
+    c: &SceneConfig,
+    bodies: &[Body],
+    p: &Particles<D>,
+) -> Option<Peridynamics<D>> {
+    let pd: Vec<PdBody<D>> = (0..bodies.len())
+        .filter(|&i| bodies[i].kind == BodyKind::Peridynamic)
+        .map(|i| {
+            let of: Vec<usize> = (0..p.len()).filter(|&q| p.body[q] as usize == i).collect();
+            let x: Vec<Vector<D>> = of.iter().map(|&q| p.x[q]).collect();
+            let volume = of.iter().map(|&q| p.volume[q]).collect();
+            PdBody::new(i, of, &x, volume, c.peridynamic(i))
+        })
+        .collect();
+    (!pd.is_empty()).then(|| Peridynamics::new(pd, &p.mass))
 }
 
 fn face_condition<const D: usize>(

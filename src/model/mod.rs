@@ -13,6 +13,7 @@ pub(crate) mod memory;
 pub mod particles;
 pub(crate) mod tensors;
 
+use crate::physics::peridynamics::Peridynamics;
 pub use loads::{load_factor, LoadTime};
 
 use crate::dim::Vector;
@@ -62,6 +63,9 @@ pub struct Model<const D: usize> {
     /// `[grid] domain_stress = "linear"`: a stress linear within each particle
     /// domain in the implicit internal force (`solver::implicit::stress_gradient`).
     pub linear_domain_stress: bool,
+    /// The peridynamic bodies' bonds (`physics::peridynamics`); None in a
+    /// scene without one, which then allocates and computes nothing of them.
+    pub peridynamics: Option<Peridynamics<D>>,
 }
 
 impl<const D: usize> Model<D> {
@@ -124,6 +128,20 @@ impl<const D: usize> Model<D> {
             .iter()
             .any(Option::is_some)
             .then(|| values.iter().map(|v| v.unwrap_or(0.0)).collect())
+    }
+
+    /// The per-particle fields the outputs add where the run has them:
+    /// `eps_p` (`plastic_strain`) and, with a peridynamic body, `damage`
+    /// (`Peridynamics::damage`, 0 off the peridynamic bodies).
+    pub fn point_fields(&self) -> Vec<(&'static str, Vec<f64>)> {
+        let mut fields: Vec<(&'static str, Vec<f64>)> = Vec::new();
+        if let Some(e) = self.plastic_strain() {
+            fields.push(("eps_p", e));
+        }
+        if let Some(pd) = &self.peridynamics {
+            fields.push(("damage", pd.damage(self.particles.len())));
+        }
+        fields
     }
 
     /// Index of the particle whose reference position is nearest to `x`.

@@ -13,6 +13,7 @@ pub(crate) mod boundary;
 pub(crate) mod contact;
 pub mod geostatic;
 pub(crate) mod kinematics;
+pub mod peridynamics;
 pub(crate) mod rigid;
 pub mod shape;
 pub mod transfer;

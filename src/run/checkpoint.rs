@@ -7,7 +7,7 @@
 //! the stage, time, step, last Δt, load factor and strength-reduction factor,
 //! every particle field (x, X, v, m, V, V0, F, σ, the CPDI/GIMP half-lengths
 //! whose images F r⁰ are the domain vectors, body, material, loads, history
-//! variables), the stepper's state across steps (`solver::stepper::SolverState`:
+//! variables), the broken bonds of peridynamic bodies, the stepper's state across steps (`solver::stepper::SolverState`:
 //! Newmark accelerations, the implicit contact's tangential forces and contact
 //! points, counts) and the recorders' state (the streamed CSVs as
 //! written so far, the frame list, when the next row and frame are due).
@@ -40,7 +40,7 @@ use std::path::{Path, PathBuf};
 /// What a checkpoint file says it is.
 pub const FORMAT: &str = "mpm checkpoint";
 /// The layout of the body; a build reads only its own version.
-pub const VERSION: u32 = 2;
+pub const VERSION: u32 = 3;
 /// How many checkpoints a run keeps (the older ones it wrote are removed).
 pub const KEEP: usize = 2;
 
@@ -83,6 +83,9 @@ pub struct Checkpoint {
     /// The simulation time the next checkpoint is due at.
     pub next_checkpoint: f64,
     pub particles: ParticleState,
+    /// Per peridynamic body, the ids of its broken bonds, ascending
+    /// (`physics::peridynamics::Peridynamics::broken_bonds`); empty without one.
+    pub broken_bonds: Vec<Vec<u32>>,
     pub solver: SolverState,
     pub recorders: RecorderState,
 }
@@ -347,6 +350,20 @@ pub(super) fn restored_particles<const D: usize>(
         )));
     }
     Ok(p)
+}
+
+/// The peridynamic bodies' bonds of a checkpoint: the scene rebuilds them
+/// intact from the reference positions, the checkpoint says which are broken.
+pub(super) fn restore_bonds<const D: usize>(
+    ck: &Checkpoint,
+    path: &Path,
+    model: &mut crate::model::Model<D>,
+) -> Result<(), RunError> {
+    let Some(pd) = &mut model.peridynamics else {
+        return Ok(());
+    };
+    (pd.restore_broken(&ck.broken_bonds))
+        .map_err(|e| RunError::Checkpoint(format!("checkpoint {}: {e}", path.display())))
 }
 
 #[cfg(test)]

@@ -136,8 +136,8 @@ fn final_outputs<const D: usize>(
 ) -> std::io::Result<()> {
     let (model, line): (&Model<D>, _) = (&run.model, &mut run.line);
     line.recorders.state(&line.moment(model), None, true)?;
-    let eps_p = model.plastic_strain();
-    let mut extra: Vec<(&str, &[f64])> = eps_p.iter().map(|e| ("eps_p", e.as_slice())).collect();
+    let fields = model.point_fields();
+    let mut extra: Vec<(&str, &[f64])> = (fields.iter()).map(|(n, v)| (*n, v.as_slice())).collect();
     let components: Vec<Vec<f64>> = (contact_forces.iter())
         .flat_map(|f| (0..D).map(move |d| f.iter().map(|v| v[d]).collect()))
         .collect();

@@ -96,8 +96,8 @@ impl ParticleDumps {
         }
         self.last = Some(t);
         let name = file_name(self.written);
-        let eps_p = m.plastic_strain();
-        let extra: Vec<(&str, &[f64])> = eps_p.iter().map(|e| ("eps_p", e.as_slice())).collect();
+        let fields = m.point_fields();
+        let extra: Vec<(&str, &[f64])> = (fields.iter()).map(|(n, v)| (*n, v.as_slice())).collect();
         write_particles_csv_with(&self.dir.join(&name), &m.particles, &extra)?;
         self.written += 1;
         self.index

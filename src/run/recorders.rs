@@ -287,9 +287,9 @@ impl Recorders {
         };
         if (force || t >= self.next_frame - tolerance) && t != self.last_frame {
             self.last_frame = t;
-            let eps_p = m.plastic_strain();
+            let fields = m.point_fields();
             let extra: Vec<(&str, &[f64])> =
-                eps_p.iter().map(|e| ("eps_p", e.as_slice())).collect();
+                (fields.iter()).map(|(n, v)| (*n, v.as_slice())).collect();
             self.frames.write_frame(t, &m.particles, &extra)?;
             while self.next_frame <= t + tolerance {
                 self.next_frame += interval;

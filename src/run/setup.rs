@@ -4,7 +4,7 @@
 
 use crate::model::Model;
 use crate::output::Progress;
-use crate::run::checkpoint::{restored_particles, Kept, Resume};
+use crate::run::checkpoint::{restore_bonds, restored_particles, Kept, Resume};
 use crate::run::checks::check_steps;
 use crate::run::error::RunError;
 use crate::run::options::RunOptions;
@@ -46,6 +46,7 @@ impl<const D: usize> SetUp<D> {
         if let Some(r) = resume {
             strength_factor = r.checkpoint.strength_factor;
             model.particles = restored_particles(&r.checkpoint, &r.path, model.particles.len())?;
+            restore_bonds(&r.checkpoint, &r.path, &mut model)?;
         }
         if strength_factor != 1.0 {
             model.reduce_strength(strength_factor);

@@ -173,6 +173,8 @@ impl Timeline {
             dt_critical: ctx.dt_critical,
             next_checkpoint: self.checkpoints.next,
             particles: ParticleState::of(&model.particles),
+            broken_bonds: (model.peridynamics.as_ref())
+                .map_or_else(Vec::new, |pd| pd.broken_bonds()),
             solver: stepper.state(),
             recorders: self.recorders.saved()?,
         };

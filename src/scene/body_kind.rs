@@ -5,10 +5,11 @@
 //! bodies' kinds from these (`model::body`); the validation checks the keys
 //! (`validate::grid_bodies`).
 
-use super::{BodyKindName, MaterialConfig, SceneConfig};
+use super::{BodyKindName, MaterialConfig, Plane, SceneConfig};
 use crate::material::parameters::FromParameters;
 use crate::material::rigid::{Motion, Rigid};
 use crate::material::Material;
+use crate::physics::peridynamics::pmb::{Pmb, Space};
 
 impl SceneConfig {
     /// The kind of body i: its `kind`, else rigid when its material is an
@@ -49,17 +50,78 @@ impl SceneConfig {
     }
 
     /// The materials the particles carry, one per table, from the tables' own
-    /// (`built`): the table of a rigid body gives the zero-stress `Rigid` with
-    /// its density instead, whatever its model (only its density acts on a
-    /// rigid body; the validation refuses a table shared by a rigid and a
-    /// continuum body).
+    /// (`built`): the table of a rigid or a peridynamic body gives the
+    /// zero-stress `Rigid` with its density instead, whatever its model (only
+    /// its density acts on a rigid body; a peridynamic body's E and ν act
+    /// through its bonds, `peridynamic`, not through the grid; the validation
+    /// refuses a table shared with a continuum body).
     pub fn particle_materials(&self, mut built: Vec<Box<dyn Material>>) -> Vec<Box<dyn Material>> {
-        for i in (0..self.bodies.len()).filter(|&i| self.body_kind(i) == BodyKindName::Rigid) {
+        let off_grid = |i: &usize| self.body_kind(*i) != BodyKindName::Continuum;
+        for i in (0..self.bodies.len()).filter(off_grid) {
             let table = (self.materials.iter()).position(|m| m.name == self.bodies[i].material);
             if let Some(k) = table {
                 built[k] = Box::new(Rigid::new(self.materials[k].density));
             }
         }
         built
+    }
+}
+
+impl SceneConfig {
+    /// Body i's particle spacing Δx: the largest over the directions of the
+    /// cell size over `particles_per_cell`.
+    pub fn particle_spacing(&self, i: usize) -> f64 {
+        let dim = self.dimension.spatial();
+        let ppc = &self.bodies[i].particles_per_cell;
+        (0..dim)
+            .map(|d| {
+                (self.grid.max[d] - self.grid.min[d])
+                    / self.grid.cells[d] as f64
+                    / ppc.get(d) as f64
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// The PMB space of peridynamic body i: 3D, or its `plane` in 2D.
+    pub fn peridynamic_space(&self, i: usize) -> Space {
+        match (
+            self.dimension.spatial(),
+            self.bodies[i].plane.unwrap_or_default(),
+        ) {
+            (3, _) => Space::ThreeD,
+            (_, Plane::Strain) => Space::PlaneStrain,
+            (_, Plane::Stress) => Space::PlaneStress,
+        }
+    }
+
+    /// The horizon δ of peridynamic body i: `horizon`, else `horizon_factor`
+    /// (default 3) × its particle spacing.
+    pub fn horizon(&self, i: usize) -> f64 {
+        let b = &self.bodies[i];
+        b.horizon
+            .unwrap_or_else(|| b.horizon_factor.unwrap_or(3.0) * self.particle_spacing(i))
+    }
+
+    /// The Young's modulus of body i's material (`youngs_modulus`), if it has one.
+    pub fn youngs_modulus(&self, i: usize) -> Option<f64> {
+        let m = self
+            .materials
+            .iter()
+            .find(|m| m.name == self.bodies[i].material)?;
+        m.parameters
+            .get("youngs_modulus")
+            .and_then(|v| v.as_float().or(v.as_integer().map(|n| n as f64)))
+    }
+
+    /// The PMB constants of peridynamic body i of a validated scene.
+    pub fn peridynamic(&self, i: usize) -> Pmb {
+        let (b, space) = (&self.bodies[i], self.peridynamic_space(i));
+        let e = self.youngs_modulus(i).unwrap();
+        let pmb = Pmb::new(space, e, self.horizon(i));
+        match (b.fracture_energy, b.critical_stretch) {
+            (Some(g0), _) => pmb.with_fracture_energy(space, e, g0),
+            (_, Some(s0)) => pmb.with_critical_stretch(s0),
+            _ => pmb,
+        }
     }
 }

@@ -154,6 +154,32 @@ pub enum BodyKindName {
     /// A rigid body (`motion`): it meets the other bodies through contact only
     /// and takes only the density of its material.
     Rigid,
+    /// A bond-based peridynamic body (`horizon`, `bond_model`, fracture):
+    /// advanced by its bonds' forces (`physics::peridynamics`); it takes the
+    /// density, E and ν of its material.
+    Peridynamic,
+}
+
+/// The bond model of a peridynamic body (`bond_model`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, IntoStaticStr, EnumIter)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum BondModel {
+    /// Prototype microelastic brittle (`physics::peridynamics::pmb`).
+    #[default]
+    Pmb,
+}
+
+/// The 2D idealisation of a peridynamic body (`plane`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, IntoStaticStr, EnumIter)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum Plane {
+    /// Plane strain (the 2D of the rest of the code; PMB ν = 1/4).
+    #[default]
+    Strain,
+    /// Plane stress (PMB ν = 1/3).
+    Stress,
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -193,6 +219,18 @@ pub struct BodyConfig {
     /// How the body is filled with particles (default `lattice`).
     #[serde(default)]
     pub fill: Fill,
+    /// Peridynamic body: its horizon δ, or `horizon_factor` m = δ/Δx (Δx its
+    /// particle spacing, the largest over the directions; default 3).
+    pub horizon: Option<f64>,
+    pub horizon_factor: Option<f64>,
+    /// Peridynamic body: its bond model (default `pmb`).
+    pub bond_model: Option<BondModel>,
+    /// Peridynamic body: fracture energy G0 or critical stretch s0 (neither: no
+    /// fracture).
+    pub fracture_energy: Option<f64>,
+    pub critical_stretch: Option<f64>,
+    /// Peridynamic body in 2D: `strain` (default) or `stress`.
+    pub plane: Option<Plane>,
 }
 
 /// The particle fill of a body.

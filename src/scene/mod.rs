@@ -133,6 +133,8 @@ mod tests {
         names_agree::<ShapeFunction>();
         names_agree::<BodyShape>();
         names_agree::<BodyKindName>();
+        names_agree::<BondModel>();
+        names_agree::<Plane>();
         names_agree::<Condition>();
         names_agree::<LoadKind>();
         names_agree::<SolverKind>();

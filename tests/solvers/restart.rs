@@ -514,3 +514,11 @@ fn particle_files_restart_byte_identically() {
     let sets = ["solver.end_time=0.1", "output.particle_interval=0.02"];
     restarts_are_exact("sliding_block.toml", &sets, 0.03, 1);
 }
+
+/// Peridynamic bonds are state: a restart that rebuilt them intact would heal
+/// the crack of the notched plate, and its damage would differ.
+#[test]
+fn a_peridynamic_restart_keeps_the_broken_bonds() {
+    let steps = restarts_are_exact("peridynamic_plate.toml", &["output.frames=2"], 7.0e-6, 2);
+    assert!(steps[0] > 0 && steps[1] > steps[0], "{steps:?}");
+}

@@ -115,3 +115,12 @@ fn apic_runs_give_identical_results_on_one_and_two_threads() {
         same_on_one_and_two_threads("collapse.toml", &overrides, &overrides[0]);
     }
 }
+
+/// Peridynamic bodies: the bond forces are gathered per particle over its
+/// bonds in a fixed order, the bonds broken per bond (`physics::peridynamics`):
+/// the notched plate, which cracks, is the same on 1 and 2 threads.
+#[test]
+fn a_cracking_peridynamic_plate_is_the_same_on_one_and_two_threads() {
+    let overrides = ["output.frames=0".to_string()];
+    same_on_one_and_two_threads("peridynamic_plate.toml", &overrides, "peridynamic plate");
+}

@@ -236,6 +236,10 @@ fn scene_with(feature: Feature) -> (String, Vec<&'static str>) {
             (apic, Vec::new())
         }
         Feature::FrictionFaces => block(&[]),
+        Feature::PeridynamicBodies => problem(
+            "peridynamic_plate.toml",
+            &["solver.end_time=2e-6", "output.frames=0"],
+        ),
     }
 }
 

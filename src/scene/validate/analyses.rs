@@ -23,8 +23,8 @@ pub fn geostatic(g: &GeostaticConfig, s: &SceneConfig, materials: &[Box<dyn Mate
         )?;
     }
     for (i, b) in s.bodies.iter().enumerate() {
-        // A rigid body carries no stress: it takes no K0 state.
-        if s.body_kind(i) == BodyKindName::Rigid {
+        // A rigid or a peridynamic body carries no stress: it takes no K0 state.
+        if s.body_kind(i) != BodyKindName::Continuum {
             continue;
         }
         let k = s

@@ -126,7 +126,21 @@ pub fn body(b: &BodyConfig, i: usize, s: &SceneConfig) -> Check {
 fn kind(i: usize, s: &SceneConfig) -> Check {
     let (b, key) = (&s.bodies[i], |k: &str| format!("body.{i}.{k}"));
     let old_form = s.old_form_rigid(i);
+    if s.body_kind(i) != BodyKindName::Peridynamic {
+        super::peridynamic::not_peridynamic(i, s)?;
+    }
     match s.body_kind(i) {
+        BodyKindName::Peridynamic => {
+            ensure(
+                old_form.is_none(),
+                key("material"),
+                format!(
+                    "`{}` is a rigid material: a peridynamic body needs E and ν",
+                    b.material
+                ),
+            )?;
+            super::peridynamic::body(i, s)
+        }
         BodyKindName::Continuum => {
             ensure(
                 old_form.is_none(),

@@ -11,6 +11,7 @@ mod check;
 mod conditions;
 mod grid_bodies;
 mod materials;
+mod peridynamic;
 mod solver;
 
 pub use analyses::bench;

@@ -48,6 +48,8 @@ pub enum Feature {
     Apic,
     /// Rough rigid faces with Coulomb friction (`physics::boundary::conditions`).
     FrictionFaces,
+    /// Peridynamic bodies, advanced by their bonds (`physics::peridynamics`).
+    PeridynamicBodies,
 }
 
 /// The transfer back-ends that serve a feature.
@@ -73,6 +75,9 @@ impl Feature {
             // The box evaluates the stencils again for the force after the
             // stress update: they would see the updated F.
             Feature::UsfReadingF => Serves::NodeMap,
+            // Advanced at the one site that hands each body kind its work,
+            // `NodeMapStep::advance_bodies`.
+            Feature::PeridynamicBodies => Serves::NodeMap,
             Feature::Fbar
             | Feature::BulkViscosity
             | Feature::AbsorbingFaces
@@ -101,6 +106,7 @@ impl Feature {
             Feature::UsfReadingF => s.scheme == Scheme::Usf && s.shape.reads_deformation(),
             Feature::Apic => s.apic,
             Feature::FrictionFaces => !m.friction.is_empty(),
+            Feature::PeridynamicBodies => m.peridynamics.is_some(),
         }
     }
 }

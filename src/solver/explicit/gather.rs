@@ -73,19 +73,34 @@ impl<const D: usize> NodeMapStep<D> {
     /// After G2P, the one place of the explicit step that hands each body
     /// kind its work (`model::body::Advance`): continuum bodies moved with the
     /// grid in G2P, and so did a prescribed rigid body (its nodes move at its
-    /// velocity); free rigid bodies advance by Newton–Euler under the step's
-    /// contact impulses and the applied forces (`physics::rigid::newton_euler`).
-    /// Then the deformable particles that entered a rigid body are put back on
-    /// its surface. Bodies other than continua meet the rest through contact
-    /// only, so a scene without contact has none (`scene::validate`).
+    /// velocity); peridynamic bodies advance from the step start by their
+    /// bond forces, gravity and loads (`physics::peridynamics::PdBody::advance`),
+    /// replacing what G2P gave them; free rigid bodies advance by Newton–Euler
+    /// under the step's contact impulses and the applied forces
+    /// (`physics::rigid::newton_euler`). Then the deformable particles that
+    /// entered a rigid body are put back on its surface. Rigid bodies meet the
+    /// rest through contact only, so a scene without contact has none
+    /// (`scene::validate`).
     fn advance_bodies(&mut self, m: &mut Model<D>, s: &Step<D>) {
+        let (mut by_bonds, mut newton_euler) = (false, false);
+        for b in &m.bodies {
+            match b.kind.advance() {
+                Advance::ByGrid | Advance::AtOwnVelocity => {}
+                Advance::ByBonds => by_bonds = true,
+                Advance::NewtonEuler => newton_euler = true,
+            }
+        }
+        if let (true, Some(pd)) = (by_bonds, &mut m.peridynamics) {
+            let p = &mut m.particles;
+            let (ramp_of, mass, load) = (&m.load_ramp_of, &p.mass, &p.load);
+            let applied = |q: usize| s.applied(ramp_of, mass, load, q);
+            for b in &mut pd.bodies {
+                b.advance(&mut p.x, &mut p.v, mass, applied, s.dt);
+            }
+        }
         let Some(c) = &mut self.contact else {
             return;
         };
-        let newton_euler = (m.bodies.iter()).any(|b| match b.kind.advance() {
-            Advance::ByGrid | Advance::AtOwnVelocity => false,
-            Advance::NewtonEuler => true,
-        });
         if let (true, Some(free)) = (newton_euler, c.free_bodies()) {
             let p = &m.particles;
             let force: Vec<Vector<D>> = (free.particles())
@@ -102,7 +117,7 @@ impl<const D: usize> NodeMapStep<D> {
     fn takes_load_work(&self, m: &Model<D>, q: usize) -> bool {
         let removed = self.removed.get(q).is_some_and(|&r| r);
         let own_motion = match m.kind_of(q).advance() {
-            Advance::ByGrid | Advance::NewtonEuler => false,
+            Advance::ByGrid | Advance::NewtonEuler | Advance::ByBonds => false,
             Advance::AtOwnVelocity => true,
         };
         !removed && !own_motion
@@ -263,6 +278,9 @@ impl<const D: usize> Backend<D> for NodeMapStep<D> {
             apic::ensure(m, s.shape);
         }
         self.removed = removed_particles(m);
+        if let Some(pd) = &mut m.peridynamics {
+            pd.begin_step(&m.particles.x, &m.particles.v);
+        }
         if let (None, Some(plan)) = (&self.contact, &m.contact) {
             self.contact = Some(Contact::new(plan.clone(), m));
         }

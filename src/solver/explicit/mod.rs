@@ -120,6 +120,14 @@ impl<const D: usize> Explicit<D> {
         }
     }
 
+    /// The peridynamic bodies' stable step (`Peridynamics::stable_dt`);
+    /// infinite without one.
+    fn peridynamic_dt(m: &Model<D>) -> f64 {
+        m.peridynamics
+            .as_ref()
+            .map_or(f64::INFINITY, |pd| pd.stable_dt)
+    }
+
     fn critical_dt_over(
         m: &Model<D>,
         viscosity: Option<&BulkViscosity>,
@@ -145,9 +153,13 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
     /// The step to take now: the fixed one, or cfl × the critical one (with bulk
     /// viscosity, also within its stable step at every particle, its rate from
     /// the particle's F rate being unknown here: ε̇_v = 0, the linear term only).
+    /// With peridynamic bodies, also within their stable step (Silling–Askari
+    /// with its safety factor, `physics::peridynamics::pmb::SAFETY`).
     fn dt(&self, m: &Model<D>) -> f64 {
-        self.fixed_dt
-            .unwrap_or_else(|| self.cfl * Self::critical_dt_with(m, self.viscosity.as_ref()))
+        self.fixed_dt.unwrap_or_else(|| {
+            let grid = self.cfl * Self::critical_dt_with(m, self.viscosity.as_ref());
+            grid.min(Self::peridynamic_dt(m))
+        })
     }
 
     /// Advance the model from t to t + dt. Returns the work done by gravity and
@@ -172,6 +184,16 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
     /// its stable step) of the stage's starting state.
     fn step_warning(&self, m: &Model<D>) -> Option<String> {
         let dt = self.fixed_dt?;
+        let bonds = Self::peridynamic_dt(m);
+        if dt > bonds {
+            return Some(format!(
+                "the fixed time step dt = {dt:e} is {:.3} × the stable step {bonds:.6e} of the \
+                 peridynamic bodies (Silling–Askari, with safety factor {}): explicit \
+                 integration of their bonds is unstable above it",
+                dt / bonds,
+                crate::physics::peridynamics::pmb::SAFETY
+            ));
+        }
         let critical = Self::critical_dt_with(m, self.viscosity.as_ref());
         (dt > critical).then(|| {
             format!(

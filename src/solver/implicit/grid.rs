@@ -114,8 +114,9 @@ impl StepGrid {
                     m.particles.x[q] += v * dt;
                 }
                 // On the grid, so never here; a free rigid body is refused
-                // in implicit contact (`scene::validate`).
-                Advance::ByGrid | Advance::NewtonEuler => {}
+                // in implicit contact, a peridynamic body on implicit stages
+                // (`scene::validate`).
+                Advance::ByGrid | Advance::NewtonEuler | Advance::ByBonds => {}
             }
         }
     }

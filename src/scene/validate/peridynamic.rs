@@ -1,0 +1,161 @@
+//! The keys of a peridynamic body (`kind = "peridynamic"`,
+//! `physics::peridynamics`): its horizon, fracture and plane keys, its
+//! material's E and the PMB Poisson ratio, the scene around it (alone, on
+//! explicit stages only: contact with other bodies and implicit PD are later
+//! slices of issue 51), and none of these keys on other bodies.
+
+use super::check::{ensure, forbidden, Check};
+use crate::physics::peridynamics::pmb::Space;
+use crate::scene::{BodyKindName, SceneConfig, SolverKind};
+
+/// The keys only a peridynamic body takes, refused on body i of another kind.
+pub fn not_peridynamic(i: usize, s: &SceneConfig) -> Check {
+    let (b, key) = (&s.bodies[i], |k: &str| format!("body.{i}.{k}"));
+    let what = "a body that is not kind = \"peridynamic\"";
+    forbidden(&b.horizon, key("horizon"), what)?;
+    forbidden(&b.horizon_factor, key("horizon_factor"), what)?;
+    forbidden(&b.bond_model, key("bond_model"), what)?;
+    forbidden(&b.fracture_energy, key("fracture_energy"), what)?;
+    forbidden(&b.critical_stretch, key("critical_stretch"), what)?;
+    forbidden(&b.plane, key("plane"), what)
+}
+
+/// Peridynamic body i.
+pub fn body(i: usize, s: &SceneConfig) -> Check {
+    let (b, key) = (&s.bodies[i], |k: &str| format!("body.{i}.{k}"));
+    forbidden(&b.motion, key("motion"), "a peridynamic body")?;
+    let positive = |v: Option<f64>, k: &str| match v {
+        Some(v) => ensure(
+            v > 0.0 && v.is_finite(),
+            key(k),
+            format!("must be a positive number; got {v}"),
+        ),
+        None => Ok(()),
+    };
+    positive(b.horizon, "horizon")?;
+    positive(b.horizon_factor, "horizon_factor")?;
+    positive(b.fracture_energy, "fracture_energy")?;
+    positive(b.critical_stretch, "critical_stretch")?;
+    ensure(
+        b.horizon.is_none() || b.horizon_factor.is_none(),
+        key("horizon_factor"),
+        "give `horizon` or `horizon_factor`, not both",
+    )?;
+    ensure(
+        b.fracture_energy.is_none() || b.critical_stretch.is_none(),
+        key("critical_stretch"),
+        "give `fracture_energy` or `critical_stretch`, not both",
+    )?;
+    ensure(
+        !s.dimension.is_axisymmetric(),
+        "dimension",
+        "a peridynamic body is 2D (plane strain or stress) or 3D, not axisymmetric",
+    )?;
+    if s.dimension.spatial() == 3 {
+        forbidden(&b.plane, key("plane"), "a 3D body")?;
+    }
+    ensure(
+        s.horizon(i) >= s.particle_spacing(i),
+        key(if b.horizon.is_some() {
+            "horizon"
+        } else {
+            "horizon_factor"
+        }),
+        format!(
+            "the horizon {:e} is below the particle spacing {:e}: no bonds",
+            s.horizon(i),
+            s.particle_spacing(i)
+        ),
+    )?;
+    material(i, s)?;
+    scene(i, s)
+}
+
+/// Its material: a table of its own with E > 0 and the PMB ν of its space.
+fn material(i: usize, s: &SceneConfig) -> Check {
+    let b = &s.bodies[i];
+    let k = (s.materials.iter())
+        .position(|m| m.name == b.material)
+        .unwrap();
+    let m = &s.materials[k];
+    let e = s.youngs_modulus(i);
+    ensure(
+        e.is_some_and(|e| e > 0.0 && e.is_finite()),
+        format!("material.{k}.youngs_modulus"),
+        format!(
+            "peridynamic body {i} takes E from its material `{}`: give it a positive \
+             youngs_modulus (model = \"linear_elastic\", say)",
+            m.name
+        ),
+    )?;
+    let space = s.peridynamic_space(i);
+    let nu = (m.parameters.get("poisson_ratio")).and_then(|v| v.as_float());
+    let want = space.poisson_ratio();
+    let (name, fraction) = match space {
+        Space::ThreeD => ("3D", "1/4"),
+        Space::PlaneStrain => ("plane strain", "1/4"),
+        Space::PlaneStress => ("plane stress", "1/3"),
+    };
+    let got = nu.map_or("none".to_string(), |nu| nu.to_string());
+    ensure(
+        nu.is_some_and(|nu| (nu - want).abs() <= 1e-4),
+        format!("material.{k}.poisson_ratio"),
+        format!(
+            "the bond-based (PMB) peridynamic body {i} has ν = {fraction} in {name} \
+             (one micromodulus fixes it); got {got}: set poisson_ratio = {want:.6} \
+             (or, in 2D, the other `plane`)"
+        ),
+    )?;
+    let shared = (0..s.bodies.len()).find(|&j| j != i && s.bodies[j].material == b.material);
+    match shared {
+        Some(j) => Err((
+            format!("body.{i}.material"),
+            format!(
+                "material `{}` is also the material of body {j}: a peridynamic body's \
+                 particles carry no stress of their material, so give it a [[material]] \
+                 table of its own",
+                b.material
+            ),
+        )),
+        None => Ok(()),
+    }
+}
+
+/// The scene around it: no other body, explicit stages only.
+fn scene(i: usize, s: &SceneConfig) -> Check {
+    let other =
+        (0..s.bodies.len()).find(|&j| j != i && s.body_kind(j) != BodyKindName::Peridynamic);
+    if let Some(j) = other {
+        return Err((
+            format!("body.{j}.kind"),
+            format!(
+                "a scene with a peridynamic body (body {i}) has peridynamic bodies only: \
+                 their contact with other bodies through the grid is not built yet \
+                 (issue 51)"
+            ),
+        ));
+    }
+    ensure(
+        s.contacts.is_empty(),
+        "contact",
+        "peridynamic bodies meet no contact yet (issue 51)",
+    )?;
+    let implicit = match &s.solver {
+        Some(st) => (st.kind == SolverKind::Implicit).then(|| "solver.kind".to_string()),
+        None => (s
+            .stages
+            .iter()
+            .position(|st| st.kind == SolverKind::Implicit))
+        .map(|k| format!("stage.{k}.kind")),
+    };
+    match implicit {
+        Some(key) => Err((
+            key,
+            format!(
+                "body {i} is peridynamic, which runs on explicit stages only: implicit \
+                 peridynamics is a later slice (issue 51)"
+            ),
+        )),
+        None => Ok(()),
+    }
+}
