@@ -13,6 +13,7 @@
 //! registers it, so a new model is a new file, one line in that list and its keys
 //! in docs/scene.md.
 
+pub mod bond;
 pub(crate) mod deviatoric;
 pub mod driver;
 pub(crate) mod eos;

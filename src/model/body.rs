@@ -102,7 +102,7 @@ pub enum Advance {
     /// (`physics::rigid::newton_euler`).
     NewtonEuler,
     /// By the forces of their bonds, gravity and loads, by central
-    /// differences (`physics::peridynamics::PdBody::advance`).
+    /// differences (`physics::peridynamics::advance`).
     ByBonds,
 }
 

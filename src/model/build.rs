@@ -13,8 +13,8 @@ use crate::model::geometry::Geometry;
 use crate::model::grid::Grid;
 use crate::model::loads::Loads;
 use crate::model::particles::Particles;
+use crate::model::peridynamics::{PdBody, Peridynamics};
 use crate::model::{axisymmetry, Model};
-use crate::physics::peridynamics::{PdBody, Peridynamics};
 use crate::scene::SceneConfig;
 use crate::scene::{
     axis, expr, BodyConfig, BoundaryConfig, Condition, DomainStress, Face, Fill, ParticlesOutside,
@@ -132,7 +132,7 @@ impl<const D: usize> Model<D> {
     }
 }
 
-/// The peridynamic bodies with their bonds (`physics::peridynamics`), built
+/// The peridynamic bodies with their bonds (`model::peridynamics`), built
 /// from the particles' reference positions and volumes; None without one.
 fn peridynamic_bodies<const D: usize>(
     c: &SceneConfig,

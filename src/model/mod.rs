@@ -11,9 +11,10 @@ pub mod grid;
 pub(crate) mod loads;
 pub(crate) mod memory;
 pub mod particles;
+pub mod peridynamics;
 pub(crate) mod tensors;
 
-use crate::physics::peridynamics::Peridynamics;
+use crate::model::peridynamics::Peridynamics;
 pub use loads::{load_factor, LoadTime};
 
 use crate::dim::Vector;
@@ -63,7 +64,7 @@ pub struct Model<const D: usize> {
     /// `[grid] domain_stress = "linear"`: a stress linear within each particle
     /// domain in the implicit internal force (`solver::implicit::stress_gradient`).
     pub linear_domain_stress: bool,
-    /// The peridynamic bodies' bonds (`physics::peridynamics`); None in a
+    /// The peridynamic bodies' bonds (`model::peridynamics`); None in a
     /// scene without one, which then allocates and computes nothing of them.
     pub peridynamics: Option<Peridynamics<D>>,
 }

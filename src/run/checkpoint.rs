@@ -84,7 +84,7 @@ pub struct Checkpoint {
     pub next_checkpoint: f64,
     pub particles: ParticleState,
     /// Per peridynamic body, the ids of its broken bonds, ascending
-    /// (`physics::peridynamics::Peridynamics::broken_bonds`); empty without one.
+    /// (`model::peridynamics::Peridynamics::broken_bonds`); empty without one.
     pub broken_bonds: Vec<Vec<u32>>,
     pub solver: SolverState,
     pub recorders: RecorderState,

@@ -6,10 +6,10 @@
 //! (`validate::grid_bodies`).
 
 use super::{BodyKindName, MaterialConfig, Plane, SceneConfig};
+use crate::material::bond::{pmb::Pmb, Space};
 use crate::material::parameters::FromParameters;
 use crate::material::rigid::{Motion, Rigid};
 use crate::material::Material;
-use crate::physics::peridynamics::pmb::{Pmb, Space};
 
 impl SceneConfig {
     /// The kind of body i: its `kind`, else rigid when its material is an

@@ -165,7 +165,7 @@ pub enum BodyKindName {
 #[serde(rename_all = "snake_case")]
 #[strum(serialize_all = "snake_case")]
 pub enum BondModel {
-    /// Prototype microelastic brittle (`physics::peridynamics::pmb`).
+    /// Prototype microelastic brittle (`material::bond::pmb`).
     #[default]
     Pmb,
 }

@@ -5,7 +5,7 @@
 //! slices of issue 51), and none of these keys on other bodies.
 
 use super::check::{ensure, forbidden, Check};
-use crate::physics::peridynamics::pmb::Space;
+use crate::material::bond::Space;
 use crate::scene::{BodyKindName, SceneConfig, SolverKind};
 
 /// The keys only a peridynamic body takes, refused on body i of another kind.

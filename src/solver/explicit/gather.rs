@@ -74,7 +74,7 @@ impl<const D: usize> NodeMapStep<D> {
     /// kind its work (`model::body::Advance`): continuum bodies moved with the
     /// grid in G2P, and so did a prescribed rigid body (its nodes move at its
     /// velocity); peridynamic bodies advance from the step start by their
-    /// bond forces, gravity and loads (`physics::peridynamics::PdBody::advance`),
+    /// bond forces, gravity and loads (`physics::peridynamics::advance`),
     /// replacing what G2P gave them; free rigid bodies advance by Newton–Euler
     /// under the step's contact impulses and the applied forces
     /// (`physics::rigid::newton_euler`). Then the deformable particles that
@@ -95,7 +95,7 @@ impl<const D: usize> NodeMapStep<D> {
             let (ramp_of, mass, load) = (&m.load_ramp_of, &p.mass, &p.load);
             let applied = |q: usize| s.applied(ramp_of, mass, load, q);
             for b in &mut pd.bodies {
-                b.advance(&mut p.x, &mut p.v, mass, applied, s.dt);
+                crate::physics::peridynamics::advance(b, &mut p.x, &mut p.v, mass, applied, s.dt);
             }
         }
         let Some(c) = &mut self.contact else {

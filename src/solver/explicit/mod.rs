@@ -154,7 +154,7 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
     /// viscosity, also within its stable step at every particle, its rate from
     /// the particle's F rate being unknown here: ε̇_v = 0, the linear term only).
     /// With peridynamic bodies, also within their stable step (Silling–Askari
-    /// with its safety factor, `physics::peridynamics::pmb::SAFETY`).
+    /// with its safety factor, `material::bond::SAFETY`).
     fn dt(&self, m: &Model<D>) -> f64 {
         self.fixed_dt.unwrap_or_else(|| {
             let grid = self.cfl * Self::critical_dt_with(m, self.viscosity.as_ref());
@@ -191,7 +191,7 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
                  peridynamic bodies (Silling–Askari, with safety factor {}): explicit \
                  integration of their bonds is unstable above it",
                 dt / bonds,
-                crate::physics::peridynamics::pmb::SAFETY
+                crate::material::bond::SAFETY
             ));
         }
         let critical = Self::critical_dt_with(m, self.viscosity.as_ref());

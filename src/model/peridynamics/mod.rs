@@ -1,0 +1,150 @@
+//! The peridynamic bodies of a model (issue 51): per body its particles, their
+//! reference volumes, its bonds and its bond law's constants, built once in
+//! the reference configuration; the bonds' broken flags are the state that
+//! evolves (and is checkpointed). Their forces on the particles and the step
+//! that advances them are `physics::peridynamics`; the bond laws are
+//! `material::bond`.
+//!
+//! - `bonds`: the families, built once in the reference configuration by cell
+//!   binning in a deterministic order; each bond stored once for both ends
+//!   (i < j), a CSR list of bond ids per particle; broken flags; damage.
+//!
+//! A scene without a peridynamic body has `Model::peridynamics = None` and
+//! allocates nothing.
+
+pub mod bonds;
+
+use crate::dim::Vector;
+use crate::material::bond::pmb::Pmb;
+use bonds::Bonds;
+
+/// One peridynamic body: its particles, bonds and PMB constants.
+#[derive(Clone, Debug)]
+pub struct PdBody<const D: usize> {
+    /// The body's index among the scene's `[[body]]`.
+    pub body: usize,
+    /// Global indices of its particles, ascending (local index = position here).
+    pub particles: Vec<usize>,
+    /// Reference volumes V_j of its particles (per unit thickness in 2D).
+    pub volume: Vec<f64>,
+    pub bonds: Bonds,
+    pub pmb: Pmb,
+    /// Step start: positions and velocities of its particles (`begin_step`).
+    pub start_x: Vec<Vector<D>>,
+    pub start_v: Vec<Vector<D>>,
+}
+
+impl<const D: usize> PdBody<D> {
+    /// Body `body` made of the particles `particles` (ascending) at reference
+    /// positions `x` with reference volumes `volume`.
+    pub fn new(
+        body: usize,
+        particles: Vec<usize>,
+        x: &[Vector<D>],
+        volume: Vec<f64>,
+        pmb: Pmb,
+    ) -> Self {
+        let bonds = Bonds::build(x, pmb.horizon);
+        PdBody {
+            body,
+            particles,
+            volume,
+            bonds,
+            pmb,
+            start_x: Vec::new(),
+            start_v: Vec::new(),
+        }
+    }
+
+    /// Damage φ_i = 1 − Σ_intact V_j / Σ_all V_j of each of its particles.
+    pub fn damage(&self) -> Vec<f64> {
+        (0..self.particles.len())
+            .map(|i| self.bonds.damage(i, &self.volume))
+            .collect()
+    }
+
+    /// The Silling–Askari stable step min_i √(2ρ_i / Σ_j V_j c/|ξ_ij|) of the
+    /// body, ρ_i = m_i / V_i from the particles' masses `mass` (global).
+    pub fn stable_dt(&self, mass: &[f64]) -> f64 {
+        (0..self.particles.len())
+            .map(|i| {
+                let rho = mass[self.particles[i]] / self.volume[i];
+                let stiffness = self.bonds.gather_scalar(i, |k, j| {
+                    self.volume[j] * self.pmb.micromodulus / self.bonds.length[k]
+                });
+                self.pmb.stable_dt(rho, stiffness)
+            })
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// Keep the step-start positions and velocities of its particles.
+    pub fn begin_step(&mut self, x: &[Vector<D>], v: &[Vector<D>]) {
+        self.start_x = self.particles.iter().map(|&q| x[q]).collect();
+        self.start_v = self.particles.iter().map(|&q| v[q]).collect();
+    }
+}
+
+/// All peridynamic bodies of a model.
+#[derive(Clone, Debug, Default)]
+pub struct Peridynamics<const D: usize> {
+    pub bodies: Vec<PdBody<D>>,
+    /// The stable step of the bodies with all their bonds (`PdBody::stable_dt`,
+    /// the smallest): a broken bond only raises it, so it holds for the run.
+    pub stable_dt: f64,
+}
+
+impl<const D: usize> Peridynamics<D> {
+    /// The bodies, with the particles' masses `mass` for their stable step.
+    pub fn new(bodies: Vec<PdBody<D>>, mass: &[f64]) -> Self {
+        let stable_dt = (bodies.iter())
+            .map(|b| b.stable_dt(mass))
+            .fold(f64::INFINITY, f64::min);
+        Peridynamics { bodies, stable_dt }
+    }
+
+    /// Keep the step-start state of every body (`PdBody::begin_step`).
+    pub fn begin_step(&mut self, x: &[Vector<D>], v: &[Vector<D>]) {
+        self.bodies.iter_mut().for_each(|b| b.begin_step(x, v));
+    }
+
+    /// Per body, the ids of its broken bonds, ascending (checkpoints).
+    pub fn broken_bonds(&self) -> Vec<Vec<u32>> {
+        (self.bodies.iter())
+            .map(|b| {
+                (0..b.bonds.len() as u32)
+                    .filter(|&k| !b.bonds.intact[k as usize])
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// Break the bonds `broken` lists (`broken_bonds` of the same scene).
+    pub fn restore_broken(&mut self, broken: &[Vec<u32>]) -> Result<(), String> {
+        if broken.len() != self.bodies.len() {
+            return Err(format!(
+                "it holds the bonds of {} peridynamic bodies, the scene has {}",
+                broken.len(),
+                self.bodies.len()
+            ));
+        }
+        for (b, ids) in self.bodies.iter_mut().zip(broken) {
+            for &k in ids {
+                let bond = (b.bonds.intact.get_mut(k as usize))
+                    .ok_or_else(|| format!("bond {k} of body {} does not exist", b.body))?;
+                *bond = false;
+            }
+        }
+        Ok(())
+    }
+
+    /// Damage per particle of the model (`n` particles; 0 off the PD bodies).
+    pub fn damage(&self, n: usize) -> Vec<f64> {
+        let mut d = vec![0.0; n];
+        for b in &self.bodies {
+            for (i, phi) in b.damage().into_iter().enumerate() {
+                d[b.particles[i]] = phi;
+            }
+        }
+        d
+    }
+}

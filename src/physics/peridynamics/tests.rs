@@ -1,0 +1,240 @@
+//! Unit checks of the bond forces (issue 51): Σ F = 0, rigid motions, a bond
+//! breaking, the crack energy, the interior energy and a plate in tension.
+
+use super::*;
+use crate::material::bond::{pmb::Pmb, Space};
+use crate::model::peridynamics::PdBody;
+
+const E: f64 = 70e9;
+
+/// A lattice of n^D points of spacing dx, each moved by `perturb` × dx
+/// times a deterministic pseudo-random number in [−1, 1).
+fn lattice<const D: usize>(n: usize, dx: f64, perturb: f64) -> Vec<Vector<D>> {
+    let mut seed = 12345u64;
+    let mut rand = move || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    };
+    (0..n.pow(D as u32))
+        .map(|q| {
+            Vector::<D>::from_fn(|d, _| {
+                ((q / n.pow(d as u32)) % n) as f64 * dx + perturb * dx * rand()
+            })
+        })
+        .collect()
+}
+
+fn body<const D: usize>(x: &[Vector<D>], dx: f64, space: Space) -> PdBody<D> {
+    let v = vec![dx.powi(D as i32); x.len()];
+    PdBody::new(
+        0,
+        (0..x.len()).collect(),
+        x,
+        v,
+        Pmb::new(space, E, 3.0 * dx),
+    )
+}
+
+fn max_norm<const D: usize>(f: &[Vector<D>]) -> f64 {
+    f.iter().map(|v| v.norm()).fold(0.0, f64::max)
+}
+
+fn sum_of_forces_vanishes<const D: usize>(space: Space) {
+    let dx = 1e-3;
+    let x = lattice::<D>(if D == 2 { 20 } else { 8 }, dx, 0.2);
+    let mut b = body(&x, dx, space);
+    // A deformed state: each point moved by up to 1 % of dx at random.
+    let n = if D == 2 { 20 } else { 8 };
+    let jitter = lattice::<D>(n, dx, 0.01);
+    let y: Vec<Vector<D>> = (x.iter().zip(&jitter))
+        .map(|(p, l)| p + (l - lattice_point::<D>(l, dx)))
+        .collect();
+    let f = bond_forces(&mut b, &y);
+    let total: Vector<D> = f.iter().sum();
+    let scale: f64 = f.iter().map(|v| v.norm()).sum();
+    println!(
+        "{space:?}: |Σ F| = {:.3e}, Σ |F| = {scale:.3e}",
+        total.norm()
+    );
+    assert!(scale > 0.0);
+    assert!(total.norm() <= 1e-13 * scale, "{} vs {scale}", total.norm());
+}
+
+/// The lattice point nearest l.
+fn lattice_point<const D: usize>(l: &Vector<D>, dx: f64) -> Vector<D> {
+    l.map(|c| (c / dx).round() * dx)
+}
+
+#[test]
+fn the_bond_forces_sum_to_zero_on_a_perturbed_lattice() {
+    sum_of_forces_vanishes::<2>(Space::PlaneStress);
+    sum_of_forces_vanishes::<3>(Space::ThreeD);
+}
+
+fn rotation<const D: usize>(angle: f64) -> crate::dim::Tensor<D> {
+    let (c, s) = (angle.cos(), angle.sin());
+    let mut r = crate::dim::Tensor::<D>::identity();
+    (r[(0, 0)], r[(0, 1)], r[(1, 0)], r[(1, 1)]) = (c, -s, s, c);
+    r
+}
+
+fn rigid_motion_gives_no_force<const D: usize>(space: Space) {
+    let dx = 1e-3;
+    let x = lattice::<D>(if D == 2 { 15 } else { 7 }, dx, 0.2);
+    let mut b = body(&x, dx, space);
+    // The force scale: the same lattice stretched by 1e-3.
+    let stretched: Vec<Vector<D>> = x.iter().map(|p| p * 1.001).collect();
+    let scale = max_norm(&bond_forces(&mut b, &stretched));
+    let shift = Vector::<D>::from_element(0.37);
+    let r = rotation::<D>(30f64.to_radians());
+    let moved: Vec<Vector<D>> = x.iter().map(|p| r * p + shift).collect();
+    let translated: Vec<Vector<D>> = x.iter().map(|p| p + shift).collect();
+    let (ft, fr) = (
+        max_norm(&bond_forces(&mut b, &translated)),
+        max_norm(&bond_forces(&mut b, &moved)),
+    );
+    println!(
+        "{space:?}: max |F| translated {ft:.2e}, rotated 30° {fr:.2e}, at s = 1e-3 {scale:.2e}"
+    );
+    assert!(ft <= 1e-9 * scale && fr <= 1e-9 * scale);
+}
+
+#[test]
+fn a_rigid_translation_and_a_30_degree_rotation_give_no_force() {
+    rigid_motion_gives_no_force::<2>(Space::PlaneStress);
+    rigid_motion_gives_no_force::<3>(Space::ThreeD);
+}
+
+#[test]
+fn a_single_bond_breaks_past_s0_and_never_heals() {
+    let dx = 1e-3;
+    let x = vec![Vector::<2>::zeros(), Vector::<2>::new(dx, 0.0)];
+    let s0 = 1e-3;
+    let pmb = Pmb::new(Space::PlaneStress, E, 1.5 * dx).with_critical_stretch(s0);
+    let mut b = PdBody::new(0, vec![0, 1], &x, vec![dx * dx; 2], pmb);
+    assert_eq!(b.bonds.len(), 1);
+    let at = |s: f64| vec![x[0], Vector::<2>::new(dx * (1.0 + s), 0.0)];
+    let f = bond_forces(&mut b, &at(0.999 * s0));
+    let expected = pmb.micromodulus * 0.999 * s0 * dx.powi(4);
+    assert!((f[0][0] - expected).abs() <= 1e-9 * expected && f[1][0] == -f[0][0]);
+    assert!(b.bonds.intact[0]);
+    bond_forces(&mut b, &at(1.001 * s0));
+    assert!(!b.bonds.intact[0]);
+    assert_eq!(b.damage(), vec![1.0, 1.0]);
+    for s in [0.5 * s0, 0.0, -0.01] {
+        let f = bond_forces(&mut b, &at(s));
+        assert!(!b.bonds.intact[0] && f[0] == Vector::<2>::zeros() && f[1] == Vector::<2>::zeros());
+    }
+}
+
+/// The energy of the bonds cut by a straight crack (the line x = x_c
+/// between two lattice columns), per unit crack length, against G0: the
+/// lattice's quadrature of the G0 integral (no partial volumes, m = 3).
+#[test]
+fn the_bonds_cut_by_a_straight_crack_hold_g0_per_unit_area() {
+    let (dx, g0) = (1e-3, 100.0);
+    let n = 30;
+    let x = lattice::<2>(n, dx, 0.0);
+    let space = Space::PlaneStress;
+    let b = body(&x, dx, space);
+    let p = b.pmb.with_fracture_energy(space, E, g0);
+    let xc = 14.5 * dx;
+    let (y0, y1) = (10.0 * dx, 20.0 * dx);
+    let energy: f64 = (0..b.bonds.len())
+        .filter(|&k| {
+            let [i, j] = b.bonds.ends[k].map(|e| x[e as usize]);
+            let mid = 0.5 * (i[1] + j[1]);
+            (i[0] - xc) * (j[0] - xc) < 0.0 && mid >= y0 && mid < y1
+        })
+        .map(|k| p.bond_energy(p.critical_stretch, b.bonds.length[k]) * dx.powi(4))
+        .sum();
+    let ratio = energy / (y1 - y0) / g0;
+    println!("cut-bond energy / (G0 × length) = {ratio:.4}");
+    assert!((ratio - 1.0).abs() < 0.06, "{ratio}");
+}
+
+/// The strain energy density of an interior particle under a homogeneous
+/// uniaxial-stress strain (ε, −νε) against ½Eε² (plane stress), and under
+/// an isotropic strain against 9Kε²/2 (3D): the lattice calibration error
+/// of m = 3 without partial volumes.
+#[test]
+fn interior_strain_energy_matches_the_classical_one_to_the_lattice_error() {
+    let (dx, eps) = (1e-3, 1e-4);
+    let x = lattice::<2>(13, dx, 0.0);
+    let b = body(&x, dx, Space::PlaneStress);
+    let y: Vec<Vector<2>> = x
+        .iter()
+        .map(|p| Vector::<2>::new(p[0] * (1.0 + eps), p[1] * (1.0 - eps / 3.0)))
+        .collect();
+    let w = interior_energy(&b, &y, 6 * 13 + 6, dx * dx);
+    let ratio_2d = w / (0.5 * E * eps * eps);
+    let x3 = lattice::<3>(9, dx, 0.0);
+    let b3 = body(&x3, dx, Space::ThreeD);
+    let y3: Vec<Vector<3>> = x3.iter().map(|p| p * (1.0 + eps)).collect();
+    let w3 = interior_energy(&b3, &y3, 4 * 81 + 4 * 9 + 4, dx.powi(3));
+    let ratio_3d = w3 / (4.5 * (2.0 * E / 3.0) * eps * eps);
+    println!("interior W_PD / W: plane stress {ratio_2d:.4}, 3D {ratio_3d:.4}");
+    assert!((ratio_2d - 1.0).abs() < 0.15 && (ratio_3d - 1.0).abs() < 0.15);
+}
+
+/// W_i = ½ Σ_j (c s² |ξ|/2) V_j.
+fn interior_energy<const D: usize>(b: &PdBody<D>, y: &[Vector<D>], i: usize, v: f64) -> f64 {
+    0.5 * b.bonds.gather_scalar(i, |k, _| {
+        b.pmb.bond_energy(b.bonds.stretch(k, y), b.bonds.length[k]) * v
+    })
+}
+
+/// Homogeneous uniaxial tension of a plane-stress plate 40Δx × 20Δx
+/// (m = 3, no surface or partial-volume correction): equal and opposite
+/// forces σW on its end columns, the static state found by dynamic
+/// relaxation (viscous damping), the strain between the columns at L/4
+/// and 3L/4, averaged over the plate's width, against σ/E.
+#[test]
+fn a_plane_stress_plate_in_tension_stretches_by_sigma_over_e_to_the_surface_error() {
+    let (nx, ny, dx, e, sigma) = (40usize, 20usize, 1e-3, 70e9, 7e6);
+    let x: Vec<Vector<2>> = (0..nx * ny)
+        .map(|q| Vector::<2>::new((q % nx) as f64 * dx, (q / nx) as f64 * dx))
+        .collect();
+    let v0 = dx * dx;
+    let pmb = Pmb::new(Space::PlaneStress, e, 3.0 * dx);
+    let mut b = PdBody::new(0, (0..x.len()).collect(), &x, vec![v0; x.len()], pmb);
+    let per = sigma * (ny as f64 * dx) / ny as f64;
+    let load = |q: usize| match q % nx {
+        0 => Vector::<2>::new(-per, 0.0),
+        c if c == nx - 1 => Vector::<2>::new(per, 0.0),
+        _ => Vector::zeros(),
+    };
+    let mass = vec![v0; x.len()]; // ρ = 1: a fictitious density
+    let dt = b.stable_dt(&mass);
+    let omega = std::f64::consts::PI / (nx as f64 * dx) * (e / 1.0f64).sqrt();
+    let damping = 2.0 * omega * dt;
+    let (mut y, mut v) = (x.clone(), vec![Vector::<2>::zeros(); x.len()]);
+    let mut residual = f64::INFINITY;
+    for _ in 0..40_000 {
+        let f = bond_forces(&mut b, &y);
+        residual = 0.0;
+        for q in 0..y.len() {
+            let total = f[q] + load(q);
+            residual = f64::max(residual, total.norm() / per);
+            v[q] = v[q] * (1.0 - damping) + total * (dt / mass[q]);
+            y[q] += v[q] * dt;
+        }
+        if residual < 1e-6 {
+            break;
+        }
+    }
+    let mean_u = |c: usize| {
+        (0..ny)
+            .map(|r| y[r * nx + c][0] - x[r * nx + c][0])
+            .sum::<f64>()
+            / ny as f64
+    };
+    let (c1, c2) = (nx / 4, 3 * nx / 4);
+    let strain = (mean_u(c2) - mean_u(c1)) / ((c2 - c1) as f64 * dx);
+    let error = strain / (sigma / e) - 1.0;
+    println!("residual {residual:.1e}; strain/(σ/E) − 1 = {error:+.4}");
+    assert!(residual < 1e-6, "not converged: {residual:e}");
+    assert!(error.abs() < 0.08, "{error}");
+}
