@@ -61,6 +61,26 @@ pub fn compose(a: &Mat3, b: &Mat3) -> Mat3 {
     )
 }
 
+/// The rotation Q of the polar decomposition A = Q S (in 2D the in-plane
+/// rotation of the upper-left block, closed form; in 3D from the SVD,
+/// A = U Σ Vᵀ, Q = U Vᵀ with det Q = +1).
+pub fn polar_rotation<const D: usize>(a: &Mat3) -> Mat3 {
+    if D == 2 {
+        let theta = (a[(1, 0)] - a[(0, 1)]).atan2(a[(0, 0)] + a[(1, 1)]);
+        let (s, c) = theta.sin_cos();
+        return Mat3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0);
+    }
+    let svd = a.svd(true, true);
+    let (Some(mut u), Some(v_t)) = (svd.u, svd.v_t) else {
+        return Mat3::identity();
+    };
+    if (u * v_t).determinant() < 0.0 {
+        let last = u.column(2) * -1.0;
+        u.set_column(2, &last);
+    }
+    u * v_t
+}
+
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;

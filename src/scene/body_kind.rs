@@ -5,8 +5,9 @@
 //! bodies' kinds from these (`model::body`); the validation checks the keys
 //! (`validate::grid_bodies`).
 
+use super::BondModel;
 use super::{BodyKindName, MaterialConfig, Plane, SceneConfig};
-use crate::material::bond::{pmb::Pmb, Space};
+use crate::material::bond::{beam::Beam, pmb::Pmb, BondLaw, Space};
 use crate::material::parameters::FromParameters;
 use crate::material::rigid::{Motion, Rigid};
 use crate::material::Material;
@@ -104,24 +105,48 @@ impl SceneConfig {
 
     /// The Young's modulus of body i's material (`youngs_modulus`), if it has one.
     pub fn youngs_modulus(&self, i: usize) -> Option<f64> {
+        self.material_number(i, "youngs_modulus")
+    }
+
+    /// The number `key` of body i's material table, if it has one.
+    fn material_number(&self, i: usize, key: &str) -> Option<f64> {
         let m = self
             .materials
             .iter()
             .find(|m| m.name == self.bodies[i].material)?;
         m.parameters
-            .get("youngs_modulus")
+            .get(key)
             .and_then(|v| v.as_float().or(v.as_integer().map(|n| n as f64)))
     }
 
-    /// The PMB constants of peridynamic body i of a validated scene.
-    pub fn peridynamic(&self, i: usize) -> Pmb {
+    /// The bond law of peridynamic body i of a validated scene: its
+    /// `bond_model` with its material's E (and ν, beam), its horizon and its
+    /// critical stretch (`fracture_energy` or `critical_stretch`).
+    pub fn peridynamic(&self, i: usize) -> BondLaw {
         let (b, space) = (&self.bodies[i], self.peridynamic_space(i));
-        let e = self.youngs_modulus(i).unwrap();
-        let pmb = Pmb::new(space, e, self.horizon(i));
-        match (b.fracture_energy, b.critical_stretch) {
-            (Some(g0), _) => pmb.with_fracture_energy(space, e, g0),
-            (_, Some(s0)) => pmb.with_critical_stretch(s0),
-            _ => pmb,
+        let (e, delta) = (self.youngs_modulus(i).unwrap(), self.horizon(i));
+        match b.bond_model.unwrap_or_default() {
+            BondModel::Pmb => {
+                let pmb = Pmb::new(space, e, delta);
+                BondLaw::Pmb(match (b.fracture_energy, b.critical_stretch) {
+                    (Some(g0), _) => pmb.with_fracture_energy(space, g0),
+                    (_, Some(s0)) => pmb.with_critical_stretch(s0),
+                    _ => pmb,
+                })
+            }
+            BondModel::Beam => {
+                let beam = Beam::new(space, e, self.poisson_ratio(i).unwrap(), delta);
+                BondLaw::Beam(match (b.fracture_energy, b.critical_stretch) {
+                    (Some(g0), _) => beam.with_fracture_energy(space, g0),
+                    (_, Some(s0)) => beam.with_critical_stretch(s0),
+                    _ => beam,
+                })
+            }
         }
+    }
+
+    /// The Poisson ratio of body i's material (`poisson_ratio`), if it has one.
+    pub fn poisson_ratio(&self, i: usize) -> Option<f64> {
+        self.material_number(i, "poisson_ratio")
     }
 }

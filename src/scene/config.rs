@@ -168,6 +168,8 @@ pub enum BondModel {
     /// Prototype microelastic brittle (`material::bond::pmb`).
     #[default]
     Pmb,
+    /// Beam-based: axial and tangential micromoduli (`material::bond::beam`).
+    Beam,
 }
 
 /// The 2D idealisation of a peridynamic body (`plane`).

@@ -1,9 +1,10 @@
-//! Bond-based (PMB) peridynamic bodies in explicit runs (issue 51, first
-//! slice; `physics::peridynamics`): the elastic bar wave speed against
-//! c0 = √(E/ρ), the shipped notched plate cracking from its notch, and the
-//! scene keys' errors. The exact unit checks (Σ F = 0, rigid motions, a single
-//! bond breaking, cut-bond energy against G0, interior energy against the
-//! classical one) are next to the code (`physics::peridynamics::pmb`).
+//! Peridynamic bodies (PMB and beam bonds) in explicit runs (issue 51;
+//! `physics::peridynamics`): the elastic bar wave speed against c0 = √(E/ρ),
+//! the shipped notched plate cracking from its notch, and the scene keys'
+//! errors. The exact unit checks (Σ F = 0, rigid motions, a single bond
+//! breaking, cut-bond energy against G0, interior energy against the
+//! classical one, the beam bond's constants and Poisson ratio, the non-local
+//! F) are next to the code (`material::bond`, `physics::peridynamics`).
 
 use crate::common::{assert_within, rejected_at, run_problem, run_text, Table};
 use mpm::scene::Scene;
@@ -80,6 +81,28 @@ fn the_bar_wave_speed_is_the_elastic_one_to_the_surface_error() {
     assert!(p.col("damage").iter().all(|&d| d == 0.0));
 }
 
+/// The beam bond (`bond_model = "beam"`) in the same bar, at ν = 0 and
+/// ν = 0.2: a thin bar's wave speed is √(E/ρ) whatever ν, so the tangential
+/// micromodulus the lower ν adds must leave it there (to the surface error).
+#[test]
+fn the_beam_bond_bar_wave_speed_is_the_elastic_one_at_any_poisson_ratio() {
+    let c0 = (70e9f64 / 2700.0).sqrt();
+    let (length, width) = (0.1, 0.01);
+    for nu in ["0.0", "0.2"] {
+        let scene = bar(length, width)
+            .replace("poisson_ratio = 0.333333", &format!("poisson_ratio = {nu}"))
+            .replace(
+                "plane = \"stress\"",
+                "plane = \"stress\"\nbond_model = \"beam\"",
+            );
+        let (summary, dir) = run_text(&scene, &[]);
+        summary.expect("the bar runs");
+        let h = Table::read(&dir.path().join("history.csv")).unwrap();
+        let c = length / (2.0 * first_minimum(h.col("t"), h.col("kinetic")));
+        assert_within(&format!("beam ν = {nu}: c/c0 − 1"), c / c0 - 1.0, 0.03);
+    }
+}
+
 #[test]
 fn the_notched_plate_cracks_from_its_notch() {
     let (summary, dir) = run_problem("peridynamic_plate.toml", &[]);
@@ -137,6 +160,28 @@ fn the_scene_keys_of_a_peridynamic_body_are_checked_by_key() {
         &with("plane = \"stress\"", ""),
         "material.0.poisson_ratio",
         &["1/3", "0.333333", "plane stress"],
+    );
+    // The beam bond takes ν in (−1, 1/4] in plane strain, (−1, 1/3] in plane stress.
+    let beam = |nu: &str, extra: &str| {
+        with(&format!("bond_model = \"beam\"\n{extra}"), "")
+            .replace("poisson_ratio = 0.25", &format!("poisson_ratio = {nu}"))
+    };
+    Scene::parse("scene.toml", &beam("-0.5", ""), &[]).expect("beam, ν = −0.5");
+    Scene::parse("scene.toml", &beam("0.3", "plane = \"stress\""), &[]).expect("beam, ν = 0.3");
+    rejected_at(
+        &beam("0.3", ""),
+        "material.0.poisson_ratio",
+        &["(−1, 1/4]", "plane strain", "0.3"],
+    );
+    rejected_at(
+        &beam("0.4", "plane = \"stress\""),
+        "material.0.poisson_ratio",
+        &["(−1, 1/3]"],
+    );
+    rejected_at(
+        &with("", "").replace("poisson_ratio = 0.25", "poisson_ratio = 0.3"),
+        "material.0.poisson_ratio",
+        &["bond_model = \"beam\""],
     );
     rejected_at(&with("horizon = -1.0", ""), "body.0.horizon", &["positive"]);
     rejected_at(

@@ -5,28 +5,54 @@
 //! pairs, intact or broken) are the model's state (`model::peridynamics`) and
 //! their forces on the particles are summed by `physics::peridynamics`.
 //!
-//! - `pmb`: bond-based prototype microelastic brittle (one micromodulus).
+//! - `pmb`: bond-based prototype microelastic brittle (one micromodulus, one ν);
+//! - `beam`: beam-based, an axial and a tangential micromodulus (any ν up to
+//!   PMB's).
 
+pub mod beam;
 pub mod pmb;
+mod space;
 
-/// The space a peridynamic body is in.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Space {
-    ThreeD,
-    PlaneStress,
-    PlaneStrain,
+pub use space::{critical_stretch, Space, SAFETY};
+
+use beam::Beam;
+use pmb::Pmb;
+
+/// The bond law of a peridynamic body.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BondLaw {
+    Pmb(Pmb),
+    Beam(Beam),
 }
 
-impl Space {
-    /// The one Poisson ratio of the PMB bond in this space.
-    pub fn poisson_ratio(self) -> f64 {
+impl BondLaw {
+    pub fn horizon(&self) -> f64 {
         match self {
-            Space::ThreeD | Space::PlaneStrain => 0.25,
-            Space::PlaneStress => 1.0 / 3.0,
+            BondLaw::Pmb(p) => p.horizon,
+            BondLaw::Beam(b) => b.horizon,
         }
     }
-}
 
-/// Safety factor on the Silling–Askari step (0.7–0.85 in Peridynamics.jl and
-/// CabanaPD, survey §2.3).
-pub const SAFETY: f64 = 0.8;
+    /// Critical stretch s0 (infinite: no fracture).
+    pub fn critical_stretch(&self) -> f64 {
+        match self {
+            BondLaw::Pmb(p) => p.critical_stretch,
+            BondLaw::Beam(b) => b.critical_stretch,
+        }
+    }
+
+    /// The bond's spring constant times |ξ| for the Silling–Askari step: c
+    /// (PMB), max(c1, c2) (beam).
+    pub fn stiffness(&self) -> f64 {
+        match self {
+            BondLaw::Pmb(p) => p.micromodulus,
+            BondLaw::Beam(b) => b.stiffness(),
+        }
+    }
+
+    /// SAFETY × √(2ρ / Σ_j V_j c/|ξ|) (Silling & Askari 2005, eq. 29), given
+    /// `stiffness` = Σ_j V_j c/|ξ| over the particle's bonds.
+    pub fn stable_dt(rho: f64, stiffness: f64) -> f64 {
+        SAFETY * (2.0 * rho / stiffness).sqrt()
+    }
+}

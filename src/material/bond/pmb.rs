@@ -23,7 +23,7 @@
 //! which with the c of each plane gives the 2D forms (survey §2.2, derived
 //! there and again here).
 
-use super::{Space, SAFETY};
+use super::space::{critical_stretch, Space};
 use crate::dim::Vector;
 use std::f64::consts::PI;
 
@@ -54,15 +54,10 @@ impl Pmb {
         }
     }
 
-    /// With the critical stretch of fracture energy G0 (module table).
-    pub fn with_fracture_energy(self, space: Space, e: f64, g0: f64) -> Pmb {
-        let d = self.horizon;
-        let s0 = match space {
-            Space::ThreeD => (5.0 * g0 / (9.0 * bulk_modulus(e) * d)).sqrt(),
-            Space::PlaneStress => (4.0 * PI * g0 / (9.0 * e * d)).sqrt(),
-            Space::PlaneStrain => (5.0 * PI * g0 / (12.0 * e * d)).sqrt(),
-        };
-        self.with_critical_stretch(s0)
+    /// With the critical stretch of fracture energy G0 (module table;
+    /// `super::critical_stretch`).
+    pub fn with_fracture_energy(self, space: Space, g0: f64) -> Pmb {
+        self.with_critical_stretch(critical_stretch(space, self.micromodulus, self.horizon, g0))
     }
 
     pub fn with_critical_stretch(self, s0: f64) -> Pmb {
@@ -91,12 +86,6 @@ impl Pmb {
     pub fn bond_energy(&self, s: f64, length: f64) -> f64 {
         0.5 * self.micromodulus * s * s * length
     }
-
-    /// SAFETY × √(2ρ / Σ_j V_j c/|ξ|) (Silling & Askari 2005, eq. 29), given
-    /// `stiffness` = Σ_j V_j c/|ξ| over the particle's bonds.
-    pub fn stable_dt(&self, rho: f64, stiffness: f64) -> f64 {
-        SAFETY * (2.0 * rho / stiffness).sqrt()
-    }
 }
 
 /// K = E/(3(1 − 2ν)) at the PMB ν = 1/4.
@@ -115,13 +104,26 @@ mod tests {
         let (g0, d) = (20e3, 3e-3);
         // G0 = c h s0² δ⁴/4 (2D, h = 1) and π c s0² δ⁵/10 (3D).
         for space in [Space::PlaneStress, Space::PlaneStrain] {
-            let p = Pmb::new(space, E, d).with_fracture_energy(space, E, g0);
+            let p = Pmb::new(space, E, d).with_fracture_energy(space, g0);
             let g = p.micromodulus * p.critical_stretch.powi(2) * d.powi(4) / 4.0;
             assert!((g / g0 - 1.0).abs() < 1e-12, "{space:?}");
         }
-        let p = Pmb::new(Space::ThreeD, E, d).with_fracture_energy(Space::ThreeD, E, g0);
+        let p = Pmb::new(Space::ThreeD, E, d).with_fracture_energy(Space::ThreeD, g0);
         let g = PI * p.micromodulus * p.critical_stretch.powi(2) * d.powi(5) / 10.0;
         assert!((g / g0 - 1.0).abs() < 1e-12);
+        // The closed forms of the module table.
+        let table = [
+            (Space::PlaneStress, (4.0 * PI * g0 / (9.0 * E * d)).sqrt()),
+            (Space::PlaneStrain, (5.0 * PI * g0 / (12.0 * E * d)).sqrt()),
+            (
+                Space::ThreeD,
+                (5.0 * g0 / (9.0 * bulk_modulus(E) * d)).sqrt(),
+            ),
+        ];
+        for (space, s0) in table {
+            let p = Pmb::new(space, E, d).with_fracture_energy(space, g0);
+            assert!((p.critical_stretch / s0 - 1.0).abs() < 1e-14, "{space:?}");
+        }
         // 3D: 18K/(πδ⁴) = 12E/(πδ⁴) at ν = 1/4.
         let c = Pmb::new(Space::ThreeD, E, d).micromodulus;
         assert!((c / (12.0 * E / (PI * d.powi(4))) - 1.0).abs() < 1e-14);

@@ -94,6 +94,16 @@ impl Bonds {
         sum
     }
 
+    /// f(k, j) for each of particle i's intact bonds k (other end j), in CSR order.
+    pub fn each_intact(&self, i: usize, mut f: impl FnMut(usize, usize)) {
+        for e in self.offset[i] as usize..self.offset[i + 1] as usize {
+            let k = self.entry[e] as usize;
+            if self.intact[k] {
+                f(k, self.other[e] as usize);
+            }
+        }
+    }
+
     /// As `gather`, of a scalar.
     pub fn gather_scalar(&self, i: usize, f: impl Fn(usize, usize) -> f64) -> f64 {
         let mut sum = 0.0;

@@ -15,10 +15,10 @@
 pub mod bonds;
 
 use crate::dim::Vector;
-use crate::material::bond::pmb::Pmb;
+use crate::material::bond::BondLaw;
 use bonds::Bonds;
 
-/// One peridynamic body: its particles, bonds and PMB constants.
+/// One peridynamic body: its particles, bonds and bond law.
 #[derive(Clone, Debug)]
 pub struct PdBody<const D: usize> {
     /// The body's index among the scene's `[[body]]`.
@@ -27,8 +27,10 @@ pub struct PdBody<const D: usize> {
     pub particles: Vec<usize>,
     /// Reference volumes V_j of its particles (per unit thickness in 2D).
     pub volume: Vec<f64>,
+    /// Reference positions of its particles (the bonds' ξ).
+    pub reference: Vec<Vector<D>>,
     pub bonds: Bonds,
-    pub pmb: Pmb,
+    pub law: BondLaw,
     /// Step start: positions and velocities of its particles (`begin_step`).
     pub start_x: Vec<Vector<D>>,
     pub start_v: Vec<Vector<D>>,
@@ -42,15 +44,16 @@ impl<const D: usize> PdBody<D> {
         particles: Vec<usize>,
         x: &[Vector<D>],
         volume: Vec<f64>,
-        pmb: Pmb,
+        law: BondLaw,
     ) -> Self {
-        let bonds = Bonds::build(x, pmb.horizon);
+        let bonds = Bonds::build(x, law.horizon());
         PdBody {
             body,
             particles,
             volume,
+            reference: x.to_vec(),
             bonds,
-            pmb,
+            law,
             start_x: Vec::new(),
             start_v: Vec::new(),
         }
@@ -63,16 +66,17 @@ impl<const D: usize> PdBody<D> {
             .collect()
     }
 
-    /// The Silling–Askari stable step min_i √(2ρ_i / Σ_j V_j c/|ξ_ij|) of the
+    /// The Silling–Askari stable step min_i √(2ρ_i / Σ_j V_j c/|ξ_ij|) (c the
+    /// law's `stiffness`) of the
     /// body, ρ_i = m_i / V_i from the particles' masses `mass` (global).
     pub fn stable_dt(&self, mass: &[f64]) -> f64 {
         (0..self.particles.len())
             .map(|i| {
                 let rho = mass[self.particles[i]] / self.volume[i];
                 let stiffness = self.bonds.gather_scalar(i, |k, j| {
-                    self.volume[j] * self.pmb.micromodulus / self.bonds.length[k]
+                    self.volume[j] * self.law.stiffness() / self.bonds.length[k]
                 });
-                self.pmb.stable_dt(rho, stiffness)
+                BondLaw::stable_dt(rho, stiffness)
             })
             .fold(f64::INFINITY, f64::min)
     }

@@ -4,25 +4,35 @@
 //! order of `model::peridynamics::bonds` (so the sums do not depend on the
 //! threads), after breaking the bonds stretched past s0.
 
+pub mod deformation;
+
 use crate::dim::Vector;
+use crate::material::bond::BondLaw;
 use crate::model::peridynamics::PdBody;
 use crate::parallel::MIN_PARALLEL_LEN;
 use rayon::prelude::*;
 
-/// The bond force on each particle of body `b` (V_i Σ_j f_ij V_j, `Pmb::pair_force`)
-/// at positions `y` (its local order), after breaking the bonds stretched past s0.
+/// The bond force on each particle of body `b` (V_i Σ_j f_ij V_j, its law's
+/// `pair_force`) at positions `y` (its local order), after breaking the bonds
+/// stretched past s0. The beam law first finds each particle's rotation
+/// (`deformation::rotations`, over the bonds left intact).
 pub fn bond_forces<const D: usize>(b: &mut PdBody<D>, y: &[Vector<D>]) -> Vec<Vector<D>> {
-    b.bonds.break_stretched(y, b.pmb.critical_stretch);
-    let (bonds, pmb, v) = (&b.bonds, &b.pmb, &b.volume);
-    (0..y.len())
-        .into_par_iter()
-        .with_min_len(MIN_PARALLEL_LEN)
-        .map(|i| {
-            bonds.gather(i, |k, j| {
-                pmb.pair_force(&y[i], &y[j], bonds.length[k]) * (v[i] * v[j])
-            })
-        })
-        .collect()
+    b.bonds.break_stretched(y, b.law.critical_stretch());
+    let (bonds, v, x) = (&b.bonds, &b.volume, &b.reference);
+    let sum = |force: &(dyn Fn(usize, usize, usize) -> Vector<D> + Sync)| -> Vec<Vector<D>> {
+        (0..y.len())
+            .into_par_iter()
+            .with_min_len(MIN_PARALLEL_LEN)
+            .map(|i| bonds.gather(i, |k, j| force(i, j, k) * (v[i] * v[j])))
+            .collect()
+    };
+    match &b.law {
+        BondLaw::Pmb(pmb) => sum(&|i, j, k| pmb.pair_force(&y[i], &y[j], bonds.length[k])),
+        BondLaw::Beam(beam) => {
+            let r = deformation::rotations(b, y);
+            sum(&|i, j, _| beam.pair_force(&y[i], &y[j], &(x[j] - x[i]), &r[i], &r[j]))
+        }
+    }
 }
 
 /// Advance body `b`'s particles over Δt from the step start (`PdBody::begin_step`)

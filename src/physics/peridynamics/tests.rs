@@ -2,7 +2,8 @@
 //! breaking, the crack energy, the interior energy and a plate in tension.
 
 use super::*;
-use crate::material::bond::{pmb::Pmb, Space};
+use crate::dim::Tensor;
+use crate::material::bond::{beam::Beam, pmb::Pmb, BondLaw, Space};
 use crate::model::peridynamics::PdBody;
 
 const E: f64 = 70e9;
@@ -33,8 +34,15 @@ fn body<const D: usize>(x: &[Vector<D>], dx: f64, space: Space) -> PdBody<D> {
         (0..x.len()).collect(),
         x,
         v,
-        Pmb::new(space, E, 3.0 * dx),
+        BondLaw::Pmb(Pmb::new(space, E, 3.0 * dx)),
     )
+}
+
+fn pmb_of<const D: usize>(b: &PdBody<D>) -> Pmb {
+    match b.law {
+        BondLaw::Pmb(p) => p,
+        _ => unreachable!("a PMB body"),
+    }
 }
 
 fn max_norm<const D: usize>(f: &[Vector<D>]) -> f64 {
@@ -73,11 +81,14 @@ fn the_bond_forces_sum_to_zero_on_a_perturbed_lattice() {
     sum_of_forces_vanishes::<3>(Space::ThreeD);
 }
 
-fn rotation<const D: usize>(angle: f64) -> crate::dim::Tensor<D> {
-    let (c, s) = (angle.cos(), angle.sin());
-    let mut r = crate::dim::Tensor::<D>::identity();
-    (r[(0, 0)], r[(0, 1)], r[(1, 0)], r[(1, 1)]) = (c, -s, s, c);
-    r
+/// A rotation by `angle`: in-plane (2D), about the axis (1, 2, 3) (3D).
+fn rotation<const D: usize>(angle: f64) -> Tensor<D> {
+    let axis = nalgebra::Unit::new_normalize(nalgebra::Vector3::new(1.0, 2.0, 3.0));
+    let r3 = match D {
+        2 => *nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::z_axis(), angle).matrix(),
+        _ => *nalgebra::Rotation3::from_axis_angle(&axis, angle).matrix(),
+    };
+    crate::dim::restrict::<D>(&r3)
 }
 
 fn rigid_motion_gives_no_force<const D: usize>(space: Space) {
@@ -113,7 +124,7 @@ fn a_single_bond_breaks_past_s0_and_never_heals() {
     let x = vec![Vector::<2>::zeros(), Vector::<2>::new(dx, 0.0)];
     let s0 = 1e-3;
     let pmb = Pmb::new(Space::PlaneStress, E, 1.5 * dx).with_critical_stretch(s0);
-    let mut b = PdBody::new(0, vec![0, 1], &x, vec![dx * dx; 2], pmb);
+    let mut b = PdBody::new(0, vec![0, 1], &x, vec![dx * dx; 2], BondLaw::Pmb(pmb));
     assert_eq!(b.bonds.len(), 1);
     let at = |s: f64| vec![x[0], Vector::<2>::new(dx * (1.0 + s), 0.0)];
     let f = bond_forces(&mut b, &at(0.999 * s0));
@@ -139,7 +150,7 @@ fn the_bonds_cut_by_a_straight_crack_hold_g0_per_unit_area() {
     let x = lattice::<2>(n, dx, 0.0);
     let space = Space::PlaneStress;
     let b = body(&x, dx, space);
-    let p = b.pmb.with_fracture_energy(space, E, g0);
+    let p = pmb_of(&b).with_fracture_energy(space, g0);
     let xc = 14.5 * dx;
     let (y0, y1) = (10.0 * dx, 20.0 * dx);
     let energy: f64 = (0..b.bonds.len())
@@ -182,37 +193,42 @@ fn interior_strain_energy_matches_the_classical_one_to_the_lattice_error() {
 /// W_i = ½ Σ_j (c s² |ξ|/2) V_j.
 fn interior_energy<const D: usize>(b: &PdBody<D>, y: &[Vector<D>], i: usize, v: f64) -> f64 {
     0.5 * b.bonds.gather_scalar(i, |k, _| {
-        b.pmb.bond_energy(b.bonds.stretch(k, y), b.bonds.length[k]) * v
+        pmb_of(b).bond_energy(b.bonds.stretch(k, y), b.bonds.length[k]) * v
     })
 }
 
-/// Homogeneous uniaxial tension of a plane-stress plate 40Δx × 20Δx
-/// (m = 3, no surface or partial-volume correction): equal and opposite
-/// forces σW on its end columns, the static state found by dynamic
-/// relaxation (viscous damping), the strain between the columns at L/4
-/// and 3L/4, averaged over the plate's width, against σ/E.
-#[test]
-fn a_plane_stress_plate_in_tension_stretches_by_sigma_over_e_to_the_surface_error() {
-    let (nx, ny, dx, e, sigma) = (40usize, 20usize, 1e-3, 70e9, 7e6);
+/// A plate nx × ny (spacing dx) of body law `law` in homogeneous uniaxial
+/// tension σ: equal and opposite forces σW on its end columns, the static
+/// state found by dynamic relaxation (viscous damping, a fictitious ρ = 1). The
+/// strains between the columns at L/4 and 3L/4 (εxx, averaged over the width)
+/// and between the rows at W/4 and 3W/4 (εyy, averaged over the columns
+/// between L/4 and 3L/4), and the residual reached.
+fn plate_in_tension(
+    law: BondLaw,
+    nx: usize,
+    ny: usize,
+    dx: f64,
+    e: f64,
+    sigma: f64,
+) -> (f64, f64, f64) {
     let x: Vec<Vector<2>> = (0..nx * ny)
         .map(|q| Vector::<2>::new((q % nx) as f64 * dx, (q / nx) as f64 * dx))
         .collect();
     let v0 = dx * dx;
-    let pmb = Pmb::new(Space::PlaneStress, e, 3.0 * dx);
-    let mut b = PdBody::new(0, (0..x.len()).collect(), &x, vec![v0; x.len()], pmb);
+    let mut b = PdBody::new(0, (0..x.len()).collect(), &x, vec![v0; x.len()], law);
     let per = sigma * (ny as f64 * dx) / ny as f64;
     let load = |q: usize| match q % nx {
         0 => Vector::<2>::new(-per, 0.0),
         c if c == nx - 1 => Vector::<2>::new(per, 0.0),
         _ => Vector::zeros(),
     };
-    let mass = vec![v0; x.len()]; // ρ = 1: a fictitious density
+    let mass = vec![v0; x.len()];
     let dt = b.stable_dt(&mass);
-    let omega = std::f64::consts::PI / (nx as f64 * dx) * (e / 1.0f64).sqrt();
+    let omega = std::f64::consts::PI / (nx as f64 * dx) * e.sqrt();
     let damping = 2.0 * omega * dt;
     let (mut y, mut v) = (x.clone(), vec![Vector::<2>::zeros(); x.len()]);
     let mut residual = f64::INFINITY;
-    for _ in 0..40_000 {
+    for _ in 0..100_000 {
         let f = bond_forces(&mut b, &y);
         residual = 0.0;
         for q in 0..y.len() {
@@ -225,16 +241,139 @@ fn a_plane_stress_plate_in_tension_stretches_by_sigma_over_e_to_the_surface_erro
             break;
         }
     }
-    let mean_u = |c: usize| {
-        (0..ny)
-            .map(|r| y[r * nx + c][0] - x[r * nx + c][0])
-            .sum::<f64>()
-            / ny as f64
-    };
-    let (c1, c2) = (nx / 4, 3 * nx / 4);
-    let strain = (mean_u(c2) - mean_u(c1)) / ((c2 - c1) as f64 * dx);
+    let u = |q: usize, d: usize| y[q][d] - x[q][d];
+    let (c1, c2, r1, r2) = (nx / 4, 3 * nx / 4, ny / 4, 3 * ny / 4);
+    let column = |c: usize| (0..ny).map(|r| u(r * nx + c, 0)).sum::<f64>() / ny as f64;
+    let row = |r: usize| (c1..=c2).map(|c| u(r * nx + c, 1)).sum::<f64>() / (c2 - c1 + 1) as f64;
+    let exx = (column(c2) - column(c1)) / ((c2 - c1) as f64 * dx);
+    let eyy = (row(r2) - row(r1)) / ((r2 - r1) as f64 * dx);
+    (exx, eyy, residual)
+}
+
+/// Homogeneous uniaxial tension of a PMB plane-stress plate 40Δx × 20Δx
+/// (m = 3, no surface or partial-volume correction): εxx against σ/E.
+#[test]
+fn a_plane_stress_plate_in_tension_stretches_by_sigma_over_e_to_the_surface_error() {
+    let (dx, e, sigma) = (1e-3, 70e9, 7e6);
+    let pmb = Pmb::new(Space::PlaneStress, e, 3.0 * dx);
+    let (strain, _, residual) = plate_in_tension(BondLaw::Pmb(pmb), 40, 20, dx, e, sigma);
     let error = strain / (sigma / e) - 1.0;
     println!("residual {residual:.1e}; strain/(σ/E) − 1 = {error:+.4}");
     assert!(residual < 1e-6, "not converged: {residual:e}");
     assert!(error.abs() < 0.08, "{error}");
+}
+
+/// The beam bond's Poisson ratio, measured in the plate's homogeneous
+/// tension as −εyy/εxx (plane stress) or −εyy/εxx = ν/(1 − ν) (plane strain),
+/// against the one asked for, and εxx against σ/E (plane stress) or
+/// σ(1 − ν²)/E (plane strain), m = 3 without surface correction.
+#[test]
+fn the_beam_bond_gives_the_poisson_ratio_asked_for() {
+    let (dx, e, sigma) = (1e-3, 70e9, 7e6);
+    let cases = [
+        (Space::PlaneStress, -0.2),
+        (Space::PlaneStress, 0.0),
+        (Space::PlaneStress, 0.2),
+        (Space::PlaneStress, 1.0 / 3.0),
+        (Space::PlaneStrain, 0.0),
+        (Space::PlaneStrain, 0.25),
+    ];
+    for (space, nu) in cases {
+        let beam = Beam::new(space, e, nu, 3.0 * dx);
+        let (exx, eyy, residual) = plate_in_tension(BondLaw::Beam(beam), 40, 24, dx, e, sigma);
+        let (measured, axial) = match space {
+            Space::PlaneStress => (-eyy / exx, exx / (sigma / e)),
+            _ => {
+                let r = -eyy / exx; // ν/(1 − ν)
+                (r / (1.0 + r), exx / (sigma * (1.0 - nu * nu) / e))
+            }
+        };
+        println!(
+            "{space:?} ν = {nu:+.3}: measured ν {measured:+.4} (Δ {:+.4}), εxx/(σ/E′) − 1 = {:+.4}, residual {residual:.1e}",
+            measured - nu,
+            axial - 1.0
+        );
+        assert!(residual < 1e-6, "not converged: {residual:e}");
+        assert!(
+            (measured - nu).abs() < 0.03,
+            "{space:?} ν = {nu}: measured {measured}"
+        );
+        assert!((axial - 1.0).abs() < 0.08, "{space:?} ν = {nu}: {axial}");
+    }
+}
+
+/// The beam bond under a rigid translation and a 30° rotation: no force with
+/// the rotation taken out (its ends' polar rotations), and a force of the
+/// order of a 1e-3 stretch's without it (R = I), so the test can fail.
+fn beam_rigid_motion<const D: usize>(space: Space) {
+    let dx = 1e-3;
+    let x = lattice::<D>(if D == 2 { 15 } else { 7 }, dx, 0.2);
+    let v = vec![dx.powi(D as i32); x.len()];
+    let beam = Beam::new(space, E, 0.0, 3.0 * dx);
+    let mut b = PdBody::new(
+        0,
+        (0..x.len()).collect(),
+        &x,
+        v.clone(),
+        BondLaw::Beam(beam),
+    );
+    let stretched: Vec<Vector<D>> = x.iter().map(|p| p * 1.001).collect();
+    let scale = max_norm(&bond_forces(&mut b, &stretched));
+    let shift = Vector::<D>::from_element(0.37);
+    let r = rotation::<D>(30f64.to_radians());
+    let moved: Vec<Vector<D>> = x.iter().map(|p| r * p + shift).collect();
+    let translated: Vec<Vector<D>> = x.iter().map(|p| p + shift).collect();
+    let ft = max_norm(&bond_forces(&mut b, &translated));
+    let fr = max_norm(&bond_forces(&mut b, &moved));
+    let i = Tensor::<D>::identity();
+    let uncorrected: Vec<Vector<D>> = (0..x.len())
+        .map(|p| {
+            b.bonds.gather(p, |_, j| {
+                beam.pair_force(&moved[p], &moved[j], &(x[j] - x[p]), &i, &i) * (v[p] * v[j])
+            })
+        })
+        .collect();
+    let fu = max_norm(&uncorrected);
+    println!(
+        "beam {space:?}: max |F| translated {ft:.2e}, rotated 30° {fr:.2e}, \
+         rotated without the correction {fu:.2e}, at s = 1e-3 {scale:.2e}"
+    );
+    assert!(ft <= 1e-9 * scale && fr <= 1e-9 * scale);
+    assert!(
+        fu > 10.0 * scale,
+        "the uncorrected measure resists the rotation only {fu:e}"
+    );
+}
+
+#[test]
+fn the_beam_bond_resists_no_rigid_rotation_once_the_rotation_is_taken_out() {
+    beam_rigid_motion::<2>(Space::PlaneStress);
+    beam_rigid_motion::<3>(Space::ThreeD);
+}
+
+#[test]
+fn the_beam_bond_forces_sum_to_zero_on_a_perturbed_lattice() {
+    beam_sum::<2>(Space::PlaneStress);
+    beam_sum::<3>(Space::ThreeD);
+}
+
+fn beam_sum<const D: usize>(space: Space) {
+    let dx = 1e-3;
+    let n = if D == 2 { 20 } else { 8 };
+    let x = lattice::<D>(n, dx, 0.2);
+    let v = vec![dx.powi(D as i32); x.len()];
+    let law = BondLaw::Beam(Beam::new(space, E, 0.1, 3.0 * dx));
+    let mut b = PdBody::new(0, (0..x.len()).collect(), &x, v, law);
+    let jitter = lattice::<D>(n, dx, 0.01);
+    let y: Vec<Vector<D>> = (x.iter().zip(&jitter))
+        .map(|(p, l)| p + (l - lattice_point::<D>(l, dx)))
+        .collect();
+    let f = bond_forces(&mut b, &y);
+    let total: Vector<D> = f.iter().sum();
+    let scale: f64 = f.iter().map(|v| v.norm()).sum();
+    println!(
+        "beam {space:?}: |Σ F| = {:.3e}, Σ |F| = {scale:.3e}",
+        total.norm()
+    );
+    assert!(scale > 0.0 && total.norm() <= 1e-13 * scale);
 }

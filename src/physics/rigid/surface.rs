@@ -23,7 +23,7 @@
 //! X = c⁰ + Qᵀ(x − c) in the body's `[[body]]` geometry. Faces on a plane of the
 //! grid's boundary (the axis, a symmetry plane) are not surface.
 
-use crate::dim::{restrict, Mat3, Tensor, Vector};
+use crate::dim::{polar_rotation, restrict, Mat3, Tensor, Vector};
 use crate::model::geometry::{Bend, Geometry};
 use crate::model::grid::Grid;
 use crate::model::particles::Particles;
@@ -295,24 +295,6 @@ pub fn on_grid_boundary<const D: usize>(grid: &Grid<D>) -> impl Fn(usize, f64) -
     move |d: usize, c: f64| {
         (c - grid.min[d]).abs() <= tolerance || (c - grid.max[d]).abs() <= tolerance
     }
-}
-
-/// The rotation of the polar decomposition A = Q S.
-fn polar_rotation<const D: usize>(a: &Mat3) -> Mat3 {
-    if D == 2 {
-        let theta = (a[(1, 0)] - a[(0, 1)]).atan2(a[(0, 0)] + a[(1, 1)]);
-        let (s, c) = theta.sin_cos();
-        return Mat3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0);
-    }
-    let svd = a.svd(true, true);
-    let (Some(mut u), Some(v_t)) = (svd.u, svd.v_t) else {
-        return Mat3::identity();
-    };
-    if (u * v_t).determinant() < 0.0 {
-        let last = u.column(2) * -1.0;
-        u.set_column(2, &last);
-    }
-    u * v_t
 }
 
 #[cfg(test)]

@@ -6,7 +6,7 @@
 
 use super::check::{ensure, forbidden, Check};
 use crate::material::bond::Space;
-use crate::scene::{BodyKindName, SceneConfig, SolverKind};
+use crate::scene::{BodyKindName, BondModel, SceneConfig, SolverKind};
 
 /// The keys only a peridynamic body takes, refused on body i of another kind.
 pub fn not_peridynamic(i: usize, s: &SceneConfig) -> Check {
@@ -88,24 +88,7 @@ fn material(i: usize, s: &SceneConfig) -> Check {
             m.name
         ),
     )?;
-    let space = s.peridynamic_space(i);
-    let nu = (m.parameters.get("poisson_ratio")).and_then(|v| v.as_float());
-    let want = space.poisson_ratio();
-    let (name, fraction) = match space {
-        Space::ThreeD => ("3D", "1/4"),
-        Space::PlaneStrain => ("plane strain", "1/4"),
-        Space::PlaneStress => ("plane stress", "1/3"),
-    };
-    let got = nu.map_or("none".to_string(), |nu| nu.to_string());
-    ensure(
-        nu.is_some_and(|nu| (nu - want).abs() <= 1e-4),
-        format!("material.{k}.poisson_ratio"),
-        format!(
-            "the bond-based (PMB) peridynamic body {i} has ν = {fraction} in {name} \
-             (one micromodulus fixes it); got {got}: set poisson_ratio = {want:.6} \
-             (or, in 2D, the other `plane`)"
-        ),
-    )?;
+    poisson_ratio(i, k, s)?;
     let shared = (0..s.bodies.len()).find(|&j| j != i && s.bodies[j].material == b.material);
     match shared {
         Some(j) => Err((
@@ -118,6 +101,39 @@ fn material(i: usize, s: &SceneConfig) -> Check {
             ),
         )),
         None => Ok(()),
+    }
+}
+
+/// Its material's ν: PMB's one ν of its space, or, beam, in (−1, PMB's].
+fn poisson_ratio(i: usize, k: usize, s: &SceneConfig) -> Check {
+    let space = s.peridynamic_space(i);
+    let nu = s.poisson_ratio(i);
+    let want = space.poisson_ratio();
+    let (name, fraction) = match space {
+        Space::ThreeD => ("3D", "1/4"),
+        Space::PlaneStrain => ("plane strain", "1/4"),
+        Space::PlaneStress => ("plane stress", "1/3"),
+    };
+    let got = nu.map_or("none".to_string(), |nu| nu.to_string());
+    let key = format!("material.{k}.poisson_ratio");
+    match s.bodies[i].bond_model.unwrap_or_default() {
+        BondModel::Pmb => ensure(
+            nu.is_some_and(|nu| (nu - want).abs() <= 1e-4),
+            key,
+            format!(
+                "the bond-based (PMB) peridynamic body {i} has ν = {fraction} in {name} \
+                 (one micromodulus fixes it); got {got}: set poisson_ratio = {want:.6}, \
+                 bond_model = \"beam\" for another ν, or, in 2D, the other `plane`"
+            ),
+        ),
+        BondModel::Beam => ensure(
+            nu.is_some_and(|nu| nu > -1.0 && nu <= want + 1e-4),
+            key,
+            format!(
+                "the beam-based peridynamic body {i} takes ν in (−1, {fraction}] in {name} \
+                 (its tangential micromodulus would be negative above); got {got}"
+            ),
+        ),
     }
 }
 
