@@ -13,7 +13,10 @@
 //! - tangent (implicit stages with the direct solver or the lagged-direct
 //!   preconditioner): D² entries per node pair for the nodes within a support
 //!   width of each other, index and value, with four times that again for the
-//!   fill of the factor.
+//!   fill of the factor;
+//! - bonds (peridynamic bodies): the lattice points times half a family, πm²
+//!   (2D) or 4πm³/3 (3D) bonds for m = δ/Δx, each stored once at
+//!   `BYTES_PER_BOND` (its ends, length, intact flag and its two CSR entries).
 //!
 //! It is an estimate to within a small factor, meant to catch the scenes that
 //! cannot fit, not to predict the peak. The limit defaults to the machine's
@@ -21,7 +24,8 @@
 //! take `--memory-limit GIB` to set another.
 
 use crate::model::tensors::Layout;
-use crate::scene::{LinearSolver, PreconditionerKind, SceneConfig, SolverKind};
+use crate::scene::{BodyKindName, LinearSolver, PreconditionerKind, SceneConfig, SolverKind};
+use std::f64::consts::PI;
 
 /// The estimate's parts, in bytes, and the counts they come from.
 #[derive(Clone, Debug, PartialEq)]
@@ -35,7 +39,16 @@ pub struct Estimate {
     pub particle_bytes: f64,
     pub grid_bytes: f64,
     pub tangent_bytes: f64,
+    /// Bonds of each peridynamic body (0 for the others), and the key that
+    /// sets their number (`horizon` or `horizon_factor`).
+    pub bonds: Vec<f64>,
+    pub bond_keys: Vec<&'static str>,
+    pub bond_bytes: f64,
 }
+
+/// One bond of `model::peridynamics::bonds::Bonds`: ends 2 × u32, |ξ| f64,
+/// intact bool, two CSR entries (bond id and other end, u32 each).
+pub const BYTES_PER_BOND: f64 = 8.0 + 8.0 + 1.0 + 2.0 * 8.0;
 
 impl Estimate {
     pub fn of(c: &SceneConfig) -> Estimate {
@@ -111,8 +124,34 @@ impl Estimate {
                 .fold(0.0, f64::max);
             grid_nodes * d * 8.0 * restart
         };
+        let bonds: Vec<f64> = (0..c.bodies.len())
+            .map(|i| match c.body_kind(i) {
+                BodyKindName::Peridynamic => {
+                    let m = c.horizon(i) / c.particle_spacing(i);
+                    let family = if dim == 3 {
+                        4.0 * PI * m.powi(3) / 3.0
+                    } else {
+                        PI * m * m
+                    };
+                    0.5 * family * lattice_points[i]
+                }
+                _ => 0.0,
+            })
+            .collect();
+        let bond_keys = (c.bodies.iter())
+            .map(|b| {
+                if b.horizon.is_some() {
+                    "horizon"
+                } else {
+                    "horizon_factor"
+                }
+            })
+            .collect();
         Estimate {
             dim,
+            bond_keys,
+            bond_bytes: bonds.iter().sum::<f64>() * BYTES_PER_BOND,
+            bonds,
             particle_bytes: 2.0 * particles * per_particle,
             grid_bytes: 2.0 * grid_nodes * per_node,
             grid_nodes,
@@ -123,7 +162,7 @@ impl Estimate {
     }
 
     pub fn total(&self) -> f64 {
-        self.particle_bytes + self.grid_bytes + self.tangent_bytes
+        self.particle_bytes + self.grid_bytes + self.tangent_bytes + self.bond_bytes
     }
 
     /// Within `limit` bytes, or an error at the key of the largest part.
@@ -142,19 +181,27 @@ impl Estimate {
         };
         let parts = format!(
             "particles {} GiB (up to {:.3e} lattice points), grid {} GiB ({:.3e} nodes), \
-             tangent or Krylov basis {} GiB",
+             tangent or Krylov basis {} GiB, bonds {} GiB ({:.3e})",
             gib(self.particle_bytes),
             self.lattice_points.iter().sum::<f64>(),
             gib(self.grid_bytes),
             self.grid_nodes,
-            gib(self.tangent_bytes)
+            gib(self.tangent_bytes),
+            gib(self.bond_bytes),
+            self.bonds.iter().sum::<f64>()
         );
         // The particles of the largest body are blamed on its particles_per_cell
         // when that is large (more than 10 per direction), else on the grid.
         let body = (0..self.lattice_points.len())
             .max_by(|&a, &b| self.lattice_points[a].total_cmp(&self.lattice_points[b]));
-        let key = match body {
-            Some(i)
+        let most_bonds =
+            (0..self.bonds.len()).max_by(|&a, &b| self.bonds[a].total_cmp(&self.bonds[b]));
+        let key = match (body, most_bonds) {
+            // The bonds of the body with most of them on its horizon.
+            (_, Some(i)) if self.bond_bytes >= self.total() - self.bond_bytes => {
+                format!("body.{i}.{}", self.bond_keys[i])
+            }
+            (Some(i), _)
                 if self.particle_bytes >= self.grid_bytes + self.tangent_bytes
                     && self.per_cell[i] > 10f64.powi(self.dim as i32) =>
             {
@@ -248,6 +295,47 @@ mod tests {
             "solver.linear_solver=gmres",
         ]);
         assert!(e.tangent_bytes < estimate(&["grid.cells=[100000, 100000]"]).tangent_bytes);
+    }
+
+    /// A peridynamic block of 101² particles: its bonds estimated against the
+    /// ones built (πm²/2 per lattice point in 2D, against the lattice's 28/2 at
+    /// m = 3 inside and fewer near the faces: an upper bound), and a horizon
+    /// too wide for the memory refused at its key.
+    #[test]
+    fn the_bonds_of_a_peridynamic_body_are_counted_and_a_huge_horizon_refused() {
+        let pd = [
+            "material.0.poisson_ratio=0.25",
+            "body.0.kind=\"peridynamic\"",
+            "solver.kind=\"explicit\"",
+        ];
+        let e = estimate(&pd);
+        let scene = Scene::parse(
+            "s.toml",
+            BLOCK,
+            &SCENE
+                .iter()
+                .chain(&pd)
+                .map(|s| s.to_string())
+                .collect::<Vec<_>>(),
+        )
+        .unwrap();
+        let model = crate::model::Model::<2>::build(&scene).unwrap();
+        let built = model.peridynamics.as_ref().unwrap().bodies[0].bonds.len() as f64;
+        println!("bonds estimated {:.0}, built {built}", e.bonds[0]);
+        assert!(
+            e.bonds[0] >= built && e.bonds[0] < 1.1 * built,
+            "{} vs {built}",
+            e.bonds[0]
+        );
+        assert!(estimate(&[]).bonds == vec![0.0] && estimate(&[]).bond_bytes == 0.0);
+        let wide: Vec<&str> = pd
+            .iter()
+            .copied()
+            .chain(["body.0.horizon_factor=3000"])
+            .collect();
+        let (key, msg) = estimate(&wide).check(limit(Some(16.0))).unwrap_err();
+        assert_eq!(key, "body.0.horizon_factor", "{msg}");
+        assert!(msg.contains("bonds"), "{msg}");
     }
 
     #[test]
