@@ -12,8 +12,9 @@ use crate::model::conditions::{Absorbing, Constraint, FaceCondition, Footing, Fr
 use crate::model::geometry::Geometry;
 use crate::model::grid::Grid;
 use crate::model::loads::Loads;
+use crate::model::particle_set::ParticleSet;
 use crate::model::particles::Particles;
-use crate::model::{axisymmetry, Model};
+use crate::model::{axisymmetry, import, Model};
 use crate::scene::{
     axis, expr, BodyConfig, BoundaryConfig, Condition, DomainStress, Face, Fill, ParticlesOutside,
     Scene, SceneError,
@@ -42,7 +43,9 @@ impl<const D: usize> Model<D> {
             .map_err(err)?;
         // A rigid body's particles carry the zero-stress material (`model::body`).
         let base_materials = c.particle_materials(tables);
-        let bodies: Vec<Body> = (0..c.bodies.len()).map(|i| Body::of(c, i)).collect();
+        let bodies = (0..c.bodies.len())
+            .map(|i| import::body_geometry(scene, i).map(|g| Body::of(c, i, g)))
+            .collect::<Result<Vec<Body>, _>>()?;
         let mut particles = Particles::default();
         for (i, b) in c.bodies.iter().enumerate() {
             let m = c
@@ -51,17 +54,17 @@ impl<const D: usize> Model<D> {
                 .position(|m| m.name == b.material)
                 .expect("validated");
             let material = base_materials[m].as_ref();
-            let added = fill_body(
-                &mut particles,
-                &grid,
-                b,
-                &bodies[i].geometry,
-                i,
-                m as u32,
-                material,
-            )
-            .map_err(err)?;
-            if c.dimension.is_axisymmetric() {
+            let added = match &bodies[i].geometry {
+                Geometry::Particles(set) => {
+                    put_file_particles(&mut particles, b, set, i, m as u32, &base_materials)
+                        .map_err(err)?
+                }
+                geometry => fill_body(&mut particles, &grid, b, geometry, i, m as u32, material)
+                    .map_err(err)?,
+            };
+            // A particle file's volumes are per radian already.
+            let file = matches!(bodies[i].geometry, Geometry::Particles(_));
+            if c.dimension.is_axisymmetric() && !file {
                 axisymmetry::per_radian(&mut particles, added);
             }
             if added == 0 {
@@ -205,7 +208,7 @@ fn fill_body<const D: usize>(
 ) -> Result<usize, (String, String)> {
     let spacing = Vector::<D>::from_fn(|d, _| grid.h[d] / b.particles_per_cell.get(d) as f64);
     let points = match b.fill {
-        Fill::Lattice => lattice(grid, b, geometry, &spacing),
+        Fill::Lattice => lattice(grid, geometry, &spacing),
         Fill::Polar => polar(b, spacing[0].min(spacing[1]), spacing[D - 1]),
     };
     let uniform = b
@@ -215,15 +218,7 @@ fn fill_body<const D: usize>(
     particles.reserve(points.len());
     let mut added = 0;
     for (x, volume, half) in points {
-        let mut v = uniform;
-        if let Some(exprs) = &b.velocity_expr {
-            let mut pos = [0.0; 3];
-            (0..D).for_each(|d| pos[d] = x[d]);
-            for (d, e) in exprs.iter().enumerate() {
-                v[d] +=
-                    expr::eval(e, &pos).map_err(|m| (format!("body.{i}.velocity_expr.{d}"), m))?;
-            }
-        }
+        let v = uniform + velocity_expr(b, i, &x)?;
         particles.push(
             x,
             v,
@@ -239,17 +234,77 @@ fn fill_body<const D: usize>(
     Ok(added)
 }
 
+/// The body's `velocity_expr` at x (zero without one).
+fn velocity_expr<const D: usize>(
+    b: &BodyConfig,
+    i: usize,
+    x: &Vector<D>,
+) -> Result<Vector<D>, (String, String)> {
+    let mut v = Vector::<D>::zeros();
+    if let Some(exprs) = &b.velocity_expr {
+        let mut pos = [0.0; 3];
+        (0..D).for_each(|d| pos[d] = x[d]);
+        for (d, e) in exprs.iter().enumerate() {
+            v[d] += expr::eval(e, &pos).map_err(|m| (format!("body.{i}.velocity_expr.{d}"), m))?;
+        }
+    }
+    Ok(v)
+}
+
+/// Put the particles of a particle file in as they are: each with its
+/// volume, its row's material (else the body's, `material`), its stress and
+/// its velocity plus the body's `velocity` and `velocity_expr`; its domain the
+/// square (cube) of its volume (`ParticleSet::half_length`).
+fn put_file_particles<const D: usize>(
+    particles: &mut Particles<D>,
+    b: &BodyConfig,
+    set: &ParticleSet,
+    i: usize,
+    material: u32,
+    materials: &[Box<dyn Material>],
+) -> Result<usize, (String, String)> {
+    let uniform = b
+        .velocity
+        .as_deref()
+        .map_or(Vector::<D>::zeros(), |v| Vector::<D>::from_fn(|d, _| v[d]));
+    particles.reserve(set.particles.len());
+    for (q, p) in set.particles.iter().enumerate() {
+        let x = Vector::<D>::from_fn(|d, _| p.x[d]);
+        let own = p
+            .velocity
+            .map_or(Vector::<D>::zeros(), |v| Vector::<D>::from_fn(|d, _| v[d]));
+        let v = own + uniform + velocity_expr(b, i, &x)?;
+        let m = p.material.unwrap_or(material);
+        let model = materials[m as usize].as_ref();
+        let h = set.half_length(q);
+        let half = Vector::<D>::from_fn(|d, _| h[d]);
+        particles.push(
+            x,
+            v,
+            model.density() * p.volume,
+            p.volume,
+            half,
+            i as u32,
+            m,
+            model.n_history(),
+        );
+        if let Some(s) = &p.stress {
+            particles.stress.set(particles.len() - 1, s);
+        }
+    }
+    Ok(set.particles.len())
+}
+
 /// A particle of a fill: position, volume and the half-lengths of its domain.
 type Point<const D: usize> = (Vector<D>, f64, Vector<D>);
 
 /// The lattice points with the given spacing that lie inside the body.
 fn lattice<const D: usize>(
     grid: &Grid<D>,
-    b: &BodyConfig,
     geometry: &Geometry,
     spacing: &Vector<D>,
 ) -> Vec<Point<D>> {
-    let (lo, hi) = b.bounds();
+    let (lo, hi) = geometry.bounds();
     let volume = spacing.product();
     // Lattice index range covering the bounding box.
     let first: [usize; D] =

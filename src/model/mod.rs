@@ -8,10 +8,13 @@ mod build;
 pub(crate) mod conditions;
 pub mod geometry;
 pub mod grid;
+pub(crate) mod import;
 pub(crate) mod loads;
 pub(crate) mod memory;
+pub mod particle_set;
 pub mod particles;
 pub(crate) mod tensors;
+pub mod triangles;
 
 pub use loads::{load_factor, LoadTime};
 
