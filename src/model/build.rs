@@ -14,6 +14,7 @@ use crate::model::grid::Grid;
 use crate::model::loads::Loads;
 use crate::model::particle_set::ParticleSet;
 use crate::model::particles::Particles;
+use crate::model::triangles::{Cells, TriangleSurface};
 use crate::model::{axisymmetry, import, Model};
 use crate::scene::{
     axis, expr, BodyConfig, BoundaryConfig, Condition, DomainStress, Face, Fill, ParticlesOutside,
@@ -207,9 +208,10 @@ fn fill_body<const D: usize>(
     model: &dyn Material,
 ) -> Result<usize, (String, String)> {
     let spacing = Vector::<D>::from_fn(|d, _| grid.h[d] / b.particles_per_cell.get(d) as f64);
-    let points = match b.fill {
-        Fill::Lattice => lattice(grid, geometry, &spacing),
-        Fill::Polar => polar(b, spacing[0].min(spacing[1]), spacing[D - 1]),
+    let points = match (b.fill, geometry) {
+        (_, Geometry::Surface(surface)) => surface_cells(grid, surface, geometry, &spacing),
+        (Fill::Lattice, _) => lattice(grid, geometry, &spacing),
+        (Fill::Polar, _) => polar(b, spacing[0].min(spacing[1]), spacing[D - 1]),
     };
     let uniform = b
         .velocity
@@ -298,15 +300,13 @@ fn put_file_particles<const D: usize>(
 /// A particle of a fill: position, volume and the half-lengths of its domain.
 type Point<const D: usize> = (Vector<D>, f64, Vector<D>);
 
-/// The lattice points with the given spacing that lie inside the body.
-fn lattice<const D: usize>(
+/// The lattice index range [first, last) covering the body's bounding box.
+fn lattice_range<const D: usize>(
     grid: &Grid<D>,
     geometry: &Geometry,
     spacing: &Vector<D>,
-) -> Vec<Point<D>> {
+) -> ([usize; D], [usize; D]) {
     let (lo, hi) = geometry.bounds();
-    let volume = spacing.product();
-    // Lattice index range covering the bounding box.
     let first: [usize; D] =
         std::array::from_fn(|d| (((lo[d] - grid.min[d]) / spacing[d]).floor().max(0.0)) as usize);
     // A body cut at a symmetry plane keeps the part inside the grid.
@@ -314,6 +314,57 @@ fn lattice<const D: usize>(
         let upper = hi[d].min(grid.min[d] + grid.h[d] * grid.cells[d] as f64);
         ((upper - grid.min[d]) / spacing[d]).ceil() as usize
     });
+    (first, last)
+}
+
+/// A closed surface on the lattice: each lattice cell the solid reaches
+/// holds one particle with the solid's volume in the cell, at the lattice
+/// point where the cell is whole (as `lattice` puts it) and at the centroid of
+/// the part inside where the surface cuts the cell (`TriangleSurface::cell_parts`);
+/// its domain the cell's, shrunk to the part's volume.
+fn surface_cells<const D: usize>(
+    grid: &Grid<D>,
+    surface: &TriangleSurface,
+    geometry: &Geometry,
+    spacing: &Vector<D>,
+) -> Vec<Point<D>> {
+    let (first, last) = lattice_range(grid, geometry, spacing);
+    let three = |v: &dyn Fn(usize) -> f64| -> [f64; 3] { std::array::from_fn(|d| v(d)) };
+    let cells = Cells {
+        origin: three(&|d| grid.min[d]),
+        spacing: three(&|d| spacing[d]),
+        first: std::array::from_fn(|d| first[d]),
+        last: std::array::from_fn(|d| last[d]),
+    };
+    let whole = spacing.product();
+    (surface.cell_parts(&cells).into_iter())
+        .map(|part| {
+            let fraction = part.volume / whole;
+            match fraction >= 1.0 - 1e-12 {
+                true => {
+                    let x = Vector::<D>::from_fn(|d, _| {
+                        grid.min[d] + (part.cell[d] as f64 + 0.5) * spacing[d]
+                    });
+                    (x, whole, spacing / 2.0)
+                }
+                false => {
+                    let x = Vector::<D>::from_fn(|d, _| part.centroid[d]);
+                    let shrink = fraction.powf(1.0 / D as f64);
+                    (x, part.volume, spacing * (0.5 * shrink))
+                }
+            }
+        })
+        .collect()
+}
+
+/// The lattice points with the given spacing that lie inside the body.
+fn lattice<const D: usize>(
+    grid: &Grid<D>,
+    geometry: &Geometry,
+    spacing: &Vector<D>,
+) -> Vec<Point<D>> {
+    let volume = spacing.product();
+    let (first, last) = lattice_range(grid, geometry, spacing);
     let counts: Vec<usize> = (0..D).map(|d| last[d].saturating_sub(first[d])).collect();
     let total: usize = counts.iter().product();
     (0..total)

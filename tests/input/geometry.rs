@@ -301,3 +301,273 @@ fn the_keys_of_a_file_body_are_checked() {
         &["[geostatic] measures depths below a body's top surface"],
     );
 }
+
+/// An elastic 3D scene on the grid [−1.5, 1.5]³ of 6 cells a side, 2
+/// particles per cell: lattice spacing 0.25, the lattice symmetric about the
+/// origin. `BODY` is replaced by the body's shape keys.
+const SOLID: &str = r#"
+dimension = 3
+
+[grid]
+min = [-1.5, -1.5, -1.5]
+max = [1.5, 1.5, 1.5]
+cells = [6, 6, 6]
+
+[[material]]
+name = "rock"
+model = "linear_elastic"
+density = 2000.0
+youngs_modulus = 1.0e6
+poisson_ratio = 0.25
+
+[[body]]
+material = "rock"
+BODY
+
+[solver]
+kind = "explicit"
+end_time = 0.01
+
+[output]
+frames = 0
+"#;
+
+type Facet = [[f32; 3]; 3];
+
+/// The unit sphere as an icosahedron subdivided `levels` times, the new
+/// corners pushed out to the sphere (20 · 4^levels facets, each facing out).
+/// Each corner is computed from its edge's ends alone, so the facets are
+/// symmetric about the three coordinate planes to the bit.
+fn sphere(levels: usize) -> Vec<Facet> {
+    let g = (1.0 + 5f64.sqrt()) / 2.0;
+    let unit = |v: [f64; 3]| {
+        let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        v.map(|c| c / l)
+    };
+    let corners: Vec<[f64; 3]> = [
+        [-1.0, g, 0.0],
+        [1.0, g, 0.0],
+        [-1.0, -g, 0.0],
+        [1.0, -g, 0.0],
+        [0.0, -1.0, g],
+        [0.0, 1.0, g],
+        [0.0, -1.0, -g],
+        [0.0, 1.0, -g],
+        [g, 0.0, -1.0],
+        [g, 0.0, 1.0],
+        [-g, 0.0, -1.0],
+        [-g, 0.0, 1.0],
+    ]
+    .into_iter()
+    .map(unit)
+    .collect();
+    let faces = [
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    let mut tris: Vec<[[f64; 3]; 3]> = faces.iter().map(|f| f.map(|k| corners[k])).collect();
+    for _ in 0..levels {
+        let mid = |a: [f64; 3], b: [f64; 3]| unit([a[0] + b[0], a[1] + b[1], a[2] + b[2]]);
+        tris = (tris.iter())
+            .flat_map(|&[a, b, c]| {
+                let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
+                [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]
+            })
+            .collect();
+    }
+    (tris.iter())
+        .map(|t| {
+            // Facing out: the normal along the facet's centre.
+            let e = |k: usize, d: usize| t[k][d] - t[0][d];
+            let n = [
+                e(1, 1) * e(2, 2) - e(1, 2) * e(2, 1),
+                e(1, 2) * e(2, 0) - e(1, 0) * e(2, 2),
+                e(1, 0) * e(2, 1) - e(1, 1) * e(2, 0),
+            ];
+            let out: f64 = (0..3).map(|d| n[d] * (t[0][d] + t[1][d] + t[2][d])).sum();
+            let f = t.map(|v| v.map(|c| c as f32));
+            match out > 0.0 {
+                true => f,
+                false => [f[0], f[2], f[1]],
+            }
+        })
+        .collect()
+}
+
+/// The cube [−1, 1]³ moved by `shift`, two facets a face, facing out.
+fn cube(shift: [f32; 3]) -> Vec<Facet> {
+    let v = |k: usize| -> [f32; 3] {
+        std::array::from_fn(|d| if (k >> d) & 1 == 1 { 1.0 } else { -1.0 } + shift[d])
+    };
+    let quads = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    (quads.iter())
+        .flat_map(|q| [[v(q[0]), v(q[1]), v(q[2])], [v(q[0]), v(q[2]), v(q[3])]])
+        .collect()
+}
+
+fn write_binary(path: &Path, facets: &[Facet]) {
+    let mesh: Vec<stl_io::Triangle> = (facets.iter())
+        .map(|f| stl_io::Triangle {
+            normal: stl_io::Normal::new([0.0; 3]),
+            vertices: f.map(stl_io::Vertex::new),
+        })
+        .collect();
+    let mut file = std::fs::File::create(path).unwrap();
+    stl_io::write_stl(&mut file, mesh.iter()).unwrap();
+}
+
+/// ASCII STL, each coordinate as the shortest text that reads back to its f32.
+fn write_ascii(path: &Path, facets: &[Facet]) {
+    let mut text = String::from("solid test\n");
+    for f in facets {
+        text += "facet normal 0 0 0\nouter loop\n";
+        for v in f {
+            text += &format!("vertex {:e} {:e} {:e}\n", v[0], v[1], v[2]);
+        }
+        text += "endloop\nendfacet\n";
+    }
+    text += "endsolid test\n";
+    std::fs::write(path, text).unwrap();
+}
+
+fn solid(dir: &Path, file: &str) -> Result<Model<3>, mpm::scene::SceneError> {
+    let body = format!("shape = \"surface\"\nfile = \"{file}\"");
+    let text = SOLID.replace("BODY", &body);
+    let scene = Scene::parse(dir.join("scene.toml").to_str().unwrap(), &text, &[])?;
+    Model::<3>::build(&scene)
+}
+
+/// The particles' total volume and volume-weighted centroid.
+fn volume_and_centroid(m: &Model<3>) -> (f64, [f64; 3]) {
+    let p = &m.particles;
+    let v: f64 = p.volume.iter().sum();
+    let c = std::array::from_fn(|d| (0..p.len()).map(|q| p.volume[q] * p.x[q][d]).sum::<f64>() / v);
+    (v, c)
+}
+
+/// Both forms of one surface give the same particles; their volume and
+/// centroid.
+fn both_forms(dir: &Path, name: &str, facets: &[Facet]) -> (f64, [f64; 3], usize) {
+    write_binary(&dir.join(format!("{name}.stl")), facets);
+    write_ascii(&dir.join(format!("{name}_ascii.stl")), facets);
+    let binary = solid(dir, &format!("{name}.stl")).unwrap();
+    let ascii = solid(dir, &format!("{name}_ascii.stl")).unwrap();
+    assert!(
+        binary.particles.x == ascii.particles.x,
+        "{name}: ASCII ≠ binary"
+    );
+    assert!(binary.particles.volume == ascii.particles.volume);
+    let (v, c) = volume_and_centroid(&binary);
+    (v, c, binary.particles.len())
+}
+
+#[test]
+fn a_sphere_and_a_cube_from_stl_have_their_volume_and_centroid() {
+    let dir = tempfile::tempdir().unwrap();
+    // The unit sphere at 8 particles across (spacing 0.25), 5120 facets.
+    let (v, c, n) = both_forms(dir.path(), "sphere", &sphere(4));
+    let exact = 4.0 / 3.0 * std::f64::consts::PI;
+    println!("sphere: {n} particles");
+    // The issue's bound; measured −0.22 %, the facets' own volume deficit
+    // (the fill is exact for the triangulated solid, below).
+    assert_within("sphere volume / (4π/3) − 1", v / exact - 1.0, 5e-3);
+    // The fill is exact for the facets' solid (measured 1e-16 or so).
+    let facets_volume: f64 = (sphere(4).iter())
+        .map(|f| {
+            let [a, b, c] = f.map(|v| v.map(f64::from));
+            let bc = [
+                b[1] * c[2] - b[2] * c[1],
+                b[2] * c[0] - b[0] * c[2],
+                b[0] * c[1] - b[1] * c[0],
+            ];
+            (a[0] * bc[0] + a[1] * bc[1] + a[2] * bc[2]) / 6.0
+        })
+        .sum();
+    assert_within(
+        "sphere volume / the facets' − 1",
+        v / facets_volume - 1.0,
+        1e-12,
+    );
+    // Round-off: measured ≤ 3.1e-17.
+    for (d, x) in c.iter().enumerate() {
+        assert_within(&format!("sphere centroid {d}"), *x, 1e-14);
+    }
+    // The cube [−1, 1]³ on the lattice: 512 whole cells, exact.
+    let (v, c, n) = both_forms(dir.path(), "cube", &cube([0.0; 3]));
+    assert_eq!((v, n), (8.0, 512));
+    assert_eq!(c.map(f64::abs), [0.0; 3]);
+    // Moved off the lattice: cut cells, their parts' volumes and centroids,
+    // against the box of the file's single-precision corners.
+    let shift = [0.1f32, 0.05, 0.03];
+    let (v, c, _) = both_forms(dir.path(), "moved", &cube(shift));
+    let (lo, hi) = (
+        shift.map(|s| f64::from(s - 1.0)),
+        shift.map(|s| f64::from(s + 1.0)),
+    );
+    let exact: f64 = (0..3).map(|d| hi[d] - lo[d]).product();
+    // Measured 0 and ≤ 1.2e-16.
+    assert_within("moved cube volume / exact − 1", v / exact - 1.0, 1e-13);
+    for d in 0..3 {
+        let centre = 0.5 * (lo[d] + hi[d]);
+        assert_within(&format!("moved cube centroid {d}"), c[d] - centre, 1e-13);
+    }
+}
+
+#[test]
+fn an_open_or_unreadable_stl_names_the_file_and_the_edge() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut open = cube([0.0; 3]);
+    open.remove(3);
+    write_ascii(&dir.path().join("open.stl"), &open);
+    let e = solid(dir.path(), "open.stl").err().unwrap();
+    assert_eq!(e.key.as_deref(), Some("body.0.file"), "{e}");
+    let s = e.to_string();
+    for part in [
+        "open.stl: the surface is not closed: the edge (1, 1, 1) – (-1, -1, 1) of triangle 3",
+        "belongs to 1 triangle(s)",
+    ] {
+        assert!(s.contains(part), "`{part}` not in: {s}");
+    }
+    std::fs::write(
+        dir.path().join("bad.stl"),
+        "solid x\nfacet normal 0 0 0\nouter loop\nvertex 1 2\n",
+    )
+    .unwrap();
+    let e = solid(dir.path(), "bad.stl").err().unwrap().to_string();
+    assert!(e.contains("bad.stl: facet 1:"), "{e}");
+    let e = solid(dir.path(), "none.stl").err().unwrap().to_string();
+    assert!(
+        e.contains("cannot read the STL file") && e.contains("none.stl"),
+        "{e}"
+    );
+    // A surface outside the grid.
+    write_binary(&dir.path().join("far.stl"), &cube([1.0, 0.0, 0.0]));
+    let e = solid(dir.path(), "far.stl").err().unwrap();
+    assert_eq!(e.key.as_deref(), Some("body.0.shape"), "{e}");
+    assert!(e.to_string().contains("far.stl: the body spans"), "{e}");
+}
