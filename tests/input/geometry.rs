@@ -571,3 +571,46 @@ fn an_open_or_unreadable_stl_names_the_file_and_the_edge() {
     assert_eq!(e.key.as_deref(), Some("body.0.shape"), "{e}");
     assert!(e.to_string().contains("far.stl: the body spans"), "{e}");
 }
+
+/// `mpm check DIR/scene.toml` through the program: its standard output.
+fn check(dir: &Path, text: &str) -> String {
+    let scene = dir.join("scene.toml");
+    std::fs::write(&scene, text).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_mpm"))
+        .arg("check")
+        .arg(&scene)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "mpm check: {stderr}");
+    String::from_utf8(out.stdout).unwrap()
+}
+
+#[test]
+fn check_prints_each_bodys_particles_volume_and_box() {
+    let dir = tempfile::tempdir().unwrap();
+    // The rectangle [0.5, 1.5] × [0, 1.25] at spacing 0.125: 8 × 10
+    // particles whose domains tile it exactly.
+    let out = check(dir.path(), &block(RECTANGLE));
+    let line = "  body 0 (rectangle): 80 particles, volume 1.25 per unit thickness, \
+                box (0.5, 0) – (1.5, 1.25)";
+    assert!(out.lines().any(|l| l == line), "{out}");
+    // A particle file: its rows, their volumes and domains (0.2 m squares).
+    let csv = "x,y,volume\n0.75,0.25,0.04\n1.25,0.5,0.04\n";
+    std::fs::write(dir.path().join("p.csv"), csv).unwrap();
+    let out = check(
+        dir.path(),
+        &block("name = \"fill\"\nshape = \"particles\"\nfile = \"p.csv\""),
+    );
+    let line = "  body 0 `fill` (particles): 2 particles, volume 0.08 per unit thickness, \
+                box (0.65, 0.15) – (1.35, 0.6)";
+    assert!(out.lines().any(|l| l == line), "{out}");
+    // A cube from STL in 3D: 512 whole cells of the lattice.
+    write_binary(&dir.path().join("cube.stl"), &cube([0.0; 3]));
+    let out = check(
+        dir.path(),
+        &SOLID.replace("BODY", "shape = \"surface\"\nfile = \"cube.stl\""),
+    );
+    let line = "  body 0 (surface): 512 particles, volume 8, box (-1, -1, -1) – (1, 1, 1)";
+    assert!(out.lines().any(|l| l == line), "{out}");
+}
