@@ -329,10 +329,9 @@ fn surface_cells<const D: usize>(
     spacing: &Vector<D>,
 ) -> Vec<Point<D>> {
     let (first, last) = lattice_range(grid, geometry, spacing);
-    let three = |v: &dyn Fn(usize) -> f64| -> [f64; 3] { std::array::from_fn(|d| v(d)) };
     let cells = Cells {
-        origin: three(&|d| grid.min[d]),
-        spacing: three(&|d| spacing[d]),
+        origin: std::array::from_fn(|d| grid.min[d]),
+        spacing: std::array::from_fn(|d| spacing[d]),
         first: std::array::from_fn(|d| first[d]),
         last: std::array::from_fn(|d| last[d]),
     };

@@ -467,9 +467,9 @@ mod tests {
             let parts = c.cell_parts(&cells);
             let volume: f64 = parts.iter().map(|p| p.volume).sum();
             assert!((volume - 1.0).abs() < 1e-13, "{volume}");
-            for d in 0..3 {
+            for (d, s) in shift.iter().enumerate() {
                 let m: f64 = parts.iter().map(|p| p.volume * p.centroid[d]).sum();
-                assert!((m - (0.5 + shift[d])).abs() < 1e-13, "{d}: {m}");
+                assert!((m - (0.5 + s)).abs() < 1e-13, "{d}: {m}");
             }
             // 3 × 3 × 3 whole cells inside, the rest cut: 5³ cells reached.
             assert_eq!(parts.len(), 125);

@@ -160,7 +160,7 @@ fn file_error(csv: &str, body_keys: &str, key: &str, parts: &[&str]) {
     let text = block(&format!(
         "shape = \"particles\"\nfile = \"p.csv\"\n{body_keys}"
     ));
-    let e = model(dir.path(), &text).err().expect("must be refused");
+    let e = model(dir.path(), &text).expect_err("must be refused");
     assert_eq!(e.key.as_deref(), Some(key), "{e}");
     let s = e.to_string();
     for part in parts {
