@@ -8,6 +8,7 @@
 //! top surface for geostatic stresses (`top`).
 
 use crate::model::particle_set::ParticleSet;
+use crate::model::terrain::Terrain;
 use crate::model::triangles::TriangleSurface;
 use crate::scene::{prism_bounds, prism_plane, BodyConfig, BodyShape};
 use std::sync::Arc;
@@ -40,6 +41,9 @@ pub enum Geometry {
     /// A closed triangulated surface (3D); none of its faces is surface for
     /// `nearest_surface` (a rigid body does not take one, validation).
     Surface(Arc<TriangleSurface>),
+    /// The ground under a raster's surface down to a base (3D, z up); none of
+    /// its faces is surface for `nearest_surface`.
+    Terrain(Arc<Terrain>),
 }
 
 impl Geometry {
@@ -70,7 +74,7 @@ impl Geometry {
                     to: extent[1],
                 }
             }
-            BodyShape::Particles | BodyShape::Surface => {
+            BodyShape::Particles | BodyShape::Surface | BodyShape::Terrain => {
                 unreachable!("read from the body's file by model::import::body_geometry")
             }
         }
@@ -106,6 +110,7 @@ impl Geometry {
             }
             Geometry::Particles(_) => false,
             Geometry::Surface(s) => s.contains(x),
+            Geometry::Terrain(t) => t.contains(x),
         }
     }
 
@@ -140,6 +145,7 @@ impl Geometry {
             }
             Geometry::Particles(set) => set.top(x, v, up),
             Geometry::Surface(s) => s.top(x, v, up),
+            Geometry::Terrain(t) => t.top(x, v, up),
         }
     }
 
@@ -175,6 +181,7 @@ impl Geometry {
             } => prism_bounds(section, *axis, [*from, *to]),
             Geometry::Particles(set) => set.bounds(),
             Geometry::Surface(s) => s.bounds(),
+            Geometry::Terrain(t) => t.bounds(),
         }
     }
 
@@ -271,7 +278,7 @@ impl Geometry {
                     }
                 }
             }
-            Geometry::Particles(_) | Geometry::Surface(_) => {}
+            Geometry::Particles(_) | Geometry::Surface(_) | Geometry::Terrain(_) => {}
         }
         faces
             .into_iter()
@@ -373,7 +380,8 @@ impl Geometry {
             Geometry::Cylinder { .. }
             | Geometry::Prism { .. }
             | Geometry::Particles(_)
-            | Geometry::Surface(_) => None,
+            | Geometry::Surface(_)
+            | Geometry::Terrain(_) => None,
         }
     }
 }

@@ -14,6 +14,7 @@ pub(crate) mod memory;
 pub mod particle_set;
 pub mod particles;
 pub(crate) mod tensors;
+pub mod terrain;
 pub mod triangles;
 
 pub use loads::{load_factor, LoadTime};

@@ -139,13 +139,19 @@ pub enum BodyShape {
     /// 3D, the closed triangulated surface of an STL `file` (binary or ASCII),
     /// filled on the lattice (`model::import::stl`).
     Surface,
+    /// 3D, the ground under the surface of an ESRI ASCII grid `file` of
+    /// elevations (z up) down to the elevation `base` (`model::import::esri_grid`).
+    Terrain,
 }
 
 impl BodyShape {
     /// Whether the body's geometry is read from its `file` (known only once
     /// read: `model::import`).
     pub fn from_file(self) -> bool {
-        matches!(self, BodyShape::Particles | BodyShape::Surface)
+        matches!(
+            self,
+            BodyShape::Particles | BodyShape::Surface | BodyShape::Terrain
+        )
     }
 }
 
@@ -199,6 +205,8 @@ pub struct BodyConfig {
     pub file: Option<String>,
     /// A `particles` body: only the rows whose `body` column is this number.
     pub body_id: Option<u32>,
+    /// A `terrain` body's bottom elevation (z).
+    pub base: Option<f64>,
     /// Particles per cell per direction: one number or one per direction.
     #[serde(default = "default_ppc")]
     pub particles_per_cell: PerDirection,
@@ -273,7 +281,7 @@ impl BodyConfig {
                     [e[0], e[1]],
                 )
             }
-            BodyShape::Particles | BodyShape::Surface => return None,
+            BodyShape::Particles | BodyShape::Surface | BodyShape::Terrain => return None,
         })
     }
 

@@ -1,11 +1,13 @@
 //! Bodies whose geometry is read from a file (docs/geometry.md): a particle
-//! file (`shape = "particles"`, CSV, `particle_file.rs`) and a closed
-//! triangulated surface (`shape = "surface"`, STL, `stl.rs`). The `file` key
+//! file (`shape = "particles"`, CSV, `particle_file.rs`), a closed
+//! triangulated surface (`shape = "surface"`, STL, `stl.rs`) and a terrain
+//! raster (`shape = "terrain"`, ESRI ASCII grid, `esri_grid.rs`). The `file` key
 //! is a path relative to the scene file's folder. A file error is a scene
 //! error at the body's `file` key whose message names the file and, where it
 //! can, the line and column (particle file) or the facet and edge (STL).
 //! Nothing here runs for a scene without such a body.
 
+pub(crate) mod esri_grid;
 pub(crate) mod particle_file;
 pub(crate) mod stl;
 
@@ -31,9 +33,15 @@ pub fn body_geometry(scene: &Scene, i: usize) -> Result<Geometry, SceneError> {
         BodyShape::Particles => Geometry::Particles(Arc::new(
             particles(scene, i, &path, &shown).map_err(at_file)?,
         )),
+        BodyShape::Terrain => {
+            let base = b.base.expect("validated");
+            Geometry::Terrain(Arc::new(
+                esri_grid::read(&path, &shown, base).map_err(at_file)?,
+            ))
+        }
         _ => Geometry::Surface(Arc::new(stl::read(&path, &shown).map_err(at_file)?)),
     };
-    if let Geometry::Surface(_) = geometry {
+    if !matches!(geometry, Geometry::Particles(_)) {
         let (lo, hi) = geometry.bounds();
         validate::inside_grid(&lo, &hi, i, &scene.config)
             .map_err(|(key, m)| scene.at_key(&key, format!("{shown}: {m}")))?;

@@ -209,7 +209,8 @@ fn shape_keys(b: &BodyConfig, i: usize, dim: usize) -> Check {
         | BodyShape::Sphere
         | BodyShape::Cylinder
         | BodyShape::Prism
-        | BodyShape::Surface => 3,
+        | BodyShape::Surface
+        | BodyShape::Terrain => 3,
         BodyShape::Particles => dim,
     };
     if b.shape != BodyShape::Prism {
@@ -221,6 +222,16 @@ fn shape_keys(b: &BodyConfig, i: usize, dim: usize) -> Check {
     }
     if b.shape != BodyShape::Particles {
         forbidden(&b.body_id, key("body_id"), &what)?;
+    }
+    if b.shape != BodyShape::Terrain {
+        forbidden(&b.base, key("base"), &what)?;
+    } else {
+        required(&b.base, key("base"), &what)?;
+        ensure(
+            b.base.unwrap().is_finite(),
+            key("base"),
+            "must be a finite elevation",
+        )?;
     }
     ensure(
         shape_dim == dim,
@@ -292,7 +303,7 @@ fn shape_keys(b: &BodyConfig, i: usize, dim: usize) -> Check {
                 "needs [from, to] along the axis, finite, with to > from",
             )
         }
-        BodyShape::Particles | BodyShape::Surface => {
+        BodyShape::Particles | BodyShape::Surface | BodyShape::Terrain => {
             required(&b.file, key("file"), &what)?;
             forbidden(&b.min, key("min"), &what)?;
             forbidden(&b.max, key("max"), &what)?;
