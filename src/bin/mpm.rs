@@ -157,6 +157,31 @@ fn run_bench(a: BenchArgs) -> ExitCode {
 }
 
 /// `1x16` → [1, 16].
+/// `mpm check`'s line per body: its particles as built, their total volume
+/// and the box of their domains.
+fn print_extents(c: &mpm::scene::SceneConfig, extents: &[mpm::model::BodyExtent]) {
+    let per = match c.dimension {
+        mpm::scene::Dimension::Axisymmetric => " per radian",
+        mpm::scene::Dimension::Cartesian(2) => " per unit thickness",
+        _ => "",
+    };
+    let point = |v: &[f64]| {
+        let parts: Vec<String> = v.iter().map(|x| format!("{x}")).collect();
+        format!("({})", parts.join(", "))
+    };
+    for (i, (b, e)) in c.bodies.iter().zip(extents).enumerate() {
+        let name = b.name.as_ref().map_or(String::new(), |n| format!(" `{n}`"));
+        println!(
+            "  body {i}{name} ({}): {} particles, volume {}{per}, box {} – {}",
+            b.shape.name(),
+            e.particles,
+            e.volume,
+            point(&e.min),
+            point(&e.max)
+        );
+    }
+}
+
 fn parse_cells(s: &str) -> Result<Vec<usize>, String> {
     s.split('x')
         .map(|n| n.trim().parse::<usize>())
@@ -181,9 +206,9 @@ fn main() -> ExitCode {
                 memory_limit,
                 ..Default::default()
             };
-            set_up_check(&s, &opts).map(|_| s)
+            set_up_check(&s, &opts).map(|extents| (s, extents))
         }) {
-            Ok(s) => {
+            Ok((s, extents)) => {
                 let c = &s.config;
                 let stages: Vec<&str> = c.stages().iter().map(|st| st.kind.name()).collect();
                 let rigid = (0..c.bodies.len())
@@ -204,6 +229,7 @@ fn main() -> ExitCode {
                     c.grid.shape_function.name(),
                     stages.join(" → ")
                 );
+                print_extents(c, &extents);
                 ExitCode::SUCCESS
             }
             Err(e) => {

@@ -68,10 +68,11 @@ pub struct Body {
 }
 
 impl Body {
-    /// Body i of a validated scene.
-    pub fn of(c: &SceneConfig, i: usize) -> Body {
+    /// Body i of a validated scene, with its geometry (from its keys or its
+    /// file: `model::import::body_geometry`).
+    pub fn of(c: &SceneConfig, i: usize, geometry: Geometry) -> Body {
         Body {
-            geometry: Geometry::of(&c.bodies[i]),
+            geometry,
             kind: BodyKind::of(c, i),
         }
     }

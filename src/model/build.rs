@@ -12,9 +12,11 @@ use crate::model::conditions::{Absorbing, Constraint, FaceCondition, Footing, Fr
 use crate::model::geometry::Geometry;
 use crate::model::grid::Grid;
 use crate::model::loads::Loads;
+use crate::model::particle_set::ParticleSet;
 use crate::model::particles::Particles;
 use crate::model::peridynamics::{PdBody, Peridynamics};
-use crate::model::{axisymmetry, Model};
+use crate::model::triangles::{Cells, TriangleSurface};
+use crate::model::{axisymmetry, import, Model};
 use crate::scene::SceneConfig;
 use crate::scene::{
     axis, expr, BodyConfig, BoundaryConfig, Condition, DomainStress, Face, Fill, ParticlesOutside,
@@ -44,7 +46,9 @@ impl<const D: usize> Model<D> {
             .map_err(err)?;
         // A rigid body's particles carry the zero-stress material (`model::body`).
         let base_materials = c.particle_materials(tables);
-        let bodies: Vec<Body> = (0..c.bodies.len()).map(|i| Body::of(c, i)).collect();
+        let bodies = (0..c.bodies.len())
+            .map(|i| import::body_geometry(scene, i).map(|g| Body::of(c, i, g)))
+            .collect::<Result<Vec<Body>, _>>()?;
         let mut particles = Particles::default();
         for (i, b) in c.bodies.iter().enumerate() {
             let m = c
@@ -53,17 +57,17 @@ impl<const D: usize> Model<D> {
                 .position(|m| m.name == b.material)
                 .expect("validated");
             let material = base_materials[m].as_ref();
-            let added = fill_body(
-                &mut particles,
-                &grid,
-                b,
-                &bodies[i].geometry,
-                i,
-                m as u32,
-                material,
-            )
-            .map_err(err)?;
-            if c.dimension.is_axisymmetric() {
+            let added = match &bodies[i].geometry {
+                Geometry::Particles(set) => {
+                    put_file_particles(&mut particles, b, set, i, m as u32, &base_materials)
+                        .map_err(err)?
+                }
+                geometry => fill_body(&mut particles, &grid, b, geometry, i, m as u32, material)
+                    .map_err(err)?,
+            };
+            // A particle file's volumes are per radian already.
+            let file = matches!(bodies[i].geometry, Geometry::Particles(_));
+            if c.dimension.is_axisymmetric() && !file {
                 axisymmetry::per_radian(&mut particles, added);
             }
             if added == 0 {
@@ -227,9 +231,10 @@ fn fill_body<const D: usize>(
     model: &dyn Material,
 ) -> Result<usize, (String, String)> {
     let spacing = Vector::<D>::from_fn(|d, _| grid.h[d] / b.particles_per_cell.get(d) as f64);
-    let points = match b.fill {
-        Fill::Lattice => lattice(grid, b, geometry, &spacing),
-        Fill::Polar => polar(b, spacing[0].min(spacing[1]), spacing[D - 1]),
+    let points = match (b.fill, geometry) {
+        (_, Geometry::Surface(surface)) => surface_cells(grid, surface, geometry, &spacing),
+        (Fill::Lattice, _) => lattice(grid, geometry, &spacing),
+        (Fill::Polar, _) => polar(b, spacing[0].min(spacing[1]), spacing[D - 1]),
     };
     let uniform = b
         .velocity
@@ -238,15 +243,7 @@ fn fill_body<const D: usize>(
     particles.reserve(points.len());
     let mut added = 0;
     for (x, volume, half) in points {
-        let mut v = uniform;
-        if let Some(exprs) = &b.velocity_expr {
-            let mut pos = [0.0; 3];
-            (0..D).for_each(|d| pos[d] = x[d]);
-            for (d, e) in exprs.iter().enumerate() {
-                v[d] +=
-                    expr::eval(e, &pos).map_err(|m| (format!("body.{i}.velocity_expr.{d}"), m))?;
-            }
-        }
+        let v = uniform + velocity_expr(b, i, &x)?;
         particles.push(
             x,
             v,
@@ -262,19 +259,77 @@ fn fill_body<const D: usize>(
     Ok(added)
 }
 
+/// The body's `velocity_expr` at x (zero without one).
+fn velocity_expr<const D: usize>(
+    b: &BodyConfig,
+    i: usize,
+    x: &Vector<D>,
+) -> Result<Vector<D>, (String, String)> {
+    let mut v = Vector::<D>::zeros();
+    if let Some(exprs) = &b.velocity_expr {
+        let mut pos = [0.0; 3];
+        (0..D).for_each(|d| pos[d] = x[d]);
+        for (d, e) in exprs.iter().enumerate() {
+            v[d] += expr::eval(e, &pos).map_err(|m| (format!("body.{i}.velocity_expr.{d}"), m))?;
+        }
+    }
+    Ok(v)
+}
+
+/// Put the particles of a particle file in as they are: each with its
+/// volume, its row's material (else the body's, `material`), its stress and
+/// its velocity plus the body's `velocity` and `velocity_expr`; its domain the
+/// square (cube) of its volume (`ParticleSet::half_length`).
+fn put_file_particles<const D: usize>(
+    particles: &mut Particles<D>,
+    b: &BodyConfig,
+    set: &ParticleSet,
+    i: usize,
+    material: u32,
+    materials: &[Box<dyn Material>],
+) -> Result<usize, (String, String)> {
+    let uniform = b
+        .velocity
+        .as_deref()
+        .map_or(Vector::<D>::zeros(), |v| Vector::<D>::from_fn(|d, _| v[d]));
+    particles.reserve(set.particles.len());
+    for (q, p) in set.particles.iter().enumerate() {
+        let x = Vector::<D>::from_fn(|d, _| p.x[d]);
+        let own = p
+            .velocity
+            .map_or(Vector::<D>::zeros(), |v| Vector::<D>::from_fn(|d, _| v[d]));
+        let v = own + uniform + velocity_expr(b, i, &x)?;
+        let m = p.material.unwrap_or(material);
+        let model = materials[m as usize].as_ref();
+        let h = set.half_length(q);
+        let half = Vector::<D>::from_fn(|d, _| h[d]);
+        particles.push(
+            x,
+            v,
+            model.density() * p.volume,
+            p.volume,
+            half,
+            i as u32,
+            m,
+            model.n_history(),
+        );
+        if let Some(s) = &p.stress {
+            particles.stress.set(particles.len() - 1, s);
+        }
+    }
+    Ok(set.particles.len())
+}
+
 /// A particle of a fill: position, volume and the half-lengths of its domain.
 type Point<const D: usize> = (Vector<D>, f64, Vector<D>);
 
-/// The lattice points with the given spacing that lie inside the body.
-fn lattice<const D: usize>(
+/// The lattice index range [first, last) covering the body's bounding box.
+fn lattice_range<const D: usize>(
     grid: &Grid<D>,
-    b: &BodyConfig,
     geometry: &Geometry,
     spacing: &Vector<D>,
-) -> Vec<Point<D>> {
-    let (lo, hi) = b.bounds();
-    let volume = spacing.product();
-    // Lattice index range covering the bounding box.
+) -> ([usize; D], [usize; D]) {
+    let (lo, hi) = geometry.bounds();
     let first: [usize; D] =
         std::array::from_fn(|d| (((lo[d] - grid.min[d]) / spacing[d]).floor().max(0.0)) as usize);
     // A body cut at a symmetry plane keeps the part inside the grid.
@@ -282,6 +337,56 @@ fn lattice<const D: usize>(
         let upper = hi[d].min(grid.min[d] + grid.h[d] * grid.cells[d] as f64);
         ((upper - grid.min[d]) / spacing[d]).ceil() as usize
     });
+    (first, last)
+}
+
+/// A closed surface on the lattice: each lattice cell the solid reaches
+/// holds one particle with the solid's volume in the cell, at the lattice
+/// point where the cell is whole (as `lattice` puts it) and at the centroid of
+/// the part inside where the surface cuts the cell (`TriangleSurface::cell_parts`);
+/// its domain the cell's, shrunk to the part's volume.
+fn surface_cells<const D: usize>(
+    grid: &Grid<D>,
+    surface: &TriangleSurface,
+    geometry: &Geometry,
+    spacing: &Vector<D>,
+) -> Vec<Point<D>> {
+    let (first, last) = lattice_range(grid, geometry, spacing);
+    let cells = Cells {
+        origin: std::array::from_fn(|d| grid.min[d]),
+        spacing: std::array::from_fn(|d| spacing[d]),
+        first: std::array::from_fn(|d| first[d]),
+        last: std::array::from_fn(|d| last[d]),
+    };
+    let whole = spacing.product();
+    (surface.cell_parts(&cells).into_iter())
+        .map(|part| {
+            let fraction = part.volume / whole;
+            match fraction >= 1.0 - 1e-12 {
+                true => {
+                    let x = Vector::<D>::from_fn(|d, _| {
+                        grid.min[d] + (part.cell[d] as f64 + 0.5) * spacing[d]
+                    });
+                    (x, whole, spacing / 2.0)
+                }
+                false => {
+                    let x = Vector::<D>::from_fn(|d, _| part.centroid[d]);
+                    let shrink = fraction.powf(1.0 / D as f64);
+                    (x, part.volume, spacing * (0.5 * shrink))
+                }
+            }
+        })
+        .collect()
+}
+
+/// The lattice points with the given spacing that lie inside the body.
+fn lattice<const D: usize>(
+    grid: &Grid<D>,
+    geometry: &Geometry,
+    spacing: &Vector<D>,
+) -> Vec<Point<D>> {
+    let volume = spacing.product();
+    let (first, last) = lattice_range(grid, geometry, spacing);
     let counts: Vec<usize> = (0..D).map(|d| last[d].saturating_sub(first[d])).collect();
     let total: usize = counts.iter().product();
     (0..total)

@@ -1,11 +1,17 @@
 //! The geometry of a body: an axis-aligned box (rectangle in 2D), a ball (disk,
 //! sphere), a cylinder along z (3D), a simple polygon (2D) or a polygon extruded
-//! along an axis (a prism, 3D), as given by the `[[body]]` keys. The model
+//! along an axis (a prism, 3D), as given by the `[[body]]` keys; or read from
+//! a file (`model::import`): the particles of a particle file, a closed
+//! triangulated surface (3D). The model
 //! fills it with particles (`contains`, within `BodyConfig::bounds`, which the
 //! validation also uses) and measures the depth of a particle below its body's
 //! top surface for geostatic stresses (`top`).
 
+use crate::model::particle_set::ParticleSet;
+use crate::model::terrain::Terrain;
+use crate::model::triangles::TriangleSurface;
 use crate::scene::{prism_bounds, prism_plane, BodyConfig, BodyShape};
+use std::sync::Arc;
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Geometry {
@@ -29,10 +35,20 @@ pub enum Geometry {
         from: f64,
         to: f64,
     },
+    /// The particles of a particle file, put in as they are: no lattice point
+    /// is inside, and no face is surface (`nearest_surface` is `None`).
+    Particles(Arc<ParticleSet>),
+    /// A closed triangulated surface (3D); none of its faces is surface for
+    /// `nearest_surface` (a rigid body does not take one, validation).
+    Surface(Arc<TriangleSurface>),
+    /// The ground under a raster's surface down to a base (3D, z up); none of
+    /// its faces is surface for `nearest_surface`.
+    Terrain(Arc<Terrain>),
 }
 
 impl Geometry {
-    /// The geometry of a validated `[[body]]` table.
+    /// The geometry of a validated `[[body]]` table whose shape is given by
+    /// its keys (one read from a file: `model::import::body_geometry`).
     pub fn of(b: &BodyConfig) -> Geometry {
         match b.shape {
             BodyShape::Rectangle | BodyShape::Box => Geometry::Box {
@@ -57,6 +73,9 @@ impl Geometry {
                     from: extent[0],
                     to: extent[1],
                 }
+            }
+            BodyShape::Particles | BodyShape::Surface | BodyShape::Terrain => {
+                unreachable!("read from the body's file by model::import::body_geometry")
             }
         }
     }
@@ -89,6 +108,9 @@ impl Geometry {
                     && x[*axis] < *to
                     && point_in_polygon(x[plane[0]], x[plane[1]], section)
             }
+            Geometry::Particles(_) => false,
+            Geometry::Surface(s) => s.contains(x),
+            Geometry::Terrain(t) => t.contains(x),
         }
     }
 
@@ -121,6 +143,9 @@ impl Geometry {
                 let k = usize::from(plane[1] == v);
                 polygon_top(section, x[plane[1 - k]], k, up)
             }
+            Geometry::Particles(set) => set.top(x, v, up),
+            Geometry::Surface(s) => s.top(x, v, up),
+            Geometry::Terrain(t) => t.top(x, v, up),
         }
     }
 
@@ -154,6 +179,9 @@ impl Geometry {
                 from,
                 to,
             } => prism_bounds(section, *axis, [*from, *to]),
+            Geometry::Particles(set) => set.bounds(),
+            Geometry::Surface(s) => s.bounds(),
+            Geometry::Terrain(t) => t.bounds(),
         }
     }
 
@@ -250,6 +278,7 @@ impl Geometry {
                     }
                 }
             }
+            Geometry::Particles(_) | Geometry::Surface(_) | Geometry::Terrain(_) => {}
         }
         faces
             .into_iter()
@@ -348,7 +377,11 @@ impl Geometry {
                     },
                 ))
             }
-            Geometry::Cylinder { .. } | Geometry::Prism { .. } => None,
+            Geometry::Cylinder { .. }
+            | Geometry::Prism { .. }
+            | Geometry::Particles(_)
+            | Geometry::Surface(_)
+            | Geometry::Terrain(_) => None,
         }
     }
 }

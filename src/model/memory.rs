@@ -5,7 +5,8 @@
 //!
 //! The estimate counts the large arrays, in bytes:
 //! - particles: the lattice points `Model::build` visits (each body's bounding
-//!   box at `particles_per_cell`, an upper bound of its particles) times the
+//!   box at `particles_per_cell`, an upper bound of its particles; none for a
+//!   body read from a file, `model::import`, which this estimate does not read) times the
 //!   fields of `Particles` (vectors, F and σ, history, APIC's B_p) and a step's stencil (the
 //!   shape function's support, a weight, a gradient and a node index each);
 //! - grid: the nodes times a step's nodal arrays (mass, momentum, force,
@@ -61,7 +62,11 @@ impl Estimate {
         let grid_nodes: f64 = (0..dim).map(|k| cells(k) + shape.degree() as f64).product();
         let lattice_points: Vec<f64> = (c.bodies.iter())
             .map(|b| {
-                let (lo, hi) = b.bounds();
+                // A body read from a file is counted once read: its particles
+                // are the file's rows, its lattice the surface's box.
+                let Some((lo, hi)) = b.bounds() else {
+                    return 0.0;
+                };
                 (0..dim)
                     .map(|k| {
                         let spacing = h(k) / b.particles_per_cell.get(k) as f64;

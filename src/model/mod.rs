@@ -8,11 +8,15 @@ mod build;
 pub(crate) mod conditions;
 pub mod geometry;
 pub mod grid;
+pub(crate) mod import;
 pub(crate) mod loads;
 pub(crate) mod memory;
+pub mod particle_set;
 pub mod particles;
 pub mod peridynamics;
 pub(crate) mod tensors;
+pub mod terrain;
+pub mod triangles;
 
 use crate::model::peridynamics::Peridynamics;
 pub use loads::{load_factor, LoadTime};
@@ -24,6 +28,17 @@ use crate::model::conditions::{Absorbing, FaceCondition, Footing, FrictionFace};
 use crate::model::grid::Grid;
 use crate::model::particles::Particles;
 use crate::scene::contact::ContactPlan;
+
+/// A body's particles as built (`Model::body_extents`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct BodyExtent {
+    pub particles: usize,
+    /// Σ V_p: area × unit thickness in 2D, per radian in an axisymmetric model.
+    pub volume: f64,
+    /// The box of the particles' domains (x_p ± half-lengths).
+    pub min: Vec<f64>,
+    pub max: Vec<f64>,
+}
 
 /// Everything a solver needs, in dimension D.
 #[derive(Debug)]
@@ -150,6 +165,31 @@ impl<const D: usize> Model<D> {
         let p = &self.particles;
         let d2 = |q: usize| (0..D).map(|d| (p.x0[q][d] - x[d]).powi(2)).sum::<f64>();
         (0..p.len()).min_by(|&a, &b| d2(a).total_cmp(&d2(b)))
+    }
+
+    /// Each body's particles as built: their count, total volume (per radian
+    /// in an axisymmetric model) and the box of their domains (`mpm check`).
+    pub fn body_extents(&self) -> Vec<BodyExtent> {
+        let p = &self.particles;
+        let mut extents: Vec<BodyExtent> = (0..self.bodies.len())
+            .map(|_| BodyExtent {
+                particles: 0,
+                volume: 0.0,
+                min: vec![f64::INFINITY; D],
+                max: vec![f64::NEG_INFINITY; D],
+            })
+            .collect();
+        for q in 0..p.len() {
+            let e = &mut extents[p.body[q] as usize];
+            e.particles += 1;
+            e.volume += p.volume[q];
+            for d in 0..D {
+                let (x, h) = (p.x[q][d], p.half_length0[q][d]);
+                e.min[d] = e.min[d].min(x - h);
+                e.max[d] = e.max[d].max(x + h);
+            }
+        }
+        extents
     }
 
     /// The kind of particle q's body.

@@ -2,7 +2,7 @@
 //! the model's build and each stage's step count.
 
 use crate::model::memory::{self, Estimate};
-use crate::model::Model;
+use crate::model::{BodyExtent, Model};
 use crate::run::options::RunOptions;
 use crate::scene::{Scene, SceneError, SolverKind};
 use crate::solver::explicit::Explicit;
@@ -10,19 +10,29 @@ use crate::solver::explicit::Explicit;
 /// What a run checks before it allocates and steps: the memory estimate, then the
 /// model's build (a body that holds no particle, an absorbing face with no
 /// material, …). `mpm check` calls it, so it rejects what `mpm run` would; an
-/// error that an override causes names the override (`Scene::blame`).
-pub fn set_up_check(scene: &Scene, opts: &RunOptions) -> Result<(), SceneError> {
+/// error that an override causes names the override (`Scene::blame`). Returns
+/// each body's particles as built (`Model::body_extents`).
+pub fn set_up_check(scene: &Scene, opts: &RunOptions) -> Result<Vec<BodyExtent>, SceneError> {
     before_steps(scene, opts).map_err(|e| scene.blame(e, |s| before_steps(s, opts)))
 }
 
 /// [`set_up_check`] without naming the override an error comes from.
-pub(super) fn before_steps(scene: &Scene, opts: &RunOptions) -> Result<(), SceneError> {
+pub(super) fn before_steps(
+    scene: &Scene,
+    opts: &RunOptions,
+) -> Result<Vec<BodyExtent>, SceneError> {
     check_memory(scene, opts)?;
     match scene.config.dimension.spatial() {
-        2 => check_steps(scene, &Model::<2>::build(scene)?),
-        3 => check_steps(scene, &Model::<3>::build(scene)?),
+        2 => built(scene, &Model::<2>::build(scene)?),
+        3 => built(scene, &Model::<3>::build(scene)?),
         d => unreachable!("validated dimension {d}"),
     }
+}
+
+/// The step counts of a built model checked, and its bodies' extents.
+fn built<const D: usize>(scene: &Scene, model: &Model<D>) -> Result<Vec<BodyExtent>, SceneError> {
+    check_steps(scene, model)?;
+    Ok(model.body_extents())
 }
 
 /// The most steps a stage may take: more is a mistake in the scene (a run of

@@ -133,6 +133,26 @@ pub enum BodyShape {
     /// other two axes (in increasing order: x–z for the default axis y),
     /// `extent` = [from, to] along `axis`.
     Prism,
+    /// The particles of a CSV `file` (positions, volumes, optional material,
+    /// stress and velocity per row), 2D or 3D (`model::import::particle_file`).
+    Particles,
+    /// 3D, the closed triangulated surface of an STL `file` (binary or ASCII),
+    /// filled on the lattice (`model::import::stl`).
+    Surface,
+    /// 3D, the ground under the surface of an ESRI ASCII grid `file` of
+    /// elevations (z up) down to the elevation `base` (`model::import::esri_grid`).
+    Terrain,
+}
+
+impl BodyShape {
+    /// Whether the body's geometry is read from its `file` (known only once
+    /// read: `model::import`).
+    pub fn from_file(self) -> bool {
+        matches!(
+            self,
+            BodyShape::Particles | BodyShape::Surface | BodyShape::Terrain
+        )
+    }
 }
 
 impl BodyShape {
@@ -208,6 +228,13 @@ pub struct BodyConfig {
     pub axis: Option<String>,
     /// [from, to] of a prism along its axis.
     pub extent: Option<Vec<f64>>,
+    /// The file of a `particles` or `surface` body, relative to the scene
+    /// file's folder.
+    pub file: Option<String>,
+    /// A `particles` body: only the rows whose `body` column is this number.
+    pub body_id: Option<u32>,
+    /// A `terrain` body's bottom elevation (z).
+    pub base: Option<f64>,
     /// Particles per cell per direction: one number or one per direction.
     #[serde(default = "default_ppc")]
     pub particles_per_cell: PerDirection,
@@ -250,9 +277,11 @@ pub enum Fill {
 }
 
 impl BodyConfig {
-    /// Corners of the bounding box of the body's shape (its keys validated).
-    pub fn bounds(&self) -> (Vec<f64>, Vec<f64>) {
-        match self.shape {
+    /// Corners of the bounding box of the body's shape (its keys validated);
+    /// `None` for a body read from a file, whose bounds the model knows once it
+    /// has read the file (`model::geometry::Geometry::bounds`).
+    pub fn bounds(&self) -> Option<(Vec<f64>, Vec<f64>)> {
+        Some(match self.shape {
             BodyShape::Rectangle | BodyShape::Box => {
                 (self.min.clone().unwrap(), self.max.clone().unwrap())
             }
@@ -292,7 +321,8 @@ impl BodyConfig {
                     [e[0], e[1]],
                 )
             }
-        }
+            BodyShape::Particles | BodyShape::Surface | BodyShape::Terrain => return None,
+        })
     }
 
     /// A prism's axis (validated): 0, 1 or 2; y when not given.

@@ -1,10 +1,12 @@
 //! Every value a scene may name is documented: the compiler does not see
 //! docs/scene.md, so a shape function, solver kind, scheme, integrator, linear
-//! solver, body kind or material model added without its documentation fails
+//! solver, body kind, body shape or material model added without its documentation fails
 //! here (docs/architecture.md, the recipes).
 
 use mpm::material::registry;
-use mpm::scene::{BodyKindName, Integrator, LinearSolver, Scheme, ShapeFunction, SolverKind};
+use mpm::scene::{
+    BodyKindName, BodyShape, Integrator, LinearSolver, Scheme, ShapeFunction, SolverKind,
+};
 use strum::IntoEnumIterator;
 
 fn scene_md() -> String {
@@ -29,6 +31,7 @@ fn every_enumerated_scene_value_is_documented() {
     names.extend(Integrator::iter().map(|v| v.name()));
     names.extend(LinearSolver::iter().map(|v| v.name()));
     names.extend(BodyKindName::iter().map(<&str>::from));
+    names.extend(BodyShape::iter().map(|v| v.name()));
     let missing = undocumented(names);
     assert!(
         missing.is_empty(),

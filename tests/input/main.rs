@@ -12,6 +12,7 @@ mod contact;
 mod documented;
 mod domain_stress;
 mod fuzz;
+mod geometry;
 mod impact;
 mod key_paths;
 mod robustness;

@@ -4,7 +4,8 @@
 use super::check::{ensure, required, vector, Check};
 use crate::material::Material;
 use crate::scene::{
-    BenchConfig, BodyKindName, GeostaticConfig, SceneConfig, SolverKind, StrengthReductionConfig,
+    BenchConfig, BodyKindName, BodyShape, GeostaticConfig, SceneConfig, SolverKind,
+    StrengthReductionConfig,
 };
 
 pub fn geostatic(g: &GeostaticConfig, s: &SceneConfig, materials: &[Box<dyn Material>]) -> Check {
@@ -27,6 +28,13 @@ pub fn geostatic(g: &GeostaticConfig, s: &SceneConfig, materials: &[Box<dyn Mate
         if s.body_kind(i) != BodyKindName::Continuum {
             continue;
         }
+        ensure(
+            b.shape != BodyShape::Particles,
+            format!("body.{i}.shape"),
+            "[geostatic] measures depths below a body's top surface, which a particle \
+             file does not give: give the initial stresses in the file's stress columns \
+             (docs/geometry.md)",
+        )?;
         let k = s
             .materials
             .iter()

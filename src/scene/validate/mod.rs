@@ -16,6 +16,7 @@ mod solver;
 
 pub use analyses::bench;
 pub use check::Check;
+pub use grid_bodies::inside_grid;
 
 use crate::scene::contact::ContactPlan;
 use crate::scene::{

@@ -1,0 +1,96 @@
+//! Bodies whose geometry is read from a file (docs/geometry.md): a particle
+//! file (`shape = "particles"`, CSV, `particle_file.rs`), a closed
+//! triangulated surface (`shape = "surface"`, STL, `stl.rs`) and a terrain
+//! raster (`shape = "terrain"`, ESRI ASCII grid, `esri_grid.rs`). The `file` key
+//! is a path relative to the scene file's folder. A file error is a scene
+//! error at the body's `file` key whose message names the file and, where it
+//! can, the line and column (particle file) or the facet and edge (STL).
+//! Nothing here runs for a scene without such a body.
+
+pub(crate) mod esri_grid;
+pub(crate) mod particle_file;
+pub(crate) mod stl;
+
+use crate::material::parameters::FromParameters;
+use crate::material::rigid::Rigid;
+use crate::model::geometry::Geometry;
+use crate::scene::{validate, BodyKindName, BodyShape, Scene, SceneError};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// The geometry of body i of a validated scene: from its keys, or read from
+/// its file.
+pub fn body_geometry(scene: &Scene, i: usize) -> Result<Geometry, SceneError> {
+    let b = &scene.config.bodies[i];
+    if !b.shape.from_file() {
+        return Ok(Geometry::of(b));
+    }
+    let file = b.file.as_deref().expect("validated");
+    let path = beside(&scene.file, file);
+    let shown = path.display().to_string();
+    let at_file = |m: String| scene.at_key(&format!("body.{i}.file"), m);
+    let geometry = match b.shape {
+        BodyShape::Particles => Geometry::Particles(Arc::new(
+            particles(scene, i, &path, &shown).map_err(at_file)?,
+        )),
+        BodyShape::Terrain => {
+            let base = b.base.expect("validated");
+            Geometry::Terrain(Arc::new(
+                esri_grid::read(&path, &shown, base).map_err(at_file)?,
+            ))
+        }
+        _ => Geometry::Surface(Arc::new(stl::read(&path, &shown).map_err(at_file)?)),
+    };
+    if !matches!(geometry, Geometry::Particles(_)) {
+        let (lo, hi) = geometry.bounds();
+        validate::inside_grid(&lo, &hi, i, &scene.config)
+            .map_err(|(key, m)| scene.at_key(&key, format!("{shown}: {m}")))?;
+    }
+    Ok(geometry)
+}
+
+/// `file` relative to the folder of the scene file `scene` (as given, if
+/// absolute).
+pub fn beside(scene: &str, file: &str) -> PathBuf {
+    let p = Path::new(file);
+    match p.is_absolute() {
+        true => p.to_path_buf(),
+        false => Path::new(scene).parent().unwrap_or(Path::new("")).join(p),
+    }
+}
+
+fn particles(
+    scene: &Scene,
+    i: usize,
+    path: &Path,
+    shown: &str,
+) -> Result<crate::model::particle_set::ParticleSet, String> {
+    let c = &scene.config;
+    let material = |name: &str| material_zone(scene, name);
+    let expect = particle_file::Expect {
+        dim: c.dimension.spatial(),
+        per_radian: c.dimension.is_axisymmetric(),
+        grid: (&c.grid.min, &c.grid.max),
+        body_id: c.bodies[i].body_id,
+        material: &material,
+    };
+    particle_file::read(path, shown, &expect)
+}
+
+/// The table index of the material a particle file's row names: a table of
+/// the scene that no rigid body takes (a rigid body's table gives only its
+/// density, `SceneConfig::particle_materials`).
+fn material_zone(scene: &Scene, name: &str) -> Result<u32, String> {
+    let c = &scene.config;
+    let k = (c.materials.iter().position(|m| m.name == name))
+        .ok_or_else(|| format!("no [[material]] is named `{name}`"))?;
+    let rigid_body = (0..c.bodies.len())
+        .any(|j| c.bodies[j].material == name && c.body_kind(j) == BodyKindName::Rigid);
+    if c.materials[k].model == Rigid::NAME || rigid_body {
+        return Err(format!(
+            "material `{name}` is a rigid body's (model = \"rigid\" or the material of a \
+             rigid body): a particle of a continuum body needs a constitutive model"
+        ));
+    }
+    Ok(k as u32)
+}
