@@ -16,3 +16,4 @@ mod impact;
 mod key_paths;
 mod robustness;
 mod scene_errors;
+mod time_histories;
