@@ -8,10 +8,13 @@
 use crate::dim::Vector;
 use crate::material::Material;
 use crate::model::body::{Body, BodyKind};
-use crate::model::conditions::{Absorbing, Constraint, FaceCondition, Footing, FrictionFace};
+use crate::model::conditions::{
+    Absorbing, Constraint, FaceCondition, FaceMotion, Footing, FrictionFace, MotionKind,
+};
+use crate::model::curve::TimeCurve;
 use crate::model::geometry::Geometry;
 use crate::model::grid::Grid;
-use crate::model::loads::Loads;
+use crate::model::loads::{LoadTime, Loads};
 use crate::model::particle_set::ParticleSet;
 use crate::model::particles::Particles;
 use crate::model::peridynamics::{PdBody, Peridynamics};
@@ -22,6 +25,7 @@ use crate::scene::{
     axis, expr, BodyConfig, BoundaryConfig, Condition, DomainStress, Face, Fill, ParticlesOutside,
     Scene, SceneError,
 };
+use std::sync::Arc;
 
 impl<const D: usize> Model<D> {
     pub fn build(scene: &Scene) -> Result<Model<D>, SceneError> {
@@ -83,6 +87,7 @@ impl<const D: usize> Model<D> {
             .iter()
             .map(|(_, b)| face_condition(b, &vec))
             .collect();
+        let face_motions = face_motions(&velocity, &vec);
         let friction = c
             .boundaries
             .iter()
@@ -123,11 +128,14 @@ impl<const D: usize> Model<D> {
             base_materials,
             bodies,
             faces,
+            face_motions,
             friction,
             footing,
             absorbing,
             contact: crate::scene::contact::plan(c).map_err(err)?,
             gravity,
+            gravity_history: (c.gravity_history.as_ref())
+                .map(|h| LoadTime::Curve(Arc::new(TimeCurve::new(&h.points())))),
             load_ramps: loads.ramps,
             load_ramp_of: loads.ramp_of,
             axisymmetric,
@@ -168,7 +176,7 @@ fn face_condition<const D: usize>(
             unreachable!("absorbing and friction faces are not velocity conditions")
         }
         Condition::Velocity => {
-            let v = vec(b.velocity.as_ref().unwrap());
+            let v = vec(motion_vector(b).1);
             let comps: Vec<usize> = match &b.components {
                 Some(c) => c.iter().map(|a| axis(a).unwrap()).collect(),
                 None => (0..D).collect(),
@@ -186,6 +194,37 @@ fn face_condition<const D: usize>(
         constraint,
         region,
     }
+}
+
+/// The vector of a velocity condition and what it is: `velocity`,
+/// `acceleration` or `displacement` (validated: exactly one).
+fn motion_vector(b: &BoundaryConfig) -> (MotionKind, &[f64]) {
+    match (&b.velocity, &b.acceleration, &b.displacement) {
+        (Some(v), _, _) => (MotionKind::Velocity, v),
+        (None, Some(a), _) => (MotionKind::Acceleration, a),
+        (None, None, Some(u)) => (MotionKind::Displacement, u),
+        (None, None, None) => unreachable!("validated: a velocity condition gives a vector"),
+    }
+}
+
+/// The velocity conditions (`velocity`, in the order of `Model::faces`) that
+/// follow a time history.
+fn face_motions<const D: usize>(
+    velocity: &[(usize, &BoundaryConfig)],
+    vec: &impl Fn(&[f64]) -> Vector<D>,
+) -> Vec<FaceMotion<D>> {
+    (velocity.iter().enumerate())
+        .filter_map(|(face, (_, b))| {
+            let h = b.time_history.as_ref()?;
+            let (kind, amplitude) = motion_vector(b);
+            Some(FaceMotion {
+                face,
+                kind,
+                amplitude: vec(amplitude),
+                curve: Arc::new(TimeCurve::new(&h.points())),
+            })
+        })
+        .collect()
 }
 
 /// The footing (the velocity condition with a `footing_width`), with the cohesion

@@ -1,6 +1,7 @@
 //! The conditions of a model as built from the scene: velocity conditions on grid
 //! faces (fixed, roller, prescribed velocity, optionally on a region: a rigid
-//! footing), rough rigid faces with Coulomb friction, and absorbing faces with the
+//! footing; a velocity, acceleration or displacement that follows a time
+//! history: `FaceMotion`), rough rigid faces with Coulomb friction, and absorbing faces with the
 //! wave properties of the materials next to them. The laws that act with them are
 //! in `physics::boundary::conditions` and `physics::boundary::absorbing`.
 //!
@@ -10,9 +11,11 @@
 
 use crate::dim::Vector;
 use crate::material::{shear_modulus, Material};
+use crate::model::curve::TimeCurve;
 use crate::model::grid::Grid;
 use crate::model::particles::Particles;
 use crate::scene::{BoundaryConfig, Condition, Face};
+use std::sync::Arc;
 
 /// Which velocity components of a node are prescribed, and their values.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -81,6 +84,48 @@ impl<const D: usize> FaceCondition<D> {
             let tol = 1e-9 * grid.h[d];
             x[d] >= lo[d] - tol && x[d] <= hi[d] + tol
         })
+    }
+}
+
+/// What a face's time history prescribes, and so the order of its integral
+/// that gives the face's displacement.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MotionKind {
+    Displacement,
+    Velocity,
+    Acceleration,
+}
+
+/// A velocity condition that follows a time history f(t) (`model::curve`):
+/// its displacement is u(t) = a F_n(t), with a the vector of the scene
+/// (`displacement`, `velocity`, `acceleration`) and F_n the integral of f
+/// from t = 0 of order n = 0, 1, 2 (from rest at the reference position).
+#[derive(Clone, Debug)]
+pub struct FaceMotion<const D: usize> {
+    /// Index of the condition in `Model::faces`.
+    pub face: usize,
+    pub kind: MotionKind,
+    pub amplitude: Vector<D>,
+    pub curve: Arc<TimeCurve>,
+}
+
+impl<const D: usize> FaceMotion<D> {
+    /// The face's displacement at t, a F_n(t).
+    pub fn displacement(&self, t: f64) -> Vector<D> {
+        let order = match self.kind {
+            MotionKind::Displacement => 0,
+            MotionKind::Velocity => 1,
+            MotionKind::Acceleration => 2,
+        };
+        self.amplitude * self.curve.integral(order, t)
+    }
+
+    /// The velocity a step from t to t + dt prescribes: the mean over the step,
+    /// (u(t + dt) − u(t)) / dt, so that the face is at u(t) after every step
+    /// whatever the steps (explicit and implicit alike).
+    pub fn step_velocity(&self, t: f64, dt: f64) -> Vector<D> {
+        debug_assert!(dt > 0.0, "a step has a positive length");
+        (self.displacement(t + dt) - self.displacement(t)) / dt
     }
 }
 

@@ -1,30 +1,41 @@
 //! Loads on particles: a point force shared by the particles of a region, or a
 //! traction on one face of each particle (axisymmetric: per radian, over the
-//! face's area per radian, `model::axisymmetry`), with its time history (a ramp or a
-//! pulse). The force at full value is stored on the particles (`Particles::load`);
+//! face's area per radian, `model::axisymmetry`), with its time history (a ramp, a
+//! pulse or a piecewise-linear curve). The force at full value is stored on the particles (`Particles::load`);
 //! a solver scales it by the factor of the particle's history at time t
 //! (`load_factor`).
 
 use crate::dim::Vector;
 use crate::model::axisymmetry::face_area_per_radian;
+use crate::model::curve::TimeCurve;
 use crate::model::particles::Particles;
 use crate::scene::{Face, LoadConfig, LoadKind, SceneConfig};
+use std::sync::Arc;
 
 /// How a load varies in time.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum LoadTime {
     /// min(t / ramp_time, 1); at once when the ramp time is 0.
     Ramp(f64),
     /// A smooth pulse of duration T: sin²(π t / T) for t ≤ T, then 0.
     Pulse(f64),
+    /// A piecewise-linear time history (`time_history`, `model::curve`).
+    Curve(Arc<TimeCurve>),
 }
 
 impl LoadTime {
     pub fn of(l: &LoadConfig) -> LoadTime {
-        match l.pulse_duration {
-            Some(t) => LoadTime::Pulse(t),
-            None => LoadTime::Ramp(l.ramp_time),
+        match (&l.time_history, l.pulse_duration) {
+            (Some(h), _) => LoadTime::Curve(Arc::new(TimeCurve::new(&h.points()))),
+            (None, Some(t)) => LoadTime::Pulse(t),
+            (None, None) => LoadTime::Ramp(l.ramp_time),
         }
+    }
+
+    /// Whether the factor follows a time history given in the scene (also in
+    /// quasi-static stages, where ramps follow the stage's load factor).
+    pub fn is_curve(&self) -> bool {
+        matches!(self, LoadTime::Curve(_))
     }
 
     pub fn factor(&self, t: f64) -> f64 {
@@ -35,6 +46,7 @@ impl LoadTime {
                 (std::f64::consts::PI * t / d).sin().powi(2)
             }
             LoadTime::Pulse(_) => 0.0,
+            LoadTime::Curve(ref c) => c.value(t),
         }
     }
 }
@@ -94,20 +106,23 @@ impl Loads {
                 ));
             }
             let time = LoadTime::of(l);
-            let ramp = ramps.iter().position(|&r| r == time).unwrap_or_else(|| {
-                ramps.push(time);
-                ramps.len() - 1
-            });
+            let ramp = match ramps.iter().position(|r| *r == time) {
+                Some(r) => r,
+                None => {
+                    ramps.push(time);
+                    ramps.len() - 1
+                }
+            };
             for &p in &selected {
                 if ramp_of[p] != u32::MAX && ramp_of[p] != ramp as u32 {
-                    let key = if l.pulse_duration.is_some() {
-                        "pulse_duration"
-                    } else {
-                        "ramp_time"
+                    let key = match (&l.time_history, l.pulse_duration) {
+                        (Some(_), _) => "time_history",
+                        (None, Some(_)) => "pulse_duration",
+                        (None, None) => "ramp_time",
                     };
                     return Err((
                         format!("load.{i}.{key}"),
-                        format!("particle {p} already carries a load with another time history (ramp_time or pulse_duration)"),
+                        format!("particle {p} already carries a load with another time history (ramp_time, pulse_duration or time_history)"),
                     ));
                 }
                 ramp_of[p] = ramp as u32;

@@ -6,6 +6,7 @@ pub(crate) mod axisymmetry;
 pub(crate) mod body;
 mod build;
 pub(crate) mod conditions;
+pub mod curve;
 pub mod geometry;
 pub mod grid;
 pub(crate) mod import;
@@ -24,10 +25,11 @@ pub use loads::{load_factor, LoadTime};
 use crate::dim::Vector;
 use crate::material::Material;
 use crate::model::body::{Body, BodyKind};
-use crate::model::conditions::{Absorbing, FaceCondition, Footing, FrictionFace};
+use crate::model::conditions::{Absorbing, FaceCondition, FaceMotion, Footing, FrictionFace};
 use crate::model::grid::Grid;
 use crate::model::particles::Particles;
 use crate::scene::contact::ContactPlan;
+use std::borrow::Cow;
 
 /// A body's particles as built (`Model::body_extents`).
 #[derive(Clone, Debug, PartialEq)]
@@ -53,6 +55,8 @@ pub struct Model<const D: usize> {
     /// Each body's geometry and kind (by `Particles::body`).
     pub bodies: Vec<Body>,
     pub faces: Vec<FaceCondition<D>>,
+    /// The velocity conditions that follow a time history (`Model::faces_during`).
+    pub face_motions: Vec<FaceMotion<D>>,
     /// Rigid rough faces (Coulomb friction; held fixed in implicit steps).
     pub friction: Vec<FrictionFace>,
     /// The velocity condition with a `footing_width`, if any.
@@ -62,6 +66,9 @@ pub struct Model<const D: usize> {
     /// Contact between bodies: velocity fields and their laws (`[[contact]]`).
     pub contact: Option<ContactPlan>,
     pub gravity: Vector<D>,
+    /// `gravity_history`: gravity times this factor on the run's clock, in place
+    /// of the stages' ramps (None: the ramps).
+    pub gravity_history: Option<LoadTime>,
     /// The distinct time histories of the loads (the force is stored on the
     /// particles grouped by history, see `load_scales`).
     pub load_ramps: Vec<LoadTime>,
@@ -113,6 +120,29 @@ impl<const D: usize> Model<D> {
             sum + 0.5 * p.mass[q] * p.v[q].norm_squared() + p.volume[q] * stored
         });
         (mass, energy)
+    }
+
+    /// The face conditions of the step t → t + dt: `faces`, the values of those
+    /// that follow a time history set to their velocity over the step
+    /// (`FaceMotion::step_velocity`). Borrowed when no face has a history.
+    pub fn faces_during(&self, t: f64, dt: f64) -> Cow<'_, [FaceCondition<D>]> {
+        if self.face_motions.is_empty() {
+            return Cow::Borrowed(&self.faces);
+        }
+        let mut faces = self.faces.clone();
+        for motion in &self.face_motions {
+            let v = motion.step_velocity(t, dt);
+            let c = &mut faces[motion.face].constraint;
+            (0..D)
+                .filter(|&d| c.fixed[d])
+                .for_each(|d| c.value[d] = v[d]);
+        }
+        Cow::Owned(faces)
+    }
+
+    /// The factor of gravity at time t: its history's, or else the stage's `ramp`.
+    pub fn gravity_factor(&self, t: f64, ramp: &LoadTime) -> f64 {
+        self.gravity_history.as_ref().unwrap_or(ramp).factor(t)
     }
 
     /// Load factor of each load time history at time t.

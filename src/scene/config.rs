@@ -6,6 +6,7 @@
 //! are arrays whose length must equal `dimension`. Enumerated values are read
 //! (serde) and named (strum, `name()`) in snake_case.
 
+use super::curve::TimeHistory;
 use super::grid::GridConfig;
 use super::material::MaterialConfig;
 use super::solver::SolverConfig;
@@ -21,6 +22,9 @@ pub struct SceneConfig {
     /// Gravitational acceleration vector (default zero).
     #[serde(default)]
     pub gravity: Option<Vec<f64>>,
+    /// Gravity times this time history's factor on the run's clock
+    /// (`scene::curve`; none: the stages' ramps).
+    pub gravity_history: Option<TimeHistory>,
     pub grid: GridConfig,
     #[serde(default, rename = "material")]
     pub materials: Vec<MaterialConfig>,
@@ -418,6 +422,19 @@ pub struct BoundaryConfig {
     pub face: String,
     pub condition: Condition,
     pub velocity: Option<Vec<f64>>,
+    /// Velocity condition: the face moves with this acceleration times the
+    /// `time_history` factor, from rest at t = 0 (instead of `velocity`).
+    pub acceleration: Option<Vec<f64>>,
+    /// Velocity condition: the face's displacement is this vector times the
+    /// `time_history` factor (instead of `velocity`).
+    pub displacement: Option<Vec<f64>>,
+    /// The factor of `velocity`, `acceleration`, `displacement` or
+    /// `incoming_velocity` on the run's clock (`scene::curve`).
+    pub time_history: Option<TimeHistory>,
+    /// Absorbing: a compliant base; the incoming (upgoing) wave's particle
+    /// velocity, times the `time_history` factor, enters as the traction
+    /// 2 ρ c v_in beside the dashpots (Joyner & Chen 1975).
+    pub incoming_velocity: Option<Vec<f64>>,
     /// Components the velocity condition acts on ("x", "y", "z"); default all.
     pub components: Option<Vec<String>>,
     /// Absorbing: springs in parallel with k_n = α_N G/R, k_s = α_T G/R, where R is
@@ -472,6 +489,9 @@ pub struct LoadConfig {
     pub ramp_time: f64,
     /// A pulse instead of a ramp: the load times sin²(π t / T) for t ≤ T, then zero.
     pub pulse_duration: Option<f64>,
+    /// A time history instead of a ramp or pulse: the load times its factor
+    /// on the run's clock (`scene::curve`).
+    pub time_history: Option<TimeHistory>,
 }
 
 /// A `[[contact]]` table: the bodies it pairs and their contact law
@@ -569,6 +589,35 @@ impl StrengthReductionConfig {
 }
 
 impl SceneConfig {
+    /// Every time history of the scene with its key path.
+    pub fn time_histories(&self) -> Vec<(String, &TimeHistory)> {
+        let loads = (self.loads.iter().enumerate()).filter_map(|(i, l)| {
+            Some((format!("load.{i}.time_history"), l.time_history.as_ref()?))
+        });
+        let faces = (self.boundaries.iter().enumerate()).filter_map(|(i, b)| {
+            Some((
+                format!("boundary.{i}.time_history"),
+                b.time_history.as_ref()?,
+            ))
+        });
+        let gravity = (self.gravity_history.as_ref()).map(|h| ("gravity_history".to_string(), h));
+        gravity.into_iter().chain(loads).chain(faces).collect()
+    }
+
+    pub fn time_histories_mut(&mut self) -> Vec<(String, &mut TimeHistory)> {
+        let loads = (self.loads.iter_mut().enumerate()).filter_map(|(i, l)| {
+            Some((format!("load.{i}.time_history"), l.time_history.as_mut()?))
+        });
+        let faces = (self.boundaries.iter_mut().enumerate()).filter_map(|(i, b)| {
+            Some((
+                format!("boundary.{i}.time_history"),
+                b.time_history.as_mut()?,
+            ))
+        });
+        let gravity = (self.gravity_history.as_mut()).map(|h| ("gravity_history".to_string(), h));
+        gravity.into_iter().chain(loads).chain(faces).collect()
+    }
+
     /// The stages of the run: the `[solver]` table alone, or the `[[stage]]` tables.
     pub fn stages(&self) -> Vec<&SolverConfig> {
         match &self.solver {

@@ -11,6 +11,7 @@
 mod body_kind;
 mod config;
 pub mod contact;
+pub mod curve;
 mod error;
 pub(crate) mod expr;
 mod grid;
@@ -22,6 +23,7 @@ pub(crate) mod testing;
 pub(crate) mod validate;
 
 pub use config::*;
+pub use curve::TimeHistory;
 pub use error::{blame, SceneError, Source};
 pub use grid::*;
 pub use material::MaterialConfig;
@@ -61,7 +63,9 @@ impl Scene {
         let applied = overrides::apply(file, text, overrides)?;
         let source = Source::new(file, text, &applied, overrides);
         let config: SceneConfig = source.deserialize()?;
+        let mut config = config;
         validate::validate(&config).map_err(|(path, msg)| source.at_key(&path, msg))?;
+        curve::read_files(config.time_histories_mut(), &source)?;
         Ok(Scene {
             file: file.to_string(),
             config,

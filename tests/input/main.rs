@@ -17,3 +17,4 @@ mod impact;
 mod key_paths;
 mod robustness;
 mod scene_errors;
+mod time_histories;

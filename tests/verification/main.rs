@@ -28,4 +28,5 @@ mod slope_runout;
 mod stages;
 mod strength_reduction;
 mod three_d;
+mod time_histories;
 mod vibrating_bar;

@@ -21,6 +21,7 @@ pub fn boundary(b: &BoundaryConfig, i: usize, dim: usize) -> Check {
         forbidden(&b.spring_distance, key("spring_distance"), what)?;
         forbidden(&b.spring_stiffness, key("spring_stiffness"), what)?;
     }
+    face_motion(b, i, dim)?;
     if b.condition != Condition::Friction {
         let what = "a fixed, roller, velocity or absorbing condition (only to friction)";
         forbidden(&b.friction_coefficient, key("friction_coefficient"), what)?;
@@ -52,8 +53,6 @@ pub fn boundary(b: &BoundaryConfig, i: usize, dim: usize) -> Check {
         }
         Condition::Absorbing => absorbing(b, i),
         Condition::Velocity => {
-            required(&b.velocity, key("velocity"), "a velocity condition")?;
-            vector(b.velocity.as_ref().unwrap(), dim, &key("velocity"))?;
             for (k, c) in b.components.iter().flatten().enumerate() {
                 let ok = axis(c).is_some_and(|a| a < dim);
                 ensure(
@@ -64,6 +63,74 @@ pub fn boundary(b: &BoundaryConfig, i: usize, dim: usize) -> Check {
             }
             Ok(())
         }
+    }
+}
+
+/// The motion of a face and its time history: a velocity condition takes one
+/// of `velocity`, `acceleration` (with a time history) or `displacement` (with
+/// a time history); an absorbing face an `incoming_velocity` (a compliant
+/// base); `time_history` goes with one of them.
+fn face_motion(b: &BoundaryConfig, i: usize, dim: usize) -> Check {
+    let key = |k: &str| format!("boundary.{i}.{k}");
+    let given: Vec<(&str, &Vec<f64>)> = [
+        ("velocity", &b.velocity),
+        ("acceleration", &b.acceleration),
+        ("displacement", &b.displacement),
+    ]
+    .into_iter()
+    .filter_map(|(k, v)| Some((k, v.as_ref()?)))
+    .collect();
+    if b.condition != Condition::Velocity {
+        let what = "fixed, roller, absorbing or friction conditions (only to velocity)";
+        forbidden(&b.acceleration, key("acceleration"), what)?;
+        forbidden(&b.displacement, key("displacement"), what)?;
+    }
+    if b.condition != Condition::Absorbing {
+        let what = "a fixed, roller, velocity or friction condition (only to absorbing)";
+        forbidden(&b.incoming_velocity, key("incoming_velocity"), what)?;
+    }
+    match b.condition {
+        Condition::Velocity => {
+            ensure(
+                !given.is_empty(),
+                key("velocity"),
+                "is required for a velocity condition (or `acceleration` or `displacement` with a `time_history`)",
+            )?;
+            if let Some((second, _)) = given.get(1) {
+                return Err((
+                    key(second),
+                    format!("a face takes one of velocity, acceleration and displacement; `{}` is given too", given[0].0),
+                ));
+            }
+            let (name, v) = given[0];
+            vector(v, dim, &key(name))?;
+            if name != "velocity" {
+                let what =
+                    format!("a face with `{name}` (the factor of the vector on the run's clock)");
+                required(&b.time_history, key("time_history"), &what)?;
+            }
+            if b.footing_width.is_some() {
+                let what = "a footing (it moves at a constant velocity)";
+                forbidden(&b.time_history, key("time_history"), what)?;
+            }
+            Ok(())
+        }
+        Condition::Absorbing => {
+            if let Some(v) = &b.incoming_velocity {
+                vector(v, dim, &key("incoming_velocity"))?;
+            }
+            let what =
+                "an absorbing face without `incoming_velocity` (it scales the incoming wave)";
+            match b.incoming_velocity {
+                Some(_) => Ok(()),
+                None => forbidden(&b.time_history, key("time_history"), what),
+            }
+        }
+        _ => forbidden(
+            &b.time_history,
+            key("time_history"),
+            "fixed, roller or friction conditions (only to velocity and absorbing faces)",
+        ),
     }
 }
 
@@ -168,6 +235,15 @@ pub fn load(l: &LoadConfig, i: usize, s: &SceneConfig) -> Check {
             l.ramp_time == 0.0,
             key("pulse_duration"),
             "a load is either ramped (ramp_time) or a pulse (pulse_duration), not both",
+        )?;
+    }
+    if l.time_history.is_some() {
+        let what = "a load with a time history (it replaces the ramp and the pulse)";
+        forbidden(&l.pulse_duration, key("pulse_duration"), what)?;
+        ensure(
+            l.ramp_time == 0.0,
+            key("ramp_time"),
+            format!("does not apply to {what}"),
         )?;
     }
     match l.kind {

@@ -10,6 +10,7 @@ mod axisymmetry;
 mod check;
 mod conditions;
 mod grid_bodies;
+mod histories;
 mod materials;
 mod peridynamic;
 mod solver;
@@ -65,6 +66,8 @@ pub fn validate(s: &SceneConfig) -> Check {
     for (i, l) in s.loads.iter().enumerate() {
         load(l, i, s)?;
     }
+    histories::time_histories(s)?;
+    histories::gravity_history(s)?;
     if s.dimension.is_axisymmetric() {
         axisymmetry(s)?;
     }

@@ -188,10 +188,11 @@ impl<const D: usize> NodeMapStep<D> {
     /// of the nodes on some, and the mirror's lines.
     fn node_conditions(&mut self, m: &Model<D>, s: &Step<D>) {
         let map = &self.map;
+        let faces = m.faces_during(s.t, s.dt);
         self.constraint = (0..map.len())
             .into_par_iter()
             .with_min_len(MIN_PARALLEL_LEN)
-            .map(|a| node_constraint(&m.grid, &m.faces, map.grid_node(a)))
+            .map(|a| node_constraint(&m.grid, &faces, map.grid_node(a)))
             .collect();
         self.friction = friction_nodes(m, map);
         // Cubic and domain-averaged B-splines: the image problem's masses at faces
@@ -202,7 +203,7 @@ impl<const D: usize> NodeMapStep<D> {
         // for them (tests/verification/column_explicit.rs) stays as it was.
         self.mirror = match s.shape {
             ShapeFunction::Bspline2 => Mirror::default(),
-            _ => Mirror::build(&m.grid, &m.faces, map),
+            _ => Mirror::build(&m.grid, &faces, map),
         };
     }
 

@@ -49,7 +49,8 @@ pub struct Explicit<const D: usize> {
     pub apic: bool,
     pub damping: f64,
     /// Gravity rises linearly from zero over `gravity_ramp_time` on the run's
-    /// clock, as a load's `ramp_time` (0: in full from the start).
+    /// clock, as a load's `ramp_time` (0: in full from the start), unless the
+    /// scene gives a `gravity_history` (`Model::gravity_factor`).
     pub gravity_ramp: LoadTime,
     /// F-bar against volumetric locking (`crate::physics::kinematics::fbar`).
     pub fbar: bool,
@@ -94,7 +95,7 @@ impl<const D: usize> Explicit<D> {
             damping: self.damping,
             fbar: self.fbar,
             viscosity: self.viscosity,
-            gravity: m.gravity * self.gravity_ramp.factor(t),
+            gravity: m.gravity * m.gravity_factor(t, &self.gravity_ramp),
             scales: m.load_scales(t),
             tiny: Step::tiny_mass(m),
             t,

@@ -13,7 +13,7 @@
 //! come with contact, which needs the node map (`solver::explicit::features`).
 
 use crate::dim::{compose, embed_deformation, Mat3, Tensor, Vector};
-use crate::model::conditions::Constraint;
+use crate::model::conditions::{Constraint, FaceCondition};
 use crate::model::grid::Grid;
 use crate::model::particles::{History, Particles};
 use crate::model::tensors::{Tensors, TensorsMut};
@@ -125,8 +125,8 @@ impl<const D: usize> Backend<D> for ScatterStep<D> {
         }
     }
 
-    fn start_velocity(&mut self, m: &Model<D>, _: &Step<D>) {
-        self.start_velocity(m);
+    fn start_velocity(&mut self, m: &Model<D>, s: &Step<D>) {
+        self.start_velocity(m, &m.faces_during(s.t, s.dt));
     }
 
     fn start_forces(&mut self, m: &Model<D>, s: &Step<D>) {
@@ -134,7 +134,8 @@ impl<const D: usize> Backend<D> for ScatterStep<D> {
     }
 
     fn grid_update(&mut self, m: &Model<D>, s: &Step<D>, start: Start) {
-        self.node_pass(m, start == Start::Formed, s.damping, s.tiny, s.dt);
+        let faces = m.faces_during(s.t, s.dt);
+        self.node_pass(m, &faces, start == Start::Formed, s.damping, s.tiny, s.dt);
     }
 
     fn g2p(&mut self, m: &mut Model<D>, s: &Step<D>, then: Then) -> Result<f64, Divergence> {
@@ -145,8 +146,8 @@ impl<const D: usize> Backend<D> for ScatterStep<D> {
         }
     }
 
-    fn remapped_velocity(&mut self, m: &Model<D>, _: &Step<D>) {
-        self.remapped_velocity(m);
+    fn remapped_velocity(&mut self, m: &Model<D>, s: &Step<D>) {
+        self.remapped_velocity(m, &m.faces_during(s.t, s.dt));
     }
 
     fn update_stress(
@@ -304,14 +305,18 @@ impl<const D: usize> ScatterStep<D> {
 
     /// The conditions of box node b at grid multi-index `ijk`, `None` for a
     /// node on no grid face (most nodes).
-    fn conditions(m: &Model<D>, ijk: [usize; D]) -> Option<Conditions<D>> {
+    fn conditions(
+        m: &Model<D>,
+        faces: &[FaceCondition<D>],
+        ijk: [usize; D],
+    ) -> Option<Conditions<D>> {
         let grid = &m.grid;
         if !(0..D).any(|d| ijk[d] == 0 || ijk[d] + 1 == grid.nodes[d]) {
             return None;
         }
         let g = grid.node_index(ijk);
         Some(Conditions {
-            constraint: node_constraint(grid, &m.faces, g),
+            constraint: node_constraint(grid, faces, g),
             friction: node_friction(grid, &m.friction, g),
         })
     }
@@ -352,9 +357,17 @@ impl<const D: usize> ScatterStep<D> {
     /// velocity. Leaves the updated velocity in `momentum` and the
     /// acceleration in `force`. USF (`usf`): `momentum` already holds p/m and
     /// `second` the constrained velocity.
-    fn node_pass(&mut self, m: &Model<D>, usf: bool, damping: f64, tiny: f64, dt: f64) {
+    fn node_pass(
+        &mut self,
+        m: &Model<D>,
+        faces: &[FaceCondition<D>],
+        usf: bool,
+        damping: f64,
+        tiny: f64,
+        dt: f64,
+    ) {
         self.for_nodes(|n, second, ijk| {
-            let c = Self::conditions(m, ijk);
+            let c = Self::conditions(m, faces, ijk);
             let (raw, v) = match usf {
                 true => (n.momentum, *second),
                 false => {
@@ -371,19 +384,19 @@ impl<const D: usize> ScatterStep<D> {
     }
 
     /// USF: p/m into `momentum`, and the velocity with the conditions into `second`.
-    fn start_velocity(&mut self, m: &Model<D>) {
+    fn start_velocity(&mut self, m: &Model<D>, faces: &[FaceCondition<D>]) {
         self.for_nodes(|n, second, ijk| {
             n.momentum = nodal_velocity(n.mass, &n.momentum);
-            *second = Self::velocity(m, &n.momentum, &Self::conditions(m, ijk));
+            *second = Self::velocity(m, &n.momentum, &Self::conditions(m, faces, ijk));
         });
     }
 
     /// MUSL: the remapped momentum in `second` becomes the velocity with the
     /// conditions.
-    fn remapped_velocity(&mut self, m: &Model<D>) {
+    fn remapped_velocity(&mut self, m: &Model<D>, faces: &[FaceCondition<D>]) {
         self.for_nodes(|n, second, ijk| {
             let raw = nodal_velocity(n.mass, second);
-            *second = Self::velocity(m, &raw, &Self::conditions(m, ijk));
+            *second = Self::velocity(m, &raw, &Self::conditions(m, faces, ijk));
         });
     }
 

@@ -179,9 +179,16 @@ pub fn unknowns<const D: usize>(m: &Model<D>, shape: ShapeFunction, s: &SolverCo
     let (mut st, mut map) = (Stencils::<D>::default(), NodeMap::default());
     let (mut grid, _) = terms::list::step_terms(m);
     grid.build(m, shape, &mut st, &mut map);
-    number_unknowns(m, &st, &map, grid.node_fields(), s.min_node_support())
-        .1
-        .free
+    number_unknowns(
+        m,
+        &m.faces,
+        &st,
+        &map,
+        grid.node_fields(),
+        s.min_node_support(),
+    )
+    .1
+    .free
 }
 
 impl<const D: usize> Stepper<D> for Implicit<D> {

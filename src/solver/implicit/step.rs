@@ -19,7 +19,7 @@ use super::terms::list::step_terms;
 use super::terms::{Couplings, Restore, StepStart, StepTerm, StepView, TermReport};
 use super::ties::{merge, natural_end_ties, nodal_support, ties, NodeFields};
 use crate::dim::Vector;
-use crate::model::conditions::Constraint;
+use crate::model::conditions::{Constraint, FaceCondition};
 use crate::model::loads::LoadTime;
 use crate::model::{load_factor, Model};
 use crate::parallel::MIN_PARALLEL_LEN;
@@ -255,15 +255,26 @@ impl StepSettings {
 
     /// Load factor of gravity and loads at time t: (t − t_start) / duration when
     /// quasi-static, otherwise the gravity ramp's factor (1 without one) and
-    /// the ramp of each load.
+    /// the ramp of each load. A time history (`gravity_history`, a load's
+    /// `time_history`) gives its own factor at t in both.
     pub fn load_factors<const D: usize>(&self, m: &Model<D>, t: f64) -> (f64, Vec<f64>) {
         match self.integrator {
             Integrator::QuasiStatic => {
                 let lambda = ((t - self.t_start) / self.end_time).clamp(0.0, 1.0);
-                let g = if self.gravity_ramp { lambda } else { 1.0 };
-                (g, vec![lambda; m.load_ramps.len()])
+                let g = match (&m.gravity_history, self.gravity_ramp) {
+                    (Some(h), _) => h.factor(t),
+                    (None, true) => lambda,
+                    (None, false) => 1.0,
+                };
+                let scales = (m.load_ramps.iter())
+                    .map(|r| if r.is_curve() { r.factor(t) } else { lambda })
+                    .collect();
+                (g, scales)
             }
-            Integrator::Newmark => (self.gravity_ramp_time.factor(t), m.load_scales(t)),
+            Integrator::Newmark => (
+                m.gravity_factor(t, &self.gravity_ramp_time),
+                m.load_scales(t),
+            ),
         }
     }
 
@@ -289,7 +300,8 @@ impl StepSettings {
         }
         let (st, map) = (&sys.stencils, &sys.map);
         let fields = sys.grid.node_fields();
-        let (constraint, dofs) = number_unknowns(m, st, map, fields, self.min_node_support);
+        let faces = m.faces_during(t, dt);
+        let (constraint, dofs) = number_unknowns(m, &faces, st, map, fields, self.min_node_support);
         let n = map.len();
 
         // External force at the end of the step; inertia terms: the Newmark
@@ -465,6 +477,7 @@ impl StepSettings {
 /// free components, weakly supported nodes tied to their neighbours.
 pub fn number_unknowns<const D: usize>(
     m: &Model<D>,
+    faces: &[FaceCondition<D>],
     st: &Stencils<D>,
     map: &NodeMap,
     fields: Option<&NodeFields>,
@@ -475,7 +488,7 @@ pub fn number_unknowns<const D: usize>(
         .par_iter()
         .enumerate()
         .with_min_len(MIN_PARALLEL_LEN)
-        .map(|(a, _)| implicit_node_constraint(&m.grid, &m.faces, &m.friction, map.grid_node(a)))
+        .map(|(a, _)| implicit_node_constraint(&m.grid, faces, &m.friction, map.grid_node(a)))
         .collect();
     let support = nodal_support(map, st, &m.particles.volume, m.grid.cell_volume());
     let fixed: Vec<[bool; D]> = constraint.iter().map(|c| c.fixed).collect();
