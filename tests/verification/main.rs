@@ -22,6 +22,7 @@ mod implicit_bar;
 mod implicit_column;
 mod limit_analysis;
 mod loads_and_conditions;
+mod site_response;
 mod slope_3d;
 mod slope_runout;
 mod stages;
