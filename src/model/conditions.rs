@@ -235,11 +235,33 @@ impl Waves {
     }
 }
 
+/// The incoming wave of a compliant base (an absorbing face with
+/// `incoming_velocity`): the particle velocity v_in(t) of the upgoing wave at
+/// the face, the scene's vector times its time history's factor (1 without
+/// one). Joyner & Chen (1975): the medium beyond the face acts on it with
+/// t = C (2 v_in − v), C the dashpots of the face (`physics::boundary::absorbing`).
+#[derive(Clone, Debug)]
+pub struct IncomingWave<const D: usize> {
+    /// Index of the face in `Absorbing::faces`.
+    pub face: usize,
+    pub velocity: Vector<D>,
+    pub curve: Option<Arc<TimeCurve>>,
+}
+
+impl<const D: usize> IncomingWave<D> {
+    /// v_in(t).
+    pub fn at(&self, t: f64) -> Vector<D> {
+        self.velocity * self.curve.as_ref().map_or(1.0, |c| c.value(t))
+    }
+}
+
 /// The absorbing faces of a scene and the wave properties of its materials.
 #[derive(Clone, Debug, Default)]
 pub struct Absorbing<const D: usize> {
     pub faces: Vec<AbsorbingFace>,
     pub waves: Vec<Waves>,
+    /// The incoming waves of the compliant bases among the faces (most scenes: none).
+    pub incoming: Vec<IncomingWave<D>>,
 }
 
 impl<const D: usize> Absorbing<D> {
@@ -267,7 +289,22 @@ impl<const D: usize> Absorbing<D> {
         } else {
             materials.iter().map(|m| Waves::of(m.as_ref())).collect()
         };
-        Absorbing { faces, waves }
+        let incoming = (faces.iter().enumerate())
+            .filter_map(|(face, f)| {
+                let b = &boundaries[f.boundary];
+                let v = b.incoming_velocity.as_ref()?;
+                Some(IncomingWave {
+                    face,
+                    velocity: Vector::<D>::from_fn(|d, _| v[d]),
+                    curve: (b.time_history.as_ref()).map(|h| Arc::new(TimeCurve::new(&h.points()))),
+                })
+            })
+            .collect();
+        Absorbing {
+            faces,
+            waves,
+            incoming,
+        }
     }
 
     pub fn is_empty(&self) -> bool {

@@ -124,3 +124,39 @@ fn a_cracking_peridynamic_plate_is_the_same_on_one_and_two_threads() {
     let overrides = ["output.frames=0".to_string()];
     same_on_one_and_two_threads("peridynamic_plate.toml", &overrides, "peridynamic plate");
 }
+
+/// Time histories (issue 55): the slope under a ground motion through its
+/// compliant base (`problems/slope_ground_motion.toml`, 3440 particles), into
+/// the shaking; and the same slope with its base a velocity face that follows
+/// the record as an acceleration (`FaceMotion`), explicit and Newmark.
+#[test]
+fn ground_motion_runs_give_identical_results_on_one_and_two_threads() {
+    let shaking = [
+        "output.frames=0".to_string(),
+        "stage.1.end_time=0.3".to_string(),
+    ];
+    same_on_one_and_two_threads("slope_ground_motion.toml", &shaking, "compliant base");
+    let dir = tempfile::tempdir().unwrap();
+    let problems = crate::common::problem("");
+    std::fs::copy(
+        problems.join("ground_motion.csv"),
+        dir.path().join("ground_motion.csv"),
+    )
+    .unwrap();
+    let text = std::fs::read_to_string(problems.join("slope_ground_motion.toml")).unwrap();
+    let base = "condition = \"absorbing\"\nspring_distance = 2.0";
+    let start = text.find(base).expect("the scene's base");
+    let end = start + text[start..].find("\n\n").unwrap();
+    let moving =
+        "condition = \"velocity\"\nacceleration = [1.0, 0.0]\ntime_history = \"ground_motion.csv\"";
+    let text = format!("{}{moving}{}", &text[..start], &text[end..]);
+    let explicit = "kind = \"explicit\"\nscheme = \"musl\"\nend_time = 3.0\ncfl = 0.4\nflip = 0.99";
+    assert!(text.contains(explicit), "the scene's shaking stage");
+    let newmark = "kind = \"implicit\"\nintegrator = \"newmark\"\nend_time = 0.3\ndt = 0.01";
+    for (stage, what) in [(explicit, "explicit"), (newmark, "Newmark")] {
+        let file = dir.path().join(format!("slope_moving_base_{what}.toml"));
+        std::fs::write(&file, text.replace(explicit, stage)).unwrap();
+        let name = file.to_str().unwrap();
+        same_on_one_and_two_threads(name, &shaking, &format!("acceleration face, {what}"));
+    }
+}

@@ -23,6 +23,7 @@ mod implicit_column;
 mod limit_analysis;
 mod loads_and_conditions;
 mod peridynamics;
+mod site_response;
 mod slope_3d;
 mod slope_runout;
 mod stages;

@@ -19,6 +19,18 @@
 //! dashpot and spring matrices are diagonal in the grid axes: ρ c_d (or k_n) on the
 //! normal axis, ρ c_s (or k_s) on the others.
 //!
+//! Compliant base (Joyner & Chen 1975). Beyond a face with an incoming wave
+//! (`incoming_velocity`) the face's velocity is the sum of the incoming and
+//! the outgoing wave's, v = v_in + v_out, and a plane wave's traction is ρc
+//! times its particle velocity, with the sign of its direction: the medium
+//! beyond acts on the face with ρc (v_in − v_out) = ρc (2 v_in − v). The
+//! dashpots are the −ρc v; the incoming wave adds 2 ρc v_in, a force
+//! independent of the motion (an external force; it leaves the implicit
+//! tangent alone), so the outgoing wave still leaves. ρc is ρ c_d normal to
+//! the face and ρ c_s along it, of the particle's material (the half-space's,
+//! in the layer next to the face); v_in is the upgoing wave alone, half the
+//! motion of an outcrop of the half-space.
+//!
 //! Spring stiffness. `spring_distance = R` gives k_n = α_N G/R and k_s = α_T G/R
 //! (Liu Jingbo et al. 2006, the viscous-spring artificial boundary; it follows
 //! from the outgoing cylindrical (2D) or spherical (3D) wave from a source at
@@ -50,12 +62,16 @@ pub struct LayerParticle<const D: usize> {
     pub q: usize,
     pub damping: Vector<D>,
     pub stiffness: Vector<D>,
+    /// The incoming wave's force on the particle at the time of the layer,
+    /// 2 C v_in (Joyner & Chen 1975; zero off a compliant base).
+    pub input: Vector<D>,
 }
 
 impl<const D: usize> LayerParticle<D> {
-    /// Boundary force on the particle, f = −(C v + K u) (2-59, 2-60, 2-63).
+    /// Boundary force on the particle, f = 2 C v_in − (C v + K u) (2-59, 2-60,
+    /// 2-63; Joyner & Chen 1975 for the incoming wave).
     pub fn force(&self, v: &Vector<D>, u: &Vector<D>) -> Vector<D> {
-        -(self.damping.component_mul(v) + self.stiffness.component_mul(u))
+        self.input - (self.damping.component_mul(v) + self.stiffness.component_mul(u))
     }
 }
 
@@ -77,14 +93,25 @@ fn face_coefficients<const D: usize>(f: &AbsorbingFace, w: &Waves) -> (Vector<D>
 }
 
 /// The particles in the outermost layer of any absorbing face now, in particle
-/// order, with their coefficients (a particle in a corner collects both faces).
+/// order, with their coefficients (a particle in a corner collects both faces)
+/// and the force of the incoming waves at time `t`.
 pub fn layer<const D: usize>(
     absorbing: &Absorbing<D>,
     grid: &Grid<D>,
     p: &Particles<D>,
+    t: f64,
 ) -> Vec<LayerParticle<D>> {
     if absorbing.is_empty() {
         return Vec::new();
+    }
+    // 2 v_in(t) of each face (zero without an incoming wave; empty, and not
+    // allocated, without any).
+    let mut twice_incoming = Vec::new();
+    if !absorbing.incoming.is_empty() {
+        twice_incoming = vec![Vector::<D>::zeros(); absorbing.faces.len()];
+        for w in &absorbing.incoming {
+            twice_incoming[w.face] = w.at(t) * 2.0;
+        }
     }
     let mut out = Vec::new();
     for q in 0..p.len() {
@@ -92,18 +119,20 @@ pub fn layer<const D: usize>(
             q,
             damping: Vector::<D>::zeros(),
             stiffness: Vector::<D>::zeros(),
+            input: Vector::<D>::zeros(),
         };
         let mut inside = false;
-        for f in absorbing
-            .faces
-            .iter()
-            .filter(|f| grid.in_outer_layer(f.face, &p.x[q]))
+        for (i, f) in (absorbing.faces.iter().enumerate())
+            .filter(|(_, f)| grid.in_outer_layer(f.face, &p.x[q]))
         {
             let (c, k) = face_coefficients::<D>(f, &absorbing.waves[p.material[q] as usize]);
             // Traction per unit area → body force on the particle (2-63).
             let scale = p.volume[q] / grid.h[f.face.axis];
             lp.damping += c * scale;
             lp.stiffness += k * scale;
+            if let Some(v2) = twice_incoming.get(i) {
+                lp.input += c.component_mul(v2) * scale;
+            }
             inside = true;
         }
         if inside {
@@ -136,7 +165,9 @@ fn add_layer_forces<const D: usize>(
 }
 
 /// Explicit solver: add the boundary forces at the start-of-step nodal velocities
-/// `v` (active nodes) to the nodal forces.
+/// `v` (active nodes) and the incoming waves at the step start `t` to the nodal
+/// forces.
+#[allow(clippy::too_many_arguments)]
 pub fn add_force<const D: usize>(
     absorbing: &Absorbing<D>,
     grid: &Grid<D>,
@@ -144,9 +175,10 @@ pub fn add_force<const D: usize>(
     map: &NodeMap,
     st: &Stencils<D>,
     v: &[Vector<D>],
+    t: f64,
     force: &mut [Vector<D>],
 ) {
-    let layer = layer(absorbing, grid, p);
+    let layer = layer(absorbing, grid, p, t);
     // u_p = x_p − X_p.
     let displacement = |q: usize| p.x[q] - p.x0[q];
     add_layer_forces(&layer, map, st, v, displacement, 1.0, force);
@@ -230,7 +262,7 @@ end_time = 1.0
     fn layer_forces_add_up_to_the_traction_times_the_area() {
         let scene = Scene::parse("layer.toml", LAYER, &[]).unwrap();
         let m = Model::<2>::build(&scene).unwrap();
-        let layer = layer(&m.absorbing, &m.grid, &m.particles);
+        let layer = layer(&m.absorbing, &m.grid, &m.particles, 0.0);
         // 8 cells × 3 × 3 particles in the bottom row of cells.
         assert_eq!(layer.len(), 72);
         let (v, u) = (Vector::<2>::new(0.3, -0.2), Vector::<2>::new(0.01, 0.02));
@@ -256,7 +288,7 @@ end_time = 1.0
         );
         let scene = Scene::parse("layer.toml", &text, &[]).unwrap();
         let m = Model::<2>::build(&scene).unwrap();
-        let layer = layer(&m.absorbing, &m.grid, &m.particles);
+        let layer = layer(&m.absorbing, &m.grid, &m.particles, 0.0);
         let k: Vector<2> = layer.iter().map(|lp| lp.stiffness).sum();
         let g = 20.0e6;
         let expected = Vector::<2>::new(0.5 * g / 10.0 * 4.0, 1.0 * g / 10.0 * 4.0);

@@ -339,6 +339,7 @@ impl<const D: usize> Backend<D> for NodeMapStep<D> {
             map,
             st,
             &self.velocity,
+            s.t,
             &mut self.force,
         );
     }

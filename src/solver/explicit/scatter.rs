@@ -686,10 +686,11 @@ impl<const D: usize> ScatterStep<D> {
 
     /// Absorbing faces: the dashpot (and spring) force f_p = −(C v_p + K u_p) of
     /// every particle in their outer cell layer (2-63), v_p = Σ_I S_Ip v_I of the
-    /// step-start velocity, spread as S_Ip f_p, in particle order.
+    /// step-start velocity, and an incoming wave's 2 C v_in(t) at the step
+    /// start, spread as S_Ip f_p, in particle order.
     fn add_absorbing_force(&mut self, m: &Model<D>, s: &Step<D>) {
         let p = &m.particles;
-        for lp in absorbing::layer(&m.absorbing, &m.grid, p) {
+        for lp in absorbing::layer(&m.absorbing, &m.grid, p, s.t) {
             let q = lp.q;
             if self.removed.get(q) == Some(&true) {
                 continue;

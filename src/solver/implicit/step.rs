@@ -150,6 +150,7 @@ impl<const D: usize> StepSystem<D> {
             map: &self.map,
             dofs: &self.dofs,
             grid: &self.grid,
+            t: self.t,
             dt: self.dt,
         }
     }
@@ -408,7 +409,7 @@ impl StepSettings {
         let (mass, momentum) = mass_momentum(map, st, p, None);
         let v = mass_average(&mass, &momentum);
         for t in &sys.terms {
-            t.add_initial_force(m, st, map, &v, &mut force);
+            t.add_initial_force(m, st, map, &v, self.t_start, &mut force);
         }
         let a: Vec<Vector<D>> = force
             .iter()

@@ -75,7 +75,8 @@ fn tangent_error_of<const D: usize>(
     );
     solver.prepare(&m, 0.0, 0.01);
     let sys = &mut solver.system;
-    let layer = crate::physics::boundary::absorbing::layer(&m.absorbing, &m.grid, &m.particles);
+    let layer =
+        crate::physics::boundary::absorbing::layer(&m.absorbing, &m.grid, &m.particles, 0.0);
     assert_eq!(layer.is_empty(), !absorbing);
     // A smooth, finite-strain iterate (strains of a few per cent).
     let nodes: Vec<usize> = (0..sys.map.len()).map(|a| sys.map.grid_node(a)).collect();

@@ -3,7 +3,8 @@
 //!
 //!   r −= f_abs(u),   f_abs = −Σ_p S_Ip (C_p v_p(u) + K_p u_p(u)),
 //!
-//! with the end-of-step velocity v(u) = v* + rate · u of Newmark (none when
+//! plus an incoming wave's 2 C_p v_in at the end of the step (a compliant
+//! base, constant in u), with the end-of-step velocity v(u) = v* + rate · u of Newmark (none when
 //! quasi-static: the springs alone) and u_p the displacement at the end of the
 //! step (`physics::boundary::absorbing::AbsorbingStep`); the tangent is
 //! Σ_p S_Ip S_Jp (rate C_p + K_p) (`assembly::absorbing`), symmetric. Linear in
@@ -41,23 +42,26 @@ impl<const D: usize> StepTerm<D> for AbsorbingFaces<D> {
         Box::new(self.clone())
     }
 
-    /// The faces' forces at the initial velocities v.
+    /// The faces' forces at the initial velocities v and time t.
     fn add_initial_force(
         &self,
         m: &Model<D>,
         st: &Stencils<D>,
         map: &NodeMap,
         v: &[Vector<D>],
+        t: f64,
         force: &mut [Vector<D>],
     ) {
-        absorbing::add_force(&m.absorbing, &m.grid, &m.particles, map, st, v, force);
+        absorbing::add_force(&m.absorbing, &m.grid, &m.particles, map, st, v, t, force);
     }
 
     /// The layer particles at the step start, and their velocity as a function
     /// of u through Newmark (none when quasi-static).
     fn begin_step(&mut self, step: &StepView<'_, D>, start: &StepStart<'_, D>) {
         let m = step.m;
-        let layer = absorbing::layer(&m.absorbing, &m.grid, &m.particles);
+        // The incoming waves at the end of the step, as the applied loads.
+        let t_end = step.t + step.dt;
+        let layer = absorbing::layer(&m.absorbing, &m.grid, &m.particles, t_end);
         if layer.is_empty() {
             self.step = AbsorbingStep::default();
             return;

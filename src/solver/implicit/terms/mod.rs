@@ -76,6 +76,7 @@ pub struct StepView<'a, const D: usize> {
     pub dofs: &'a Dofs,
     pub grid: &'a StepGrid,
     /// The step t → t + dt.
+    pub t: f64,
     pub dt: f64,
 }
 
@@ -195,14 +196,15 @@ pub trait StepTerm<const D: usize>: Debug + Send + Sync {
     fn cloned(&self) -> Box<dyn StepTerm<D>>;
 
     /// Newmark's first step: the term's force at the initial state, with the
-    /// nodal velocities v (M a₀ = f), added into `force`. Called before the
-    /// first step begins.
+    /// nodal velocities v at time t (M a₀ = f), added into `force`. Called
+    /// before the first step begins.
     fn add_initial_force(
         &self,
         _m: &Model<D>,
         _st: &Stencils<D>,
         _map: &NodeMap,
         _v: &[Vector<D>],
+        _t: f64,
         _force: &mut [Vector<D>],
     ) {
     }
