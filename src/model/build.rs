@@ -118,7 +118,7 @@ impl<const D: usize> Model<D> {
         let gravity = c.gravity.as_deref().map_or(Vector::<D>::zeros(), vec);
         let loads = Loads::apply(c, &mut particles).map_err(err)?;
         let erosion = base_materials.iter().any(|m| m.erodes());
-        Ok(Model {
+        let mut model = Model {
             erosion,
             remove_outside: c.grid.particles_outside == ParticlesOutside::Remove,
             linear_domain_stress: c.grid.domain_stress == DomainStress::Linear,
@@ -140,7 +140,12 @@ impl<const D: usize> Model<D> {
             load_ramp_of: loads.ramp_of,
             axisymmetric,
             peridynamics,
-        })
+            staging: None,
+        };
+        if c.stages_construction() {
+            model.start_staging(&c.inactive_bodies());
+        }
+        Ok(model)
     }
 }
 

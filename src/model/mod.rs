@@ -15,6 +15,7 @@ pub(crate) mod memory;
 pub mod particle_set;
 pub mod particles;
 pub mod peridynamics;
+pub mod staging;
 pub(crate) mod tensors;
 pub mod terrain;
 pub mod triangles;
@@ -89,6 +90,9 @@ pub struct Model<const D: usize> {
     /// The peridynamic bodies' bonds (`model::peridynamics`); None in a
     /// scene without one, which then allocates and computes nothing of them.
     pub peridynamics: Option<Peridynamics<D>>,
+    /// Staged construction (`model::staging`): the bodies not yet active and
+    /// the built index of each particle; None in a scene that stages nothing.
+    pub staging: Option<staging::Staging<D>>,
 }
 
 impl<const D: usize> Model<D> {
@@ -198,9 +202,10 @@ impl<const D: usize> Model<D> {
     }
 
     /// Each body's particles as built: their count, total volume (per radian
-    /// in an axisymmetric model) and the box of their domains (`mpm check`).
+    /// in an axisymmetric model) and the box of their domains (`mpm check`),
+    /// also of a body not active yet (`model::staging`).
     pub fn body_extents(&self) -> Vec<BodyExtent> {
-        let p = &self.particles;
+        let dormant = self.staging.iter().flat_map(|s| s.dormant_particles());
         let mut extents: Vec<BodyExtent> = (0..self.bodies.len())
             .map(|_| BodyExtent {
                 particles: 0,
@@ -209,14 +214,16 @@ impl<const D: usize> Model<D> {
                 max: vec![f64::NEG_INFINITY; D],
             })
             .collect();
-        for q in 0..p.len() {
-            let e = &mut extents[p.body[q] as usize];
-            e.particles += 1;
-            e.volume += p.volume[q];
-            for d in 0..D {
-                let (x, h) = (p.x[q][d], p.half_length0[q][d]);
-                e.min[d] = e.min[d].min(x - h);
-                e.max[d] = e.max[d].max(x + h);
+        for p in std::iter::once(&self.particles).chain(dormant) {
+            for q in 0..p.len() {
+                let e = &mut extents[p.body[q] as usize];
+                e.particles += 1;
+                e.volume += p.volume[q];
+                for d in 0..D {
+                    let (x, h) = (p.x[q][d], p.half_length0[q][d]);
+                    e.min[d] = e.min[d].min(x - h);
+                    e.max[d] = e.max[d].max(x + h);
+                }
             }
         }
         extents
@@ -227,13 +234,10 @@ impl<const D: usize> Model<D> {
         self.bodies[self.particles.body[q] as usize].kind
     }
 
-    /// Number of bodies (for per-body outputs).
+    /// Number of bodies (for per-body outputs): the scene's, also those not
+    /// active yet (`model::staging`).
     pub fn n_bodies(&self) -> usize {
-        self.particles
-            .body
-            .iter()
-            .map(|&b| b as usize + 1)
-            .max()
-            .unwrap_or(0)
+        let of_particles = self.particles.body.iter().map(|&b| b as usize + 1).max();
+        of_particles.unwrap_or(0).max(self.bodies.len())
     }
 }

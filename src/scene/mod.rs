@@ -18,6 +18,7 @@ mod grid;
 mod material;
 pub(crate) mod overrides;
 mod solver;
+pub mod staging;
 #[cfg(test)]
 pub(crate) mod testing;
 pub(crate) mod validate;

@@ -177,6 +177,16 @@ pub struct SolverConfig {
     pub gravity_ramp_time: Option<f64>,
     /// F-bar against volumetric locking (explicit and implicit; default false).
     pub fbar: Option<bool>,
+    // Staged construction (`[[stage]]` only; `scene::staging`, `model::staging`).
+    /// Bodies, by name, whose particles leave the model at the stage's start.
+    pub deactivate: Option<Vec<String>>,
+    /// Regions whose continuum particles leave the model at the stage's start.
+    pub excavate: Option<Vec<super::staging::RegionConfig>>,
+    /// Bodies, by name (`active = false`), that enter the model at the stage's
+    /// start, unstressed.
+    pub activate: Option<Vec<String>>,
+    /// Displacements measured from the stage's start (default false).
+    pub reset_displacement: Option<bool>,
 }
 
 impl SolverKind {
@@ -410,8 +420,10 @@ impl SolverConfig {
         self.max_cutbacks.unwrap_or(5)
     }
     /// Quasi-static gravity ramps from zero over the stage (default true).
+    /// A stage that changes the model (`changes_model`) finds the ground under
+    /// gravity already: there gravity is in full by default.
     pub fn gravity_ramp(&self) -> bool {
-        self.gravity_ramp.unwrap_or(true)
+        self.gravity_ramp.unwrap_or(!self.changes_model())
     }
     /// Nodes whose particle support Σ_p V_p S_Ip is below this fraction of a cell
     /// volume are tied to two neighbours by linear extrapolation (default 1e-2;
