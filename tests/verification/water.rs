@@ -174,3 +174,26 @@ fn k0_state_with_a_water_table_is_at_rest_in_the_explicit_solver() {
         assert!(e_v < 1e-9 && e_h < 1e-9);
     }
 }
+
+/// Strength reduction with a water table (`problems/slope_water_table.toml` on
+/// the test grid h = 1 m): the Griffiths & Lane slope, dry F = 1.41 on this grid
+/// (strength_reduction.rs), loses strength to the pore pressure below its
+/// phreatic line (8 m at the back to the toe): measured F = 1.3094.
+#[test]
+fn water_table_lowers_the_factor_of_safety_of_the_slope() {
+    let (result, _dir) =
+        crate::common::search_problem("slope_water_table.toml", &["grid.cells=[40,12]"]);
+    let s = result.unwrap();
+    let fos = s.factor_of_safety.unwrap();
+    let (dry, _dry_dir) = crate::common::search_problem(
+        "slope_water_table.toml",
+        &["grid.cells=[40,12]", "water.unit_weight=1e-9"],
+    );
+    let f_dry = dry.unwrap().factor_of_safety.unwrap();
+    eprintln!("slope with a water table: F = {fos:.4} (dry, the same scene: {f_dry:.4})");
+    assert!((fos - 1.3094).abs() < 0.02, "F = {fos:.4}, measured 1.3094");
+    assert!(
+        f_dry - fos > 0.07,
+        "the pore pressure weakens the slope: {f_dry:.4} vs {fos:.4}"
+    );
+}
