@@ -19,6 +19,7 @@ use crate::model::particle_set::ParticleSet;
 use crate::model::particles::Particles;
 use crate::model::peridynamics::{PdBody, Peridynamics};
 use crate::model::triangles::{Cells, TriangleSurface};
+use crate::model::water::Water;
 use crate::model::{axisymmetry, import, Model};
 use crate::scene::SceneConfig;
 use crate::scene::{
@@ -118,7 +119,7 @@ impl<const D: usize> Model<D> {
         let gravity = c.gravity.as_deref().map_or(Vector::<D>::zeros(), vec);
         let loads = Loads::apply(c, &mut particles).map_err(err)?;
         let erosion = base_materials.iter().any(|m| m.erodes());
-        Ok(Model {
+        let mut model = Model {
             erosion,
             remove_outside: c.grid.particles_outside == ParticlesOutside::Remove,
             linear_domain_stress: c.grid.domain_stress == DomainStress::Linear,
@@ -140,7 +141,11 @@ impl<const D: usize> Model<D> {
             load_ramp_of: loads.ramp_of,
             axisymmetric,
             peridynamics,
-        })
+            water: (c.water.as_ref())
+                .map(|w| Water::new(w, c.gravity.as_deref().expect("validated"))),
+        };
+        model.update_pore_pressure();
+        Ok(model)
     }
 }
 

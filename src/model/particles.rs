@@ -35,6 +35,10 @@ pub struct Particles<const D: usize> {
     /// APIC's affine moment B_p = Σ_I S_Ip v_I (x_I − x_p)ᵀ (`solver::explicit::apic`):
     /// one per particle in a stage with `velocity_transfer = "apic"`, else empty.
     pub affine: Vec<Tensor<D>>,
+    /// Pore pressure p (compression positive) of the prescribed water field at
+    /// the start of the step (`model::water`): one per particle with `[water]`,
+    /// else empty. `stress` holds the effective stress σ′.
+    pub pore_pressure: Vec<f64>,
 }
 
 /// Per-particle history variables, only for materials that declare some.
@@ -121,6 +125,7 @@ impl<const D: usize> Default for Particles<D> {
             load: Vec::new(),
             history: History::default(),
             affine: Vec::new(),
+            pore_pressure: Vec::new(),
         }
     }
 }
@@ -132,6 +137,22 @@ impl<const D: usize> Particles<D> {
 
     pub fn is_empty(&self) -> bool {
         self.x.is_empty()
+    }
+
+    /// The total stress σ = σ′ − p I (Terzaghi, tension positive) of particle
+    /// q with effective stress `effective`: σ′ itself without `[water]`.
+    #[inline(always)]
+    pub fn total_stress(&self, q: usize, effective: &Mat3) -> Mat3 {
+        match self.pore_pressure.get(q) {
+            Some(&p) => effective - Mat3::identity() * p,
+            None => *effective,
+        }
+    }
+
+    /// The total stress of particle q from its stored (effective) stress.
+    #[inline(always)]
+    pub fn stored_total_stress(&self, q: usize) -> Mat3 {
+        self.total_stress(q, &self.stress.get(q))
     }
 
     /// Room for `additional` more particles (a fill knows its count: no regrowth).

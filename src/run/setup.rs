@@ -47,6 +47,7 @@ impl<const D: usize> SetUp<D> {
             strength_factor = r.checkpoint.strength_factor;
             model.particles = restored_particles(&r.checkpoint, &r.path, model.particles.len())?;
             restore_bonds(&r.checkpoint, &r.path, &mut model)?;
+            model.update_pore_pressure();
         }
         if strength_factor != 1.0 {
             model.reduce_strength(strength_factor);
