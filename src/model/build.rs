@@ -19,6 +19,7 @@ use crate::model::particle_set::ParticleSet;
 use crate::model::particles::Particles;
 use crate::model::peridynamics::{PdBody, Peridynamics};
 use crate::model::triangles::{Cells, TriangleSurface};
+use crate::model::water::Water;
 use crate::model::{axisymmetry, import, Model};
 use crate::scene::SceneConfig;
 use crate::scene::{
@@ -141,10 +142,13 @@ impl<const D: usize> Model<D> {
             axisymmetric,
             peridynamics,
             staging: None,
+            water: (c.water.as_ref())
+                .map(|w| Water::new(w, c.gravity.as_deref().expect("validated"))),
         };
         if c.stages_construction() {
             model.start_staging(&c.inactive_bodies());
         }
+        model.update_pore_pressure();
         Ok(model)
     }
 }

@@ -19,6 +19,7 @@ pub mod staging;
 pub(crate) mod tensors;
 pub mod terrain;
 pub mod triangles;
+pub mod water;
 
 use crate::model::peridynamics::Peridynamics;
 pub use loads::{load_factor, LoadTime};
@@ -29,6 +30,7 @@ use crate::model::body::{Body, BodyKind};
 use crate::model::conditions::{Absorbing, FaceCondition, FaceMotion, Footing, FrictionFace};
 use crate::model::grid::Grid;
 use crate::model::particles::Particles;
+use crate::model::water::Water;
 use crate::scene::contact::ContactPlan;
 use std::borrow::Cow;
 
@@ -93,6 +95,9 @@ pub struct Model<const D: usize> {
     /// Staged construction (`model::staging`): the bodies not yet active and
     /// the built index of each particle; None in a scene that stages nothing.
     pub staging: Option<staging::Staging<D>>,
+    /// The prescribed pore-water field (`[water]`, `model::water`); None
+    /// without one, and then no particle carries a pore pressure.
+    pub water: Option<Water>,
 }
 
 impl<const D: usize> Model<D> {
@@ -181,8 +186,9 @@ impl<const D: usize> Model<D> {
     }
 
     /// The per-particle fields the outputs add where the run has them:
-    /// `eps_p` (`plastic_strain`) and, with a peridynamic body, `damage`
-    /// (`Peridynamics::damage`, 0 off the peridynamic bodies).
+    /// `eps_p` (`plastic_strain`), with a peridynamic body `damage`
+    /// (`Peridynamics::damage`, 0 off the peridynamic bodies) and with
+    /// `[water]` `p_water`, the pore pressure of the last step (at its start).
     pub fn point_fields(&self) -> Vec<(&'static str, Vec<f64>)> {
         let mut fields: Vec<(&'static str, Vec<f64>)> = Vec::new();
         if let Some(e) = self.plastic_strain() {
@@ -191,7 +197,18 @@ impl<const D: usize> Model<D> {
         if let Some(pd) = &self.peridynamics {
             fields.push(("damage", pd.damage(self.particles.len())));
         }
+        if self.water.is_some() {
+            fields.push(("p_water", self.particles.pore_pressure.clone()));
+        }
         fields
+    }
+
+    /// Set the particles' pore pressures at their current positions (the run
+    /// calls this before every step); nothing without `[water]`.
+    pub fn update_pore_pressure(&mut self) {
+        if let Some(w) = &self.water {
+            w.assign(&self.bodies, &mut self.particles);
+        }
     }
 
     /// Index of the particle whose reference position is nearest to `x`.

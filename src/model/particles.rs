@@ -35,6 +35,10 @@ pub struct Particles<const D: usize> {
     /// APIC's affine moment B_p = Σ_I S_Ip v_I (x_I − x_p)ᵀ (`solver::explicit::apic`):
     /// one per particle in a stage with `velocity_transfer = "apic"`, else empty.
     pub affine: Vec<Tensor<D>>,
+    /// Pore pressure p (compression positive) of the prescribed water field at
+    /// the start of the step (`model::water`): one per particle with `[water]`,
+    /// else empty. `stress` holds the effective stress σ′.
+    pub pore_pressure: Vec<f64>,
 }
 
 /// Per-particle history variables, only for materials that declare some.
@@ -145,6 +149,7 @@ impl<const D: usize> Default for Particles<D> {
             load: Vec::new(),
             history: History::default(),
             affine: Vec::new(),
+            pore_pressure: Vec::new(),
         }
     }
 }
@@ -156,6 +161,22 @@ impl<const D: usize> Particles<D> {
 
     pub fn is_empty(&self) -> bool {
         self.x.is_empty()
+    }
+
+    /// The total stress σ = σ′ − p I (Terzaghi, tension positive) of particle
+    /// q with effective stress `effective`: σ′ itself without `[water]`.
+    #[inline(always)]
+    pub fn total_stress(&self, q: usize, effective: &Mat3) -> Mat3 {
+        match self.pore_pressure.get(q) {
+            Some(&p) => effective - Mat3::identity() * p,
+            None => *effective,
+        }
+    }
+
+    /// The total stress of particle q from its stored (effective) stress.
+    #[inline(always)]
+    pub fn stored_total_stress(&self, q: usize) -> Mat3 {
+        self.total_stress(q, &self.stress.get(q))
     }
 
     /// Room for `additional` more particles (a fill knows its count: no regrowth).
@@ -198,12 +219,13 @@ impl<const D: usize> Particles<D> {
             load: pick(&self.load, rows),
             history: self.history.select(rows),
             affine: pick(&self.affine, rows),
+            pore_pressure: pick(&self.pore_pressure, rows),
         }
     }
 
     /// Append `other`'s particles after these. A per-particle array only one
-    /// side keeps (loads, APIC's affine moments) is kept for all, zero for
-    /// the particles that had none.
+    /// side keeps (loads, APIC's affine moments, pore pressures) is kept for
+    /// all, zero for the particles that had none.
     pub fn append(&mut self, other: &Particles<D>) {
         let (n, m) = (self.len(), other.len());
         self.x.extend_from_slice(&other.x);
@@ -219,6 +241,7 @@ impl<const D: usize> Particles<D> {
         self.material.extend_from_slice(&other.material);
         append_optional(&mut self.load, n, &other.load, m, Vector::<D>::zeros());
         append_optional(&mut self.affine, n, &other.affine, m, Tensor::<D>::zeros());
+        append_optional(&mut self.pore_pressure, n, &other.pore_pressure, m, 0.0);
         self.history.append(&other.history);
     }
 

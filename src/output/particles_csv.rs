@@ -4,7 +4,9 @@
 //! `id,body,X0,Y0[,Z0],x,y[,z],vx,vy[,vz],sxx,syy,szz,sxy[,syz,sxz],volume0,volume,mass`,
 //! followed by extra columns only where the run has them (`eps_p`, the equivalent
 //! plastic strain, when a material has one; `contact_fx,contact_fy[,contact_fz]`,
-//! each particle's contact force, after an implicit stage with rigid contact).
+//! each particle's contact force, after an implicit stage with rigid contact;
+//! `p_water`, the pore pressure, with `[water]`, when the stresses are the
+//! effective ones).
 
 use std::io;
 use std::path::Path;

@@ -14,6 +14,13 @@
 //! when the upper layers are thin, or load them by a gravity stage).
 //! K0 is the scene's `k0`, else Jáky's 1 − sin φ of the body's material (as
 //! given, before any strength reduction).
+//!
+//! With `[water]` K0 holds for the effective stress (Terzaghi, tension
+//! positive: σ = σ′ − p I): σ_v = −ρ g d from the total (saturated) density as
+//! before, σ′_v = σ_v + p with p of the water field at the particle
+//! (`model::water`), σ′_h = K0 σ′_v, and the particle stores σ′. The water table
+//! is taken to lie at or below the body's top (free water above it would load
+//! the top surface, which this column does not count).
 
 use crate::dim::Mat3;
 use crate::model::Model;
@@ -44,8 +51,11 @@ pub fn initialise<const D: usize>(model: &mut Model<D>, g: &GeostaticConfig) {
         });
         let depth = (body.geometry.top(p.x0[q].as_slice(), v, up) - up * p.x0[q][v]).max(0.0);
         let sigma_v = -model.materials[m].density() * g_mag * depth;
-        let mut s = Mat3::from_diagonal_element(k0 * sigma_v);
-        s[(v, v)] = sigma_v;
+        // σ′_v = σ_v + p (Terzaghi), 0 without [water].
+        let pore = (model.water.as_ref()).map_or(0.0, |w| w.pressure(p.x0[q].as_slice()));
+        let effective_v = sigma_v + pore;
+        let mut s = Mat3::from_diagonal_element(k0 * effective_v);
+        s[(v, v)] = effective_v;
         p.stress.set(q, &s);
     }
 }

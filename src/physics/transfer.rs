@@ -377,8 +377,9 @@ struct ForceSource<const D: usize> {
     volume: f64,
 }
 
-/// Nodal force f_ext − f_int with the particles' Cauchy stress and current volume
-/// (2-51, 2-52), summed entry by entry (one gather over per-particle sources).
+/// Nodal force f_ext − f_int with the particles' total Cauchy stress σ′ − p I
+/// (`Particles::total_stress`) and current volume (2-51, 2-52), summed entry by
+/// entry (one gather over per-particle sources).
 pub fn nodal_force<const D: usize>(
     map: &NodeMap,
     st: &Stencils<D>,
@@ -389,11 +390,14 @@ pub fn nodal_force<const D: usize>(
     let sources: Vec<ForceSource<D>> = (0..p.len())
         .into_par_iter()
         .with_min_len(MIN_PARALLEL_LEN)
-        .map(|q| ForceSource {
-            applied: applied_force(p, q, gravity, load_factor),
-            stress: restrict::<D>(&p.stress.get(q)),
-            hoop_stress: p.stress.get(q)[(2, 2)],
-            volume: p.volume[q],
+        .map(|q| {
+            let total = p.stored_total_stress(q);
+            ForceSource {
+                applied: applied_force(p, q, gravity, load_factor),
+                stress: restrict::<D>(&total),
+                hoop_stress: total[(2, 2)],
+                volume: p.volume[q],
+            }
         })
         .collect();
     map.gather(st.stride, Vector::<D>::zeros(), |q, e| {

@@ -213,6 +213,8 @@ impl ParticleState {
             body: self.body.clone(),
             material: self.material.clone(),
             load: vectors(&self.load),
+            // Recomputed from the positions (`Model::update_pore_pressure`).
+            pore_pressure: Vec::new(),
             history: History {
                 offset: self.history_offset.clone(),
                 len: self.history_len.clone(),

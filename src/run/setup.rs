@@ -49,6 +49,7 @@ impl<const D: usize> SetUp<D> {
             restore_staging(&r.checkpoint, &r.path, cfg, &mut model)?;
             model.particles = restored_particles(&r.checkpoint, &r.path, model.particles.len())?;
             restore_bonds(&r.checkpoint, &r.path, &mut model)?;
+            model.update_pore_pressure();
         }
         if strength_factor != 1.0 {
             model.reduce_strength(strength_factor);

@@ -98,6 +98,8 @@ impl Timeline {
             if !(dt > 0.0 && self.t + dt > self.t) {
                 return Ok((Err(stalled(self.step, self.t, dt)), last_dt));
             }
+            // The step's pore pressures, at the step-start positions.
+            model.update_pore_pressure();
             self.recorders.state(&self.moment(model), Some(dt), false)?;
             let result = stepper.step(model, self.t, dt, self.step);
             self.recorders.newton(&stepper.take_newton_rows())?;

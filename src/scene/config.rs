@@ -46,6 +46,8 @@ pub struct SceneConfig {
     pub output: OutputConfig,
     /// Geostatic (K0) initial stresses, set before the first stage.
     pub geostatic: Option<GeostaticConfig>,
+    /// A prescribed pore-water field (`model::water`, docs/pore_water.md).
+    pub water: Option<WaterConfig>,
     /// Search for the factor of safety by strength reduction (`mpm run` runs the
     /// stages once per trial factor; docs/strength_reduction.md).
     pub strength_reduction: Option<StrengthReductionConfig>,
@@ -563,6 +565,35 @@ pub struct GeostaticConfig {
     /// Lateral earth pressure coefficient; default 1 − sin φ of each body's
     /// material (Jáky).
     pub k0: Option<f64>,
+}
+
+/// The `[water]` table: a prescribed pore pressure below a phreatic surface
+/// (docs/pore_water.md).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WaterConfig {
+    /// γ_w = ρ_w g in the scene's units (required: scenes use kPa or Pa).
+    pub unit_weight: Option<f64>,
+    /// A plane water table at this coordinate along the gravity axis.
+    pub level: Option<f64>,
+    /// The water table as points [horizontal, elevation] of a polyline (2D and
+    /// axisymmetric), linear between them and level beyond its ends.
+    pub phreatic_line: Option<Vec<Vec<f64>>>,
+    /// How the water flows below the phreatic surface (default hydrostatic).
+    #[serde(default)]
+    pub seepage: Seepage,
+}
+
+/// The flow below the phreatic surface, which sets the pore pressure there.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, IntoStaticStr, EnumIter)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum Seepage {
+    /// No flow: p = γ_w d_v, d_v the vertical depth below the surface.
+    #[default]
+    Hydrostatic,
+    /// Flow parallel to the phreatic surface inclined at β: p = γ_w d_v cos²β.
+    Parallel,
 }
 
 /// The `[strength_reduction]` table.

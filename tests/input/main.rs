@@ -18,3 +18,4 @@ mod key_paths;
 mod robustness;
 mod scene_errors;
 mod time_histories;
+mod water;

@@ -160,3 +160,36 @@ fn ground_motion_runs_give_identical_results_on_one_and_two_threads() {
         same_on_one_and_two_threads(name, &shaking, &format!("acceleration face, {what}"));
     }
 }
+
+/// A pore-water field (`[water]`, `model::water`): the Griffiths & Lane slope
+/// with a water table (`problems/slope_water_table.toml`, its strength reduction
+/// off), K0 on the effective stress then full gravity, implicit; and 0.3 s of
+/// explicit MUSL after it (the box scatter's force with σ′ − p I).
+#[test]
+fn water_table_runs_give_identical_results_on_one_and_two_threads() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(crate::common::problem("slope_water_table.toml")).unwrap();
+    let search = text
+        .find("[strength_reduction]")
+        .expect("the scene's search");
+    let end = search + text[search..].find("\n\n").unwrap();
+    let single = format!("{}{}", &text[..search], &text[end..]);
+    let file = dir.path().join("slope_water_table.toml");
+    std::fs::write(&file, &single).unwrap();
+    let coarse = [
+        "output.frames=0".to_string(),
+        "grid.cells=[40,12]".to_string(),
+    ];
+    same_on_one_and_two_threads(file.to_str().unwrap(), &coarse, "water table, implicit");
+    let solver = single.find("[solver]").unwrap();
+    let next = solver + single[solver..].find("\n\n").unwrap();
+    let staged = format!(
+        "{}[[stage]]\n{}\n\n[[stage]]\nkind = \"explicit\"\nscheme = \"musl\"\nend_time = 0.3\ncfl = 0.4{}",
+        &single[..solver],
+        &single[solver + "[solver]\n".len()..next],
+        &single[next..]
+    );
+    let file = dir.path().join("slope_water_table_staged.toml");
+    std::fs::write(&file, staged).unwrap();
+    same_on_one_and_two_threads(file.to_str().unwrap(), &coarse, "water table, explicit");
+}

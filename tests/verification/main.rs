@@ -32,3 +32,4 @@ mod strength_reduction;
 mod three_d;
 mod time_histories;
 mod vibrating_bar;
+mod water;

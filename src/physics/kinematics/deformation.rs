@@ -117,7 +117,7 @@ impl<const D: usize> Trial<D> {
         &self.u
     }
 
-    /// `measure(ΔF_p, σ_p)` of every particle under nodal displacements `u`,
+    /// `measure(p, ΔF_p, σ_p)` of every particle under nodal displacements `u`,
     /// with the ΔF_p (ΔF̄_p with F-bar) and the stress that `evaluate` would
     /// leave (the same arithmetic; the stress packed and read back as `stress`
     /// holds it), keeping nothing: the trial state stays that of the last
@@ -132,7 +132,7 @@ impl<const D: usize> Trial<D> {
         map: &NodeMap,
         u: &[Vector<D>],
         dt: f64,
-        measure: impl Fn(&Mat3, &Mat3) -> T + Sync,
+        measure: impl Fn(usize, &Mat3, &Mat3) -> T + Sync,
     ) -> Result<Vec<T>, usize> {
         let n = p.len();
         let axisymmetric = !st.hoop.is_empty();
@@ -168,7 +168,7 @@ impl<const D: usize> Trial<D> {
                 let new = advance(material, &inc, p.volume0[q], hist);
                 inverted.fetch_min(new.inverted_at(q), Ordering::Relaxed);
                 packed.set(0, &new.stress);
-                measure(&df, &packed.get(0))
+                measure(q, &df, &packed.get(0))
             })
             .collect();
         match inverted.into_inner() {

@@ -3,7 +3,7 @@
 //!
 //! One file per group of tables: `grid_bodies`, `conditions` (boundaries and
 //! loads), `materials`, `solver` (solver and stages) and `analyses` (geostatic,
-//! strength reduction, bench); `check` holds the checks they share.
+//! strength reduction, bench), `water`; `check` holds the checks they share.
 
 mod analyses;
 mod axisymmetry;
@@ -15,6 +15,7 @@ mod materials;
 mod peridynamic;
 mod solver;
 mod staging;
+mod water;
 
 pub use analyses::bench;
 pub use check::Check;
@@ -32,6 +33,7 @@ use conditions::{boundary, load};
 use grid_bodies::{body, grid};
 use materials::materials;
 use solver::{needs_krylov, solver, stage_strength_factor};
+use water::water;
 
 /// Check a parsed scene, table by table; the first failure names its key.
 pub fn validate(s: &SceneConfig) -> Check {
@@ -133,6 +135,9 @@ pub fn validate(s: &SceneConfig) -> Check {
     )?;
     if let Some(g) = &s.geostatic {
         geostatic(g, s, &materials)?;
+    }
+    if let Some(w) = &s.water {
+        water(w, s)?;
     }
     if let Some(r) = &s.strength_reduction {
         strength_reduction(r, s, &materials)?;

@@ -17,7 +17,8 @@ pub struct Source<const D: usize> {
     pub momentum: Vector<D>,
     /// m g + s f (`Step::applied`).
     pub applied: Vector<D>,
-    /// V σ, the in-plane block of the Cauchy stress times the current volume.
+    /// V σ, the in-plane block of the total Cauchy stress σ′ − p I times the
+    /// current volume.
     pub stress: Tensor<D>,
 }
 
@@ -29,7 +30,7 @@ impl<const D: usize> Source<D> {
             mass: p.mass[q],
             momentum: p.v[q] * p.mass[q],
             applied,
-            stress: restrict::<D>(&p.stress.get(q)) * p.volume[q],
+            stress: restrict::<D>(&p.stored_total_stress(q)) * p.volume[q],
         }
     }
 
@@ -46,5 +47,5 @@ impl<const D: usize> Source<D> {
 /// radial force of node I loses (the hoop term of the virtual work).
 #[inline(always)]
 pub fn hoop_stress<const D: usize>(p: &Particles<D>, q: usize) -> f64 {
-    p.stress.get(q)[(2, 2)] * p.volume[q] / p.x[q][0]
+    p.stored_total_stress(q)[(2, 2)] * p.volume[q] / p.x[q][0]
 }

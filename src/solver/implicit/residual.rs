@@ -4,7 +4,8 @@
 //!
 //! with u the nodal displacement increments, M lumped or consistent (no inertia
 //! when quasi-static), f_int the internal force of the relative first
-//! Piola-Kirchhoff stress of the trial state at u on the step-start volumes (the
+//! Piola-Kirchhoff stress of the trial state's total stress σ′ − p I at u
+//! (`model::water`: p fixed over the step) on the step-start volumes (the
 //! stresses always recomputed from the step-start state, `Trial`), f_ext the
 //! external force at t + Δt, and the optional terms of the step
 //! (`super::terms`: the absorbing faces' dashpots and springs −f_abs(u) (2-63),
@@ -51,7 +52,10 @@ pub fn residual<const D: usize>(
     let pk1: Vec<_> = (0..p.len())
         .into_par_iter()
         .with_min_len(MIN_PARALLEL_LEN)
-        .map(|q| relative_pk1(&sys.trial.df(st, map, q), &sys.trial.stress.get(q)))
+        .map(|q| {
+            let total = p.total_stress(q, &sys.trial.stress.get(q));
+            relative_pk1(&sys.trial.df(st, map, q), &total)
+        })
         .collect();
     let mut r = material_residual(m, sys, u, &pk1);
     sys.for_each_term(m, |step, t| t.evaluate(step, u, &mut r));
@@ -68,7 +72,9 @@ pub fn probe_residual<const D: usize>(
     let p = &m.particles;
     let (st, map) = (&sys.stencils, &sys.map);
     let pk1 = (sys.trial)
-        .probe(p, &m.materials, st, map, u, sys.dt, relative_pk1)
+        .probe(p, &m.materials, st, map, u, sys.dt, |q, df, sigma| {
+            relative_pk1(df, &p.total_stress(q, sigma))
+        })
         .map_err(inverted)?;
     let mut r = material_residual(m, sys, u, &pk1);
     let step = sys.view(m);

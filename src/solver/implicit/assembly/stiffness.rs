@@ -154,7 +154,9 @@ pub fn particle_tangents<const D: usize>(
                     numerical.then(|| numerical_stress_derivative(mat, &inc, NUMERICAL_STEP))
                 })
                 .map(|ds| {
-                    let full = pk1_derivative::<D>(&df, &trial.stress.get(q), &ds, hoop);
+                    // ∂P/∂ΔF of the total stress σ′ − p I at fixed p (p of the step start).
+                    let total = p.total_stress(q, &trial.stress.get(q));
+                    let full = pk1_derivative::<D>(&df, &total, &ds, hoop);
                     compact::<D>(&full, a_q);
                     if hoop {
                         compact_hoop::<D>(&full, hoop_q);
