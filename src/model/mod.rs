@@ -246,6 +246,67 @@ impl<const D: usize> Model<D> {
         extents
     }
 
+    /// Start staging (`model::staging`): the particles of the `inactive`
+    /// bodies held aside until a stage activates them.
+    pub(crate) fn start_staging(&mut self, inactive: &[usize]) {
+        let continuum = self.continuum_bodies();
+        let mut a = staging::Arrays {
+            particles: &mut self.particles,
+            load_ramp_of: &mut self.load_ramp_of,
+            continuum: &continuum,
+        };
+        self.staging = Some(staging::Staging::start(&mut a, inactive));
+    }
+
+    /// Apply a stage's changes at its start (`model::staging`; nothing
+    /// without staging).
+    pub fn change(&mut self, changes: &staging::StageChanges) {
+        let continuum = self.continuum_bodies();
+        if let Some(s) = &mut self.staging {
+            let mut a = staging::Arrays {
+                particles: &mut self.particles,
+                load_ramp_of: &mut self.load_ramp_of,
+                continuum: &continuum,
+            };
+            s.change(&mut a, changes);
+        }
+    }
+
+    /// A restart's particles of a staged scene (`Staging::restore`).
+    pub fn restore_staging(&mut self, activated: &[usize], built: &[u32]) -> Result<(), String> {
+        let continuum = self.continuum_bodies();
+        let Some(s) = &mut self.staging else {
+            return Ok(());
+        };
+        let mut a = staging::Arrays {
+            particles: &mut self.particles,
+            load_ramp_of: &mut self.load_ramp_of,
+            continuum: &continuum,
+        };
+        s.restore(&mut a, activated, built)
+    }
+
+    /// The particle now in the model that was built as `built` (None: it has
+    /// left, `model::staging`); the identity without staging.
+    pub fn particle_built_as(&self, built: usize) -> Option<usize> {
+        match &self.staging {
+            None => Some(built),
+            Some(s) => s.built.iter().position(|&b| b as usize == built),
+        }
+    }
+
+    /// The index as built of particle q (q itself without staging).
+    pub fn built_index(&self, q: usize) -> usize {
+        self.staging.as_ref().map_or(q, |s| s.built[q] as usize)
+    }
+
+    /// Whether each body is a continuum body.
+    fn continuum_bodies(&self) -> Vec<bool> {
+        (self.bodies.iter())
+            .map(|b| b.kind == BodyKind::Continuum)
+            .collect()
+    }
+
     /// The kind of particle q's body.
     pub fn kind_of(&self, q: usize) -> BodyKind {
         self.bodies[self.particles.body[q] as usize].kind

@@ -8,14 +8,13 @@
 //! body not yet active is held here as built, outside the model. Each
 //! particle keeps its index among all the particles as built (`built`), by
 //! which a checkpoint names the particles present and a restart rebuilds
-//! them (`Model::restore_staging`). A scene that stages nothing has no
+//! them (`Staging::restore`). The model's methods (`Model::change`, …) hand
+//! their arrays over (`Arrays`). A scene that stages nothing has no
 //! `Staging` (`Model::staging` is None).
 
-use crate::model::body::BodyKind;
 use crate::model::geometry::Geometry;
 use crate::model::particles::Particles;
-use crate::model::Model;
-use crate::scene::staging::{RegionConfig, RegionShape};
+use crate::scene::region::{RegionConfig, RegionShape};
 use crate::scene::SceneConfig;
 
 /// The particles outside the model and the built index of those inside.
@@ -26,13 +25,6 @@ pub struct Staging<const D: usize> {
     pub built: Vec<u32>,
     /// The bodies not yet active, as built.
     dormant: Vec<Dormant<D>>,
-}
-
-impl<const D: usize> Staging<D> {
-    /// The particles of the bodies not active yet, as built.
-    pub fn dormant_particles(&self) -> impl Iterator<Item = &Particles<D>> {
-        self.dormant.iter().map(|d| &d.particles)
-    }
 }
 
 /// A body held outside the model until a stage activates it.
@@ -79,138 +71,139 @@ impl StageChanges {
     }
 }
 
-impl<const D: usize> Model<D> {
-    /// Start staging: every particle numbered as built, and the particles of
-    /// the `inactive` bodies taken out and held until activated.
-    pub(crate) fn start_staging(&mut self, inactive: &[usize]) {
-        let n = self.particles.len();
-        self.staging = Some(Staging {
-            built: (0..n as u32).collect(),
+/// The model's per-particle arrays a change touches: the particles, the
+/// index of each one's load history (`Model::load_ramp_of`), and whether
+/// each body is a continuum body (the kind staging applies to).
+pub struct Arrays<'a, const D: usize> {
+    pub particles: &'a mut Particles<D>,
+    pub load_ramp_of: &'a mut Vec<u32>,
+    pub continuum: &'a [bool],
+}
+
+impl<const D: usize> Arrays<'_, D> {
+    /// Whether particle q belongs to a continuum body.
+    fn continuum(&self, q: usize) -> bool {
+        (self.continuum.get(self.particles.body[q] as usize)).is_some_and(|&c| c)
+    }
+
+    /// Keep the particles of `rows`, in that order, with their loads' histories
+    /// and their built indices `built`.
+    fn keep(&mut self, rows: &[usize], built: &mut Vec<u32>) {
+        *self.particles = self.particles.select(rows);
+        *self.load_ramp_of = pick(self.load_ramp_of, rows);
+        *built = pick(built, rows);
+    }
+}
+
+impl<const D: usize> Staging<D> {
+    /// Staging of a model as built: every particle numbered as built, and the
+    /// particles of the `inactive` bodies taken out and held until activated.
+    pub fn start(a: &mut Arrays<D>, inactive: &[usize]) -> Staging<D> {
+        let mut s = Staging {
+            built: (0..a.particles.len() as u32).collect(),
             dormant: Vec::new(),
-        });
+        };
         for &body in inactive {
-            let rows = self.rows_of_body(body);
-            let dormant = Dormant {
+            let (of, rest): (Vec<usize>, Vec<usize>) =
+                (0..a.particles.len()).partition(|&q| a.particles.body[q] as usize == body);
+            s.dormant.push(Dormant {
                 body,
-                particles: self.particles.select(&rows),
-                built: rows.iter().map(|&q| q as u32).collect(),
-                load_ramp_of: pick(&self.load_ramp_of, &rows),
-            };
-            self.staging.as_mut().expect("set above").dormant.push(dormant);
-            self.retain(|m, q| m.particles.body[q] as usize != body);
+                particles: a.particles.select(&of),
+                built: pick(&s.built, &of),
+                load_ramp_of: pick(a.load_ramp_of, &of),
+            });
+            a.keep(&rest, &mut s.built);
         }
+        s
     }
 
     /// Apply a stage's changes at its start (`StageChanges`, in its order).
-    pub fn change(&mut self, changes: &StageChanges) {
+    pub fn change(&mut self, a: &mut Arrays<D>, changes: &StageChanges) {
         for &body in &changes.deactivate {
-            self.retain(|m, q| m.particles.body[q] as usize != body);
+            self.retain(a, |a, q| a.particles.body[q] as usize != body);
         }
         for region in &changes.excavate {
-            self.retain(|m, q| !m.excavated_by(region, q));
+            let inside = |a: &Arrays<D>, q: usize| region.contains(a.particles.x[q].as_slice());
+            self.retain(a, |a, q| !(a.continuum(q) && inside(a, q)));
         }
         for &body in &changes.activate {
-            self.activate(body);
+            self.activate(a, body);
         }
         if changes.reset_displacement {
-            self.reset_displacement();
+            reset_displacement(a);
         }
-    }
-
-    /// Whether excavating `region` takes particle q: a continuum particle
-    /// whose current position lies inside.
-    fn excavated_by(&self, region: &Geometry, q: usize) -> bool {
-        self.kind_of(q) == BodyKind::Continuum && region.contains(self.particles.x[q].as_slice())
     }
 
     /// The particles of dormant `body` added after those in the model, at
     /// rest as built (unstressed, undeformed).
-    fn activate(&mut self, body: usize) {
-        let staging = self.staging.as_mut().expect("a staged scene");
-        let Some(k) = staging.dormant.iter().position(|d| d.body == body) else {
+    fn activate(&mut self, a: &mut Arrays<D>, body: usize) {
+        let Some(k) = self.dormant.iter().position(|d| d.body == body) else {
             return;
         };
-        let d = staging.dormant.remove(k);
-        let n = self.particles.len();
-        self.particles.append(&d.particles);
-        staging.built.extend_from_slice(&d.built);
-        if !(self.load_ramp_of.is_empty() && d.load_ramp_of.is_empty()) {
-            self.load_ramp_of.resize(n, u32::MAX);
+        let d = self.dormant.remove(k);
+        let n = a.particles.len();
+        a.particles.append(&d.particles);
+        self.built.extend_from_slice(&d.built);
+        if !(a.load_ramp_of.is_empty() && d.load_ramp_of.is_empty()) {
+            a.load_ramp_of.resize(n, u32::MAX);
             match d.load_ramp_of.is_empty() {
-                true => self.load_ramp_of.resize(n + d.built.len(), u32::MAX),
-                false => self.load_ramp_of.extend_from_slice(&d.load_ramp_of),
+                true => a.load_ramp_of.resize(n + d.built.len(), u32::MAX),
+                false => a.load_ramp_of.extend_from_slice(&d.load_ramp_of),
             }
         }
     }
 
-    /// Displacements measured from now on: the reference position of every
-    /// continuum particle set to its current one (a rigid body's reference
-    /// positions define its shape and stay).
-    fn reset_displacement(&mut self) {
-        for q in 0..self.particles.len() {
-            if self.kind_of(q) == BodyKind::Continuum {
-                self.particles.x0[q] = self.particles.x[q];
-            }
+    /// Keep the particles for which `keep` holds.
+    fn retain(&mut self, a: &mut Arrays<D>, keep: impl Fn(&Arrays<D>, usize) -> bool) {
+        let rows: Vec<usize> = (0..a.particles.len()).filter(|&q| keep(a, q)).collect();
+        if rows.len() < a.particles.len() {
+            a.keep(&rows, &mut self.built);
         }
     }
 
-    /// Keep the particles for which `keep` holds, with their per-particle
-    /// arrays (`Particles::select`, the loads' histories, the built indices).
-    fn retain(&mut self, keep: impl Fn(&Model<D>, usize) -> bool) {
-        let rows: Vec<usize> = (0..self.particles.len()).filter(|&q| keep(self, q)).collect();
-        if rows.len() == self.particles.len() {
-            return;
-        }
-        self.particles = self.particles.select(&rows);
-        self.load_ramp_of = pick(&self.load_ramp_of, &rows);
-        if let Some(s) = &mut self.staging {
-            s.built = pick(&s.built, &rows);
-        }
-    }
-
-    fn rows_of_body(&self, body: usize) -> Vec<usize> {
-        (0..self.particles.len())
-            .filter(|&q| self.particles.body[q] as usize == body)
-            .collect()
-    }
-
-    /// A restart's particles: the bodies activated up to its stage (`active`)
-    /// added, then the particles the checkpoint names by their built index
-    /// (`built`), in its order; the caller then restores their state. Err
-    /// names an index the scene does not build.
-    pub fn restore_staging(&mut self, activated: &[usize], built: &[u32]) -> Result<(), String> {
+    /// A restart's particles: the bodies activated up to its stage
+    /// (`activated`) added, then the particles the checkpoint names by their
+    /// built index (`built`) kept, in its order; the caller then restores
+    /// their state. Err names an index the scene does not build.
+    pub fn restore(
+        &mut self,
+        a: &mut Arrays<D>,
+        activated: &[usize],
+        built: &[u32],
+    ) -> Result<(), String> {
         for &body in activated {
-            self.activate(body);
+            self.activate(a, body);
         }
-        let staging = self.staging.as_ref().expect("a staged scene");
-        let mut row_of = vec![usize::MAX; 1 + staging.built.iter().max().map_or(0, |&b| b as usize)];
-        for (q, &b) in staging.built.iter().enumerate() {
+        let mut row_of = vec![usize::MAX; 1 + self.built.iter().max().map_or(0, |&b| b as usize)];
+        for (q, &b) in self.built.iter().enumerate() {
             row_of[b as usize] = q;
         }
         let rows = (built.iter())
             .map(|&b| match row_of.get(b as usize) {
                 Some(&q) if q != usize::MAX => Ok(q),
-                _ => Err(format!("particle {b} (as built) is not in the staged scene")),
+                _ => Err(format!(
+                    "particle {b} (as built) is not in the staged scene"
+                )),
             })
             .collect::<Result<Vec<usize>, String>>()?;
-        self.particles = self.particles.select(&rows);
-        self.load_ramp_of = pick(&self.load_ramp_of, &rows);
-        self.staging.as_mut().expect("a staged scene").built = built.to_vec();
+        a.keep(&rows, &mut self.built);
         Ok(())
     }
 
-    /// The particle now in the model that was built as `built` (None: it has
-    /// left); the identity without staging.
-    pub fn particle_built_as(&self, built: usize) -> Option<usize> {
-        match &self.staging {
-            None => Some(built),
-            Some(s) => s.built.iter().position(|&b| b as usize == built),
-        }
+    /// The particles of the bodies not active yet, as built.
+    pub fn dormant_particles(&self) -> impl Iterator<Item = &Particles<D>> {
+        self.dormant.iter().map(|d| &d.particles)
     }
+}
 
-    /// The built index of particle q (q itself without staging).
-    pub fn built_index(&self, q: usize) -> usize {
-        self.staging.as_ref().map_or(q, |s| s.built[q] as usize)
+/// Displacements measured from now on: the reference position of every
+/// continuum particle set to its current one (a rigid body's reference
+/// positions define its shape and stay).
+fn reset_displacement<const D: usize>(a: &mut Arrays<D>) {
+    for q in 0..a.particles.len() {
+        if a.continuum(q) {
+            a.particles.x0[q] = a.particles.x[q];
+        }
     }
 }
 

@@ -343,7 +343,8 @@ fn change_model<const D: usize>(
     }
     // The state the last stage ended in is recorded before it changes (with
     // no step between: it is the nearest to an output time due now).
-    line.recorders.state(&line.moment(model), Some(0.0), false)?;
+    line.recorders
+        .state(&line.moment(model), Some(0.0), false)?;
     model.change(&changes);
     Ok(match model.particles.is_empty() {
         false => Ok(()),

@@ -17,6 +17,7 @@ pub(crate) mod expr;
 mod grid;
 mod material;
 pub(crate) mod overrides;
+pub mod region;
 mod solver;
 pub mod staging;
 #[cfg(test)]

@@ -181,7 +181,7 @@ pub struct SolverConfig {
     /// Bodies, by name, whose particles leave the model at the stage's start.
     pub deactivate: Option<Vec<String>>,
     /// Regions whose continuum particles leave the model at the stage's start.
-    pub excavate: Option<Vec<super::staging::RegionConfig>>,
+    pub excavate: Option<Vec<super::region::RegionConfig>>,
     /// Bodies, by name (`active = false`), that enter the model at the stage's
     /// start, unstressed.
     pub activate: Option<Vec<String>>,
@@ -419,6 +419,16 @@ impl SolverConfig {
     pub fn max_cutbacks(&self) -> usize {
         self.max_cutbacks.unwrap_or(5)
     }
+
+    /// Whether this stage changes the model at its start (staged
+    /// construction: `scene::staging`, `model::staging`).
+    pub fn changes_model(&self) -> bool {
+        self.activate.as_ref().is_some_and(|v| !v.is_empty())
+            || self.deactivate.as_ref().is_some_and(|v| !v.is_empty())
+            || self.excavate.as_ref().is_some_and(|v| !v.is_empty())
+            || self.reset_displacement == Some(true)
+    }
+
     /// Quasi-static gravity ramps from zero over the stage (default true).
     /// A stage that changes the model (`changes_model`) finds the ground under
     /// gravity already: there gravity is in full by default.

@@ -1,42 +1,9 @@
-//! The staged-construction keys of a `[[stage]]`: the bodies it activates and
-//! deactivates by name, the regions it excavates and its displacement reset
-//! (`model::staging` applies them; docs/staging.md), and the bodies active at
-//! each stage's start.
+//! Staged construction in a scene (docs/staging.md): the bodies by name, those
+//! that start inactive and those the stages activate up to a stage
+//! (`model::staging` applies the changes; the keys are `SolverConfig`'s, the
+//! regions `region::RegionConfig`).
 
 use crate::scene::{BodyKindName, SceneConfig};
-use serde::Deserialize;
-use strum::IntoStaticStr;
-
-/// A region of space: its continuum particles leave the model at the stage's
-/// start (`excavate`).
-#[derive(Clone, Debug, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct RegionConfig {
-    pub shape: RegionShape,
-    pub min: Option<Vec<f64>>,
-    pub max: Option<Vec<f64>>,
-    pub centre: Option<Vec<f64>>,
-    pub radius: Option<f64>,
-    pub vertices: Option<Vec<Vec<f64>>>,
-}
-
-/// The shapes a region takes: those of the bodies given by corners, a centre
-/// and radius, or vertices.
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq, IntoStaticStr)]
-#[serde(rename_all = "snake_case")]
-#[strum(serialize_all = "snake_case")]
-pub enum RegionShape {
-    /// 2D, `min` and `max` corners.
-    Rectangle,
-    /// 3D, `min` and `max` corners.
-    Box,
-    /// 2D, `centre` and `radius`.
-    Disk,
-    /// 3D, `centre` and `radius`.
-    Sphere,
-    /// 2D, `vertices` of a simple polygon in order.
-    Polygon,
-}
 
 impl SceneConfig {
     /// Whether the scene stages its construction: a body starts inactive or a
@@ -71,15 +38,5 @@ impl SceneConfig {
     /// Whether body i is a continuum body (the kind staging applies to).
     pub fn is_continuum(&self, i: usize) -> bool {
         self.body_kind(i) == BodyKindName::Continuum
-    }
-}
-
-impl crate::scene::SolverConfig {
-    /// Whether this stage changes the model at its start.
-    pub fn changes_model(&self) -> bool {
-        self.activate.as_ref().is_some_and(|v| !v.is_empty())
-            || self.deactivate.as_ref().is_some_and(|v| !v.is_empty())
-            || self.excavate.as_ref().is_some_and(|v| !v.is_empty())
-            || self.reset_displacement == Some(true)
     }
 }

@@ -58,10 +58,16 @@ fn an_opening_excavated_under_isotropic_stress_follows_kirsch() {
         inside / std::f64::consts::FRAC_PI_4 - 1.0,
         0.03,
     );
-    assert!(rows.iter().all(|r| r.0 >= 1.0), "no particle left inside r < a");
+    assert!(
+        rows.iter().all(|r| r.0 >= 1.0),
+        "no particle left inside r < a"
+    );
     let wall: Vec<&(f64, f64, f64)> = rows.iter().filter(|r| r.0 < 1.125).collect();
     let u = mean(wall.iter().map(|&&(r, u, _)| u / (-P0 / (2.0 * G * r))));
-    let hoop = mean(wall.iter().map(|&&(r, _, h)| h / (-P0 * (1.0 + 1.0 / (r * r)))));
+    let hoop = mean(
+        wall.iter()
+            .map(|&&(r, _, h)| h / (-P0 * (1.0 + 1.0 / (r * r)))),
+    );
     // Measured +2.0e-2 and -1.4e-2; the issue's bound is 3 %.
     assert_within("wall displacement / Kirsch's - 1", u - 1.0, 0.03);
     assert_within("hoop stress at the wall / Kirsch's - 1", hoop - 1.0, 0.03);
@@ -72,7 +78,11 @@ fn an_opening_excavated_under_isotropic_stress_follows_kirsch() {
         .collect();
     let trace = mean(far.iter().map(|&q| p.col("sxx")[q] + p.col("syy")[q]));
     // Measured 4e-3 (the tractions act half a particle spacing inside the faces).
-    assert_within("far-field (sxx + syy) / (-2 p0) - 1", trace / (-2.0 * P0) - 1.0, 1e-2);
+    assert_within(
+        "far-field (sxx + syy) / (-2 p0) - 1",
+        trace / (-2.0 * P0) - 1.0,
+        1e-2,
+    );
 }
 
 /// An elastic medium: the opening dug in one stage, or its inner half first
@@ -100,7 +110,9 @@ fn an_excavation_in_one_stage_equals_the_same_in_two() {
         "\n[[stage]]\nname = \"rest\"\n{whole}\nkind = \"implicit\"\n\
          integrator = \"quasi_static\"\nend_time = 1.0\nload_steps = 1\n"
     );
-    let staged = text.replace(whole, half).replace("\n[output]", &format!("{second}\n[output]"));
+    let staged = text
+        .replace(whole, half)
+        .replace("\n[output]", &format!("{second}\n[output]"));
     let twice = run_text(&staged, &coarse);
     let (a, b) = (once.0.unwrap(), twice.0.unwrap());
     assert_eq!(a.particles, b.particles, "the same particles are taken out");
@@ -151,7 +163,11 @@ fn a_fill_placed_in_layers_settles_as_the_closed_form() {
     let u = mean(rows.iter().map(|&q| y[q] - y0[q]));
     let closed = -weight * (height * 9.75 - 9.75 * 9.75 / 2.0) / m;
     // Measured -3.9e-4.
-    assert_within("settlement of the first layer's top / closed form - 1", u / closed - 1.0, 1e-3);
+    assert_within(
+        "settlement of the first layer's top / closed form - 1",
+        u / closed - 1.0,
+        1e-3,
+    );
 
     let text = std::fs::read_to_string(crate::common::problem("fill_layers.toml")).unwrap();
     let at_once = text.replace("active = false\n", "");
@@ -165,5 +181,9 @@ fn a_fill_placed_in_layers_settles_as_the_closed_form() {
         .map(|&q| (y[q] - q1.col("y")[q]).abs() / closed.abs())
         .fold(0.0, f64::max);
     // Measured 2.5e-5.
-    assert_within("first layer, in layers vs at once / settlement", worst, 7.5e-5);
+    assert_within(
+        "first layer, in layers vs at once / settlement",
+        worst,
+        7.5e-5,
+    );
 }

@@ -6,7 +6,7 @@
 //! scene with a peridynamic body stages nothing.
 
 use super::check::{ensure, forbidden, required, vector, Check};
-use crate::scene::staging::{RegionConfig, RegionShape};
+use crate::scene::region::{RegionConfig, RegionShape};
 use crate::scene::{BodyKindName, SceneConfig, SolverConfig};
 
 /// The staging keys of scene `s`.
@@ -79,7 +79,11 @@ fn only_in_stages(st: &SolverConfig) -> Check {
     forbidden(&st.activate, "solver.activate".into(), what)?;
     forbidden(&st.deactivate, "solver.deactivate".into(), what)?;
     forbidden(&st.excavate, "solver.excavate".into(), what)?;
-    forbidden(&st.reset_displacement, "solver.reset_displacement".into(), what)
+    forbidden(
+        &st.reset_displacement,
+        "solver.reset_displacement".into(),
+        what,
+    )
 }
 
 /// Body i starts inactive: a continuum body some stage activates.
@@ -96,8 +100,12 @@ fn inactive_body(s: &SceneConfig, i: usize) -> Check {
         format!("body.{i}.name"),
         "a body with `active = false` needs a name, by which a stage activates it",
     )?;
-    let activated = (s.stages.iter())
-        .any(|st| st.activate.iter().flatten().any(|n| Some(n.as_str()) == name));
+    let activated = (s.stages.iter()).any(|st| {
+        st.activate
+            .iter()
+            .flatten()
+            .any(|n| Some(n.as_str()) == name)
+    });
     ensure(
         activated,
         key,
@@ -109,7 +117,11 @@ fn inactive_body(s: &SceneConfig, i: usize) -> Check {
 }
 
 /// The bodies named `name` (at `key`): at least one, all continuum bodies.
-fn continuum_bodies(s: &SceneConfig, name: &str, key: &str) -> Result<Vec<usize>, (String, String)> {
+fn continuum_bodies(
+    s: &SceneConfig,
+    name: &str,
+    key: &str,
+) -> Result<Vec<usize>, (String, String)> {
     let bodies = s.bodies_named(name);
     if bodies.is_empty() {
         let names: Vec<&str> = s.bodies.iter().filter_map(|b| b.name.as_deref()).collect();
@@ -161,7 +173,11 @@ fn region(r: &RegionConfig, dim: usize, prefix: &str) -> Check {
             required(&r.radius, key("radius"), shape)?;
             vector(r.centre.as_ref().unwrap(), dim, &key("centre"))?;
             let radius = r.radius.unwrap();
-            ensure(radius > 0.0 && radius.is_finite(), key("radius"), "must be > 0")
+            ensure(
+                radius > 0.0 && radius.is_finite(),
+                key("radius"),
+                "must be > 0",
+            )
         }
         RegionShape::Polygon => {
             required(&r.vertices, key("vertices"), shape)?;
@@ -202,7 +218,11 @@ fn first_staging_key(s: &SceneConfig) -> String {
     if let Some(i) = s.bodies.iter().position(|b| b.active == Some(false)) {
         return format!("body.{i}.active");
     }
-    let k = s.stages.iter().position(|st| st.changes_model()).unwrap_or(0);
+    let k = s
+        .stages
+        .iter()
+        .position(|st| st.changes_model())
+        .unwrap_or(0);
     let st = &s.stages[k];
     let key = [
         ("deactivate", st.deactivate.is_some()),
