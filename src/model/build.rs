@@ -141,9 +141,13 @@ impl<const D: usize> Model<D> {
             load_ramp_of: loads.ramp_of,
             axisymmetric,
             peridynamics,
+            staging: None,
             water: (c.water.as_ref())
                 .map(|w| Water::new(w, c.gravity.as_deref().expect("validated"))),
         };
+        if c.stages_construction() {
+            model.start_staging(&c.inactive_bodies());
+        }
         model.update_pore_pressure();
         Ok(model)
     }

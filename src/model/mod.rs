@@ -15,6 +15,7 @@ pub(crate) mod memory;
 pub mod particle_set;
 pub mod particles;
 pub mod peridynamics;
+pub mod staging;
 pub(crate) mod tensors;
 pub mod terrain;
 pub mod triangles;
@@ -91,6 +92,9 @@ pub struct Model<const D: usize> {
     /// The peridynamic bodies' bonds (`model::peridynamics`); None in a
     /// scene without one, which then allocates and computes nothing of them.
     pub peridynamics: Option<Peridynamics<D>>,
+    /// Staged construction (`model::staging`): the bodies not yet active and
+    /// the built index of each particle; None in a scene that stages nothing.
+    pub staging: Option<staging::Staging<D>>,
     /// The prescribed pore-water field (`[water]`, `model::water`); None
     /// without one, and then no particle carries a pore pressure.
     pub water: Option<Water>,
@@ -215,9 +219,10 @@ impl<const D: usize> Model<D> {
     }
 
     /// Each body's particles as built: their count, total volume (per radian
-    /// in an axisymmetric model) and the box of their domains (`mpm check`).
+    /// in an axisymmetric model) and the box of their domains (`mpm check`),
+    /// also of a body not active yet (`model::staging`).
     pub fn body_extents(&self) -> Vec<BodyExtent> {
-        let p = &self.particles;
+        let dormant = self.staging.iter().flat_map(|s| s.dormant_particles());
         let mut extents: Vec<BodyExtent> = (0..self.bodies.len())
             .map(|_| BodyExtent {
                 particles: 0,
@@ -226,17 +231,80 @@ impl<const D: usize> Model<D> {
                 max: vec![f64::NEG_INFINITY; D],
             })
             .collect();
-        for q in 0..p.len() {
-            let e = &mut extents[p.body[q] as usize];
-            e.particles += 1;
-            e.volume += p.volume[q];
-            for d in 0..D {
-                let (x, h) = (p.x[q][d], p.half_length0[q][d]);
-                e.min[d] = e.min[d].min(x - h);
-                e.max[d] = e.max[d].max(x + h);
+        for p in std::iter::once(&self.particles).chain(dormant) {
+            for q in 0..p.len() {
+                let e = &mut extents[p.body[q] as usize];
+                e.particles += 1;
+                e.volume += p.volume[q];
+                for d in 0..D {
+                    let (x, h) = (p.x[q][d], p.half_length0[q][d]);
+                    e.min[d] = e.min[d].min(x - h);
+                    e.max[d] = e.max[d].max(x + h);
+                }
             }
         }
         extents
+    }
+
+    /// Start staging (`model::staging`): the particles of the `inactive`
+    /// bodies held aside until a stage activates them.
+    pub(crate) fn start_staging(&mut self, inactive: &[usize]) {
+        let continuum = self.continuum_bodies();
+        let mut a = staging::Arrays {
+            particles: &mut self.particles,
+            load_ramp_of: &mut self.load_ramp_of,
+            continuum: &continuum,
+        };
+        self.staging = Some(staging::Staging::start(&mut a, inactive));
+    }
+
+    /// Apply a stage's changes at its start (`model::staging`; nothing
+    /// without staging).
+    pub fn change(&mut self, changes: &staging::StageChanges) {
+        let continuum = self.continuum_bodies();
+        if let Some(s) = &mut self.staging {
+            let mut a = staging::Arrays {
+                particles: &mut self.particles,
+                load_ramp_of: &mut self.load_ramp_of,
+                continuum: &continuum,
+            };
+            s.change(&mut a, changes);
+        }
+    }
+
+    /// A restart's particles of a staged scene (`Staging::restore`).
+    pub fn restore_staging(&mut self, activated: &[usize], built: &[u32]) -> Result<(), String> {
+        let continuum = self.continuum_bodies();
+        let Some(s) = &mut self.staging else {
+            return Ok(());
+        };
+        let mut a = staging::Arrays {
+            particles: &mut self.particles,
+            load_ramp_of: &mut self.load_ramp_of,
+            continuum: &continuum,
+        };
+        s.restore(&mut a, activated, built)
+    }
+
+    /// The particle now in the model that was built as `built` (None: it has
+    /// left, `model::staging`); the identity without staging.
+    pub fn particle_built_as(&self, built: usize) -> Option<usize> {
+        match &self.staging {
+            None => Some(built),
+            Some(s) => s.built.iter().position(|&b| b as usize == built),
+        }
+    }
+
+    /// The index as built of particle q (q itself without staging).
+    pub fn built_index(&self, q: usize) -> usize {
+        self.staging.as_ref().map_or(q, |s| s.built[q] as usize)
+    }
+
+    /// Whether each body is a continuum body.
+    fn continuum_bodies(&self) -> Vec<bool> {
+        (self.bodies.iter())
+            .map(|b| b.kind == BodyKind::Continuum)
+            .collect()
     }
 
     /// The kind of particle q's body.
@@ -244,13 +312,10 @@ impl<const D: usize> Model<D> {
         self.bodies[self.particles.body[q] as usize].kind
     }
 
-    /// Number of bodies (for per-body outputs).
+    /// Number of bodies (for per-body outputs): the scene's, also those not
+    /// active yet (`model::staging`).
     pub fn n_bodies(&self) -> usize {
-        self.particles
-            .body
-            .iter()
-            .map(|&b| b as usize + 1)
-            .max()
-            .unwrap_or(0)
+        let of_particles = self.particles.body.iter().map(|&b| b as usize + 1).max();
+        of_particles.unwrap_or(0).max(self.bodies.len())
     }
 }

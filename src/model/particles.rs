@@ -96,6 +96,30 @@ impl History {
     }
 }
 
+impl History {
+    /// The slots of `rows`, in that order, packed anew.
+    pub fn select(&self, rows: &[usize]) -> History {
+        let mut h = History::default();
+        for &q in rows {
+            let values = self.get(q);
+            h.push(values.len());
+            let start = h.data.len() - values.len();
+            h.data[start..].copy_from_slice(values);
+        }
+        h
+    }
+
+    /// Append the slots of `other` after these.
+    pub fn append(&mut self, other: &History) {
+        for q in 0..other.len.len() {
+            let values = other.get(q);
+            self.push(values.len());
+            let start = self.data.len() - values.len();
+            self.data[start..].copy_from_slice(values);
+        }
+    }
+}
+
 /// Split `data` into consecutive slices of the given lengths.
 fn split_slots<'a>(len: &[u16], data: &'a mut [f64]) -> Vec<&'a mut [f64]> {
     let mut rest = data;
@@ -171,6 +195,56 @@ impl<const D: usize> Particles<D> {
         self.material.reserve_exact(n);
     }
 
+    /// The particles of `rows`, in that order, with everything they carry
+    /// (staged construction, `model::staging`).
+    pub fn select(&self, rows: &[usize]) -> Particles<D> {
+        fn pick<T: Clone>(v: &[T], rows: &[usize]) -> Vec<T> {
+            match v.is_empty() {
+                true => Vec::new(),
+                false => rows.iter().map(|&q| v[q].clone()).collect(),
+            }
+        }
+        Particles {
+            x: pick(&self.x, rows),
+            x0: pick(&self.x0, rows),
+            v: pick(&self.v, rows),
+            mass: pick(&self.mass, rows),
+            volume: pick(&self.volume, rows),
+            volume0: pick(&self.volume0, rows),
+            f: self.f.select(rows),
+            stress: self.stress.select(rows),
+            half_length0: pick(&self.half_length0, rows),
+            body: pick(&self.body, rows),
+            material: pick(&self.material, rows),
+            load: pick(&self.load, rows),
+            history: self.history.select(rows),
+            affine: pick(&self.affine, rows),
+            pore_pressure: pick(&self.pore_pressure, rows),
+        }
+    }
+
+    /// Append `other`'s particles after these. A per-particle array only one
+    /// side keeps (loads, APIC's affine moments, pore pressures) is kept for
+    /// all, zero for the particles that had none.
+    pub fn append(&mut self, other: &Particles<D>) {
+        let (n, m) = (self.len(), other.len());
+        self.x.extend_from_slice(&other.x);
+        self.x0.extend_from_slice(&other.x0);
+        self.v.extend_from_slice(&other.v);
+        self.mass.extend_from_slice(&other.mass);
+        self.volume.extend_from_slice(&other.volume);
+        self.volume0.extend_from_slice(&other.volume0);
+        self.f.append(&other.f);
+        self.stress.append(&other.stress);
+        self.half_length0.extend_from_slice(&other.half_length0);
+        self.body.extend_from_slice(&other.body);
+        self.material.extend_from_slice(&other.material);
+        append_optional(&mut self.load, n, &other.load, m, Vector::<D>::zeros());
+        append_optional(&mut self.affine, n, &other.affine, m, Tensor::<D>::zeros());
+        append_optional(&mut self.pore_pressure, n, &other.pore_pressure, m, 0.0);
+        self.history.append(&other.history);
+    }
+
     /// Add one particle at rest, undeformed and unstressed.
     #[allow(clippy::too_many_arguments)]
     pub fn push(
@@ -199,5 +273,20 @@ impl<const D: usize> Particles<D> {
             self.load.push(Vector::<D>::zeros());
         }
         self.history.push(n_history);
+    }
+}
+
+/// `a` (of `n` particles, or empty) followed by `b` (of `m`, or empty): empty
+/// when both are, else every particle's value, `zero` where a side had none.
+fn append_optional<T: Clone>(a: &mut Vec<T>, n: usize, b: &[T], m: usize, zero: T) {
+    if a.is_empty() && b.is_empty() {
+        return;
+    }
+    if a.is_empty() {
+        a.resize(n, zero.clone());
+    }
+    match b.is_empty() {
+        true => a.resize(n + m, zero),
+        false => a.extend_from_slice(b),
     }
 }

@@ -146,6 +146,24 @@ impl Tensors {
         }
     }
 
+    /// The tensors of `rows`, in that order (`Particles::select`).
+    pub fn select(&self, rows: &[usize]) -> Tensors {
+        let n = self.layout.components();
+        let data = (rows.iter())
+            .flat_map(|&q| self.data[q * n..(q + 1) * n].iter().copied())
+            .collect();
+        Tensors {
+            layout: self.layout,
+            data,
+        }
+    }
+
+    /// Append the tensors of `other` (of the same layout).
+    pub fn append(&mut self, other: &Tensors) {
+        assert_eq!(self.layout, other.layout, "tensors of one layout");
+        self.data.extend_from_slice(&other.data);
+    }
+
     pub fn reserve(&mut self, additional: usize) {
         self.data
             .reserve_exact(additional * self.layout.components());

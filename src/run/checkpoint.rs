@@ -86,6 +86,10 @@ pub struct Checkpoint {
     /// Per peridynamic body, the ids of its broken bonds, ascending
     /// (`model::peridynamics::Peridynamics::broken_bonds`); empty without one.
     pub broken_bonds: Vec<Vec<u32>>,
+    /// A staged scene's particles by their index as built, in the order of
+    /// `particles` (`model::staging`); None in a scene that stages nothing.
+    #[serde(default)]
+    pub staged_particles: Option<Vec<u32>>,
     pub solver: SolverState,
     pub recorders: RecorderState,
 }
@@ -352,6 +356,29 @@ pub(super) fn restored_particles<const D: usize>(
         )));
     }
     Ok(p)
+}
+
+/// A staged scene's particles as the checkpoint of stage `ck.stage` has
+/// them: the bodies activated up to that stage added to the model as built,
+/// then the particles it names kept, in its order (`Model::restore_staging`);
+/// their state is restored next (`restored_particles`).
+pub(super) fn restore_staging<const D: usize>(
+    ck: &Checkpoint,
+    path: &Path,
+    cfg: &crate::scene::SceneConfig,
+    model: &mut crate::model::Model<D>,
+) -> Result<(), RunError> {
+    if model.staging.is_none() {
+        return Ok(());
+    }
+    let name = path.display();
+    let Some(built) = &ck.staged_particles else {
+        return Err(RunError::Checkpoint(format!(
+            "checkpoint {name} does not list the particles of this staged scene"
+        )));
+    };
+    (model.restore_staging(&cfg.activated_by_stage(ck.stage), built))
+        .map_err(|e| RunError::Checkpoint(format!("checkpoint {name}: {e}")))
 }
 
 /// The peridynamic bodies' bonds of a checkpoint: the scene rebuilds them

@@ -58,7 +58,7 @@ pub(super) fn summary<const D: usize>(
         stages: std::mem::take(&mut ran.stages),
         footing: line.recorders.footing_summary(model),
         monitor_particle: monitor,
-        monitor_displacement: monitor
+        monitor_displacement: (monitor.and_then(|b| model.particle_built_as(b)))
             .map(|q| (model.particles.x[q] - model.particles.x0[q]).norm()),
         strength_factor: opts.strength_factor,
         resumed_from: resume.map(|r| ResumedFrom {

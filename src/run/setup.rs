@@ -4,7 +4,7 @@
 
 use crate::model::Model;
 use crate::output::Progress;
-use crate::run::checkpoint::{restore_bonds, restored_particles, Kept, Resume};
+use crate::run::checkpoint::{restore_bonds, restore_staging, restored_particles, Kept, Resume};
 use crate::run::checks::check_steps;
 use crate::run::error::RunError;
 use crate::run::options::RunOptions;
@@ -21,7 +21,8 @@ pub(super) struct SetUp<const D: usize> {
     pub model: Model<D>,
     /// The strength-reduction factor in force (1: as given).
     pub strength_factor: f64,
-    /// The particle whose displacement summary.json reports.
+    /// The particle whose displacement summary.json reports, by its index as
+    /// built (`Model::built_index`).
     pub monitor: Option<usize>,
     pub line: Timeline,
     /// The run's step number at the start (a restart's).
@@ -45,6 +46,7 @@ impl<const D: usize> SetUp<D> {
         let mut strength_factor = opts.strength_factor.unwrap_or(1.0);
         if let Some(r) = resume {
             strength_factor = r.checkpoint.strength_factor;
+            restore_staging(&r.checkpoint, &r.path, cfg, &mut model)?;
             model.particles = restored_particles(&r.checkpoint, &r.path, model.particles.len())?;
             restore_bonds(&r.checkpoint, &r.path, &mut model)?;
             model.update_pore_pressure();
@@ -58,7 +60,8 @@ impl<const D: usize> SetUp<D> {
         let monitor = opts
             .monitor
             .as_deref()
-            .and_then(|x| model.nearest_particle(x));
+            .and_then(|x| model.nearest_particle(x))
+            .map(|q| model.built_index(q));
         let ck = resume.map(|r| &r.checkpoint);
         let recorders = match resume {
             Some(r) => {

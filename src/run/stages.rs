@@ -3,6 +3,7 @@
 //! checkpoint when one is due or a signal asks for it.
 
 use crate::dim::Vector;
+use crate::model::staging::StageChanges;
 use crate::model::Model;
 use crate::output::Progress;
 use crate::run::checkpoint::{self, Checkpoint, Kept, ParticleState};
@@ -177,6 +178,7 @@ impl Timeline {
             particles: ParticleState::of(&model.particles),
             broken_bonds: (model.peridynamics.as_ref())
                 .map_or_else(Vec::new, |pd| pd.broken_bonds()),
+            staged_particles: (model.staging.as_ref()).map(|s| s.built.clone()),
             solver: stepper.state(),
             recorders: self.recorders.saved()?,
         };
@@ -268,6 +270,12 @@ pub(super) fn run_stages<const D: usize>(
             model.reduce_strength(f);
             *strength_factor = f;
         }
+        if resumed.is_none() && !cfg.stages.is_empty() {
+            outcome = change_model(model, cfg, k, line)?;
+            if outcome.is_err() {
+                break;
+            }
+        }
         let (mut stepper, start, steps_before, last_dt) =
             stage_stepper(scene, out, sc, resumed, model, line)?;
         let name = sc.name.clone().unwrap_or_else(|| format!("stage{k}"));
@@ -317,6 +325,37 @@ pub(super) fn run_stages<const D: usize>(
         last,
         contact_forces,
         failure,
+    })
+}
+
+/// Stage k's changes of the model at its start (`model::staging`); a stage
+/// that leaves no particle stops the run (the inner error). The outer error
+/// is an output that could not be written.
+fn change_model<const D: usize>(
+    model: &mut Model<D>,
+    cfg: &crate::scene::SceneConfig,
+    k: usize,
+    line: &mut Timeline,
+) -> std::io::Result<Result<(), Divergence>> {
+    let changes = StageChanges::of(cfg, k);
+    if changes.is_empty() {
+        return Ok(Ok(()));
+    }
+    // The state the last stage ended in is recorded before it changes (with
+    // no step between: it is the nearest to an output time due now).
+    line.recorders
+        .state(&line.moment(model), Some(0.0), false)?;
+    model.change(&changes);
+    Ok(match model.particles.is_empty() {
+        false => Ok(()),
+        true => Err(Divergence {
+            step: line.step,
+            time: line.t,
+            particle: None,
+            message: format!(
+                "stage {k} leaves no particle in the model (its deactivate and excavate)"
+            ),
+        }),
     })
 }
 

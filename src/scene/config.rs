@@ -221,6 +221,9 @@ pub struct BodyConfig {
     pub kind: Option<BodyKindName>,
     /// A rigid body's motion: `prescribed` (the default) or `free`.
     pub motion: Option<Motion>,
+    /// `false`: the body enters the model when a stage activates it
+    /// (`[[stage]] activate`; default true).
+    pub active: Option<bool>,
     pub material: String,
     pub shape: BodyShape,
     pub min: Option<Vec<f64>>,

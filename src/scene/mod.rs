@@ -17,7 +17,9 @@ pub(crate) mod expr;
 mod grid;
 mod material;
 pub(crate) mod overrides;
+pub mod region;
 mod solver;
+pub mod staging;
 #[cfg(test)]
 pub(crate) mod testing;
 pub(crate) mod validate;

@@ -177,6 +177,16 @@ pub struct SolverConfig {
     pub gravity_ramp_time: Option<f64>,
     /// F-bar against volumetric locking (explicit and implicit; default false).
     pub fbar: Option<bool>,
+    // Staged construction (`[[stage]]` only; `scene::staging`, `model::staging`).
+    /// Bodies, by name, whose particles leave the model at the stage's start.
+    pub deactivate: Option<Vec<String>>,
+    /// Regions whose continuum particles leave the model at the stage's start.
+    pub excavate: Option<Vec<super::region::RegionConfig>>,
+    /// Bodies, by name (`active = false`), that enter the model at the stage's
+    /// start, unstressed.
+    pub activate: Option<Vec<String>>,
+    /// Displacements measured from the stage's start (default false).
+    pub reset_displacement: Option<bool>,
 }
 
 impl SolverKind {
@@ -409,9 +419,21 @@ impl SolverConfig {
     pub fn max_cutbacks(&self) -> usize {
         self.max_cutbacks.unwrap_or(5)
     }
+
+    /// Whether this stage changes the model at its start (staged
+    /// construction: `scene::staging`, `model::staging`).
+    pub fn changes_model(&self) -> bool {
+        self.activate.as_ref().is_some_and(|v| !v.is_empty())
+            || self.deactivate.as_ref().is_some_and(|v| !v.is_empty())
+            || self.excavate.as_ref().is_some_and(|v| !v.is_empty())
+            || self.reset_displacement == Some(true)
+    }
+
     /// Quasi-static gravity ramps from zero over the stage (default true).
+    /// A stage that changes the model (`changes_model`) finds the ground under
+    /// gravity already: there gravity is in full by default.
     pub fn gravity_ramp(&self) -> bool {
-        self.gravity_ramp.unwrap_or(true)
+        self.gravity_ramp.unwrap_or(!self.changes_model())
     }
     /// Nodes whose particle support Σ_p V_p S_Ip is below this fraction of a cell
     /// volume are tied to two neighbours by linear extrapolation (default 1e-2;

@@ -17,5 +17,6 @@ mod impact;
 mod key_paths;
 mod robustness;
 mod scene_errors;
+mod staging;
 mod time_histories;
 mod water;

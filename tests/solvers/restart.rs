@@ -245,6 +245,33 @@ fn staged_restart_at_a_stage_end() {
     assert_eq!(a.solver.newton_iterations, b.solver.newton_iterations);
 }
 
+/// Staged construction (`model::staging`): a checkpoint lists its particles
+/// by their index as built, and a restart rebuilds them. In the middle of an
+/// excavation stage (its particles taken out at the stage's start, the
+/// displacements reset) and at the end of it; after a fill layer entered and
+/// before the next does.
+#[test]
+fn a_restart_across_a_stage_that_removes_or_adds_particles_is_byte_identical() {
+    let coarse = [
+        "grid.max=[10.0, 10.0]",
+        "grid.cells=[40, 40]",
+        "body.0.max=[10.0, 10.0]",
+        "load.0.region_min=[9.9, 0.0]",
+        "load.0.region_max=[10.0, 10.0]",
+        "load.1.region_min=[0.0, 9.9]",
+        "load.1.region_max=[10.0, 10.0]",
+        "stage.1.load_steps=4",
+    ];
+    let steps = restarts_are_exact("tunnel_excavation.toml", &coarse, 0.5, 1);
+    assert_eq!(steps, [3, 5], "in the excavation stage and at its end");
+    let steps = restarts_are_exact("fill_layers.toml", &[], 1.0, 2);
+    assert_eq!(
+        steps,
+        [3, 4],
+        "after the second and the third layer entered"
+    );
+}
+
 #[test]
 fn a_restart_on_another_thread_count_is_byte_identical_too() {
     restarts_are_exact("column_explicit.toml", &["solver.end_time=2"], 0.8, 2);

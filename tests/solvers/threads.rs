@@ -193,3 +193,35 @@ fn water_table_runs_give_identical_results_on_one_and_two_threads() {
     std::fs::write(&file, staged).unwrap();
     same_on_one_and_two_threads(file.to_str().unwrap(), &coarse, "water table, explicit");
 }
+
+/// Staged construction (`model::staging`): particles taken out of and put
+/// into the arrays at a stage's start keep their order, so the excavation and
+/// the layered fill are the same on 1 and 2 threads, implicit, and with an
+/// explicit stage after the fill's last layer.
+#[test]
+fn staged_construction_gives_identical_results_on_one_and_two_threads() {
+    let coarse: Vec<String> = [
+        "grid.max=[10.0, 10.0]",
+        "grid.cells=[40, 40]",
+        "body.0.max=[10.0, 10.0]",
+        "load.0.region_min=[9.9, 0.0]",
+        "load.0.region_max=[10.0, 10.0]",
+        "load.1.region_min=[0.0, 9.9]",
+        "load.1.region_max=[10.0, 10.0]",
+        "output.frames=0",
+    ]
+    .map(String::from)
+    .to_vec();
+    same_on_one_and_two_threads("tunnel_excavation.toml", &coarse, "excavation");
+    same_on_one_and_two_threads("fill_layers.toml", &[], "layered fill");
+    let text = std::fs::read_to_string(crate::common::problem("fill_layers.toml")).unwrap();
+    let last = "activate = [\"layer3\"]\nkind = \"implicit\"\nintegrator = \"quasi_static\"\n\
+                end_time = 1.0\nload_steps = 1";
+    assert!(text.contains(last), "the fill's last stage");
+    let explicit = "activate = [\"layer3\"]\nkind = \"explicit\"\nend_time = 0.02\ndamping = 0.05";
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("fill_layers_explicit.toml");
+    std::fs::write(&file, text.replace(last, explicit)).unwrap();
+    let name = file.to_str().unwrap();
+    same_on_one_and_two_threads(name, &[], "layered fill, explicit last layer");
+}

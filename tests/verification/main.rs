@@ -27,6 +27,7 @@ mod site_response;
 mod slope_3d;
 mod slope_runout;
 mod stages;
+mod staging;
 mod strength_reduction;
 mod three_d;
 mod time_histories;

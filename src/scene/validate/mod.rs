@@ -14,6 +14,7 @@ mod histories;
 mod materials;
 mod peridynamic;
 mod solver;
+mod staging;
 mod water;
 
 pub use analyses::bench;
@@ -104,6 +105,7 @@ pub fn validate(s: &SceneConfig) -> Check {
             ))
         }
     }
+    staging::staging(s)?;
     ensure(
         s.output.history_interval >= 0.0,
         "output.history_interval",

@@ -47,6 +47,10 @@ pub struct StepSettings {
     pub end_time: f64,
     /// Quasi-static: gravity ramps with the load factor (else it is in full).
     pub gravity_ramp: bool,
+    /// Quasi-static: the loads without a time history ramp with the load
+    /// factor (else they are in full: a stage that changes the model,
+    /// `SolverConfig::changes_model`, finds them applied already).
+    pub ramp_loads: bool,
     /// Newmark: gravity rises linearly from zero over this time on the run's
     /// clock (`gravity_ramp_time`; 0: in full from the start).
     pub gravity_ramp_time: LoadTime,
@@ -243,6 +247,7 @@ impl StepSettings {
             t_start,
             end_time: s.end_time,
             gravity_ramp: s.gravity_ramp(),
+            ramp_loads: !s.changes_model(),
             gravity_ramp_time: LoadTime::Ramp(s.gravity_ramp_time()),
             min_node_support: s.min_node_support(),
             fbar: s.fbar(),
@@ -268,7 +273,11 @@ impl StepSettings {
                     (None, false) => 1.0,
                 };
                 let scales = (m.load_ramps.iter())
-                    .map(|r| if r.is_curve() { r.factor(t) } else { lambda })
+                    .map(|r| match (r.is_curve(), self.ramp_loads) {
+                        (true, _) => r.factor(t),
+                        (false, true) => lambda,
+                        (false, false) => 1.0,
+                    })
                     .collect();
                 (g, scales)
             }
