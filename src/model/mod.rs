@@ -13,6 +13,7 @@ pub(crate) mod import;
 pub(crate) mod loads;
 pub(crate) mod memory;
 pub mod particle_set;
+pub mod mesh;
 pub mod particles;
 pub mod peridynamics;
 pub(crate) mod tensors;
