@@ -13,7 +13,7 @@ it, point, curve and surface entities, the base as 2-node lines (physical
 group 2 "base", which a 2D body passes over) and the triangles of surface 1
 (physical group 1 "soil").
 
-Usage: python3 problems/slope_gmsh.py [--nx 60] [--ny 25] [--quads] [OUT]
+Usage: python3 problems/slope_gmsh.py [--nx 90] [--ny 30] [--quads] [OUT]
 """
 
 import argparse
@@ -72,8 +72,8 @@ def write(path, nx, ny, quads):
 
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--nx", type=int, default=60)
-    p.add_argument("--ny", type=int, default=25)
+    p.add_argument("--nx", type=int, default=90)
+    p.add_argument("--ny", type=int, default=30)
     p.add_argument("--quads", action="store_true")
     p.add_argument("out", nargs="?", default="problems/slope_gmsh.msh")
     a = p.parse_args()

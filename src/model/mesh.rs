@@ -145,7 +145,9 @@ impl ElementKind {
     /// The faces (corner indices, in order around each) of a 3D element.
     fn faces(self) -> Vec<Vec<usize>> {
         match self {
-            ElementKind::Tetrahedron => vec![vec![0, 2, 1], vec![0, 1, 3], vec![0, 3, 2], vec![1, 2, 3]],
+            ElementKind::Tetrahedron => {
+                vec![vec![0, 2, 1], vec![0, 1, 3], vec![0, 3, 2], vec![1, 2, 3]]
+            }
             ElementKind::Hexahedron => vec![
                 vec![0, 3, 2, 1],
                 vec![4, 5, 6, 7],
@@ -313,7 +315,10 @@ fn box_size(points: &[[f64; 3]], dim: usize) -> f64 {
     (0..dim)
         .map(|d| {
             let lo = points.iter().map(|p| p[d]).fold(f64::INFINITY, f64::min);
-            let hi = points.iter().map(|p| p[d]).fold(f64::NEG_INFINITY, f64::max);
+            let hi = points
+                .iter()
+                .map(|p| p[d])
+                .fold(f64::NEG_INFINITY, f64::max);
             hi - lo
         })
         .fold(0.0, f64::max)
@@ -342,12 +347,15 @@ fn triangle_height(t: &[[f64; 3]; 3], x: &[f64], v: usize, up: f64) -> f64 {
         _ => (0, 1),
     };
     // Barycentric coordinates of (x_p, x_q) in the triangle's projection.
-    let area = (t[1][p] - t[0][p]) * (t[2][q] - t[0][q]) - (t[2][p] - t[0][p]) * (t[1][q] - t[0][q]);
+    let area =
+        (t[1][p] - t[0][p]) * (t[2][q] - t[0][q]) - (t[2][p] - t[0][p]) * (t[1][q] - t[0][q]);
     if area == 0.0 {
         return f64::NEG_INFINITY;
     }
-    let l1 = ((x[p] - t[0][p]) * (t[2][q] - t[0][q]) - (t[2][p] - t[0][p]) * (x[q] - t[0][q])) / area;
-    let l2 = ((t[1][p] - t[0][p]) * (x[q] - t[0][q]) - (x[p] - t[0][p]) * (t[1][q] - t[0][q])) / area;
+    let l1 =
+        ((x[p] - t[0][p]) * (t[2][q] - t[0][q]) - (t[2][p] - t[0][p]) * (x[q] - t[0][q])) / area;
+    let l2 =
+        ((t[1][p] - t[0][p]) * (x[q] - t[0][q]) - (x[p] - t[0][p]) * (t[1][q] - t[0][q])) / area;
     let l0 = 1.0 - l1 - l2;
     let tol = -1e-12;
     if l0 < tol || l1 < tol || l2 < tol {
@@ -377,7 +385,12 @@ mod tests {
     #[test]
     fn a_distorted_element_has_its_volume_and_centroid() {
         // A quadrilateral (0,0), (3,0), (2,2), (0,1): area 4 (shoelace).
-        let q = vec![[0.0, 0.0, 0.0], [3.0, 0.0, 0.0], [2.0, 2.0, 0.0], [0.0, 1.0, 0.0]];
+        let q = vec![
+            [0.0, 0.0, 0.0],
+            [3.0, 0.0, 0.0],
+            [2.0, 2.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ];
         let m = mesh(2, q, ElementKind::Quadrilateral);
         m.check().unwrap();
         let p = m.gauss_points();
@@ -387,7 +400,10 @@ mod tests {
         // Centroid of the polygon: x = 14/12, y = 10/12 (shoelace moments / 6A).
         let cx: f64 = p.iter().map(|g| g.0[0] * g.1).sum::<f64>() / v;
         let cy: f64 = p.iter().map(|g| g.0[1] * g.1).sum::<f64>() / v;
-        assert!((cx - 7.0 / 6.0).abs() < 1e-14 && (cy - 5.0 / 6.0).abs() < 1e-14, "{cx} {cy}");
+        assert!(
+            (cx - 7.0 / 6.0).abs() < 1e-14 && (cy - 5.0 / 6.0).abs() < 1e-14,
+            "{cx} {cy}"
+        );
         // A hexahedron: the unit cube with its top corner 6 raised by 1.
         let mut h: Vec<[f64; 3]> = (0..8).map(|a| cube(a).map(|c| 0.5 * (c + 1.0))).collect();
         h[6][2] = 2.0;
@@ -411,7 +427,12 @@ mod tests {
 
     #[test]
     fn the_top_of_a_tetrahedron_is_its_upper_face() {
-        let t = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let t = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ];
         let m = mesh(3, t, ElementKind::Tetrahedron);
         let top = m.top(&[0.25, 0.25, 0.1], 2, 1.0);
         assert!((top - 0.5).abs() < 1e-15, "{top}");

@@ -388,10 +388,9 @@ impl BodyConfig {
                     [e[0], e[1]],
                 )
             }
-            BodyShape::Particles
-            | BodyShape::Surface
-            | BodyShape::Terrain
-            | BodyShape::Mesh => return None,
+            BodyShape::Particles | BodyShape::Surface | BodyShape::Terrain | BodyShape::Mesh => {
+                return None
+            }
         })
     }
 

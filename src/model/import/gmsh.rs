@@ -51,7 +51,10 @@ pub fn read(path: &Path, shown: &str, select: &Select) -> Result<ElementMesh, St
 /// data size 4 or 8; whether the file is binary. Errors start with `:line: `.
 fn mesh_format(bytes: &[u8]) -> Result<bool, String> {
     let text = String::from_utf8_lossy(&bytes[..bytes.len().min(256)]);
-    let mut lines = text.lines().enumerate().skip_while(|(_, l)| l.trim().is_empty());
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .skip_while(|(_, l)| l.trim().is_empty());
     match lines.next() {
         Some((_, l)) if l.trim() == "$MeshFormat" => {}
         _ => return Err(": not a Gmsh MSH file: it does not start with `$MeshFormat`".into()),
@@ -90,7 +93,8 @@ fn physical_names(bytes: &[u8]) -> Result<HashMap<(i32, i32), String>, String> {
     let first = 1 + bytes[..start].iter().filter(|&&b| b == b'\n').count();
     let rest = String::from_utf8_lossy(&bytes[start..]);
     let mut lines = rest.lines().enumerate().skip(1);
-    let bad = |k: usize, l: &str| format!(":{}: `{l}`: expected `dimension tag \"name\"`", first + k);
+    let bad =
+        |k: usize, l: &str| format!(":{}: `{l}`: expected `dimension tag \"name\"`", first + k);
     let (k, l) = lines.next().ok_or(": the file ends in $PhysicalNames")?;
     let count: usize = l.trim().parse().map_err(|_| bad(k, l))?;
     for _ in 0..count {
@@ -100,7 +104,9 @@ fn physical_names(bytes: &[u8]) -> Result<HashMap<(i32, i32), String>, String> {
         let tag = parts.next().and_then(|w| w.parse().ok());
         let name = parts.next().map(|w| w.trim());
         match (dim, tag, name) {
-            (Some(d), Some(t), Some(n)) if n.len() >= 2 && n.starts_with('"') && n.ends_with('"') => {
+            (Some(d), Some(t), Some(n))
+                if n.len() >= 2 && n.starts_with('"') && n.ends_with('"') =>
+            {
                 names.insert((d, t), n[1..n.len() - 1].to_string());
             }
             _ => return Err(bad(k, l)),
@@ -128,11 +134,16 @@ fn find_line(bytes: &[u8], word: &[u8]) -> Option<usize> {
 fn parse(bytes: &[u8], binary: bool) -> Result<Msh, String> {
     let parsed = std::panic::catch_unwind(|| {
         mshio::parse_msh_bytes(bytes).map_err(|e| {
-            let at = e.backtrace.first().map_or(bytes.len(), |(rest, _)| bytes.len() - rest.len());
+            let at = e
+                .backtrace
+                .first()
+                .map_or(bytes.len(), |(rest, _)| bytes.len() - rest.len());
             let what: Vec<String> = (e.backtrace.iter().rev())
                 .filter_map(|(_, k)| k.context().map(str::to_string))
                 .collect();
-            let why = e.first_msh_error().map_or("cannot be read".into(), |k| k.to_string());
+            let why = e
+                .first_msh_error()
+                .map_or("cannot be read".into(), |k| k.to_string());
             (at, what.join(", in "), why)
         })
     });
@@ -141,7 +152,10 @@ fn parse(bytes: &[u8], binary: bool) -> Result<Msh, String> {
         Ok(Err((at, what, why))) => {
             let place = match binary {
                 true => format!(": byte {at}"),
-                false => format!(":{}", 1 + bytes[..at].iter().filter(|&&b| b == b'\n').count()),
+                false => format!(
+                    ":{}",
+                    1 + bytes[..at].iter().filter(|&&b| b == b'\n').count()
+                ),
             };
             Err(format!("{place}: in {what}: {why}"))
         }
@@ -161,8 +175,16 @@ fn entities(
     };
     let dim = select.dim as i32;
     let of_dim: Vec<(i32, Vec<i32>)> = match &msh.data.entities {
-        Some(e) if dim == 2 => e.surfaces.iter().map(|s| (s.tag, s.physical_tags.clone())).collect(),
-        Some(e) => e.volumes.iter().map(|v| (v.tag, v.physical_tags.clone())).collect(),
+        Some(e) if dim == 2 => e
+            .surfaces
+            .iter()
+            .map(|s| (s.tag, s.physical_tags.clone()))
+            .collect(),
+        Some(e) => e
+            .volumes
+            .iter()
+            .map(|v| (v.tag, v.physical_tags.clone()))
+            .collect(),
         None => Vec::new(),
     };
     let mut groups: Vec<i32> = of_dim.iter().flat_map(|(_, p)| p.iter().copied()).collect();
@@ -186,10 +208,15 @@ fn entities(
             true => "it has none".to_string(),
             false => format!("its {dim}D groups are {}", listed.join(", ")),
         };
-        return Err(format!("no physical group {group} of dimension {dim}: {known}"));
+        return Err(format!(
+            "no physical group {group} of dimension {dim}: {known}"
+        ));
     };
     Ok(Some(
-        (of_dim.iter()).filter(|(_, p)| p.contains(&tag)).map(|(e, _)| *e).collect(),
+        (of_dim.iter())
+            .filter(|(_, p)| p.contains(&tag))
+            .map(|(e, _)| *e)
+            .collect(),
     ))
 }
 
@@ -230,7 +257,11 @@ fn dim_of(t: ElementType) -> usize {
 
 /// The body's elements with their nodes, numbered in the order they are first
 /// used.
-fn elements(msh: &Msh, entities: &Option<HashSet<i32>>, select: &Select) -> Result<ElementMesh, String> {
+fn elements(
+    msh: &Msh,
+    entities: &Option<HashSet<i32>>,
+    select: &Select,
+) -> Result<ElementMesh, String> {
     let coordinates = node_coordinates(msh);
     let mut index: HashMap<u64, usize> = HashMap::new();
     let mut mesh = ElementMesh {
@@ -239,9 +270,15 @@ fn elements(msh: &Msh, entities: &Option<HashSet<i32>>, select: &Select) -> Resu
         elements: Vec::new(),
         quadrature: select.quadrature,
     };
-    let blocks = msh.data.elements.as_ref().map_or(&[][..], |e| &e.element_blocks[..]);
+    let blocks = msh
+        .data
+        .elements
+        .as_ref()
+        .map_or(&[][..], |e| &e.element_blocks[..]);
     for block in blocks {
-        let taken = entities.as_ref().is_none_or(|s| s.contains(&block.entity_tag));
+        let taken = entities
+            .as_ref()
+            .is_none_or(|s| s.contains(&block.entity_tag));
         if block.entity_dim as usize != select.dim || !taken {
             continue;
         }
@@ -252,7 +289,10 @@ fn elements(msh: &Msh, entities: &Option<HashSet<i32>>, select: &Select) -> Resu
             let mut nodes = Vec::with_capacity(e.nodes.len());
             for &t in &e.nodes {
                 let x = coordinates.get(&t).ok_or_else(|| {
-                    format!("element {}: its node {t} is not in the $Nodes section", e.element_tag)
+                    format!(
+                        "element {}: its node {t} is not in the $Nodes section",
+                        e.element_tag
+                    )
                 })?;
                 nodes.push(*index.entry(t).or_insert_with(|| {
                     mesh.nodes.push(*x);
@@ -264,7 +304,9 @@ fn elements(msh: &Msh, entities: &Option<HashSet<i32>>, select: &Select) -> Resu
         }
     }
     if mesh.elements.is_empty() {
-        let group = select.physical.map_or(String::new(), |g| format!(" in physical group {g}"));
+        let group = select
+            .physical
+            .map_or(String::new(), |g| format!(" in physical group {g}"));
         return Err(format!("the file holds no {}D element{group}", select.dim));
     }
     Ok(mesh)
