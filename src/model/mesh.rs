@@ -25,6 +25,7 @@
 //! and with a right-handed (positive) volume in 3D, as Gmsh writes them.
 
 use crate::scene::Quadrature;
+use std::sync::OnceLock;
 
 /// The element types a mesh body takes (their Gmsh node orderings).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -182,18 +183,115 @@ pub struct Element {
 }
 
 /// A body's elements and their nodes (x, y, z; z unused in 2D).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub struct ElementMesh {
     pub dim: usize,
     pub nodes: Vec<[f64; 3]>,
     pub elements: Vec<Element>,
     pub quadrature: Quadrature,
+    /// Per vertical axis v, the elements binned by their extent across it
+    /// (`top`), built on first use.
+    columns: [OnceLock<Columns>; 3],
+}
+
+impl PartialEq for ElementMesh {
+    fn eq(&self, o: &Self) -> bool {
+        (self.dim, &self.nodes, &self.elements, self.quadrature)
+            == (o.dim, &o.nodes, &o.elements, o.quadrature)
+    }
+}
+
+/// The elements binned on a uniform grid of the plane (line) across the
+/// vertical axis: each bin lists the elements whose box reaches it.
+#[derive(Clone, Debug, PartialEq)]
+struct Columns {
+    /// The axes across the vertical (one in 2D, two in 3D).
+    axes: Vec<usize>,
+    lo: Vec<f64>,
+    width: Vec<f64>,
+    bins: Vec<usize>,
+    elements: Vec<Vec<usize>>,
+}
+
+impl Columns {
+    fn new(mesh: &ElementMesh, v: usize) -> Columns {
+        let axes: Vec<usize> = (0..mesh.dim).filter(|&d| d != v).collect();
+        let (lo, hi) = mesh.bounds();
+        let n = mesh.elements.len() as f64;
+        // About one element per bin: n bins in 2D, √n × √n in 3D.
+        let per = n.powf(1.0 / axes.len() as f64).ceil().max(1.0) as usize;
+        let bins = vec![per; axes.len()];
+        let width: Vec<f64> = (axes.iter())
+            .map(|&d| (hi[d] - lo[d]).max(f64::MIN_POSITIVE) / per as f64)
+            .collect();
+        let lo: Vec<f64> = axes.iter().map(|&d| lo[d]).collect();
+        let mut c = Columns {
+            axes,
+            lo,
+            width,
+            bins,
+            elements: vec![Vec::new(); per.pow(mesh.dim as u32 - 1)],
+        };
+        for (k, e) in mesh.elements.iter().enumerate() {
+            let corners = mesh.corners(e);
+            let range = |a: usize| {
+                let d = c.axes[a];
+                let (min, max) = corners
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| {
+                        (l.min(x[d]), h.max(x[d]))
+                    });
+                (c.bin(a, min), c.bin(a, max))
+            };
+            let r0 = range(0);
+            let r1 = if c.axes.len() == 2 { range(1) } else { (0, 0) };
+            for i in r0.0..=r0.1 {
+                for j in r1.0..=r1.1 {
+                    c.elements[i + c.bins[0] * j].push(k);
+                }
+            }
+        }
+        c
+    }
+
+    /// The bin along the a-th axis across of the coordinate x (clamped).
+    fn bin(&self, a: usize, x: f64) -> usize {
+        let b = ((x - self.lo[a]) / self.width[a]).floor();
+        (b.max(0.0) as usize).min(self.bins[a] - 1)
+    }
+
+    /// The elements whose box may reach the vertical line through x.
+    fn at(&self, x: &[f64]) -> &[usize] {
+        let i = self.bin(0, x[self.axes[0]]);
+        let j = if self.axes.len() == 2 {
+            self.bin(1, x[self.axes[1]])
+        } else {
+            0
+        };
+        &self.elements[i + self.bins[0] * j]
+    }
 }
 
 /// A particle of the mesh: its position and volume.
 pub type GaussPoint = ([f64; 3], f64);
 
 impl ElementMesh {
+    pub fn new(
+        dim: usize,
+        nodes: Vec<[f64; 3]>,
+        elements: Vec<Element>,
+        quadrature: Quadrature,
+    ) -> Self {
+        let columns = Default::default();
+        ElementMesh {
+            dim,
+            nodes,
+            elements,
+            quadrature,
+            columns,
+        }
+    }
+
     fn corners(&self, e: &Element) -> Vec<[f64; 3]> {
         e.nodes.iter().map(|&n| self.nodes[n]).collect()
     }
@@ -277,7 +375,8 @@ impl ElementMesh {
     /// (a hexahedron's as two triangles); −∞ where the line misses the mesh.
     pub fn top(&self, x: &[f64], v: usize, up: f64) -> f64 {
         let mut best = f64::NEG_INFINITY;
-        for e in &self.elements {
+        let columns = self.columns[v].get_or_init(|| Columns::new(self, v));
+        for e in columns.at(x).iter().map(|&k| &self.elements[k]) {
             let c = self.corners(e);
             if self.dim == 2 {
                 let h = x[1 - v];
@@ -370,16 +469,12 @@ mod tests {
 
     fn mesh(dim: usize, nodes: Vec<[f64; 3]>, kind: ElementKind) -> ElementMesh {
         let n = nodes.len();
-        ElementMesh {
-            dim,
-            nodes,
-            elements: vec![Element {
-                kind,
-                tag: 7,
-                nodes: (0..n).collect(),
-            }],
-            quadrature: Quadrature::Full,
-        }
+        let elements = vec![Element {
+            kind,
+            tag: 7,
+            nodes: (0..n).collect(),
+        }];
+        ElementMesh::new(dim, nodes, elements, Quadrature::Full)
     }
 
     #[test]
@@ -397,11 +492,11 @@ mod tests {
         assert_eq!(p.len(), 4);
         let v: f64 = p.iter().map(|g| g.1).sum();
         assert!((v - 4.0).abs() < 1e-14, "{v}");
-        // Centroid of the polygon: x = 14/12, y = 10/12 (shoelace moments / 6A).
+        // Centroid of the polygon (shoelace moments / 6A): x = 34/24, y = 18/24.
         let cx: f64 = p.iter().map(|g| g.0[0] * g.1).sum::<f64>() / v;
         let cy: f64 = p.iter().map(|g| g.0[1] * g.1).sum::<f64>() / v;
         assert!(
-            (cx - 7.0 / 6.0).abs() < 1e-14 && (cy - 5.0 / 6.0).abs() < 1e-14,
+            (cx - 17.0 / 12.0).abs() < 1e-14 && (cy - 0.75).abs() < 1e-14,
             "{cx} {cy}"
         );
         // A hexahedron: the unit cube with its top corner 6 raised by 1.

@@ -5,6 +5,7 @@
 
 /// One block of elements: its entity's dimension and tag, the Gmsh element
 /// type and the elements' node tags (element tags follow on from 1).
+#[derive(Clone)]
 pub struct Block {
     pub dim: usize,
     pub entity: i32,
@@ -13,9 +14,9 @@ pub struct Block {
 }
 
 /// An MSH 4.1 file, ASCII: nodes tagged 1.. in order, the blocks' elements
-/// tagged 1.. in order, one surface (2D) or volume (3D) entity per block tag
-/// with its physical groups (`groups`: entity tag, group tags) and the named
-/// groups `names` (dimension, tag, name).
+/// tagged 1.. in order, the surface (2D) or volume (3D: with a block of 3D
+/// elements) entities `groups` (entity tag, its physical group tags) and the
+/// named groups `names` (dimension, tag, name).
 pub fn msh_ascii(
     nodes: &[[f64; 3]],
     blocks: &[Block],
@@ -30,7 +31,7 @@ pub fn msh_ascii(
         }
         s += "$EndPhysicalNames\n";
     }
-    let dim = blocks.first().map_or(2, |b| b.dim);
+    let dim = blocks.iter().map(|b| b.dim).max().unwrap_or(2);
     let (surfaces, volumes) = if dim == 2 {
         (groups.len(), 0)
     } else {
@@ -70,7 +71,7 @@ pub fn msh_binary(nodes: &[[f64; 3]], blocks: &[Block], groups: &[(i32, Vec<i32>
     let mut s = b"$MeshFormat\n4.1 1 8\n".to_vec();
     int(&mut s, 1);
     s.extend(b"\n$EndMeshFormat\n$Entities\n");
-    let dim = blocks[0].dim;
+    let dim = blocks.iter().map(|b| b.dim).max().unwrap_or(2);
     let counts = if dim == 2 {
         [0, 0, groups.len(), 0]
     } else {

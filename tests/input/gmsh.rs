@@ -473,3 +473,110 @@ fn gmsh_body_in_mpm_check() {
         .unwrap();
     assert!(rel(volume, 3.0) < 1e-12, "{line}");
 }
+
+/// A 3D scene on the grid [0, 2] × [0, 1] × [0, 1] (4 × 2 × 2 cells).
+const SOLID: &str = r#"
+dimension = 3
+[grid]
+min = [0.0, 0.0, 0.0]
+max = [2.0, 1.0, 1.0]
+cells = [4, 2, 2]
+
+[[material]]
+name = "soil"
+model = "linear_elastic"
+density = 2000.0
+youngs_modulus = 1.0e6
+poisson_ratio = 0.25
+
+[[body]]
+material = "soil"
+shape = "mesh"
+file = "box.msh"
+BODY
+
+[solver]
+kind = "explicit"
+end_time = 0.01
+
+[output]
+frames = 0
+"#;
+
+#[test]
+fn gmsh_3d_groups_pass_over_faces_and_refuse_prisms() {
+    use crate::common::gmsh::box_mesh;
+    let dir = tempfile::tempdir().unwrap();
+    // [0, 1]³ as tetrahedra in volume 1 (group 5 "left"), [1, 2] × [0, 1]²
+    // as hexahedra in volume 2 (group 6 "right"); a boundary face (2D, type 2).
+    let (mut nodes, tets) = box_mesh([0.0; 3], [1.0; 3], [2, 2, 2], true);
+    let (right_nodes, hexes) = box_mesh([1.0, 0.0, 0.0], [2.0, 1.0, 1.0], [2, 2, 2], false);
+    let shift = nodes.len() as u64;
+    nodes.extend(right_nodes);
+    let hexes: Vec<Vec<u64>> = hexes
+        .iter()
+        .map(|e| e.iter().map(|t| t + shift).collect())
+        .collect();
+    let face = Block {
+        dim: 2,
+        entity: 1,
+        kind: 2,
+        elements: vec![vec![1, 2, 4]],
+    };
+    let blocks = |prism: bool| {
+        let mut right = hexes.clone();
+        let kind = if prism { 6 } else { 5 };
+        if prism {
+            right = right.iter().map(|e| e[..6].to_vec()).collect();
+        }
+        [
+            face.clone(),
+            Block {
+                dim: 3,
+                entity: 1,
+                kind: 4,
+                elements: tets.clone(),
+            },
+            Block {
+                dim: 3,
+                entity: 2,
+                kind,
+                elements: right,
+            },
+        ]
+    };
+    let groups = [(1, vec![5]), (2, vec![6])];
+    let names = [(3, 5, "left"), (3, 6, "right")];
+    let build = |text: &str| {
+        let scene = Scene::parse(dir.path().join("s.toml").to_str().unwrap(), text, &[])?;
+        Model::<3>::build(&scene)
+    };
+    std::fs::write(
+        dir.path().join("box.msh"),
+        msh_ascii(&nodes, &blocks(false), &groups, &names),
+    )
+    .unwrap();
+    for (keys, count, volume) in [
+        ("physical = \"left\"", 48 * 4, 1.0),
+        ("physical = 6", 64, 1.0),
+        ("", 48 * 4 + 64, 2.0),
+    ] {
+        let m = build(&SOLID.replace("BODY", keys)).unwrap();
+        let v: f64 = m.particles.volume.iter().sum();
+        assert_eq!(m.particles.len(), count, "{keys}");
+        assert!((v / volume - 1.0).abs() < 1e-12, "{keys}: {v}");
+    }
+    // Prisms (type 6) in the right half: refused by the first one's tag (the
+    // tetrahedra are 48 elements after the face: tags 2..49, the prisms 50..).
+    std::fs::write(
+        dir.path().join("box.msh"),
+        msh_ascii(&nodes, &blocks(true), &groups, &names),
+    )
+    .unwrap();
+    let e = build(&SOLID.replace("BODY", "")).err().unwrap();
+    assert_eq!(e.key.as_deref(), Some("body.0.file"), "{e}");
+    let s = e.to_string();
+    assert!(s.contains("box.msh: element 50: Gmsh element type 6 (Pri6) is not read: a 3D mesh body takes 4-node tetrahedra and 8-node hexahedra"), "{s}");
+    // The left group alone has no prism.
+    assert!(build(&SOLID.replace("BODY", "physical = \"left\"")).is_ok());
+}

@@ -134,16 +134,17 @@ fn find_line(bytes: &[u8], word: &[u8]) -> Option<usize> {
 fn parse(bytes: &[u8], binary: bool) -> Result<Msh, String> {
     let parsed = std::panic::catch_unwind(|| {
         mshio::parse_msh_bytes(bytes).map_err(|e| {
-            let at = e
-                .backtrace
-                .first()
-                .map_or(bytes.len(), |(rest, _)| bytes.len() - rest.len());
+            let at = e.backtrace.first().map_or(bytes.len(), |(rest, _)| {
+                bytes.len().saturating_sub(rest.len())
+            });
             let what: Vec<String> = (e.backtrace.iter().rev())
                 .filter_map(|(_, k)| k.context().map(str::to_string))
                 .collect();
-            let why = e
-                .first_msh_error()
-                .map_or("cannot be read".into(), |k| k.to_string());
+            // A kind that is only a context would repeat the last one.
+            let why = match e.first_msh_error() {
+                Some(k) if k.context().is_none() => k.to_string(),
+                _ => "not what the format has there".to_string(),
+            };
             (at, what.join(", in "), why)
         })
     });
@@ -244,13 +245,18 @@ fn kind(t: ElementType, dim: usize, tag: u64) -> Result<Option<ElementKind>, Str
     Ok((kind.dim() == dim).then_some(kind))
 }
 
-/// The dimension of a Gmsh element type (points 0, lines 1, faces 2, cells 3).
+/// The dimension of a Gmsh element type, from its name in mshio: points
+/// (`Pnt…`) 0, lines (`Lin…`) 1, triangles, quadrilaterals and polygons 2,
+/// the rest (tetrahedra, hexahedra, prisms, pyramids, polyhedra, the
+/// trihedron `Trih4`) 3.
 fn dim_of(t: ElementType) -> usize {
     let name = format!("{t:?}");
-    match name.as_str() {
-        "Pnt" => 0,
-        n if n.starts_with("Lin") => 1,
-        n if n.starts_with("Tri") || n.starts_with("Qua") || n.starts_with("Polyg") => 2,
+    let starts = |p: &[&str]| p.iter().any(|p| name.starts_with(p));
+    match () {
+        _ if starts(&["Pnt"]) => 0,
+        _ if starts(&["Lin"]) => 1,
+        _ if starts(&["Trih"]) => 3,
+        _ if starts(&["Tri", "Qua", "Polyg"]) => 2,
         _ => 3,
     }
 }
@@ -264,12 +270,7 @@ fn elements(
 ) -> Result<ElementMesh, String> {
     let coordinates = node_coordinates(msh);
     let mut index: HashMap<u64, usize> = HashMap::new();
-    let mut mesh = ElementMesh {
-        dim: select.dim,
-        nodes: Vec::new(),
-        elements: Vec::new(),
-        quadrature: select.quadrature,
-    };
+    let mut mesh = ElementMesh::new(select.dim, Vec::new(), Vec::new(), select.quadrature);
     let blocks = msh
         .data
         .elements
