@@ -15,6 +15,7 @@ use crate::model::curve::TimeCurve;
 use crate::model::geometry::Geometry;
 use crate::model::grid::Grid;
 use crate::model::loads::{LoadTime, Loads};
+use crate::model::mesh::ElementMesh;
 use crate::model::particle_set::ParticleSet;
 use crate::model::particles::Particles;
 use crate::model::peridynamics::{PdBody, Peridynamics};
@@ -281,6 +282,7 @@ fn fill_body<const D: usize>(
     let spacing = Vector::<D>::from_fn(|d, _| grid.h[d] / b.particles_per_cell.get(d) as f64);
     let points = match (b.fill, geometry) {
         (_, Geometry::Surface(surface)) => surface_cells(grid, surface, geometry, &spacing),
+        (_, Geometry::Mesh(mesh)) => mesh_points(mesh),
         (Fill::Lattice, _) => lattice(grid, geometry, &spacing),
         (Fill::Polar, _) => polar(b, spacing[0].min(spacing[1]), spacing[D - 1]),
     };
@@ -386,6 +388,19 @@ fn lattice_range<const D: usize>(
         ((upper - grid.min[d]) / spacing[d]).ceil() as usize
     });
     (first, last)
+}
+
+/// A mesh's particles at its elements' Gauss points (`ElementMesh::gauss_points`),
+/// each domain the square (cube) of its volume, as a particle file's
+/// (`ParticleSet::half_length`; of the area, before `axisymmetry::per_radian`).
+fn mesh_points<const D: usize>(mesh: &ElementMesh) -> Vec<Point<D>> {
+    (mesh.gauss_points().into_iter())
+        .map(|(x, volume)| {
+            let half = 0.5 * volume.powf(1.0 / D as f64);
+            let x = Vector::<D>::from_fn(|d, _| x[d]);
+            (x, volume, Vector::<D>::repeat(half))
+        })
+        .collect()
 }
 
 /// A closed surface on the lattice: each lattice cell the solid reaches

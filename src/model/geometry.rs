@@ -2,11 +2,12 @@
 //! sphere), a cylinder along z (3D), a simple polygon (2D) or a polygon extruded
 //! along an axis (a prism, 3D), as given by the `[[body]]` keys; or read from
 //! a file (`model::import`): the particles of a particle file, a closed
-//! triangulated surface (3D). The model
+//! triangulated surface (3D), a raster's ground, finite elements. The model
 //! fills it with particles (`contains`, within `BodyConfig::bounds`, which the
 //! validation also uses) and measures the depth of a particle below its body's
 //! top surface for geostatic stresses (`top`).
 
+use crate::model::mesh::ElementMesh;
 use crate::model::particle_set::ParticleSet;
 use crate::model::terrain::Terrain;
 use crate::model::triangles::TriangleSurface;
@@ -44,6 +45,9 @@ pub enum Geometry {
     /// The ground under a raster's surface down to a base (3D, z up); none of
     /// its faces is surface for `nearest_surface`.
     Terrain(Arc<Terrain>),
+    /// Finite elements with a particle at each Gauss point (`model::mesh`):
+    /// no lattice point is inside, and no face is surface.
+    Mesh(Arc<ElementMesh>),
 }
 
 impl Geometry {
@@ -74,7 +78,7 @@ impl Geometry {
                     to: extent[1],
                 }
             }
-            BodyShape::Particles | BodyShape::Surface | BodyShape::Terrain => {
+            BodyShape::Particles | BodyShape::Surface | BodyShape::Terrain | BodyShape::Mesh => {
                 unreachable!("read from the body's file by model::import::body_geometry")
             }
         }
@@ -108,7 +112,7 @@ impl Geometry {
                     && x[*axis] < *to
                     && point_in_polygon(x[plane[0]], x[plane[1]], section)
             }
-            Geometry::Particles(_) => false,
+            Geometry::Particles(_) | Geometry::Mesh(_) => false,
             Geometry::Surface(s) => s.contains(x),
             Geometry::Terrain(t) => t.contains(x),
         }
@@ -146,6 +150,7 @@ impl Geometry {
             Geometry::Particles(set) => set.top(x, v, up),
             Geometry::Surface(s) => s.top(x, v, up),
             Geometry::Terrain(t) => t.top(x, v, up),
+            Geometry::Mesh(m) => m.top(x, v, up),
         }
     }
 
@@ -182,6 +187,7 @@ impl Geometry {
             Geometry::Particles(set) => set.bounds(),
             Geometry::Surface(s) => s.bounds(),
             Geometry::Terrain(t) => t.bounds(),
+            Geometry::Mesh(m) => m.bounds(),
         }
     }
 
@@ -278,7 +284,10 @@ impl Geometry {
                     }
                 }
             }
-            Geometry::Particles(_) | Geometry::Surface(_) | Geometry::Terrain(_) => {}
+            Geometry::Particles(_)
+            | Geometry::Surface(_)
+            | Geometry::Terrain(_)
+            | Geometry::Mesh(_) => {}
         }
         faces
             .into_iter()
@@ -381,7 +390,8 @@ impl Geometry {
             | Geometry::Prism { .. }
             | Geometry::Particles(_)
             | Geometry::Surface(_)
-            | Geometry::Terrain(_) => None,
+            | Geometry::Terrain(_)
+            | Geometry::Mesh(_) => None,
         }
     }
 }

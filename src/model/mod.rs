@@ -12,6 +12,7 @@ pub mod grid;
 pub(crate) mod import;
 pub(crate) mod loads;
 pub(crate) mod memory;
+pub mod mesh;
 pub mod particle_set;
 pub mod particles;
 pub mod peridynamics;

@@ -148,6 +148,10 @@ pub enum BodyShape {
     /// 3D, the ground under the surface of an ESRI ASCII grid `file` of
     /// elevations (z up) down to the elevation `base` (`model::import::esri_grid`).
     Terrain,
+    /// The elements of a Gmsh MSH 4.1 `file` (2D: triangles and quadrilaterals,
+    /// 3D: tetrahedra and hexahedra), optionally of one `physical` group, with a
+    /// particle at each Gauss point of the `quadrature` (`model::import::gmsh`).
+    Mesh,
 }
 
 impl BodyShape {
@@ -156,7 +160,7 @@ impl BodyShape {
     pub fn from_file(self) -> bool {
         matches!(
             self,
-            BodyShape::Particles | BodyShape::Surface | BodyShape::Terrain
+            BodyShape::Particles | BodyShape::Surface | BodyShape::Terrain | BodyShape::Mesh
         )
     }
 }
@@ -244,6 +248,11 @@ pub struct BodyConfig {
     pub body_id: Option<u32>,
     /// A `terrain` body's bottom elevation (z).
     pub base: Option<f64>,
+    /// A `mesh` body: the elements of this physical group only (its name or
+    /// its number); without it, every element of the scene's dimension.
+    pub physical: Option<PhysicalGroup>,
+    /// A `mesh` body: the Gauss points per element (default `full`).
+    pub quadrature: Option<Quadrature>,
     /// Particles per cell per direction: one number or one per direction.
     #[serde(default = "default_ppc")]
     pub particles_per_cell: PerDirection,
@@ -269,6 +278,60 @@ pub struct BodyConfig {
     pub critical_stretch: Option<f64>,
     /// Peridynamic body in 2D: `strain` (default) or `stress`.
     pub plane: Option<Plane>,
+}
+
+/// A physical group of a Gmsh file, by its name or its number.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum PhysicalGroup {
+    Name(String),
+    Tag(i64),
+}
+
+impl<'de> Deserialize<'de> for PhysicalGroup {
+    fn deserialize<De: serde::Deserializer<'de>>(d: De) -> Result<Self, De::Error> {
+        struct Visitor;
+        impl serde::de::Visitor<'_> for Visitor {
+            type Value = PhysicalGroup;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("the name (a string) or the number of a physical group")
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<PhysicalGroup, E> {
+                Ok(PhysicalGroup::Tag(v))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<PhysicalGroup, E> {
+                i64::try_from(v)
+                    .map(PhysicalGroup::Tag)
+                    .map_err(|_| E::custom(format!("physical group {v}: too large a number")))
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<PhysicalGroup, E> {
+                Ok(PhysicalGroup::Name(v.to_string()))
+            }
+        }
+        d.deserialize_any(Visitor)
+    }
+}
+
+impl std::fmt::Display for PhysicalGroup {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        match self {
+            PhysicalGroup::Name(n) => write!(f, "`{n}`"),
+            PhysicalGroup::Tag(t) => write!(f, "{t}"),
+        }
+    }
+}
+
+/// The Gauss points a `mesh` body puts in each element (`model::mesh`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, IntoStaticStr, EnumIter)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum Quadrature {
+    /// 3 per triangle, 2 × 2 per quadrilateral, 4 per tetrahedron, 2 × 2 × 2
+    /// per hexahedron: the body's volume and first moments exact.
+    #[default]
+    Full,
+    /// One per element, at ξ = 0 (a simplex's centroid) with the element's
+    /// volume.
+    One,
 }
 
 /// The particle fill of a body.
@@ -330,7 +393,9 @@ impl BodyConfig {
                     [e[0], e[1]],
                 )
             }
-            BodyShape::Particles | BodyShape::Surface | BodyShape::Terrain => return None,
+            BodyShape::Particles | BodyShape::Surface | BodyShape::Terrain | BodyShape::Mesh => {
+                return None
+            }
         })
     }
 

@@ -30,6 +30,8 @@
 //! the behaviour has.
 #![allow(dead_code)]
 
+pub mod gmsh;
+
 use mpm::analyses::strength_reduction::{search, SearchError, SearchSummary};
 use mpm::run::summary::Summary;
 use mpm::run::{run, RunError, RunOptions};

@@ -13,6 +13,7 @@ mod documented;
 mod domain_stress;
 mod fuzz;
 mod geometry;
+mod gmsh;
 mod impact;
 mod key_paths;
 mod robustness;

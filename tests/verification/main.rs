@@ -17,6 +17,7 @@ mod footing;
 mod friction;
 mod geomaterial_driver;
 mod geomaterial_mpm;
+mod gmsh;
 mod impact;
 mod implicit_bar;
 mod implicit_column;

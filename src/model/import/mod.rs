@@ -1,13 +1,16 @@
 //! Bodies whose geometry is read from a file (docs/geometry.md): a particle
 //! file (`shape = "particles"`, CSV, `particle_file.rs`), a closed
 //! triangulated surface (`shape = "surface"`, STL, `stl.rs`) and a terrain
-//! raster (`shape = "terrain"`, ESRI ASCII grid, `esri_grid.rs`). The `file` key
+//! raster (`shape = "terrain"`, ESRI ASCII grid, `esri_grid.rs`) and finite
+//! elements (`shape = "mesh"`, Gmsh MSH 4.1, `gmsh.rs`). The `file` key
 //! is a path relative to the scene file's folder. A file error is a scene
 //! error at the body's `file` key whose message names the file and, where it
-//! can, the line and column (particle file) or the facet and edge (STL).
+//! can, the line and column (particle file), the facet and edge (STL) or the
+//! element (Gmsh).
 //! Nothing here runs for a scene without such a body.
 
 pub(crate) mod esri_grid;
+pub(crate) mod gmsh;
 pub(crate) mod particle_file;
 pub(crate) mod stl;
 
@@ -39,9 +42,22 @@ pub fn body_geometry(scene: &Scene, i: usize) -> Result<Geometry, SceneError> {
                 esri_grid::read(&path, &shown, base).map_err(at_file)?,
             ))
         }
+        BodyShape::Mesh => {
+            let c = &scene.config;
+            let select = gmsh::Select {
+                dim: c.dimension.spatial(),
+                physical: b.physical.as_ref(),
+                quadrature: b.quadrature.unwrap_or_default(),
+                grid: (&c.grid.min, &c.grid.max),
+            };
+            Geometry::Mesh(Arc::new(
+                gmsh::read(&path, &shown, &select).map_err(at_file)?,
+            ))
+        }
         _ => Geometry::Surface(Arc::new(stl::read(&path, &shown).map_err(at_file)?)),
     };
-    if !matches!(geometry, Geometry::Particles(_)) {
+    // A particle file's and a mesh's rows and nodes were checked one by one.
+    if !matches!(geometry, Geometry::Particles(_) | Geometry::Mesh(_)) {
         let (lo, hi) = geometry.bounds();
         validate::inside_grid(&lo, &hi, i, &scene.config)
             .map_err(|(key, m)| scene.at_key(&key, format!("{shown}: {m}")))?;

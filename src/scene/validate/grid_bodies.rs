@@ -225,7 +225,7 @@ fn shape_keys(b: &BodyConfig, i: usize, dim: usize) -> Check {
         | BodyShape::Prism
         | BodyShape::Surface
         | BodyShape::Terrain => 3,
-        BodyShape::Particles => dim,
+        BodyShape::Particles | BodyShape::Mesh => dim,
     };
     if b.shape != BodyShape::Prism {
         forbidden(&b.axis, key("axis"), &what)?;
@@ -236,6 +236,10 @@ fn shape_keys(b: &BodyConfig, i: usize, dim: usize) -> Check {
     }
     if b.shape != BodyShape::Particles {
         forbidden(&b.body_id, key("body_id"), &what)?;
+    }
+    if b.shape != BodyShape::Mesh {
+        forbidden(&b.physical, key("physical"), &what)?;
+        forbidden(&b.quadrature, key("quadrature"), &what)?;
     }
     if b.shape != BodyShape::Terrain {
         forbidden(&b.base, key("base"), &what)?;
@@ -317,7 +321,7 @@ fn shape_keys(b: &BodyConfig, i: usize, dim: usize) -> Check {
                 "needs [from, to] along the axis, finite, with to > from",
             )
         }
-        BodyShape::Particles | BodyShape::Surface | BodyShape::Terrain => {
+        BodyShape::Particles | BodyShape::Surface | BodyShape::Terrain | BodyShape::Mesh => {
             required(&b.file, key("file"), &what)?;
             forbidden(&b.min, key("min"), &what)?;
             forbidden(&b.max, key("max"), &what)?;
