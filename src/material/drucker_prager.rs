@@ -43,6 +43,7 @@ use super::return_mapping::{
     Elasticity, Frictional, Principal, PrincipalTangent, Return, ReturnMapping,
 };
 use super::{reduced_angle, Strength};
+use crate::dim::Mat3;
 use serde::Deserialize;
 
 /// How the cone is matched to the Mohr–Coulomb parameters (module documentation).
@@ -162,8 +163,8 @@ fn equivalent(s: &Principal) -> f64 {
 }
 
 impl ReturnMapping for DruckerPrager {
-    fn elasticity(&self) -> Elasticity {
-        self.elastic()
+    fn elastic_strain(&self, tau: &Mat3, _history: &[f64]) -> Mat3 {
+        self.elastic().strain_of_stress(tau)
     }
 
     fn return_map(&self, eps: &Principal, h_old: &[f64], h_new: &mut [f64]) -> Return {
@@ -219,6 +220,10 @@ impl ReturnMapping for DruckerPrager {
 
 /// Its `Material` implementation is the one of `return_mapping::Frictional`.
 impl Frictional for DruckerPrager {
+    fn elasticity(&self) -> Elasticity {
+        self.elastic()
+    }
+
     fn reference_density(&self) -> f64 {
         self.density
     }

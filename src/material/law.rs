@@ -105,6 +105,12 @@ pub trait Material: CloneMaterial + Send + Sync + std::fmt::Debug {
         false
     }
 
+    /// Set the history of a point that starts at `stress` (its initial Cauchy
+    /// stress at F = I: geostatic, or a particle file's), e.g. a
+    /// pre-consolidation pressure from an over-consolidation ratio. The history
+    /// is zero before; most models keep it so.
+    fn initial_history(&self, _stress: &Mat3, _history: &mut [f64]) {}
+
     /// The peak frictional strength c, φ, ψ (radians; for Jáky's K0 = 1 − sin φ
     /// and the footing's cohesion), `None` for a model without one.
     fn frictional_strength(&self) -> Option<Strength> {

@@ -50,6 +50,7 @@ models! {
     mooney_rivlin::MooneyRivlin,
     drucker_prager::DruckerPrager,
     mohr_coulomb::MohrCoulomb,
+    modified_cam_clay::ModifiedCamClay,
     ogden::Ogden,
     johnson_cook::JohnsonCook,
     jh2::Jh2,

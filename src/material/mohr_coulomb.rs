@@ -49,6 +49,7 @@ use super::return_mapping::{
     Elasticity, Frictional, Principal, PrincipalTangent, Return, ReturnMapping,
 };
 use super::{reduced_angle, Strength};
+use crate::dim::Mat3;
 use nalgebra::{SMatrix, SVector};
 
 /// The local Newton system has at most three surfaces and κ; smaller sets are
@@ -506,8 +507,8 @@ impl MohrCoulomb {
 }
 
 impl ReturnMapping for MohrCoulomb {
-    fn elasticity(&self) -> Elasticity {
-        self.elastic()
+    fn elastic_strain(&self, tau: &Mat3, _history: &[f64]) -> Mat3 {
+        self.elastic().strain_of_stress(tau)
     }
 
     fn return_map(&self, eps: &Principal, h_old: &[f64], h_new: &mut [f64]) -> Return {
@@ -631,6 +632,10 @@ fn softening(p: &Parameters, c: f64, phi: f64, psi: f64) -> Result<Option<Soften
 
 /// Its `Material` implementation is the one of `return_mapping::Frictional`.
 impl Frictional for MohrCoulomb {
+    fn elasticity(&self) -> Elasticity {
+        self.elastic()
+    }
+
     fn reference_density(&self) -> f64 {
         self.density
     }

@@ -93,7 +93,10 @@ pub struct Return {
 
 /// A return mapping in principal logarithmic strains / Kirchhoff stresses.
 pub trait ReturnMapping {
-    fn elasticity(&self) -> Elasticity;
+    /// The elastic logarithmic strain of a Kirchhoff stress (the inverse of the
+    /// elastic law) with the history at the start of the increment: how the
+    /// elastic state is recovered from the stored stress.
+    fn elastic_strain(&self, tau: &Mat3, history: &[f64]) -> Mat3;
 
     /// Principal Kirchhoff stresses for the trial principal elastic strains
     /// `eps_trial` (any order), with ∂τ_a/∂ε_b; writes the new history.
@@ -131,10 +134,11 @@ struct Trial {
 }
 
 impl Trial {
-    fn of(el: &Elasticity, inc: &Increment) -> Trial {
+    fn of<R: ReturnMapping + ?Sized>(r: &R, inc: &Increment) -> Trial {
         let j_old = inc.f_old.determinant();
         // b_e,old − I = exp(2 ε_e,old) − I, exact at zero stress.
-        let (eps_old, v) = symmetric_eigen(&el.strain_of_stress(&(inc.stress_old * j_old)));
+        let eps_e_old = r.elastic_strain(&(inc.stress_old * j_old), inc.history_old);
+        let (eps_old, v) = symmetric_eigen(&eps_e_old);
         let be_old_minus_i = from_principal(&v, &eps_old.map(|e| (2.0 * e).exp_m1()));
         // b_e^tr − I = ΔF (b_e,old − I) ΔFᵀ + (ΔF ΔFᵀ − I), without cancellation.
         let h = inc.df - Mat3::identity();
@@ -157,7 +161,7 @@ impl Trial {
 
 /// Cauchy stress at the end of the increment; writes the new history.
 pub fn update<R: ReturnMapping + ?Sized>(r: &R, inc: &Increment, history_new: &mut [f64]) -> Mat3 {
-    let trial = Trial::of(&r.elasticity(), inc);
+    let trial = Trial::of(r, inc);
     let tau = r.return_stress(&trial.eps, inc.history_old, history_new);
     trial.rotate(&tau) / trial.j
 }
@@ -171,7 +175,7 @@ pub fn stress_derivative<R: ReturnMapping + ?Sized>(
     r: &R,
     inc: &Increment,
 ) -> Option<StressDerivative> {
-    let trial = Trial::of(&r.elasticity(), inc);
+    let trial = Trial::of(r, inc);
     let mut scratch = vec![0.0; inc.history_old.len()];
     let ret = r.return_map(&trial.eps, inc.history_old, &mut scratch);
     let df_inv = inc.df.try_inverse()?;
@@ -224,6 +228,9 @@ pub fn stored_energy_density(el: &Elasticity, f: &Mat3, stress: &Mat3) -> f64 {
 pub trait Frictional:
     ReturnMapping + FromParameters + Clone + std::fmt::Debug + Send + Sync + 'static
 {
+    /// The (constant) Hencky elasticity of the model.
+    fn elasticity(&self) -> Elasticity;
+
     /// Reference mass density ρ0.
     fn reference_density(&self) -> f64;
 
@@ -294,8 +301,8 @@ mod tests {
     struct Elastic(Elasticity, Hencky);
 
     impl ReturnMapping for Elastic {
-        fn elasticity(&self) -> Elasticity {
-            self.0
+        fn elastic_strain(&self, tau: &Mat3, _: &[f64]) -> Mat3 {
+            self.0.strain_of_stress(tau)
         }
         fn return_map(&self, eps: &Principal, _: &[f64], _: &mut [f64]) -> Return {
             Return {

@@ -171,6 +171,20 @@ impl<const D: usize> Model<D> {
             .collect();
     }
 
+    /// Set every particle's history from its initial stress
+    /// (`Material::initial_history`, e.g. Modified Cam-Clay's pre-consolidation
+    /// pressure from OCR) of the material as given (before strength reduction):
+    /// once, after the geostatic stresses, in a run that does not restart.
+    pub fn initialise_history(&mut self) {
+        let p = &mut self.particles;
+        let stress = &p.stress;
+        let slots = p.history.own_slots_mut();
+        for (q, slot) in slots.into_iter().enumerate() {
+            let m = &self.base_materials[p.material[q] as usize];
+            m.initial_history(&stress.get(q), slot);
+        }
+    }
+
     /// Equivalent plastic strain of every particle (0 where the material has
     /// none), or `None` when no material of the scene has one.
     pub fn plastic_strain(&self) -> Option<Vec<f64>> {

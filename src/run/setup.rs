@@ -57,6 +57,9 @@ impl<const D: usize> SetUp<D> {
         if let (Some(g), None) = (&cfg.geostatic, resume) {
             crate::physics::geostatic::initialise(&mut model, g);
         }
+        if resume.is_none() {
+            model.initialise_history();
+        }
         let monitor = opts
             .monitor
             .as_deref()
