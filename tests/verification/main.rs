@@ -7,6 +7,7 @@ mod common;
 
 mod absorbing;
 mod apic;
+mod cam_clay;
 mod axisymmetric;
 mod cantilever;
 mod collapse;

@@ -1,0 +1,122 @@
+//! Modified Cam-Clay against the closed forms of the critical state (issue 52,
+//! item 4; `shared/reference/geotech-targets.py`): triaxial compression from
+//! p′0 = 200 kPa with λ = 0.2, κ = 0.04, M = 1.2, isotropically consolidated to
+//! p_c0 = OCR p′0. Tension is positive, stresses in Pa.
+//!
+//! - Undrained (isochoric, F = diag(a^−½, a^−½, a)): at the critical state
+//!   p′_f = p′0 (OCR/2)^Λ, Λ = (λ − κ)/λ, q_f = M p′_f; with a constant total
+//!   cell pressure σ3 = p′0 (no back pressure) the excess pore pressure is
+//!   u = p_total − p′ = p′0 + q/3 − p′. The closed form needs only
+//!   ε_v^e + ε_v^p = 0 with the logarithmic laws ε_v^e = κ̃ ln(p/p0),
+//!   ε_v^p = (λ̃ − κ̃) ln(p_c/p_c0), which the model uses (J = 1, so τ = σ).
+//! - Drained (constant cell pressure, axial compression): the stress path
+//!   p′ = p′0 + q/3 meets the critical-state line q = M p′ at p′0/(1 − M/3),
+//!   for any elasticity (q/p′ is the same for τ and σ).
+//!
+//! Single point through the driver, and one MPM cell (explicit) whose nodes
+//! all move with a uniform isochoric velocity gradient.
+
+use crate::common::assert_within;
+use mpm::dim::Mat3;
+use mpm::material::driver::{run_from, run_mixed, StressControl};
+use mpm::material::modified_cam_clay::{ModifiedCamClay, Preconsolidation};
+use mpm::material::Material;
+
+const P0: f64 = 2.0e5;
+const M: f64 = 1.2;
+
+fn model(ocr: f64) -> ModifiedCamClay {
+    ModifiedCamClay {
+        density: 1800.0,
+        lambda: 0.2,
+        kappa: 0.04,
+        critical_state_ratio: M,
+        poisson_ratio: 0.3,
+        initial_void_ratio: 1.0,
+        preconsolidation: Preconsolidation::Ratio(ocr),
+    }
+}
+
+/// The isotropic start −p′0 I and its history (p_c0 = OCR p′0).
+fn start(m: &ModifiedCamClay) -> (Mat3, Vec<f64>) {
+    let sigma = Mat3::identity() * -P0;
+    let mut h = vec![0.0; m.n_history()];
+    m.initial_history(&sigma, &mut h);
+    (sigma, h)
+}
+
+/// p′ and q = σ_r − σ_a of a triaxial stress.
+fn p_q(s: &Mat3) -> (f64, f64) {
+    (-s.trace() / 3.0, s[(0, 0)] - s[(2, 2)])
+}
+
+/// The closed-form undrained (p′_f, q_f, u_f).
+fn undrained_target(ocr: f64) -> (f64, f64, f64) {
+    let big_lambda = (0.2 - 0.04) / 0.2;
+    let p = P0 * (ocr / 2.0f64).powf(big_lambda);
+    (p, M * p, P0 + M * p / 3.0 - p)
+}
+
+fn rel(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs()
+}
+
+/// Axial strain of the undrained tests: ln a = −0.5 (a = 0.61).
+const UNDRAINED_LOG_STRAIN: f64 = 0.5;
+
+#[test]
+fn cam_clay_undrained_triaxial_reaches_the_critical_state() {
+    let steps = 500;
+    let path: Vec<Mat3> = (0..=steps)
+        .map(|k| {
+            let a = (-UNDRAINED_LOG_STRAIN * k as f64 / steps as f64).exp();
+            Mat3::from_diagonal(&[a.powf(-0.5), a.powf(-0.5), a].into())
+        })
+        .collect();
+    for (ocr, issue) in [(1.0, (114.87, 137.84, 131.08)), (2.0, (200.0, 240.0, 80.0)), (4.0, (348.22, 417.86, -8.93))] {
+        let m = model(ocr);
+        let (sigma, h) = start(&m);
+        let r = run_from(&m, &path, 0.0, sigma, h);
+        let (p, q) = p_q(r.stress.last().unwrap());
+        let u = P0 + q / 3.0 - p;
+        let (pt, qt, ut) = undrained_target(ocr);
+        eprintln!(
+            "undrained OCR {ocr}: p′_f = {:.2} kPa (target {:.2}, issue {}), q_f = {:.2} (target {:.2}, issue {}), u_f = {:.2} (target {:.2}, issue {}) at ln a = −{UNDRAINED_LOG_STRAIN}",
+            p / 1e3, pt / 1e3, issue.0, q / 1e3, qt / 1e3, issue.1, u / 1e3, ut / 1e3, issue.2
+        );
+        assert!(rel(pt / 1e3, issue.0) < 5e-5 && rel(qt / 1e3, issue.1) < 5e-5, "closed form = the issue's numbers");
+        // The issue's bound, 0.5 %.
+        assert_within(&format!("OCR {ocr}: p′_f"), rel(p, pt), 5e-3);
+        assert_within(&format!("OCR {ocr}: q_f"), rel(q, qt), 5e-3);
+        assert_within(&format!("OCR {ocr}: u_f (of p′0)"), (u - ut).abs() / P0, 5e-3);
+    }
+}
+
+#[test]
+fn cam_clay_drained_triaxial_reaches_the_critical_state() {
+    let steps = 1000;
+    let axial = 1.2_f64; // ln of the axial stretch reached: −1.2
+    let ratio = (-axial / steps as f64).exp();
+    let increments = vec![Mat3::from_diagonal(&[1.0, 1.0, ratio].into()); steps];
+    let controls = [StressControl {
+        stress: (0, 0),
+        target: -P0,
+        free: (0, 0),
+        mirror: Some((1, 1)),
+    }];
+    let (pt, qt) = (P0 / (1.0 - M / 3.0), M * P0 / (1.0 - M / 3.0));
+    for ocr in [1.0, 2.0, 4.0] {
+        let m = model(ocr);
+        let (sigma, h) = start(&m);
+        let r = run_mixed(&m, &increments, &controls, 0.0, sigma, h, 1e-12)
+            .expect("drained path converges");
+        let (p, q) = p_q(r.response.stress.last().unwrap());
+        let iterations = r.residuals.iter().map(Vec::len).max().unwrap();
+        eprintln!(
+            "drained OCR {ocr}: p′_f = {:.2} kPa (target {:.2}), q_f = {:.2} (target {:.2}) at ln a = −{axial}; at most {iterations} Newton iterates per increment",
+            p / 1e3, pt / 1e3, q / 1e3, qt / 1e3
+        );
+        assert_within(&format!("drained OCR {ocr}: p′_f"), rel(p, pt), 5e-3);
+        assert_within(&format!("drained OCR {ocr}: q_f"), rel(q, qt), 5e-3);
+    }
+}
