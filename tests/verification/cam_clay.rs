@@ -73,7 +73,11 @@ fn cam_clay_undrained_triaxial_reaches_the_critical_state() {
             Mat3::from_diagonal(&[a.powf(-0.5), a.powf(-0.5), a].into())
         })
         .collect();
-    for (ocr, issue) in [(1.0, (114.87, 137.84, 131.08)), (2.0, (200.0, 240.0, 80.0)), (4.0, (348.22, 417.86, -8.93))] {
+    for (ocr, issue) in [
+        (1.0, (114.87, 137.84, 131.08)),
+        (2.0, (200.0, 240.0, 80.0)),
+        (4.0, (348.22, 417.86, -8.93)),
+    ] {
         let m = model(ocr);
         let (sigma, h) = start(&m);
         let r = run_from(&m, &path, 0.0, sigma, h);
@@ -84,11 +88,18 @@ fn cam_clay_undrained_triaxial_reaches_the_critical_state() {
             "undrained OCR {ocr}: p′_f = {:.2} kPa (target {:.2}, issue {}), q_f = {:.2} (target {:.2}, issue {}), u_f = {:.2} (target {:.2}, issue {}) at ln a = −{UNDRAINED_LOG_STRAIN}",
             p / 1e3, pt / 1e3, issue.0, q / 1e3, qt / 1e3, issue.1, u / 1e3, ut / 1e3, issue.2
         );
-        assert!(rel(pt / 1e3, issue.0) < 5e-5 && rel(qt / 1e3, issue.1) < 5e-5, "closed form = the issue's numbers");
+        assert!(
+            rel(pt / 1e3, issue.0) < 5e-5 && rel(qt / 1e3, issue.1) < 5e-5,
+            "closed form = the issue's numbers"
+        );
         // The issue's bound, 0.5 %.
         assert_within(&format!("OCR {ocr}: p′_f"), rel(p, pt), 5e-3);
         assert_within(&format!("OCR {ocr}: q_f"), rel(q, qt), 5e-3);
-        assert_within(&format!("OCR {ocr}: u_f (of p′0)"), (u - ut).abs() / P0, 5e-3);
+        assert_within(
+            &format!("OCR {ocr}: u_f (of p′0)"),
+            (u - ut).abs() / P0,
+            5e-3,
+        );
     }
 }
 

@@ -7,8 +7,8 @@ mod common;
 
 mod absorbing;
 mod apic;
-mod cam_clay;
 mod axisymmetric;
+mod cam_clay;
 mod cantilever;
 mod collapse;
 mod column_explicit;
