@@ -701,9 +701,7 @@ mod tests {
             ("ocr = 1.0\ninitial_void_ratio = 0.0", "material.0.initial_void_ratio", "positive"),
         ];
         for (extra, key, message) in cases {
-            // A later key of the same name overrides the default table's.
-            let text = extra.replace('\n', "\n");
-            let err = build_overriding(&text).expect_err(extra);
+            let err = build_overriding(extra).expect_err(extra);
             assert_eq!(err.0, key, "{extra}: {err:?}");
             assert!(err.1.contains(message), "{extra}: {}", err.1);
         }
