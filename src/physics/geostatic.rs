@@ -59,3 +59,45 @@ pub fn initialise<const D: usize>(model: &mut Model<D>, g: &GeostaticConfig) {
         p.stress.set(q, &s);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Scene;
+
+    /// A 2 × 4 m column of Modified Cam-Clay at OCR 2 with K0 = 1 − sin φ_cs
+    /// (no `k0`): after the K0 stresses, `Model::initialise_history` gives every
+    /// particle p_c0 = OCR (p′ + q²/(M² p′)) of its own stress.
+    #[test]
+    fn cam_clay_preconsolidation_follows_the_k0_stresses() {
+        let text = "dimension = 2\ngravity = [0.0, -10.0]\n[grid]\nmin = [0.0, 0.0]\nmax = [2.0, 4.0]\ncells = [2, 4]\n\
+            [[material]]\nname = \"clay\"\nmodel = \"modified_cam_clay\"\ndensity = 1800.0\nlambda = 0.2\nkappa = 0.04\n\
+            critical_state_ratio = 1.2\npoisson_ratio = 0.3\ninitial_void_ratio = 1.0\nocr = 2.0\n\
+            [[body]]\nname = \"column\"\nmaterial = \"clay\"\nshape = \"rectangle\"\nmin = [0.0, 0.0]\nmax = [2.0, 4.0]\n\
+            [[boundary]]\nface = \"ymin\"\ncondition = \"fixed\"\n[geostatic]\n[solver]\nkind = \"explicit\"\nend_time = 0.1\n";
+        let scene = Scene::parse("column.toml", text, &[]).unwrap();
+        let mut model = Model::<2>::build(&scene).unwrap();
+        initialise(&mut model, scene.config.geostatic.as_ref().unwrap());
+        model.initialise_history();
+        let m = 1.2f64;
+        let sin = 3.0 * m / (6.0 + m);
+        let p = &model.particles;
+        for q in 0..p.len() {
+            let s = p.stress.get(q);
+            let (sv, sh) = (s[(1, 1)], s[(0, 0)]);
+            assert!(
+                (sh - (1.0 - sin) * sv).abs() < 1e-9 * sv.abs(),
+                "Jáky's K0 of φ_cs"
+            );
+            let mean = -s.trace() / 3.0;
+            let dev = s + Mat3::identity() * mean;
+            let q2 = 1.5 * dev.norm_squared();
+            let expect = 2.0 * (mean + q2 / (m * m * mean));
+            let pc = p.history.get(q)[1];
+            assert!(
+                (pc - expect).abs() < 1e-12 * expect,
+                "particle {q}: p_c = {pc}, expected {expect}"
+            );
+        }
+    }
+}
