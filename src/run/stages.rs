@@ -220,7 +220,7 @@ fn stalled(step: usize, time: f64, dt: f64) -> Divergence {
 
 /// How the stages went: the outcome, each stage's summary, the last stage's
 /// solver report, step and active nodes, its per-particle contact forces
-/// (implicit contact only), and an output that could not be written.
+/// (`Stepper::contact_forces`), and an output that could not be written.
 pub(super) struct Ran<const D: usize> {
     pub outcome: Result<(), Divergence>,
     pub stages: Vec<StageSummary>,
@@ -253,7 +253,7 @@ pub(super) fn run_stages<const D: usize>(
     let first_stage = ck.map_or(0, |c| c.stage);
     let mut stages = ck.map_or_else(Vec::new, |c| c.stages_done.clone());
     let mut last: Option<(SolverReport, f64, usize)> = None;
-    // The last stage's per-particle contact forces (implicit contact only).
+    // The last stage's per-particle contact forces (`Stepper::contact_forces`).
     let mut contact_forces: Option<Vec<Vector<D>>> = None;
     // An output that cannot be written ends the run as failed.
     let mut failure: Option<std::io::Error> = None;
@@ -314,7 +314,7 @@ pub(super) fn run_stages<const D: usize>(
             warnings,
         });
         last = Some((report, dt, stepper.active_nodes()));
-        contact_forces = stepper.contact_forces(model.particles.len());
+        contact_forces = stepper.contact_forces(model);
         if line.interrupted.is_some() {
             break;
         }

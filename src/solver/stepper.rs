@@ -82,11 +82,11 @@ pub trait Stepper<const D: usize> {
         Vec::new()
     }
 
-    /// The contact force on every particle at the last converged step
-    /// (implicit contact with rigid bodies, `particles_final.csv`'s
-    /// `contact_f*` columns); `None` for a solver without per-particle contact
-    /// forces.
-    fn contact_forces(&self, _particles: usize) -> Option<Vec<Vector<D>>> {
+    /// The contact force on every particle of `m` in the last (converged)
+    /// step (`particles_final.csv`'s `contact_f*` columns): implicit contact
+    /// with rigid bodies, explicit contact between bodies; `None` for a
+    /// solver or a scene without per-particle contact forces.
+    fn contact_forces(&self, _m: &Model<D>) -> Option<Vec<Vector<D>>> {
         None
     }
 

@@ -18,6 +18,7 @@ mod impact;
 mod key_paths;
 mod robustness;
 mod scene_errors;
+mod shipped;
 mod staging;
 mod time_histories;
 mod water;

@@ -110,6 +110,50 @@ fn contact_force_carries_the_block() {
     );
 }
 
+/// Explicit contact forces per particle (particles_final.csv's `contact_f*`):
+/// the momentum exchanged at each node in the last step, shared by its
+/// field's particles by their mass, over Δt. With a history row at every
+/// step, contact.csv's last row is the last step's force on the base (the
+/// pair's first body): the base's particles sum to it, the block's to its
+/// opposite, to round-off (measured ≤ 4.6e-16), and only the
+/// particles along the interface carry any (86 of the base's 1400).
+#[test]
+fn explicit_contact_forces_per_particle_sum_to_the_pair_force() {
+    let (result, dir) = run_problem(
+        "contact_incline.toml",
+        &["output.history_interval=0", "output.frames=0"],
+    );
+    result.unwrap();
+    let p = Table::read(&dir.path().join("particles_final.csv")).unwrap();
+    let c = Table::read(&dir.path().join("contact.csv")).unwrap();
+    let last = c.col("t").len() - 1;
+    let pair = [c.col("fx")[last], c.col("fy")[last]];
+    let scale = pair[0].hypot(pair[1]);
+    assert!(scale > 0.0, "the block presses on the base");
+    let body = p.col("body");
+    for (b, sign, what) in [(0.0, 1.0, "base"), (1.0, -1.0, "block")] {
+        for (d, column) in ["contact_fx", "contact_fy"].into_iter().enumerate() {
+            let sum: f64 = (p.col(column).iter().zip(body))
+                .filter(|(_, &k)| k == b)
+                .map(|(f, _)| f)
+                .sum();
+            assert_within(
+                &format!("{what}: sum of {column} / pair force - sign, relative"),
+                (sum - sign * pair[d]) / scale,
+                1e-12,
+            );
+        }
+    }
+    let (fx, fy) = (p.col("contact_fx"), p.col("contact_fy"));
+    let touching = (0..fx.len())
+        .filter(|&q| fx[q] != 0.0 || fy[q] != 0.0)
+        .count();
+    assert!(
+        touching > 0 && touching < fx.len() / 4,
+        "{touching} particles carry a force"
+    );
+}
+
 #[test]
 fn block_sticks_when_tan_theta_is_below_mu() {
     // tan 45° = 1 < μ = 1.2. The weight comes on suddenly and the base pressure

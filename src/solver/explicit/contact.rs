@@ -29,6 +29,7 @@
 //! in field order.
 
 use crate::dim::Vector;
+use crate::model::particles::Particles;
 use crate::model::Model;
 use crate::parallel::MIN_PARALLEL_LEN;
 use crate::physics::contact::field_split::{pair_position, FieldSplit, Meeting};
@@ -57,6 +58,13 @@ pub struct Contact<const D: usize> {
     /// The rigid fields that keep deformable particles out
     /// (`physics::rigid::surface`).
     surfaces: Vec<Surface>,
+    /// This step's momentum exchanged at each node (by the node map's index),
+    /// as far as it reaches the particles (the `delivered` fractions), and
+    /// the momentum the rigid surfaces gave particles they pushed out, with
+    /// the step's Δt: the per-particle forces (`particle_forces`).
+    node_impulse: Vec<Vector<D>>,
+    pushed: Vec<(usize, Vector<D>)>,
+    dt: f64,
 }
 
 impl<const D: usize> Contact<D> {
@@ -77,6 +85,9 @@ impl<const D: usize> Contact<D> {
             field,
             meetings: Vec::new(),
             rigid_nodes: Vec::new(),
+            node_impulse: Vec::new(),
+            pushed: Vec::new(),
+            dt: 0.0,
             totals,
         }
     }
@@ -95,6 +106,9 @@ impl<const D: usize> Contact<D> {
         let n_grid = m.grid.node_count();
         self.fields.split(st, map, n_grid);
         self.meetings = self.fields.meetings(&self.plan, m, st, map, false);
+        self.node_impulse.clear();
+        self.node_impulse.resize(map.len(), Vector::<D>::zeros());
+        self.pushed.clear();
         self.rigid_nodes.clear();
         if let Some(free) = &mut self.free {
             free.start(p, m.axisymmetric);
@@ -185,6 +199,9 @@ impl<const D: usize> Contact<D> {
                 total.dissipation -= friction.dot(&slip_after) * delivered;
                 total.impulse += dp * delivered;
                 total.nodes += 1;
+                self.node_impulse[mt.r] += dp * delivered;
+                self.node_impulse[mt.s] -= dp * delivered;
+                self.dt = dt;
             }
         }
         corrected.sort_unstable();
@@ -219,6 +236,7 @@ impl<const D: usize> Contact<D> {
             let fq = self.field[q] as usize;
             let total = &mut self.totals[pair_position(self.plan.fields, fq.min(k), fq.max(k))];
             total.impulse += if fq < k { dp } else { -dp };
+            self.pushed.push((q, dp));
             if self.plan.free[k] {
                 kicks.push((k, push.x, -dp));
             }
@@ -262,6 +280,38 @@ impl<const D: usize> Contact<D> {
                     })
             })
             .collect()
+    }
+
+    /// The contact force on every particle in the last step: the momentum
+    /// exchanged at each node, J_I, shared by the particles of its field by
+    /// their mass, f_p = Σ_I (m_p S_Ip / m_I) J_I / Δt, plus a push out of a
+    /// rigid body, Δp/Δt. Over a field's particles they sum to the nodes'
+    /// J_I/Δt (Σ_p m_p S_Ip = m_I), the pair's force in contact.csv over
+    /// that step. `st`, `map` and `mass` are the step's.
+    pub fn particle_forces(
+        &self,
+        st: &Stencils<D>,
+        map: &NodeMap,
+        mass: &[f64],
+        p: &Particles<D>,
+    ) -> Vec<Vector<D>> {
+        let mut f = vec![Vector::<D>::zeros(); p.len()];
+        if self.dt <= 0.0 || self.node_impulse.len() != map.len() {
+            return f;
+        }
+        for (q, fq) in f.iter_mut().enumerate() {
+            for e in st.range(q) {
+                let a = map.local_of(st, e);
+                if mass[a] > 0.0 {
+                    *fq += self.node_impulse[a] * (p.mass[q] * st.weight_at(q, e) / mass[a]);
+                }
+            }
+        }
+        for &(q, dp) in &self.pushed {
+            f[q] += dp;
+        }
+        f.iter_mut().for_each(|fq| *fq /= self.dt);
+        f
     }
 
     /// The totals since the last call, reset.

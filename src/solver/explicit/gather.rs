@@ -70,6 +70,13 @@ impl<const D: usize> NodeMapStep<D> {
             .map_or_else(Vec::new, |c| c.take_totals())
     }
 
+    /// The contact force on every particle in the last step
+    /// (`Contact::particle_forces`); None without contact.
+    pub fn contact_forces(&self, m: &Model<D>) -> Option<Vec<Vector<D>>> {
+        (self.contact.as_ref())
+            .map(|c| c.particle_forces(&self.stencils, &self.map, &self.mass, &m.particles))
+    }
+
     /// After G2P, the one place of the explicit step that hands each body
     /// kind its work (`model::body::Advance`): continuum bodies moved with the
     /// grid in G2P, and so did a prescribed rigid body (its nodes move at its

@@ -224,4 +224,8 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
     fn take_contact(&mut self) -> Vec<PairTotal<D>> {
         self.node_map.take_contact()
     }
+
+    fn contact_forces(&self, m: &Model<D>) -> Option<Vec<crate::dim::Vector<D>>> {
+        self.node_map.contact_forces(m)
+    }
 }

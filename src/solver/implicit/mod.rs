@@ -213,8 +213,8 @@ impl<const D: usize> Stepper<D> for Implicit<D> {
         self.system.take_pair_totals()
     }
 
-    fn contact_forces(&self, particles: usize) -> Option<Vec<Vector<D>>> {
-        self.system.particle_forces(particles)
+    fn contact_forces(&self, m: &Model<D>) -> Option<Vec<Vector<D>>> {
+        self.system.particle_forces(m.particles.len())
     }
 
     fn take_newton_rows(&mut self) -> Vec<NewtonRow> {
