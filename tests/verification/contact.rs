@@ -450,7 +450,8 @@ fn bodies_that_never_touch_run_bit_for_bit_as_without_contact() {
     );
     // particles_final.csv: the same columns to the bit, and the contact run's
     // per-particle contact forces (its extra columns) zero.
-    let table = |dir: &tempfile::TempDir| Table::read(&dir.path().join("particles_final.csv")).unwrap();
+    let table =
+        |dir: &tempfile::TempDir| Table::read(&dir.path().join("particles_final.csv")).unwrap();
     let (a, b) = (table(&dir_with), table(&dir_without));
     for name in &a.header {
         match name.starts_with("contact_f") {
