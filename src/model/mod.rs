@@ -264,41 +264,39 @@ impl<const D: usize> Model<D> {
     /// Start staging (`model::staging`): the particles of the `inactive`
     /// bodies held aside until a stage activates them.
     pub(crate) fn start_staging(&mut self, inactive: &[usize]) {
-        let continuum = self.continuum_bodies();
-        let mut a = staging::Arrays {
-            particles: &mut self.particles,
-            load_ramp_of: &mut self.load_ramp_of,
-            continuum: &continuum,
-        };
-        self.staging = Some(staging::Staging::start(&mut a, inactive));
+        let staging = self.with_arrays(|a| staging::Staging::start(a, inactive));
+        self.staging = Some(staging);
     }
 
     /// Apply a stage's changes at its start (`model::staging`; nothing
     /// without staging).
     pub fn change(&mut self, changes: &staging::StageChanges) {
-        let continuum = self.continuum_bodies();
-        if let Some(s) = &mut self.staging {
-            let mut a = staging::Arrays {
-                particles: &mut self.particles,
-                load_ramp_of: &mut self.load_ramp_of,
-                continuum: &continuum,
-            };
-            s.change(&mut a, changes);
+        if let Some(mut s) = self.staging.take() {
+            self.with_arrays(|a| s.change(a, changes));
+            self.staging = Some(s);
         }
     }
 
     /// A restart's particles of a staged scene (`Staging::restore`).
     pub fn restore_staging(&mut self, activated: &[usize], built: &[u32]) -> Result<(), String> {
-        let continuum = self.continuum_bodies();
-        let Some(s) = &mut self.staging else {
+        let Some(mut s) = self.staging.take() else {
             return Ok(());
         };
-        let mut a = staging::Arrays {
+        let restored = self.with_arrays(|a| s.restore(a, activated, built));
+        self.staging = Some(s);
+        restored
+    }
+
+    /// `f` on the per-particle arrays staging changes (`staging::Arrays`).
+    fn with_arrays<R>(&mut self, f: impl FnOnce(&mut staging::Arrays<D>) -> R) -> R {
+        let continuum: Vec<bool> = (self.bodies.iter())
+            .map(|b| b.kind == BodyKind::Continuum)
+            .collect();
+        f(&mut staging::Arrays {
             particles: &mut self.particles,
             load_ramp_of: &mut self.load_ramp_of,
             continuum: &continuum,
-        };
-        s.restore(&mut a, activated, built)
+        })
     }
 
     /// The particle now in the model that was built as `built` (None: it has
@@ -313,13 +311,6 @@ impl<const D: usize> Model<D> {
     /// The index as built of particle q (q itself without staging).
     pub fn built_index(&self, q: usize) -> usize {
         self.staging.as_ref().map_or(q, |s| s.built[q] as usize)
-    }
-
-    /// Whether each body is a continuum body.
-    fn continuum_bodies(&self) -> Vec<bool> {
-        (self.bodies.iter())
-            .map(|b| b.kind == BodyKind::Continuum)
-            .collect()
     }
 
     /// The kind of particle q's body.

@@ -100,23 +100,29 @@ impl History {
     /// The slots of `rows`, in that order, packed anew.
     pub fn select(&self, rows: &[usize]) -> History {
         let mut h = History::default();
-        for &q in rows {
-            let values = self.get(q);
-            h.push(values.len());
-            let start = h.data.len() - values.len();
-            h.data[start..].copy_from_slice(values);
-        }
+        rows.iter().for_each(|&q| h.push_values(self.get(q)));
         h
     }
 
     /// Append the slots of `other` after these.
     pub fn append(&mut self, other: &History) {
-        for q in 0..other.len.len() {
-            let values = other.get(q);
-            self.push(values.len());
-            let start = self.data.len() - values.len();
-            self.data[start..].copy_from_slice(values);
-        }
+        (0..other.len.len()).for_each(|q| self.push_values(other.get(q)));
+    }
+
+    /// Append a slot holding `values`.
+    fn push_values(&mut self, values: &[f64]) {
+        self.push(values.len());
+        let start = self.data.len() - values.len();
+        self.data[start..].copy_from_slice(values);
+    }
+}
+
+/// The values of `rows`, in that order (an empty array stays empty: no
+/// particle has one).
+pub fn pick<T: Clone>(v: &[T], rows: &[usize]) -> Vec<T> {
+    match v.is_empty() {
+        true => Vec::new(),
+        false => rows.iter().map(|&q| v[q].clone()).collect(),
     }
 }
 
@@ -198,12 +204,6 @@ impl<const D: usize> Particles<D> {
     /// The particles of `rows`, in that order, with everything they carry
     /// (staged construction, `model::staging`).
     pub fn select(&self, rows: &[usize]) -> Particles<D> {
-        fn pick<T: Clone>(v: &[T], rows: &[usize]) -> Vec<T> {
-            match v.is_empty() {
-                true => Vec::new(),
-                false => rows.iter().map(|&q| v[q].clone()).collect(),
-            }
-        }
         Particles {
             x: pick(&self.x, rows),
             x0: pick(&self.x0, rows),

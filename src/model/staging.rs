@@ -13,7 +13,7 @@
 //! `Staging` (`Model::staging` is None).
 
 use crate::model::geometry::Geometry;
-use crate::model::particles::Particles;
+use crate::model::particles::{pick, Particles};
 use crate::scene::region::{RegionConfig, RegionShape};
 use crate::scene::SceneConfig;
 
@@ -219,13 +219,5 @@ fn region(r: &RegionConfig) -> Geometry {
             radius: r.radius.expect("validated"),
         },
         RegionShape::Polygon => Geometry::Polygon(r.vertices.clone().expect("validated")),
-    }
-}
-
-/// The values of `rows` (an empty array stays empty: no particle has one).
-fn pick<T: Copy>(v: &[T], rows: &[usize]) -> Vec<T> {
-    match v.is_empty() {
-        true => Vec::new(),
-        false => rows.iter().map(|&q| v[q]).collect(),
     }
 }

@@ -39,6 +39,18 @@ use mpm::scene::{Scene, Scheme, ShapeFunction};
 use std::path::{Path, PathBuf};
 use strum::IntoEnumIterator;
 
+/// problems/tunnel_excavation.toml made coarse: a 10 m square at a/dx = 4,
+/// its load regions on the outermost column of particles (staging tests).
+pub const TUNNEL_COARSE: [&str; 7] = [
+    "grid.max=[10.0, 10.0]",
+    "grid.cells=[40, 40]",
+    "body.0.max=[10.0, 10.0]",
+    "load.0.region_min=[9.9, 0.0]",
+    "load.0.region_max=[10.0, 10.0]",
+    "load.1.region_min=[0.0, 9.9]",
+    "load.1.region_max=[10.0, 10.0]",
+];
+
 pub fn problem(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("problems")

@@ -252,16 +252,7 @@ fn staged_restart_at_a_stage_end() {
 /// before the next does.
 #[test]
 fn a_restart_across_a_stage_that_removes_or_adds_particles_is_byte_identical() {
-    let coarse = [
-        "grid.max=[10.0, 10.0]",
-        "grid.cells=[40, 40]",
-        "body.0.max=[10.0, 10.0]",
-        "load.0.region_min=[9.9, 0.0]",
-        "load.0.region_max=[10.0, 10.0]",
-        "load.1.region_min=[0.0, 9.9]",
-        "load.1.region_max=[10.0, 10.0]",
-        "stage.1.load_steps=4",
-    ];
+    let coarse = [&crate::common::TUNNEL_COARSE[..], &["stage.1.load_steps=4"]].concat();
     let steps = restarts_are_exact("tunnel_excavation.toml", &coarse, 0.5, 1);
     assert_eq!(steps, [3, 5], "in the excavation stage and at its end");
     let steps = restarts_are_exact("fill_layers.toml", &[], 1.0, 2);

@@ -200,18 +200,11 @@ fn water_table_runs_give_identical_results_on_one_and_two_threads() {
 /// explicit stage after the fill's last layer.
 #[test]
 fn staged_construction_gives_identical_results_on_one_and_two_threads() {
-    let coarse: Vec<String> = [
-        "grid.max=[10.0, 10.0]",
-        "grid.cells=[40, 40]",
-        "body.0.max=[10.0, 10.0]",
-        "load.0.region_min=[9.9, 0.0]",
-        "load.0.region_max=[10.0, 10.0]",
-        "load.1.region_min=[0.0, 9.9]",
-        "load.1.region_max=[10.0, 10.0]",
-        "output.frames=0",
-    ]
-    .map(String::from)
-    .to_vec();
+    let coarse: Vec<String> = (crate::common::TUNNEL_COARSE
+        .iter()
+        .chain(&["output.frames=0"]))
+    .map(|s| s.to_string())
+    .collect();
     same_on_one_and_two_threads("tunnel_excavation.toml", &coarse, "excavation");
     same_on_one_and_two_threads("fill_layers.toml", &[], "layered fill");
     let text = std::fs::read_to_string(crate::common::problem("fill_layers.toml")).unwrap();

@@ -93,16 +93,7 @@ fn an_opening_excavated_under_isotropic_stress_follows_kirsch() {
 #[test]
 fn an_excavation_in_one_stage_equals_the_same_in_two() {
     let text = std::fs::read_to_string(crate::common::problem("tunnel_excavation.toml")).unwrap();
-    let coarse = [
-        "grid.max=[10.0, 10.0]",
-        "grid.cells=[40, 40]",
-        "body.0.max=[10.0, 10.0]",
-        "load.0.region_min=[9.9, 0.0]",
-        "load.0.region_max=[10.0, 10.0]",
-        "load.1.region_min=[0.0, 9.9]",
-        "load.1.region_max=[10.0, 10.0]",
-        "output.frames=0",
-    ];
+    let coarse = [&crate::common::TUNNEL_COARSE[..], &["output.frames=0"]].concat();
     let once = run_text(&text, &coarse);
     let half = "excavate = [{ shape = \"disk\", centre = [0.0, 0.0], radius = 0.5 }]";
     let whole = "excavate = [{ shape = \"disk\", centre = [0.0, 0.0], radius = 1.0 }]";
