@@ -129,6 +129,12 @@ pub trait Material: CloneMaterial + Send + Sync + std::fmt::Debug {
         None
     }
 
+    /// The excess pore pressure held in `history` (compression positive) of an
+    /// undrained material (`material::undrained`), `None` for the others.
+    fn excess_pore_pressure(&self, _history: &[f64]) -> Option<f64> {
+        None
+    }
+
     /// Whether the model erodes points at all (`material::erosion`).
     fn erodes(&self) -> bool {
         false

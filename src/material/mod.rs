@@ -24,6 +24,7 @@ pub mod return_mapping;
 pub(crate) mod spectral;
 #[cfg(test)]
 mod testing;
+pub mod undrained;
 
 mod law;
 

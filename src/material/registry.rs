@@ -6,7 +6,7 @@
 //! calls it to check a table and `Model::build` to construct the material.
 
 use super::parameters::{Entry, KeyError, Parameters};
-use super::{Material, MODELS};
+use super::{undrained, Material, MODELS};
 use std::sync::OnceLock;
 
 /// The model of this name.
@@ -25,7 +25,7 @@ pub fn all_keys() -> &'static [&'static str] {
     static KEYS: OnceLock<Vec<&'static str>> = OnceLock::new();
     KEYS.get_or_init(|| {
         let mut keys: Vec<&'static str> = Vec::new();
-        for k in MODELS.iter().flat_map(|m| m.keys) {
+        for k in MODELS.iter().flat_map(|m| m.keys).chain(undrained::KEYS) {
             if !keys.contains(k) {
                 keys.push(k);
             }
@@ -35,7 +35,8 @@ pub fn all_keys() -> &'static [&'static str] {
 }
 
 /// The material of the table at `table` (`material.0`): model `model` with this
-/// density and these other keys. An error names the key.
+/// density and these other keys, undrained when the drainage keys say so
+/// (`material::undrained`). An error names the key.
 pub fn build(
     table: &str,
     model: &str,
@@ -51,13 +52,18 @@ pub fn build(
             ),
         )
     })?;
-    if let Some(k) = values.keys().find(|k| !entry.keys.contains(&k.as_str())) {
+    let (drainage, own): (toml::Table, toml::Table) = values
+        .clone()
+        .into_iter()
+        .partition(|(k, _)| undrained::KEYS.contains(&k.as_str()));
+    if let Some(k) = own.keys().find(|k| !entry.keys.contains(&k.as_str())) {
         return Err((
             format!("{table}.{k}"),
             format!("does not apply to model `{}`", entry.name),
         ));
     }
-    (entry.construct)(density, &Parameters::new(table, entry.name, values))
+    let skeleton = (entry.construct)(density, &Parameters::new(table, entry.name, &own))?;
+    undrained::wrap(skeleton, &Parameters::new(table, entry.name, &drainage))
 }
 
 #[cfg(test)]

@@ -200,10 +200,25 @@ impl<const D: usize> Model<D> {
             .then(|| values.iter().map(|v| v.unwrap_or(0.0)).collect())
     }
 
+    /// Each particle's excess pore pressure (`material::undrained`, 0 for a
+    /// drained material), `None` when no material is undrained.
+    pub fn excess_pore_pressure(&self) -> Option<Vec<f64>> {
+        let p = &self.particles;
+        let values: Vec<Option<f64>> = (0..p.len())
+            .map(|q| self.materials[p.material[q] as usize].excess_pore_pressure(p.history.get(q)))
+            .collect();
+        values
+            .iter()
+            .any(Option::is_some)
+            .then(|| values.iter().map(|v| v.unwrap_or(0.0)).collect())
+    }
+
     /// The per-particle fields the outputs add where the run has them:
     /// `eps_p` (`plastic_strain`), with a peridynamic body `damage`
     /// (`Peridynamics::damage`, 0 off the peridynamic bodies) and with
-    /// `[water]` `p_water`, the pore pressure of the last step (at its start).
+    /// `[water]` `p_water`, the pore pressure of the last step (at its start),
+    /// and with an undrained material `p_excess` (the stress columns are then
+    /// σ′ − p_excess I: see docs/pore_water.md).
     pub fn point_fields(&self) -> Vec<(&'static str, Vec<f64>)> {
         let mut fields: Vec<(&'static str, Vec<f64>)> = Vec::new();
         if let Some(e) = self.plastic_strain() {
@@ -214,6 +229,9 @@ impl<const D: usize> Model<D> {
         }
         if self.water.is_some() {
             fields.push(("p_water", self.particles.pore_pressure.clone()));
+        }
+        if let Some(p) = self.excess_pore_pressure() {
+            fields.push(("p_excess", p));
         }
         fields
     }

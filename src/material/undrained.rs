@@ -1,0 +1,422 @@
+//! Undrained effective-stress loading of a soil skeleton in a single-phase run
+//! (issue 52, item 2; PLAXIS's "Undrained A"): the pore water cannot leave the
+//! point, so every volume change compresses it and raises an excess pore
+//! pressure that the skeleton does not see.
+//!
+//! With the water's bulk modulus K_w and the porosity n, the pore fluid adds the
+//! bulk stiffness K_f = K_w/n to the skeleton (Biot coefficient 1, incompressible
+//! grains; e.g. Potts & Zdravković, *Finite element analysis in geotechnical
+//! engineering*, 1999, §3.4). Over an increment with ΔJ = det ΔF
+//!
+//!   p_ex,new = p_ex,old − K_f ln det ΔF,
+//!
+//! so that p_ex = −K_f ln J for the whole undrained history (path independent),
+//! and the skeleton (any model of `SKELETONS`) updates its effective stress σ′
+//! from σ′_old = σ_old + p_ex,old I as it would drained. The stored stress is
+//!
+//!   σ = σ′ − p_ex I   (Terzaghi, tension positive),
+//!
+//! the stress the particle transmits in the momentum balance besides a `[water]`
+//! table's hydrostatic pressure; p_ex is the last history slot. The consistent
+//! tangent is the skeleton's plus the fluid's: ∂σ_ij/∂ΔF_kl = ∂σ′_ij/∂ΔF_kl +
+//! K_f δ_ij (ΔF⁻ᵀ)_kl, since ∂ ln det ΔF/∂ΔF = ΔF⁻ᵀ.
+//!
+//! Scene keys (on the skeleton's `[[material]]` table): `drainage =
+//! "undrained"` (or "drained", the default), `porosity` n in (0, 1) and
+//! `water_bulk_modulus` K_w (Pa, default 2.2e9).
+
+use super::parameters::{KeyError, Parameters};
+use super::{set_derivative_column, Increment, Material, Strength, StressDerivative};
+use crate::dim::Mat3;
+
+/// The keys this module adds to a material table.
+pub const KEYS: &[&str] = &["drainage", "porosity", "water_bulk_modulus"];
+
+/// The models that may be undrained: the soil skeletons and the elastic laws
+/// (an equation of state, a rigid body or a bond law has no drained skeleton).
+pub const SKELETONS: &[&str] = &[
+    "linear_elastic",
+    "neo_hookean",
+    "hencky",
+    "drucker_prager",
+    "mohr_coulomb",
+    "modified_cam_clay",
+];
+
+/// Bulk modulus of water at 20 °C (Pa).
+pub const WATER_BULK_MODULUS: f64 = 2.2e9;
+
+/// A skeleton loaded undrained: its effective stress and the excess pore
+/// pressure of the water in its pores.
+#[derive(Clone, Debug)]
+pub struct Undrained {
+    pub skeleton: Box<dyn Material>,
+    /// K_f = K_w/n, the pore fluid's bulk stiffness per unit volume of soil.
+    pub fluid_bulk_modulus: f64,
+}
+
+impl Undrained {
+    /// Index of p_ex in the history.
+    fn slot(&self) -> usize {
+        self.skeleton.n_history()
+    }
+
+    /// The excess pore pressure held in `history` (compression positive).
+    pub fn excess(&self, history: &[f64]) -> f64 {
+        history[self.slot()]
+    }
+
+    /// The increment the skeleton sees: its effective start stress and its
+    /// own history.
+    fn skeleton_increment<'a>(&self, inc: &Increment<'a>) -> Increment<'a> {
+        let n = self.slot();
+        let effective = inc.stress_old + Mat3::identity() * inc.history_old[n];
+        Increment::new(inc.f_old, inc.df, inc.dt, effective, &inc.history_old[..n])
+    }
+}
+
+/// The material of a table with drainage keys: the skeleton itself when
+/// drained, else the skeleton wrapped. `p` holds the table's drainage keys.
+pub fn wrap(skeleton: Box<dyn Material>, p: &Parameters) -> Result<Box<dyn Material>, KeyError> {
+    let drainage: String = p.get("drainage")?.unwrap_or_else(|| "drained".into());
+    match drainage.as_str() {
+        "drained" => {
+            if let Some(k) = ["porosity", "water_bulk_modulus"]
+                .into_iter()
+                .find(|k| p.given(k))
+            {
+                return Err((
+                    p.key(k),
+                    "applies only with drainage = \"undrained\"".into(),
+                ));
+            }
+            Ok(skeleton)
+        }
+        "undrained" => {
+            p.ensure(
+                SKELETONS.contains(&skeleton.model()),
+                "drainage",
+                format!(
+                    "an undrained material needs a soil skeleton: model `{}` is not one of {}",
+                    skeleton.model(),
+                    SKELETONS.join(", ")
+                ),
+            )?;
+            let n: f64 = p.required_for("porosity", "drainage = \"undrained\"")?;
+            p.ensure(n > 0.0 && n < 1.0, "porosity", "must lie in (0, 1)")?;
+            let kw: f64 = p.get("water_bulk_modulus")?.unwrap_or(WATER_BULK_MODULUS);
+            p.ensure(
+                kw > 0.0 && kw.is_finite(),
+                "water_bulk_modulus",
+                "must be positive",
+            )?;
+            Ok(Box::new(Undrained {
+                skeleton,
+                fluid_bulk_modulus: kw / n,
+            }))
+        }
+        other => Err((
+            p.key("drainage"),
+            format!("unknown drainage `{other}`; use \"drained\" or \"undrained\""),
+        )),
+    }
+}
+
+impl Material for Undrained {
+    fn model(&self) -> &'static str {
+        self.skeleton.model()
+    }
+
+    fn density(&self) -> f64 {
+        self.skeleton.density()
+    }
+
+    fn n_history(&self) -> usize {
+        self.skeleton.n_history() + 1
+    }
+
+    fn update(&self, inc: &Increment, history_new: &mut [f64]) -> Mat3 {
+        let n = self.slot();
+        let effective = self
+            .skeleton
+            .update(&self.skeleton_increment(inc), &mut history_new[..n]);
+        let p = inc.history_old[n] - self.fluid_bulk_modulus * inc.df.determinant().ln();
+        history_new[n] = p;
+        effective - Mat3::identity() * p
+    }
+
+    /// The undrained P-wave modulus: the skeleton's plus K_f.
+    fn p_wave_modulus(&self) -> f64 {
+        self.skeleton.p_wave_modulus() + self.fluid_bulk_modulus
+    }
+
+    fn wave_speed(&self, j: f64, history: &[f64]) -> f64 {
+        let c = self.skeleton.wave_speed(j, &history[..self.slot()]);
+        (c * c + self.fluid_bulk_modulus * j / self.density()).sqrt()
+    }
+
+    /// The skeleton's energy at its effective stress plus the water's, K_f (ln J)²/2.
+    fn strain_energy_density(&self, f: &Mat3, stress: &Mat3, history: &[f64]) -> f64 {
+        let n = self.slot();
+        let effective = stress + Mat3::identity() * history[n];
+        let ln_j = f.determinant().ln();
+        self.skeleton
+            .strain_energy_density(f, &effective, &history[..n])
+            + 0.5 * self.fluid_bulk_modulus * ln_j * ln_j / f.determinant()
+    }
+
+    fn stress_derivative(&self, inc: &Increment) -> Option<StressDerivative> {
+        let mut d = self
+            .skeleton
+            .stress_derivative(&self.skeleton_increment(inc))?;
+        let df_inv_t = inc.df.try_inverse()?.transpose();
+        for k in 0..3 {
+            for l in 0..3 {
+                let mut column = Mat3::zeros();
+                for i in 0..3 {
+                    column[(i, i)] =
+                        d[(4 * i, 3 * k + l)] + self.fluid_bulk_modulus * df_inv_t[(k, l)];
+                }
+                for i in 0..3 {
+                    for j in 0..3 {
+                        if i != j {
+                            column[(i, j)] = d[(3 * i + j, 3 * k + l)];
+                        }
+                    }
+                }
+                set_derivative_column(&mut d, k, l, &column);
+            }
+        }
+        Some(d)
+    }
+
+    fn has_analytic_tangent(&self) -> bool {
+        self.skeleton.has_analytic_tangent()
+    }
+
+    fn integrates_from_stored_stress(&self) -> bool {
+        self.skeleton.integrates_from_stored_stress()
+    }
+
+    /// The start stress is effective (p_ex = 0 before undrained loading).
+    fn initial_history(&self, stress: &Mat3, history: &mut [f64]) {
+        let n = self.slot();
+        self.skeleton.initial_history(stress, &mut history[..n]);
+    }
+
+    fn frictional_strength(&self) -> Option<Strength> {
+        self.skeleton.frictional_strength()
+    }
+
+    fn with_reduced_strength(&self, factor: f64) -> Option<Box<dyn Material>> {
+        Some(Box::new(Undrained {
+            skeleton: self.skeleton.with_reduced_strength(factor)?,
+            fluid_bulk_modulus: self.fluid_bulk_modulus,
+        }))
+    }
+
+    fn equivalent_plastic_strain(&self, history: &[f64]) -> Option<f64> {
+        self.skeleton
+            .equivalent_plastic_strain(&history[..self.slot()])
+    }
+
+    fn excess_pore_pressure(&self, history: &[f64]) -> Option<f64> {
+        Some(self.excess(history))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::driver::{run_mixed, tangent_error, StressControl};
+    use crate::material::linear_elastic::LinearElastic;
+    use crate::material::modified_cam_clay::{ModifiedCamClay, Preconsolidation};
+    use crate::material::mohr_coulomb::MohrCoulomb;
+    use crate::material::testing::{general_f, increment, rotated};
+
+    const P0: f64 = 2.0e5;
+
+    fn cam_clay(ocr: f64, fluid_bulk_modulus: f64) -> Undrained {
+        Undrained {
+            skeleton: Box::new(ModifiedCamClay {
+                density: 1800.0,
+                lambda: 0.2,
+                kappa: 0.04,
+                critical_state_ratio: 1.2,
+                poisson_ratio: 0.3,
+                initial_void_ratio: 1.0,
+                preconsolidation: Preconsolidation::Ratio(ocr),
+            }),
+            fluid_bulk_modulus,
+        }
+    }
+
+    fn start(m: &dyn Material) -> (Mat3, Vec<f64>) {
+        let sigma = Mat3::identity() * -P0;
+        let mut h = vec![0.0; m.n_history()];
+        m.initial_history(&sigma, &mut h);
+        (sigma, h)
+    }
+
+    /// The closed-form critical state of the undrained triaxial test
+    /// (tests/verification/cam_clay.rs): p′_f, q_f and u_f.
+    fn target(ocr: f64) -> (f64, f64, f64) {
+        let p = P0 * (ocr / 2.0f64).powf(0.8);
+        (p, 1.2 * p, P0 + 1.2 * p / 3.0 - p)
+    }
+
+    /// Triaxial compression at constant total cell pressure, the volume free:
+    /// the stiff pore water makes it undrained, and the skeleton's effective
+    /// path reaches the critical state of the isochoric closed form, with the
+    /// excess pore pressure in the history.
+    #[test]
+    fn cam_clay_with_stiff_water_reaches_the_undrained_critical_state() {
+        let steps = 500;
+        let ratio = (-0.5 / steps as f64).exp();
+        let increments = vec![Mat3::from_diagonal(&[1.0, 1.0, ratio].into()); steps];
+        let controls = [StressControl {
+            stress: (0, 0),
+            target: -P0,
+            free: (0, 0),
+            mirror: Some((1, 1)),
+        }];
+        for (ocr, issue) in [
+            (1.0, (114.87, 137.84, 131.08)),
+            (2.0, (200.0, 240.0, 80.0)),
+            (4.0, (348.22, 417.86, -8.93)),
+        ] {
+            // K_f = 2.2e9/0.4, ~500 times the skeleton's bulk modulus p/κ̃ = 1e7.
+            let m = cam_clay(ocr, WATER_BULK_MODULUS / 0.4);
+            let (sigma, h) = start(&m);
+            let r = run_mixed(&m, &increments, &controls, 0.0, sigma, h, 1e-10).unwrap();
+            let last = r.response.stress.last().unwrap();
+            let u = m.excess(r.response.history.last().unwrap());
+            let effective = last + Mat3::identity() * u;
+            let (p, q) = (
+                -effective.trace() / 3.0,
+                effective[(0, 0)] - effective[(2, 2)],
+            );
+            let (pt, qt, ut) = target(ocr);
+            let j = r.response.f.last().unwrap().determinant();
+            eprintln!(
+                "OCR {ocr}: p′_f {:.2} kPa (issue {}), q_f {:.2} (issue {}), u_f {:.2} (issue {}), J − 1 = {:.1e}",
+                p / 1e3, issue.0, q / 1e3, issue.1, u / 1e3, issue.2, j - 1.0
+            );
+            assert!((p - pt).abs() < 5e-3 * pt, "p′_f {p} vs {pt}");
+            assert!((q - qt).abs() < 5e-3 * qt, "q_f {q} vs {qt}");
+            assert!((u - ut).abs() < 5e-3 * P0, "u_f {u} vs {ut}");
+        }
+    }
+
+    /// Elastic skeleton, isotropic compression: p_ex = −K_f ln J exactly, and
+    /// the total pressure K ln-strain shared in the ratio K_f : K′.
+    #[test]
+    fn elastic_skeleton_shares_a_volume_change_with_the_water() {
+        let e = LinearElastic::new(2000.0, 1.0e7, 0.25);
+        let k_skeleton = 1.0e7 / (3.0 * 0.5);
+        let m = Undrained {
+            skeleton: Box::new(e),
+            fluid_bulk_modulus: 1.0e8,
+        };
+        let stretch = 0.999_f64;
+        let df = Mat3::identity() * stretch;
+        let mut h = vec![0.0; m.n_history()];
+        let s = m.update(
+            &increment(Mat3::identity(), df, Mat3::zeros(), &[0.0]),
+            &mut h,
+        );
+        let ln_j = 3.0 * stretch.ln();
+        assert!((h[0] + 1.0e8 * ln_j).abs() < 1e-9 * 1.0e8 * ln_j.abs());
+        let effective = s + Mat3::identity() * h[0];
+        // Hughes–Winget's volumetric increment tr G = 3·2(s−1)/(s+1).
+        let tr_g = 6.0 * (stretch - 1.0) / (stretch + 1.0);
+        assert!((effective[(0, 0)] - k_skeleton * tr_g).abs() < 1e-6 * k_skeleton * tr_g.abs());
+    }
+
+    #[test]
+    fn tangent_matches_finite_differences() {
+        let mc = MohrCoulomb {
+            density: 2000.0,
+            youngs_modulus: 2.0e7,
+            poisson_ratio: 0.3,
+            peak: Strength {
+                cohesion: 1.0e4,
+                friction_angle: 30f64.to_radians(),
+                dilation_angle: 5f64.to_radians(),
+            },
+            softening: None,
+            tensile_strength: None,
+        };
+        let skeletons: Vec<Box<dyn Material>> = vec![
+            Box::new(LinearElastic::new(2000.0, 1.0e7, 0.3)),
+            Box::new(mc),
+            cam_clay(2.0, 1.0e8).skeleton,
+        ];
+        for skeleton in skeletons {
+            let m = Undrained {
+                skeleton,
+                fluid_bulk_modulus: 5.0e7,
+            };
+            let (sigma, mut h) = start(&m);
+            let n = h.len() - 1;
+            h[n] = 3.0e4;
+            let general = Mat3::identity() + (general_f() - Mat3::identity()) * 0.005;
+            for df in [rotated([0.998, 1.001, 0.997]), general] {
+                let inc = increment(Mat3::identity(), df, sigma - Mat3::identity() * 3.0e4, &h);
+                let err = tangent_error(&m, &inc, 1e-7);
+                assert!(err < 1e-5, "{}: tangent error {err:.2e}", m.model());
+            }
+        }
+    }
+
+    fn build(extra: &str) -> Result<Box<dyn Material>, KeyError> {
+        let text = format!("youngs_modulus = 1e7\npoisson_ratio = 0.3\n{extra}");
+        let values: toml::Table = toml::from_str(&text).unwrap();
+        crate::material::registry::build("material.0", "linear_elastic", 2000.0, &values)
+    }
+
+    #[test]
+    fn drainage_keys_build_the_wrapper_or_are_refused_at_their_keys() {
+        let m = build("drainage = \"undrained\"\nporosity = 0.4").unwrap();
+        assert_eq!(m.n_history(), 1);
+        assert!((m.p_wave_modulus() - (1.0e7 * 0.7 / (1.3 * 0.4) + 2.2e9 / 0.4)).abs() < 1.0);
+        assert_eq!(build("drainage = \"drained\"").unwrap().n_history(), 0);
+        let cases = [
+            (
+                "porosity = 0.4",
+                "material.0.porosity",
+                "only with drainage",
+            ),
+            (
+                "drainage = \"undrained\"",
+                "material.0.porosity",
+                "is required",
+            ),
+            (
+                "drainage = \"undrained\"\nporosity = 1.0",
+                "material.0.porosity",
+                "(0, 1)",
+            ),
+            (
+                "drainage = \"partly\"",
+                "material.0.drainage",
+                "unknown drainage",
+            ),
+            (
+                "drainage = \"undrained\"\nporosity = 0.4\nwater_bulk_modulus = -1.0",
+                "material.0.water_bulk_modulus",
+                "positive",
+            ),
+        ];
+        for (extra, key, message) in cases {
+            let err = build(extra).expect_err(extra);
+            assert_eq!(err.0, key, "{extra}: {err:?}");
+            assert!(err.1.contains(message), "{extra}: {}", err.1);
+        }
+        let values: toml::Table =
+            toml::from_str("drainage = \"undrained\"\nporosity = 0.4").unwrap();
+        let err = crate::material::registry::build("material.0", "rigid", 2000.0, &values)
+            .expect_err("rigid skeleton");
+        assert_eq!(err.0, "material.0.drainage");
+    }
+}
