@@ -197,3 +197,55 @@ fn water_table_lowers_the_factor_of_safety_of_the_slope() {
         "the pore pressure weakens the slope: {f_dry:.4} vs {fos:.4}"
     );
 }
+
+/// Undrained gravity loading of the confined column (problems/column.toml,
+/// Hencky, ν = 0, E = 1 MPa, quasi-static Newton) with K_w/n = 2 MPa: every
+/// particle's excess pore pressure is −K_f ln J and its effective stress the
+/// skeleton's Kirchhoff τ′ = E ln λ over J (1D, λ = J), so the stored stress
+/// σ′ − p_ex I splits the load in the closed-form ratio. Measured first run
+/// (2026-12-02): bottom particle p_ex 25.73 kPa of σ_yy −38.76 kPa.
+#[test]
+fn undrained_column_shares_its_weight_with_the_pore_water() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/problems/column.toml"
+    ))
+    .unwrap()
+    .replace(
+        "poisson_ratio = 0.0",
+        "poisson_ratio = 0.0\ndrainage = \"undrained\"\nporosity = 0.5\nwater_bulk_modulus = 1.0e6",
+    );
+    let (result, out) = crate::common::run_text(&text, &[]);
+    result.unwrap_or_else(|e| panic!("{e}"));
+    let p = crate::common::Table::read(&out.path().join("particles_final.csv")).unwrap();
+    let (syy, pex, v, v0) = (
+        p.col("syy"),
+        p.col("p_excess"),
+        p.col("volume"),
+        p.col("volume0"),
+    );
+    let (e, k_f) = (1.0e6, 2.0e6);
+    let mut worst = 0.0f64;
+    for q in 0..syy.len() {
+        let ln_j = (v[q] / v0[q]).ln();
+        let effective = syy[q] + pex[q];
+        worst = worst
+            .max((pex[q] + k_f * ln_j).abs() / syy[q].abs())
+            .max((effective - e * ln_j / (v[q] / v0[q])).abs() / syy[q].abs());
+    }
+    let bottom = (0..syy.len())
+        .max_by(|&a, &b| pex[a].total_cmp(&pex[b]))
+        .unwrap();
+    eprintln!(
+        "undrained column: bottom p_ex {:.1} Pa of σ_yy {:.1} Pa; worst closed-form error {worst:.1e} of |σ_yy|",
+        pex[bottom], syy[bottom]
+    );
+    assert!(
+        pex[bottom] > 0.6 * syy[bottom].abs(),
+        "the water carries about 2/3"
+    );
+    assert!(
+        worst < 1e-8,
+        "p_ex = −K_f ln J and σ′ = E ln J / J: {worst:.1e}"
+    );
+}
