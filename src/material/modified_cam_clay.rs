@@ -529,7 +529,7 @@ impl Material for ModifiedCamClay {
 mod tests {
     use super::*;
     use crate::material::driver;
-    use crate::material::testing::{increment, rotated};
+    use crate::material::testing::{assert_refused_at_keys, increment, rotated};
 
     const P0: f64 = 2.0e5;
 
@@ -700,11 +700,7 @@ mod tests {
             ("ocr = 1.0\npoisson_ratio = 0.5", "material.0.poisson_ratio", "(-1, 0.5)"),
             ("ocr = 1.0\ninitial_void_ratio = 0.0", "material.0.initial_void_ratio", "positive"),
         ];
-        for (extra, key, message) in cases {
-            let err = build_overriding(extra).expect_err(extra);
-            assert_eq!(err.0, key, "{extra}: {err:?}");
-            assert!(err.1.contains(message), "{extra}: {}", err.1);
-        }
+        assert_refused_at_keys(build_overriding, &cases);
     }
 
     /// The defaults of `build` with the keys of `extra` replaced.

@@ -1,7 +1,8 @@
 //! Fixtures shared by the models' unit tests: increments, a general deformation
 //! gradient, rotations about a skew axis and the relative difference of tensors.
 
-use super::Increment;
+use super::parameters::KeyError;
+use super::{Increment, Material};
 use crate::dim::Mat3;
 use nalgebra::{Rotation3, Unit, Vector3};
 
@@ -39,4 +40,17 @@ pub fn rotated(d: [f64; 3]) -> Mat3 {
 /// |a − b| / |b|.
 pub fn rel(a: &Mat3, b: &Mat3) -> f64 {
     (a - b).norm() / b.norm()
+}
+
+/// Each (extra keys, key path, message part): `build(extra)` fails at that key
+/// with a message containing that part.
+pub fn assert_refused_at_keys(
+    build: impl Fn(&str) -> Result<Box<dyn Material>, KeyError>,
+    cases: &[(&str, &str, &str)],
+) {
+    for &(extra, key, message) in cases {
+        let err = build(extra).expect_err(extra);
+        assert_eq!(err.0, key, "{extra}: {err:?}");
+        assert!(err.1.contains(message), "{extra}: {}", err.1);
+    }
 }

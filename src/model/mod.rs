@@ -188,24 +188,29 @@ impl<const D: usize> Model<D> {
     /// Equivalent plastic strain of every particle (0 where the material has
     /// none), or `None` when no material of the scene has one.
     pub fn plastic_strain(&self) -> Option<Vec<f64>> {
-        let p = &self.particles;
-        let values: Vec<Option<f64>> = (0..p.len())
-            .map(|q| {
-                self.materials[p.material[q] as usize].equivalent_plastic_strain(p.history.get(q))
-            })
-            .collect();
-        values
-            .iter()
-            .any(Option::is_some)
-            .then(|| values.iter().map(|v| v.unwrap_or(0.0)).collect())
+        self.material_field(|m, h| m.equivalent_plastic_strain(h))
     }
 
     /// Each particle's excess pore pressure (`material::undrained`, 0 for a
     /// drained material), `None` when no material is undrained.
     pub fn excess_pore_pressure(&self) -> Option<Vec<f64>> {
+        self.material_field(|m, h| m.excess_pore_pressure(h))
+    }
+
+    /// A value each particle's material reads off its history, 0 where the
+    /// material has none; `None` when no particle's has one.
+    fn material_field(
+        &self,
+        value: impl Fn(&dyn Material, &[f64]) -> Option<f64>,
+    ) -> Option<Vec<f64>> {
         let p = &self.particles;
         let values: Vec<Option<f64>> = (0..p.len())
-            .map(|q| self.materials[p.material[q] as usize].excess_pore_pressure(p.history.get(q)))
+            .map(|q| {
+                value(
+                    self.materials[p.material[q] as usize].as_ref(),
+                    p.history.get(q),
+                )
+            })
             .collect();
         values
             .iter()

@@ -20,6 +20,7 @@ use crate::common::{assert_within, run_text, Table};
 use mpm::dim::Mat3;
 use mpm::material::driver::{run_from, run_mixed, StressControl};
 use mpm::material::modified_cam_clay::{ModifiedCamClay, Preconsolidation};
+use mpm::material::undrained::{Undrained, WATER_BULK_MODULUS};
 use mpm::material::Material;
 use mpm::run::summary::Status;
 
@@ -60,6 +61,16 @@ fn undrained_target(ocr: f64) -> (f64, f64, f64) {
 
 fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / b.abs()
+}
+
+/// The total radial stresses held at −p′0 (ΔF_xx = ΔF_yy solved for).
+fn cell_pressure() -> [StressControl; 1] {
+    [StressControl {
+        stress: (0, 0),
+        target: -P0,
+        free: (0, 0),
+        mirror: Some((1, 1)),
+    }]
 }
 
 /// Axial strain of the undrained tests: ln a = −0.5 (a = 0.61).
@@ -104,18 +115,53 @@ fn cam_clay_undrained_triaxial_reaches_the_critical_state() {
     }
 }
 
+/// The same undrained test by the pore water (`material::undrained`, issue 52
+/// item 2): constant total cell pressure, the volume left free, K_w/n =
+/// 2.2e9/0.4 (about 500 times the skeleton's p/κ̃ = 1e7); the skeleton's
+/// effective path reaches the isochoric closed form, with the excess pore
+/// pressure in the history (measured 114.90/200.03/348.21 kPa, 137.88/240.04/
+/// 417.86, 131.06/79.98/−8.93; |J − 1| ≤ 2.4e-5).
+#[test]
+fn cam_clay_with_stiff_pore_water_reaches_the_undrained_critical_state() {
+    let steps = 500;
+    let ratio = (-UNDRAINED_LOG_STRAIN / steps as f64).exp();
+    let increments = vec![Mat3::from_diagonal(&[1.0, 1.0, ratio].into()); steps];
+    for ocr in [1.0, 2.0, 4.0] {
+        let m = Undrained {
+            skeleton: Box::new(model(ocr)),
+            fluid_bulk_modulus: WATER_BULK_MODULUS / 0.4,
+        };
+        let (sigma, mut h) = start(&model(ocr));
+        h.push(0.0); // p_ex
+                     // Newton stops at round-off amplified by K_f (4e-12), above 1e-12.
+        let r = run_mixed(&m, &increments, &cell_pressure(), 0.0, sigma, h, 1e-10)
+            .expect("the undrained path converges");
+        let u = m.excess(r.response.history.last().unwrap());
+        let effective = r.response.stress.last().unwrap() + Mat3::identity() * u;
+        let (p, q) = p_q(&effective);
+        let (pt, qt, ut) = undrained_target(ocr);
+        let j = r.response.f.last().unwrap().determinant();
+        eprintln!(
+            "pore water, OCR {ocr}: p′_f = {:.2} kPa (target {:.2}), q_f = {:.2} (target {:.2}), u_f = {:.2} (target {:.2}); J − 1 = {:.1e}",
+            p / 1e3, pt / 1e3, q / 1e3, qt / 1e3, u / 1e3, ut / 1e3, j - 1.0
+        );
+        assert_within(&format!("pore water OCR {ocr}: p′_f"), rel(p, pt), 5e-3);
+        assert_within(&format!("pore water OCR {ocr}: q_f"), rel(q, qt), 5e-3);
+        assert_within(
+            &format!("pore water OCR {ocr}: u_f (of p′0)"),
+            (u - ut).abs() / P0,
+            5e-3,
+        );
+    }
+}
+
 #[test]
 fn cam_clay_drained_triaxial_reaches_the_critical_state() {
     let steps = 1000;
     let axial = 1.2_f64; // ln of the axial stretch reached: −1.2
     let ratio = (-axial / steps as f64).exp();
     let increments = vec![Mat3::from_diagonal(&[1.0, 1.0, ratio].into()); steps];
-    let controls = [StressControl {
-        stress: (0, 0),
-        target: -P0,
-        free: (0, 0),
-        mirror: Some((1, 1)),
-    }];
+    let controls = cell_pressure();
     let (pt, qt) = (P0 / (1.0 - M / 3.0), M * P0 / (1.0 - M / 3.0));
     for ocr in [1.0, 2.0, 4.0] {
         let m = model(ocr);
