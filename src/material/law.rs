@@ -62,6 +62,19 @@ pub struct Strength {
     pub dilation_angle: f64,
 }
 
+/// What the flow between points needs of a point's pore water
+/// (`Material::pore_fluid`; built by `material::undrained`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PoreFluid {
+    /// K_f = K_w/n.
+    pub bulk_modulus: f64,
+    /// k/γ_w (0: undrained).
+    pub mobility: f64,
+    /// The index of p_ex in the point's history; with mobility > 0 the next
+    /// slot holds ln J at the last flow update (`physics::pore_flow`).
+    pub slot: usize,
+}
+
 pub trait Material: CloneMaterial + Send + Sync + std::fmt::Debug {
     /// Model name as written in scene files.
     fn model(&self) -> &'static str;
@@ -132,6 +145,12 @@ pub trait Material: CloneMaterial + Send + Sync + std::fmt::Debug {
     /// The excess pore pressure held in `history` (compression positive) of an
     /// undrained material (`material::undrained`), `None` for the others.
     fn excess_pore_pressure(&self, _history: &[f64]) -> Option<f64> {
+        None
+    }
+
+    /// The pore water of a saturated point (`material::undrained`: undrained
+    /// or coupled), `None` for the others.
+    fn pore_fluid(&self) -> Option<PoreFluid> {
         None
     }
 

@@ -31,7 +31,7 @@ mod law;
 pub(crate) use law::debug_check_elastic;
 pub use law::{
     lame, reduced_angle, set_derivative_column, shear_modulus, CloneMaterial, Increment, Material,
-    Strength, StressDerivative,
+    PoreFluid, Strength, StressDerivative,
 };
 
 /// Declares each model's module and lists it in `MODELS` (its file, then its type).

@@ -24,13 +24,30 @@
 //! Scene keys (on the skeleton's `[[material]]` table): `drainage =
 //! "undrained"` (or "drained", the default), `porosity` n in (0, 1) and
 //! `water_bulk_modulus` K_w (Pa, default 2.2e9).
+//!
+//! `drainage = "coupled"` is the same skeleton with Darcy flow between points
+//! (issue 52, item 3, explicit): `hydraulic_conductivity` k and
+//! `water_unit_weight` γ_w give the mobility k/γ_w. Its whole storage
+//! equation, the volumetric part −K_f Δ ln J included, is then solved on the
+//! grid by `physics::pore_flow`, so this update leaves p_ex as it was (the
+//! stored stress σ′ − p_ex,old I) and keeps the point's ln J of the last flow
+//! update in the history slot after p_ex.
 
 use super::parameters::{KeyError, Parameters};
-use super::{Increment, Material, Strength, StressDerivative};
+use super::{Increment, Material, PoreFluid, Strength, StressDerivative};
 use crate::dim::Mat3;
 
 /// The keys this module adds to a material table.
-pub const KEYS: &[&str] = &["drainage", "porosity", "water_bulk_modulus"];
+pub const KEYS: &[&str] = &[
+    "drainage",
+    "porosity",
+    "water_bulk_modulus",
+    "hydraulic_conductivity",
+    "water_unit_weight",
+];
+
+/// The keys of Darcy flow (`drainage = "coupled"` only).
+const FLOW_KEYS: &[&str] = &["hydraulic_conductivity", "water_unit_weight"];
 
 /// The models that may be undrained: the soil skeletons and the elastic laws
 /// (an equation of state, a rigid body or a bond law has no drained skeleton).
@@ -53,6 +70,9 @@ pub struct Undrained {
     pub skeleton: Box<dyn Material>,
     /// K_f = K_w/n, the pore fluid's bulk stiffness per unit volume of soil.
     pub fluid_bulk_modulus: f64,
+    /// k/γ_w, Darcy's mobility of the excess pore pressure (m²/(Pa s)); 0 when
+    /// undrained (no flow between points).
+    pub mobility: f64,
 }
 
 impl Undrained {
@@ -64,6 +84,12 @@ impl Undrained {
     /// The excess pore pressure held in `history` (compression positive).
     pub fn excess(&self, history: &[f64]) -> f64 {
         history[self.slot()]
+    }
+
+    /// Does the water flow between points (`drainage = "coupled"`)? Then the
+    /// grid updates p_ex (`physics::pore_flow`), not `update`.
+    fn coupled(&self) -> bool {
+        self.mobility > 0.0
     }
 
     /// The increment the skeleton sees: its effective start stress and its
@@ -79,47 +105,71 @@ impl Undrained {
 /// drained, else the skeleton wrapped. `p` holds the table's drainage keys.
 pub fn wrap(skeleton: Box<dyn Material>, p: &Parameters) -> Result<Box<dyn Material>, KeyError> {
     let drainage: String = p.get("drainage")?.unwrap_or_else(|| "drained".into());
+    let refuse = |keys: &[&str], what: &str| match keys.iter().find(|k| p.given(k)) {
+        Some(k) => Err((p.key(k), format!("applies only with {what}"))),
+        None => Ok(()),
+    };
     match drainage.as_str() {
         "drained" => {
-            if let Some(k) = ["porosity", "water_bulk_modulus"]
-                .into_iter()
-                .find(|k| p.given(k))
-            {
-                return Err((
-                    p.key(k),
-                    "applies only with drainage = \"undrained\"".into(),
-                ));
-            }
+            refuse(&KEYS[1..], "drainage = \"undrained\" or \"coupled\"")?;
             Ok(skeleton)
         }
         "undrained" => {
+            refuse(FLOW_KEYS, "drainage = \"coupled\"")?;
+            Ok(Box::new(saturated(skeleton, p, "undrained", 0.0)?))
+        }
+        "coupled" => {
+            let when = "drainage = \"coupled\"";
+            let k: f64 = p.required_for("hydraulic_conductivity", when)?;
             p.ensure(
-                SKELETONS.contains(&skeleton.model()),
-                "drainage",
-                format!(
-                    "an undrained material needs a soil skeleton: model `{}` is not one of {}",
-                    skeleton.model(),
-                    SKELETONS.join(", ")
-                ),
+                k > 0.0 && k.is_finite(),
+                "hydraulic_conductivity",
+                "must be positive (m/s)",
             )?;
-            let n: f64 = p.required_for("porosity", "drainage = \"undrained\"")?;
-            p.ensure(n > 0.0 && n < 1.0, "porosity", "must lie in (0, 1)")?;
-            let kw: f64 = p.get("water_bulk_modulus")?.unwrap_or(WATER_BULK_MODULUS);
+            let gamma_w: f64 = p.required_for("water_unit_weight", when)?;
             p.ensure(
-                kw > 0.0 && kw.is_finite(),
-                "water_bulk_modulus",
+                gamma_w > 0.0 && gamma_w.is_finite(),
+                "water_unit_weight",
                 "must be positive",
             )?;
-            Ok(Box::new(Undrained {
-                skeleton,
-                fluid_bulk_modulus: kw / n,
-            }))
+            Ok(Box::new(saturated(skeleton, p, "coupled", k / gamma_w)?))
         }
         other => Err((
             p.key("drainage"),
-            format!("unknown drainage `{other}`; use \"drained\" or \"undrained\""),
+            format!("unknown drainage `{other}`; use \"drained\", \"undrained\" or \"coupled\""),
         )),
     }
+}
+
+/// The skeleton with its pore water (`drainage` = `mode`), of mobility k/γ_w.
+fn saturated(
+    skeleton: Box<dyn Material>,
+    p: &Parameters,
+    mode: &str,
+    mobility: f64,
+) -> Result<Undrained, KeyError> {
+    p.ensure(
+        SKELETONS.contains(&skeleton.model()),
+        "drainage",
+        format!(
+            "a {mode} material needs a soil skeleton: model `{}` is not one of {}",
+            skeleton.model(),
+            SKELETONS.join(", ")
+        ),
+    )?;
+    let n: f64 = p.required_for("porosity", &format!("drainage = \"{mode}\""))?;
+    p.ensure(n > 0.0 && n < 1.0, "porosity", "must lie in (0, 1)")?;
+    let kw: f64 = p.get("water_bulk_modulus")?.unwrap_or(WATER_BULK_MODULUS);
+    p.ensure(
+        kw > 0.0 && kw.is_finite(),
+        "water_bulk_modulus",
+        "must be positive",
+    )?;
+    Ok(Undrained {
+        skeleton,
+        fluid_bulk_modulus: kw / n,
+        mobility,
+    })
 }
 
 impl Material for Undrained {
@@ -132,7 +182,7 @@ impl Material for Undrained {
     }
 
     fn n_history(&self) -> usize {
-        self.skeleton.n_history() + 1
+        self.skeleton.n_history() + 1 + usize::from(self.coupled())
     }
 
     fn update(&self, inc: &Increment, history_new: &mut [f64]) -> Mat3 {
@@ -140,7 +190,11 @@ impl Material for Undrained {
         let effective = self
             .skeleton
             .update(&self.skeleton_increment(inc), &mut history_new[..n]);
-        let p = inc.history_old[n] - self.fluid_bulk_modulus * inc.df.determinant().ln();
+        history_new[n..].copy_from_slice(&inc.history_old[n..]);
+        let p = match self.coupled() {
+            true => inc.history_old[n],
+            false => inc.history_old[n] - self.fluid_bulk_modulus * inc.df.determinant().ln(),
+        };
         history_new[n] = p;
         effective - Mat3::identity() * p
     }
@@ -155,20 +209,24 @@ impl Material for Undrained {
         (c * c + self.fluid_bulk_modulus * j / self.density()).sqrt()
     }
 
-    /// The skeleton's energy at its effective stress plus the water's, K_f (ln J)²/2.
+    /// The skeleton's energy at its effective stress plus the water's,
+    /// p_ex²/(2 K_f) (= K_f (ln J)²/2 undrained), per current volume.
     fn strain_energy_density(&self, f: &Mat3, stress: &Mat3, history: &[f64]) -> f64 {
         let n = self.slot();
-        let effective = stress + Mat3::identity() * history[n];
-        let ln_j = f.determinant().ln();
+        let p = history[n];
+        let effective = stress + Mat3::identity() * p;
         self.skeleton
             .strain_energy_density(f, &effective, &history[..n])
-            + 0.5 * self.fluid_bulk_modulus * ln_j * ln_j / f.determinant()
+            + 0.5 * p * p / self.fluid_bulk_modulus / f.determinant()
     }
 
     fn stress_derivative(&self, inc: &Increment) -> Option<StressDerivative> {
         let mut d = self
             .skeleton
             .stress_derivative(&self.skeleton_increment(inc))?;
+        if self.coupled() {
+            return Some(d); // p_ex does not follow ΔF within the point
+        }
         let df_inv_t = inc.df.try_inverse()?.transpose();
         for (k, l) in (0..3).flat_map(|k| (0..3).map(move |l| (k, l))) {
             for i in 0..3 {
@@ -201,6 +259,7 @@ impl Material for Undrained {
         Some(Box::new(Undrained {
             skeleton: self.skeleton.with_reduced_strength(factor)?,
             fluid_bulk_modulus: self.fluid_bulk_modulus,
+            mobility: self.mobility,
         }))
     }
 
@@ -211,6 +270,14 @@ impl Material for Undrained {
 
     fn excess_pore_pressure(&self, history: &[f64]) -> Option<f64> {
         Some(self.excess(history))
+    }
+
+    fn pore_fluid(&self) -> Option<PoreFluid> {
+        Some(PoreFluid {
+            bulk_modulus: self.fluid_bulk_modulus,
+            mobility: self.mobility,
+            slot: self.slot(),
+        })
     }
 }
 
@@ -253,6 +320,7 @@ mod tests {
         let m = Undrained {
             skeleton: Box::new(e),
             fluid_bulk_modulus: 1.0e8,
+            mobility: 0.0,
         };
         let stretch = 0.999_f64;
         let df = Mat3::identity() * stretch;
@@ -292,6 +360,7 @@ mod tests {
             let m = Undrained {
                 skeleton,
                 fluid_bulk_modulus: 5.0e7,
+                mobility: 0.0,
             };
             let (sigma, mut h) = start(&m);
             let n = h.len() - 1;
@@ -317,6 +386,19 @@ mod tests {
         assert_eq!(m.n_history(), 1);
         assert!((m.p_wave_modulus() - (1.0e7 * 0.7 / (1.3 * 0.4) + 2.2e9 / 0.4)).abs() < 1.0);
         assert_eq!(build("drainage = \"drained\"").unwrap().n_history(), 0);
+        let coupled = build(
+            "drainage = \"coupled\"\nporosity = 0.4\nhydraulic_conductivity = 1e-4\n\
+             water_unit_weight = 9810.0",
+        )
+        .unwrap();
+        assert_eq!(
+            coupled.n_history(),
+            2,
+            "p_ex and ln J of the last flow update"
+        );
+        let fluid = coupled.pore_fluid().unwrap();
+        assert_eq!((fluid.slot, fluid.bulk_modulus), (0, 2.2e9 / 0.4));
+        assert!((fluid.mobility - 1e-4 / 9810.0).abs() < 1e-24);
         let cases = [
             (
                 "porosity = 0.4",
@@ -332,6 +414,22 @@ mod tests {
                 "drainage = \"undrained\"\nporosity = 1.0",
                 "material.0.porosity",
                 "(0, 1)",
+            ),
+            (
+                "drainage = \"coupled\"\nporosity = 0.4\nwater_unit_weight = 9810.0",
+                "material.0.hydraulic_conductivity",
+                "is required",
+            ),
+            (
+                "drainage = \"coupled\"\nporosity = 0.4\nhydraulic_conductivity = 0.0\n\
+                 water_unit_weight = 9810.0",
+                "material.0.hydraulic_conductivity",
+                "positive",
+            ),
+            (
+                "drainage = \"undrained\"\nporosity = 0.4\nwater_unit_weight = 9810.0",
+                "material.0.water_unit_weight",
+                "only with drainage = \"coupled\"",
             ),
             (
                 "drainage = \"partly\"",

@@ -12,6 +12,7 @@ use crate::model::conditions::{
     Absorbing, Constraint, FaceCondition, FaceMotion, Footing, FrictionFace, MotionKind,
 };
 use crate::model::curve::TimeCurve;
+use crate::model::drainage::Drainage;
 use crate::model::geometry::Geometry;
 use crate::model::grid::Grid;
 use crate::model::loads::{LoadTime, Loads};
@@ -117,6 +118,11 @@ impl<const D: usize> Model<D> {
         absorbing
             .check_adjacent(&grid, &particles)
             .map_err(|(i, msg)| err((format!("boundary.{i}.face"), msg)))?;
+        let drained: Vec<FaceCondition<D>> = (c.boundaries.iter())
+            .filter(|b| b.condition == Condition::Drained)
+            .map(|b| face_condition(b, &vec))
+            .collect();
+        let drainage = Drainage::new(&base_materials, drained);
         let gravity = c.gravity.as_deref().map_or(Vector::<D>::zeros(), vec);
         let loads = Loads::apply(c, &mut particles).map_err(err)?;
         let erosion = base_materials.iter().any(|m| m.erodes());
@@ -145,6 +151,7 @@ impl<const D: usize> Model<D> {
             staging: None,
             water: (c.water.as_ref())
                 .map(|w| Water::new(w, c.gravity.as_deref().expect("validated"))),
+            drainage,
         };
         if c.stages_construction() {
             model.start_staging(&c.inactive_bodies());
@@ -182,6 +189,8 @@ fn face_condition<const D: usize>(
     match b.condition {
         Condition::Fixed => (0..D).for_each(|d| constraint.set(d, 0.0)),
         Condition::Roller => constraint.set(face.axis, 0.0),
+        // A drained face holds the pore pressure, not the velocity.
+        Condition::Drained => {}
         Condition::Absorbing | Condition::Friction => {
             unreachable!("absorbing and friction faces are not velocity conditions")
         }

@@ -7,6 +7,7 @@ pub(crate) mod body;
 mod build;
 pub(crate) mod conditions;
 pub mod curve;
+pub mod drainage;
 pub mod geometry;
 pub mod grid;
 pub(crate) mod import;
@@ -99,6 +100,9 @@ pub struct Model<const D: usize> {
     /// The prescribed pore-water field (`[water]`, `model::water`); None
     /// without one, and then no particle carries a pore pressure.
     pub water: Option<Water>,
+    /// The drained faces of coupled pore flow (`model::drainage`); None
+    /// without a coupled material, and then no pore water flows.
+    pub drainage: Option<drainage::Drainage<D>>,
 }
 
 impl<const D: usize> Model<D> {

@@ -4,8 +4,9 @@
 //! ΔF, F-bar), the laws of the grid-face conditions (`boundary`: velocity
 //! conditions, rough walls, absorbing faces), rigid bodies (`rigid`: their
 //! surfaces and Newton–Euler motion), what contact between bodies shares
-//! (`contact`: the split grid of velocity fields, the per-pair totals) and the
-//! geostatic initial stress. Nothing here knows which solver calls it: what
+//! (`contact`: the split grid of velocity fields, the per-pair totals) the
+//! geostatic initial stress, and the Darcy flow of coupled pore water
+//! (`pore_flow`). Nothing here knows which solver calls it: what
 //! only one solver uses lives under that solver (`solver::explicit`,
 //! `solver::implicit`).
 
@@ -14,6 +15,7 @@ pub(crate) mod contact;
 pub mod geostatic;
 pub(crate) mod kinematics;
 pub mod peridynamics;
+pub mod pore_flow;
 pub(crate) mod rigid;
 pub mod shape;
 pub mod transfer;

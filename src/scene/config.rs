@@ -471,6 +471,9 @@ pub enum Condition {
     /// Rigid rough wall: no penetration, Coulomb friction with
     /// `friction_coefficient` (explicit solver; fixed in implicit steps).
     Friction,
+    /// The excess pore pressure of coupled materials is zero on the face's
+    /// nodes (`model::drainage`); no velocity condition.
+    Drained,
 }
 
 impl Condition {
@@ -481,7 +484,10 @@ impl Condition {
     /// Fixed, roller and velocity conditions prescribe nodal velocity components;
     /// absorbing and friction faces act through forces and contact.
     pub fn prescribes_velocity(&self) -> bool {
-        !matches!(self, Condition::Absorbing | Condition::Friction)
+        !matches!(
+            self,
+            Condition::Absorbing | Condition::Friction | Condition::Drained
+        )
     }
 }
 

@@ -150,3 +150,63 @@ fn refusals_name_their_keys() {
         &["radial"],
     );
 }
+
+/// Coupled pore flow (`drainage = "coupled"`, `condition = "drained"`): its
+/// keys are refused at their paths, it runs in explicit stages only, and a
+/// drained face needs a coupled material.
+#[test]
+fn coupled_flow_is_refused_where_it_cannot_apply() {
+    let coupled = "drainage = \"coupled\"\nporosity = 0.4\nhydraulic_conductivity = 1e-4\n\
+                   water_unit_weight = 10.0\n";
+    let with = |material: &str, boundary: &str, solver: &str| {
+        crate::common::GOOD
+            .replace(
+                "poisson_ratio = 0.3\n",
+                &format!("poisson_ratio = 0.3\n{material}"),
+            )
+            .replace("[solver]\n", &format!("{boundary}[solver]\n"))
+            .replace("kind = \"explicit\"\nend_time = 1.0\ncfl = 0.5\n", solver)
+    };
+    let explicit = "kind = \"explicit\"\nend_time = 1.0\ncfl = 0.5\n";
+    let implicit =
+        "kind = \"implicit\"\nintegrator = \"quasi_static\"\nend_time = 1.0\nload_steps = 1\n";
+    let drained = "[[boundary]]\nface = \"ymax\"\ncondition = \"drained\"\n";
+    accepted(&with(coupled, drained, explicit));
+    rejected_at(
+        &with(coupled, drained, implicit),
+        "solver.kind",
+        &["explicit stages only", "issue 52"],
+    );
+    rejected_at(
+        &with("", drained, explicit),
+        "boundary.0.condition",
+        &["drainage = \"coupled\""],
+    );
+    rejected_at(
+        &with(
+            "drainage = \"coupled\"\nporosity = 0.4\nwater_unit_weight = 10.0\n",
+            "",
+            explicit,
+        ),
+        "material.0.hydraulic_conductivity",
+        &["required"],
+    );
+    rejected_at(
+        &with(
+            "drainage = \"undrained\"\nporosity = 0.4\nhydraulic_conductivity = 1e-4\n",
+            "",
+            explicit,
+        ),
+        "material.0.hydraulic_conductivity",
+        &["drainage = \"coupled\""],
+    );
+    rejected_at(
+        &with(
+            coupled,
+            "[[boundary]]\nface = \"ymax\"\ncondition = \"drained\"\nvelocity = [0.0, 0.0]\n",
+            explicit,
+        ),
+        "boundary.0.velocity",
+        &["drained"],
+    );
+}

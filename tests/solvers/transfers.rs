@@ -240,6 +240,10 @@ fn scene_with(feature: Feature) -> (String, Vec<&'static str>) {
             "peridynamic_plate.toml",
             &["solver.end_time=2e-6", "output.frames=0"],
         ),
+        Feature::PoreFlow => problem(
+            "terzaghi.toml",
+            &["solver.end_time=0.01", "output.particle_times=[]"],
+        ),
     }
 }
 

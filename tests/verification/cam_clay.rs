@@ -130,6 +130,7 @@ fn cam_clay_with_stiff_pore_water_reaches_the_undrained_critical_state() {
         let m = Undrained {
             skeleton: Box::new(model(ocr)),
             fluid_bulk_modulus: WATER_BULK_MODULUS / 0.4,
+            mobility: 0.0,
         };
         let (sigma, mut h) = start(&model(ocr));
         h.push(0.0); // p_ex

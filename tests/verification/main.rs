@@ -12,6 +12,7 @@ mod cam_clay;
 mod cantilever;
 mod collapse;
 mod column_explicit;
+mod consolidation;
 mod contact;
 mod disks;
 mod footing;

@@ -52,6 +52,11 @@ pub fn boundary(b: &BoundaryConfig, i: usize, dim: usize) -> Check {
             )
         }
         Condition::Absorbing => absorbing(b, i),
+        Condition::Drained => {
+            let what = "a drained condition (it holds the pore pressure, not the velocity)";
+            forbidden(&b.velocity, key("velocity"), what)?;
+            forbidden(&b.components, key("components"), what)
+        }
         Condition::Velocity => {
             for (k, c) in b.components.iter().flatten().enumerate() {
                 let ok = axis(c).is_some_and(|a| a < dim);
@@ -157,8 +162,8 @@ fn friction(b: &BoundaryConfig, i: usize) -> Check {
 /// not on absorbing faces.
 fn region(b: &BoundaryConfig, i: usize, dim: usize) -> Check {
     let key = |k: &str| format!("boundary.{i}.{k}");
-    if !b.condition.prescribes_velocity() {
-        let what = "a fixed, roller or velocity condition (not to absorbing or friction)";
+    if !b.condition.prescribes_velocity() && b.condition != Condition::Drained {
+        let what = "a fixed, roller, velocity or drained condition (not to absorbing or friction)";
         forbidden(&b.region_min, key("region_min"), what)?;
         return forbidden(&b.region_max, key("region_max"), what);
     }

@@ -9,6 +9,7 @@ mod analyses;
 mod axisymmetry;
 mod check;
 mod conditions;
+mod drainage;
 mod grid_bodies;
 mod histories;
 mod materials;
@@ -139,6 +140,7 @@ pub fn validate(s: &SceneConfig) -> Check {
     if let Some(w) = &s.water {
         water(w, s)?;
     }
+    drainage::drainage(s)?;
     if let Some(r) = &s.strength_reduction {
         strength_reduction(r, s, &materials)?;
     }

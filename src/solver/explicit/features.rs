@@ -50,6 +50,8 @@ pub enum Feature {
     FrictionFaces,
     /// Peridynamic bodies, advanced by their bonds (`physics::peridynamics`).
     PeridynamicBodies,
+    /// Darcy flow of coupled pore water between particles (`physics::pore_flow`).
+    PoreFlow,
 }
 
 /// The transfer back-ends that serve a feature.
@@ -78,6 +80,9 @@ impl Feature {
             // Advanced at the one site that hands each body kind its work,
             // `NodeMapStep::advance_bodies`.
             Feature::PeridynamicBodies => Serves::NodeMap,
+            // Its nodal sums gather through the node map's stored stencils
+            // after the stress update; the box keeps no stencils.
+            Feature::PoreFlow => Serves::NodeMap,
             Feature::Fbar
             | Feature::BulkViscosity
             | Feature::AbsorbingFaces
@@ -107,6 +112,7 @@ impl Feature {
             Feature::Apic => s.apic,
             Feature::FrictionFaces => !m.friction.is_empty(),
             Feature::PeridynamicBodies => m.peridynamics.is_some(),
+            Feature::PoreFlow => m.drainage.is_some(),
         }
     }
 }

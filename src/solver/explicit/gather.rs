@@ -215,7 +215,8 @@ impl<const D: usize> NodeMapStep<D> {
     }
 
     /// The stress update from nodal velocities `velocity` (2-31, 2-32): the
-    /// shared deformation update with the nodal displacement u_I = Δt v_I.
+    /// shared deformation update with the nodal displacement u_I = Δt v_I,
+    /// then the Darcy flow of coupled pore water.
     fn update_stress_from(
         &mut self,
         m: &mut Model<D>,
@@ -226,7 +227,11 @@ impl<const D: usize> NodeMapStep<D> {
         let (st, map) = (&self.stencils, &self.map);
         (self.trial)
             .advance(&mut m.particles, &m.materials, st, map, &u, s.dt)
-            .map_err(|(q, det)| inverted(q, det, s.step + 1, s.t + s.dt))
+            .map_err(|(q, det)| inverted(q, det, s.step + 1, s.t + s.dt))?;
+        // Coupled pore water: the flow part of its storage equation, after
+        // each point's undrained part (`physics::pore_flow`).
+        crate::physics::pore_flow::darcy_step(m, st, map, s.dt);
+        Ok(())
     }
 
     /// Nodal velocities of `momentum` over the nodal masses, with the mirror

@@ -129,6 +129,12 @@ impl<const D: usize> Explicit<D> {
             .map_or(f64::INFINITY, |pd| pd.stable_dt)
     }
 
+    /// The stable step of coupled pore flow (`Drainage::stable_dt`); infinite
+    /// without it.
+    fn pore_flow_dt(m: &Model<D>) -> f64 {
+        (m.drainage.as_ref()).map_or(f64::INFINITY, |d| d.stable_dt(&m.grid))
+    }
+
     fn critical_dt_over(
         m: &Model<D>,
         viscosity: Option<&BulkViscosity>,
@@ -155,11 +161,13 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
     /// viscosity, also within its stable step at every particle, its rate from
     /// the particle's F rate being unknown here: ε̇_v = 0, the linear term only).
     /// With peridynamic bodies, also within their stable step (Silling–Askari
-    /// with its safety factor, `material::bond::SAFETY`).
+    /// with its safety factor, `material::bond::SAFETY`). With coupled pore
+    /// water, also within the flow's stable step h²/(2 D c_f), a bound with a
+    /// margin of its own (`Drainage::stable_dt`), so cfl does not scale it.
     fn dt(&self, m: &Model<D>) -> f64 {
         self.fixed_dt.unwrap_or_else(|| {
             let grid = self.cfl * Self::critical_dt_with(m, self.viscosity.as_ref());
-            grid.min(Self::peridynamic_dt(m))
+            grid.min(Self::pore_flow_dt(m)).min(Self::peridynamic_dt(m))
         })
     }
 
@@ -193,6 +201,15 @@ impl<const D: usize> Stepper<D> for Explicit<D> {
                  integration of their bonds is unstable above it",
                 dt / bonds,
                 crate::material::bond::SAFETY
+            ));
+        }
+        let flow = Self::pore_flow_dt(m);
+        if dt > flow {
+            return Some(format!(
+                "the fixed time step dt = {dt:e} is {:.3} × the stable step {flow:.6e} of the \
+                 coupled pore flow (h²/(2 D c_f), c_f = K_f k/γ_w): its explicit update is \
+                 unstable above it",
+                dt / flow
             ));
         }
         let critical = Self::critical_dt_with(m, self.viscosity.as_ref());
