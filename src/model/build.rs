@@ -100,14 +100,8 @@ impl<const D: usize> Model<D> {
                 coefficient: b.friction_coefficient.unwrap(),
             })
             .collect();
-        // A region must hold at least one node of its face.
         for ((i, _), fc) in velocity.iter().zip(&faces) {
-            if !(0..grid.node_count()).any(|g| fc.acts_on(&grid, grid.node_ijk(g))) {
-                return Err(err((
-                    format!("boundary.{i}.region_min"),
-                    "the region holds no grid node of the face".into(),
-                )));
-            }
+            holds_a_node(*i, fc, &grid).map_err(err)?;
         }
         let footing = footing(&velocity, &faces, &grid, &particles, &base_materials);
         let axisymmetric = c.dimension.is_axisymmetric();
@@ -118,10 +112,14 @@ impl<const D: usize> Model<D> {
         absorbing
             .check_adjacent(&grid, &particles)
             .map_err(|(i, msg)| err((format!("boundary.{i}.face"), msg)))?;
-        let drained: Vec<FaceCondition<D>> = (c.boundaries.iter())
-            .filter(|b| b.condition == Condition::Drained)
-            .map(|b| face_condition(b, &vec))
+        let drained: Vec<(usize, FaceCondition<D>)> = (c.boundaries.iter().enumerate())
+            .filter(|(_, b)| b.condition == Condition::Drained)
+            .map(|(i, b)| (i, face_condition(b, &vec)))
             .collect();
+        for (i, fc) in &drained {
+            holds_a_node(*i, fc, &grid).map_err(err)?;
+        }
+        let drained = drained.into_iter().map(|(_, fc)| fc).collect();
         let drainage = Drainage::new(&base_materials, drained);
         let gravity = c.gravity.as_deref().map_or(Vector::<D>::zeros(), vec);
         let loads = Loads::apply(c, &mut particles).map_err(err)?;
@@ -178,6 +176,22 @@ fn peridynamic_bodies<const D: usize>(
         })
         .collect();
     (!pd.is_empty()).then(|| Peridynamics::new(pd, &p.mass))
+}
+
+/// A condition's region must hold at least one node of its face (boundary i).
+fn holds_a_node<const D: usize>(
+    i: usize,
+    fc: &FaceCondition<D>,
+    grid: &Grid<D>,
+) -> Result<(), (String, String)> {
+    if (0..grid.node_count()).any(|g| fc.acts_on(grid, grid.node_ijk(g))) {
+        Ok(())
+    } else {
+        Err((
+            format!("boundary.{i}.region_min"),
+            "the region holds no grid node of the face".into(),
+        ))
+    }
 }
 
 fn face_condition<const D: usize>(

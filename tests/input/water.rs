@@ -209,4 +209,17 @@ fn coupled_flow_is_refused_where_it_cannot_apply() {
         "boundary.0.velocity",
         &["drained"],
     );
+    // A drained region must hold a node of its face (checked as the model is built).
+    let off = with(
+        coupled,
+        "[[boundary]]\nface = \"ymax\"\ncondition = \"drained\"\n\
+         region_min = [0.2, 0.0]\nregion_max = [0.4, 0.5]\n",
+        explicit,
+    );
+    let scene = Scene::parse("scene.toml", &off, &[]).expect("valid scene");
+    let e = mpm::model::Model::<2>::build(&scene).unwrap_err().to_string();
+    assert!(
+        e.contains("boundary.0.region_min") && e.contains("no grid node"),
+        "{e}"
+    );
 }

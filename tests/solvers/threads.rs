@@ -218,3 +218,16 @@ fn staged_construction_gives_identical_results_on_one_and_two_threads() {
     let name = file.to_str().unwrap();
     same_on_one_and_two_threads(name, &[], "layered fill, explicit last layer");
 }
+
+/// Coupled pore flow (`physics::pore_flow`): every nodal sum gathers in
+/// particle order, so the Terzaghi column, widened to 8000 particles that the
+/// parallel loops split, is the same on 1 and 2 threads.
+#[test]
+fn coupled_pore_flow_is_the_same_on_one_and_two_threads() {
+    let overrides = [
+        "grid.cells=[20, 100]".to_string(),
+        "solver.end_time=0.01".to_string(),
+        "output.particle_times=[]".to_string(),
+    ];
+    same_on_one_and_two_threads("terzaghi.toml", &overrides, "coupled pore flow");
+}
