@@ -217,7 +217,9 @@ fn coupled_flow_is_refused_where_it_cannot_apply() {
         explicit,
     );
     let scene = Scene::parse("scene.toml", &off, &[]).expect("valid scene");
-    let e = mpm::model::Model::<2>::build(&scene).unwrap_err().to_string();
+    let e = mpm::model::Model::<2>::build(&scene)
+        .unwrap_err()
+        .to_string();
     assert!(
         e.contains("boundary.0.region_min") && e.contains("no grid node"),
         "{e}"

@@ -172,3 +172,42 @@ fn pore_flow_runs_within_its_stable_step_and_stops_cleanly_beyond_it() {
         beyond.warnings
     );
 }
+
+/// The same column undrained in an explicit run (`drainage = "undrained"`: no
+/// flow, no drained face): once the load's wave has died out under the
+/// damping, every particle carries p_ex = B q and σ′_yy = −(1 − B) q
+/// (B = K_f/(K_f + M) = 0.9524; the closed form of undrained 1D loading).
+/// Checked below the top cell: the traction acts at the top row of particles
+/// (Y0 = 0.9875), which hands a quarter of it to the nodes at y = 0.95, so the
+/// top cell carries 3/4 of q (measured there: p_ex 0.239 q below B q).
+#[test]
+fn undrained_column_takes_the_load_in_its_pore_water_in_an_explicit_run() {
+    let text = std::fs::read_to_string(crate::common::problem("terzaghi.toml")).unwrap();
+    let text = text
+        .replace("drainage = \"coupled\"", "drainage = \"undrained\"")
+        .replace("hydraulic_conductivity = 1.0e-4\n", "")
+        .replace("water_unit_weight = 1.0e4\n", "")
+        .replace(
+            "face = \"ymax\"\ncondition = \"drained\"",
+            "face = \"xmin\"\ncondition = \"roller\"",
+        );
+    let (summary, dir) = crate::common::run_text(
+        &text,
+        &["solver.end_time=0.5", "output.particle_times=[0.5]"],
+    );
+    assert_eq!(summary.unwrap().status, Status::Completed);
+    let p = Table::read(&dir.path().join("particles_final.csv")).unwrap();
+    let b = K_F / (K_F + M);
+    let below: Vec<usize> = (0..p.len()).filter(|&i| p.col("Y0")[i] < 0.95).collect();
+    assert_eq!(below.len(), 4 * 19);
+    let (pex, syy) = (p.col("p_excess"), p.col("syy"));
+    let worst_p = (below.iter())
+        .map(|&i| (pex[i] - b * Q).abs() / Q)
+        .fold(0.0, f64::max);
+    let worst_s = (below.iter())
+        .map(|&i| (syy[i] + pex[i] + (1.0 - b) * Q).abs() / Q)
+        .fold(0.0, f64::max);
+    println!("max |p_ex − B q|/q {worst_p:.2e}, max |σ′_yy + (1 − B) q|/q {worst_s:.2e}");
+    assert_within("max |p_ex − B q|/q", worst_p, 1e-3);
+    assert_within("max |σ′_yy + (1 − B) q|/q", worst_s, 1e-3);
+}
