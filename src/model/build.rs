@@ -91,15 +91,17 @@ impl<const D: usize> Model<D> {
             .map(|(_, b)| face_condition(b, &vec))
             .collect();
         let face_motions = face_motions(&velocity, &vec);
-        let friction = c
-            .boundaries
-            .iter()
-            .filter(|b| b.condition == Condition::Friction)
-            .map(|b| FrictionFace {
+        let friction_tables: Vec<(usize, &BoundaryConfig)> = (c.boundaries.iter().enumerate())
+            .filter(|(_, b)| b.condition == Condition::Friction)
+            .collect();
+        let friction = (friction_tables.iter())
+            .map(|(_, b)| FrictionFace {
                 face: Face::parse(&b.face, D).unwrap(),
                 coefficient: b.friction_coefficient.unwrap(),
+                velocity: Vector::<D>::zeros(),
             })
             .collect();
+        let wall_motions = wall_motions(&friction_tables, &vec);
         for ((i, _), fc) in velocity.iter().zip(&faces) {
             holds_a_node(*i, fc, &grid).map_err(err)?;
         }
@@ -135,6 +137,7 @@ impl<const D: usize> Model<D> {
             bodies,
             faces,
             face_motions,
+            wall_motions,
             friction,
             footing,
             absorbing,
@@ -256,6 +259,27 @@ fn face_motions<const D: usize>(
                 amplitude: vec(amplitude),
                 curve: Arc::new(TimeCurve::new(&h.points())),
             })
+        })
+        .collect()
+}
+
+/// The friction faces (in the order of `Model::friction`) that move along
+/// themselves: a constant `velocity`, or a vector with a time history.
+fn wall_motions<const D: usize>(
+    friction: &[(usize, &BoundaryConfig)],
+    vec: &impl Fn(&[f64]) -> Vector<D>,
+) -> Vec<FaceMotion<D>> {
+    (friction.iter().enumerate())
+        .filter(|(_, (_, b))| b.velocity.is_some() || b.time_history.is_some())
+        .map(|(face, (_, b))| {
+            let (kind, amplitude) = motion_vector(b);
+            let points = (b.time_history.as_ref()).map_or(vec![[0.0, 1.0]], |h| h.points());
+            FaceMotion {
+                face,
+                kind,
+                amplitude: vec(amplitude),
+                curve: Arc::new(TimeCurve::new(&points)),
+            }
         })
         .collect()
 }

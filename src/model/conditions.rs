@@ -132,17 +132,22 @@ impl<const D: usize> FaceMotion<D> {
 /// A rigid face with Coulomb friction (a rough base): a node on the face may
 /// separate from it, but not move into it, and slides along it only against a
 /// friction impulse of at most μ times the normal impulse (rigid-wall contact in
-/// the manner of Bardenhagen et al. 2001, with the wall as the rigid body).
+/// the manner of Bardenhagen et al. 2001, with the wall as the rigid body). The
+/// wall may move along itself (a shaken base): the law acts on the velocity
+/// relative to the wall's.
 #[derive(Clone, Copy, Debug)]
-pub struct FrictionFace {
+pub struct FrictionFace<const D: usize> {
     pub face: Face,
     /// Coulomb friction coefficient μ ≥ 0 (0: a roller that lets go).
     pub coefficient: f64,
+    /// The wall's velocity over the current step, tangential (zero at rest;
+    /// `Model::walls_during` sets it from the wall's motion).
+    pub velocity: Vector<D>,
 }
 
-impl FrictionFace {
+impl<const D: usize> FrictionFace<D> {
     /// Unit outward normal of the face (out of the grid, into the wall).
-    pub fn normal<const D: usize>(&self) -> Vector<D> {
+    pub fn normal(&self) -> Vector<D> {
         let mut n = Vector::<D>::zeros();
         n[self.face.axis] = if self.face.upper { 1.0 } else { -1.0 };
         n

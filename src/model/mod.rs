@@ -62,8 +62,11 @@ pub struct Model<const D: usize> {
     pub faces: Vec<FaceCondition<D>>,
     /// The velocity conditions that follow a time history (`Model::faces_during`).
     pub face_motions: Vec<FaceMotion<D>>,
-    /// Rigid rough faces (Coulomb friction; held fixed in implicit steps).
-    pub friction: Vec<FrictionFace>,
+    /// Rigid rough faces (Coulomb friction; no slip in implicit steps).
+    pub friction: Vec<FrictionFace<D>>,
+    /// The friction faces that move along themselves (`Model::walls_during`;
+    /// `FaceMotion::face` indexes `friction`).
+    pub wall_motions: Vec<FaceMotion<D>>,
     /// The velocity condition with a `footing_width`, if any.
     pub footing: Option<Footing<D>>,
     /// Non-reflecting faces (Lysmer–Kuhlemeyer dashpots, optional springs).
@@ -152,6 +155,20 @@ impl<const D: usize> Model<D> {
                 .for_each(|d| c.value[d] = v[d]);
         }
         Cow::Owned(faces)
+    }
+
+    /// The friction faces of the step t → t + dt: `friction`, each moving
+    /// wall's velocity set to its mean over the step (`FaceMotion::step_velocity`).
+    /// Borrowed when no wall moves.
+    pub fn walls_during(&self, t: f64, dt: f64) -> Cow<'_, [FrictionFace<D>]> {
+        if self.wall_motions.is_empty() {
+            return Cow::Borrowed(&self.friction);
+        }
+        let mut walls = self.friction.clone();
+        for motion in &self.wall_motions {
+            walls[motion.face].velocity = motion.step_velocity(t, dt);
+        }
+        Cow::Owned(walls)
     }
 
     /// The factor of gravity at time t: its history's, or else the stage's `ramp`.

@@ -447,9 +447,34 @@ fn friction_face_needs_a_valid_coefficient() {
         &with("friction_coefficient = -0.1"),
         &["scene.toml:25:24", "≥ 0"],
     );
+    // A shaken wall moves along itself: a tangential velocity, or a vector
+    // with a time history; never into the body or away from it.
+    for motion in [
+        "velocity = [0.5, 0.0]",
+        "acceleration = [-4.9, 0.0]\ntime_history = [[0.0, 1.0], [0.2, 0.0]]",
+    ] {
+        Scene::parse(
+            "scene.toml",
+            &with(&format!("friction_coefficient = 0.4\n{motion}")),
+            &[],
+        )
+        .unwrap();
+    }
     rejected(
-        &with("friction_coefficient = 0.4\nvelocity = [0.0, 0.0]"),
-        &["boundary.0.velocity"],
+        &with("friction_coefficient = 0.4\nvelocity = [0.0, 1.0]"),
+        &["boundary.0.velocity", "moves along itself"],
+    );
+    rejected(
+        &with("friction_coefficient = 0.4\nacceleration = [1.0, 0.0]"),
+        &["boundary.0.time_history", "acceleration"],
+    );
+    rejected(
+        &with("friction_coefficient = 0.4\ntime_history = [[0.0, 1.0]]"),
+        &["boundary.0.time_history", "at rest"],
+    );
+    rejected(
+        &with("friction_coefficient = 0.4\ncomponents = [\"x\"]"),
+        &["boundary.0.components"],
     );
 }
 

@@ -301,3 +301,15 @@ fn scatter_and_gather_agree_with_the_moved_features_in_every_scheme() {
         }
     }
 }
+
+/// A friction face shaken along itself (`Model::walls_during`): the moving
+/// wall's velocity reaches every scheme's conditioned velocities on both
+/// back-ends (Newmark's block into its pulse, slipping).
+#[test]
+fn scatter_and_gather_agree_on_a_shaken_friction_face() {
+    for scheme in ["usl", "usf", "musl"] {
+        let scheme = format!("solver.scheme=\"{scheme}\"");
+        let overrides = [scheme.as_str(), "solver.end_time=0.4"];
+        agree("newmark_sliding_block.toml", &overrides, 1e-10);
+    }
+}

@@ -136,3 +136,81 @@ fn friction_face_is_fixed_in_implicit_steps() {
         "the block slid {moved} m in an implicit step (elastic shear {shear} m)"
     );
 }
+
+/// Newmark's sliding block (Newmark 1965, Géotechnique 15(2), the single
+/// rectangular pulse): `problems/newmark_sliding_block.toml`, a stiff block on a
+/// rough base inclined at θ = 20° (μ = 0.5, tilted gravity), the base (the
+/// friction face) shaken along itself by an acceleration pulse A = 0.5 g for
+/// t0 = 0.2 s from t = 0.3 s. The yield acceleration a_y = g (μ cos θ − sin θ)
+/// = 1.254 m/s² < A, so the block slips down the slope relative to the base by
+///   d = A (A − a_y) t0² / (2 a_y) = 0.2856 m
+/// and then stays. Measured at the end (1.4 s): +0.72 % (bound 5 %, the
+/// issue's), the slip over the last 0.2 s 1.6e-4 m; on a grid twice as fine
+/// +2.0 % (a slow creep after the stop, 1.5 mm per 0.1 s). A pulse below the
+/// yield acceleration (A = 0.1 g) moves the block by 0.19 mm (bound 1 mm). The base's
+/// displacement is −A F₂(t) with F₂ the double integral of the pulse.
+#[test]
+fn shaken_block_slips_by_newmarks_displacement() {
+    let th = 20f64.to_radians();
+    let a_y = G * (0.5 * th.cos() - th.sin());
+    let (t0, start) = (0.2, 0.3);
+    // F₂ of the pulse (1 on [start, start + t0], ramps of 1e-4 s at its ends:
+    // their effect on the base's displacement is below 1e-5 of d).
+    let base = |t: f64, a: f64| {
+        let tau = (t - start).clamp(0.0, t0);
+        -a * (0.5 * tau * tau + t0 * (t - start - t0).max(0.0))
+    };
+    let slip = |a: f64| {
+        let (result, dir) = run_problem(
+            "newmark_sliding_block.toml",
+            &[&format!("boundary.0.acceleration=[{},0.0]", -a)],
+        );
+        assert_eq!(result.unwrap().status, Status::Completed);
+        let h = Table::read(&dir.path().join("history.csv")).unwrap();
+        let (t, x) = (h.col("t"), h.col("body0_x"));
+        let rel: Vec<f64> = (t.iter().zip(x))
+            .map(|(&s, &xs)| xs - x[0] - base(s, a))
+            .collect();
+        let n = t.len();
+        let back = t.iter().position(|&s| s >= t[n - 1] - 0.2).unwrap();
+        (rel[n - 1], rel[n - 1] - rel[back])
+    };
+    let a = 0.5 * G;
+    let exact = a * (a - a_y) * t0 * t0 / (2.0 * a_y);
+    let (d, late) = slip(a);
+    println!("slip {d:.4} m against Newmark's {exact:.4} m; over the last 0.2 s {late:.2e} m");
+    assert_within("slip / Newmark − 1", d / exact - 1.0, 0.05);
+    assert!(
+        late.abs() < 0.01 * exact,
+        "still slipping: {late:.2e} m in 0.2 s"
+    );
+    let (small, _) = slip(0.1 * G);
+    println!("below the yield acceleration: slip {small:.2e} m");
+    assert!(
+        small.abs() < 1e-3,
+        "slipped {small:.2e} m under A = 0.1 g < a_y"
+    );
+    // Newmark implicit steps hold a friction face's nodes to the wall: the block
+    // rides with the shaken base (which moves 0.98 m) up to its elastic shear
+    // (measured |x − u_base| ≤ 3.8e-4 m).
+    let text = std::fs::read_to_string(crate::common::problem("newmark_sliding_block.toml"))
+        .unwrap()
+        .replace(
+            "kind = \"explicit\"\nend_time = 1.4\ncfl = 0.5\nflip = 0.0\n",
+            "kind = \"implicit\"\nintegrator = \"newmark\"\nend_time = 1.4\ndt = 0.01\n",
+        );
+    let (result, dir) = crate::common::run_text(&text, &[]);
+    assert_eq!(result.unwrap().status, Status::Completed);
+    let h = Table::read(&dir.path().join("history.csv")).unwrap();
+    let (t, x) = (h.col("t"), h.col("body0_x"));
+    let worst =
+        (t.iter().zip(x)).fold(0.0f64, |w, (&s, &xs)| w.max((xs - x[0] - base(s, a)).abs()));
+    println!(
+        "implicit: |x − u_base| ≤ {worst:.2e} m (base {:.3} m)",
+        base(1.4, a)
+    );
+    assert!(
+        worst < 1e-3,
+        "the block left the implicit wall by {worst:.2e} m"
+    );
+}

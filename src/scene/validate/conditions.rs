@@ -85,8 +85,8 @@ fn face_motion(b: &BoundaryConfig, i: usize, dim: usize) -> Check {
     .into_iter()
     .filter_map(|(k, v)| Some((k, v.as_ref()?)))
     .collect();
-    if b.condition != Condition::Velocity {
-        let what = "fixed, roller, absorbing or friction conditions (only to velocity)";
+    if !matches!(b.condition, Condition::Velocity | Condition::Friction) {
+        let what = "fixed, roller or absorbing conditions (only to velocity and friction)";
         forbidden(&b.acceleration, key("acceleration"), what)?;
         forbidden(&b.displacement, key("displacement"), what)?;
     }
@@ -101,19 +101,7 @@ fn face_motion(b: &BoundaryConfig, i: usize, dim: usize) -> Check {
                 key("velocity"),
                 "is required for a velocity condition (or `acceleration` or `displacement` with a `time_history`)",
             )?;
-            if let Some((second, _)) = given.get(1) {
-                return Err((
-                    key(second),
-                    format!("a face takes one of velocity, acceleration and displacement; `{}` is given too", given[0].0),
-                ));
-            }
-            let (name, v) = given[0];
-            vector(v, dim, &key(name))?;
-            if name != "velocity" {
-                let what =
-                    format!("a face with `{name}` (the factor of the vector on the run's clock)");
-                required(&b.time_history, key("time_history"), &what)?;
-            }
+            motion_vector(b, i, dim, &given)?;
             if b.footing_width.is_some() {
                 let what = "a footing (it moves at a constant velocity)";
                 forbidden(&b.time_history, key("time_history"), what)?;
@@ -131,19 +119,61 @@ fn face_motion(b: &BoundaryConfig, i: usize, dim: usize) -> Check {
                 None => forbidden(&b.time_history, key("time_history"), what),
             }
         }
+        Condition::Friction if !given.is_empty() => {
+            motion_vector(b, i, dim, &given)?;
+            let (name, v) = given[0];
+            let axis = Face::parse(&b.face, dim).unwrap().axis;
+            ensure(
+                v[axis] == 0.0,
+                key(name),
+                format!(
+                    "a friction face moves along itself only: its component normal to \
+                     the face (axis {axis}) must be 0; got {}",
+                    v[axis]
+                ),
+            )
+        }
+        Condition::Friction => forbidden(
+            &b.time_history,
+            key("time_history"),
+            "a friction face at rest (give the wall's `velocity`, `acceleration` or \
+             `displacement` with it)",
+        ),
         _ => forbidden(
             &b.time_history,
             key("time_history"),
-            "fixed, roller or friction conditions (only to velocity and absorbing faces)",
+            "fixed or roller conditions (only to velocity, friction and absorbing faces)",
         ),
     }
 }
 
-/// Keys of a friction face: a coefficient μ ≥ 0 and no velocity.
+/// The one motion vector of a velocity or friction face (`given`, not empty):
+/// `dim` components; `acceleration` and `displacement` need a time history.
+fn motion_vector(b: &BoundaryConfig, i: usize, dim: usize, given: &[(&str, &Vec<f64>)]) -> Check {
+    let key = |k: &str| format!("boundary.{i}.{k}");
+    if let Some((second, _)) = given.get(1) {
+        return Err((
+            key(second),
+            format!(
+                "a face takes one of velocity, acceleration and displacement; `{}` is given too",
+                given[0].0
+            ),
+        ));
+    }
+    let (name, v) = given[0];
+    vector(v, dim, &key(name))?;
+    if name != "velocity" {
+        let what = format!("a face with `{name}` (the factor of the vector on the run's clock)");
+        required(&b.time_history, key("time_history"), &what)?;
+    }
+    Ok(())
+}
+
+/// Keys of a friction face: a coefficient μ ≥ 0, no components (its motion,
+/// tangential, is checked with the other faces' in `face_motion`).
 fn friction(b: &BoundaryConfig, i: usize) -> Check {
     let key = |k: &str| format!("boundary.{i}.{k}");
-    let what = "a friction condition (the wall is at rest)";
-    forbidden(&b.velocity, key("velocity"), what)?;
+    let what = "a friction condition (the wall moves as a whole)";
     forbidden(&b.components, key("components"), what)?;
     required(
         &b.friction_coefficient,

@@ -9,7 +9,7 @@
 
 use crate::dim::Vector;
 use crate::model::body::Advance;
-use crate::model::conditions::Constraint;
+use crate::model::conditions::{Constraint, FrictionFace};
 use crate::model::{load_factor, Model};
 use crate::parallel::{deterministic_sum, MIN_PARALLEL_LEN};
 use crate::physics::boundary::absorbing;
@@ -43,6 +43,9 @@ pub struct NodeMapStep<const D: usize> {
     /// Per active node: its constraint, and the friction faces of the nodes on some.
     constraint: Vec<Constraint<D>>,
     friction: Vec<(usize, Vec<u8>)>,
+    /// The friction faces with their walls' velocities this step
+    /// (`Model::walls_during`).
+    walls: Vec<FrictionFace<D>>,
     mirror: Mirror,
     /// APIC: the active nodes' positions.
     positions: Vec<Vector<D>>,
@@ -202,6 +205,7 @@ impl<const D: usize> NodeMapStep<D> {
             .map(|a| node_constraint(&m.grid, &faces, map.grid_node(a)))
             .collect();
         self.friction = friction_nodes(m, map);
+        self.walls = m.walls_during(s.t, s.dt).into_owned();
         // Cubic and domain-averaged B-splines: the image problem's masses at faces
         // with prescribed velocities. Point-sampled quadratic B-splines keep the
         // clamped masses: the mirror removes their O(ε) stress error at the face
@@ -243,24 +247,23 @@ impl<const D: usize> NodeMapStep<D> {
         momentum: &[Vector<D>],
         dt: f64,
         delivered: f64,
-        m: &Model<D>,
     ) -> (Vec<Vector<D>>, Vec<Vector<D>>) {
         let mut raw = mass_average(&self.mass, momentum);
         self.mirror.velocity(&self.mass, momentum, &mut raw);
         if let Some(c) = &mut self.contact {
             c.correct(&self.mass, &mut raw, dt, delivered);
         }
-        let velocity = self.conditioned(&raw, m);
+        let velocity = self.conditioned(&raw);
         (raw, velocity)
     }
 
     /// The velocities `raw` with the conditions of their nodes.
-    fn conditioned(&self, raw: &[Vector<D>], m: &Model<D>) -> Vec<Vector<D>> {
+    fn conditioned(&self, raw: &[Vector<D>]) -> Vec<Vector<D>> {
         let mut v: Vec<Vector<D>> = (raw.iter().zip(&self.constraint))
-            .map(|(v, c)| with_conditions(v, c, &m.friction, &[]))
+            .map(|(v, c)| with_conditions(v, c, &self.walls, &[]))
             .collect();
         for (a, on) in &self.friction {
-            v[*a] = with_conditions(&raw[*a], &self.constraint[*a], &m.friction, on);
+            v[*a] = with_conditions(&raw[*a], &self.constraint[*a], &self.walls, on);
         }
         v
     }
@@ -330,10 +333,10 @@ impl<const D: usize> Backend<D> for NodeMapStep<D> {
         }
     }
 
-    fn start_velocity(&mut self, m: &Model<D>, s: &Step<D>) {
+    fn start_velocity(&mut self, _m: &Model<D>, s: &Step<D>) {
         // Contact after P2G: its momentum reaches the particles through the PIC part.
         let momentum = std::mem::take(&mut self.momentum);
-        (self.raw_velocity, self.velocity) = self.velocity_of(&momentum, s.dt, 1.0 - s.flip, m);
+        (self.raw_velocity, self.velocity) = self.velocity_of(&momentum, s.dt, 1.0 - s.flip);
         self.momentum = momentum;
     }
 
@@ -393,7 +396,7 @@ impl<const D: usize> Backend<D> for NodeMapStep<D> {
                 &raw[*a],
                 &self.accel[*a],
                 &constraint[*a],
-                &m.friction,
+                &self.walls,
                 on,
                 s.dt,
             );
@@ -429,9 +432,9 @@ impl<const D: usize> Backend<D> for NodeMapStep<D> {
         Ok(work)
     }
 
-    fn remapped_velocity(&mut self, m: &Model<D>, s: &Step<D>) {
+    fn remapped_velocity(&mut self, _m: &Model<D>, s: &Step<D>) {
         let momentum = std::mem::take(&mut self.momentum);
-        (_, self.velocity) = self.velocity_of(&momentum, s.dt, 0.0, m);
+        (_, self.velocity) = self.velocity_of(&momentum, s.dt, 0.0);
         self.momentum = momentum;
     }
 

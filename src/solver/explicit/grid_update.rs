@@ -60,7 +60,7 @@ pub fn acceleration<const D: usize>(
 pub fn with_conditions<const D: usize>(
     raw: &Vector<D>,
     constraint: &Constraint<D>,
-    faces: &[FrictionFace],
+    faces: &[FrictionFace<D>],
     on: &[u8],
 ) -> Vector<D> {
     let mut v = *raw;
@@ -79,7 +79,7 @@ pub fn updated_velocity<const D: usize>(
     raw: &Vector<D>,
     acc: &Vector<D>,
     constraint: &Constraint<D>,
-    faces: &[FrictionFace],
+    faces: &[FrictionFace<D>],
     on: &[u8],
     dt: f64,
 ) -> (Vector<D>, Vector<D>) {

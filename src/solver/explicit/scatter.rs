@@ -13,7 +13,7 @@
 //! come with contact, which needs the node map (`solver::explicit::features`).
 
 use crate::dim::{compose, embed_deformation, Mat3, Tensor, Vector};
-use crate::model::conditions::{Constraint, FaceCondition};
+use crate::model::conditions::{Constraint, FaceCondition, FrictionFace};
 use crate::model::grid::Grid;
 use crate::model::particles::{History, Particles};
 use crate::model::tensors::{Tensors, TensorsMut};
@@ -34,6 +34,7 @@ use crate::solver::explicit::node_box::{NodeBox, Points, Stencil};
 use crate::solver::explicit::p2g::{hoop_stress, Source};
 use crate::solver::explicit::step::{removed_particles, Backend, P2g, Start, Step, Then, Velocity};
 use rayon::prelude::*;
+use std::borrow::Cow;
 
 /// Particles per task of a particle pass: small enough that a scene of a few
 /// thousand particles keeps every thread busy. The work of the loads is summed
@@ -88,6 +89,22 @@ struct FBarStep {
     df: Vec<Mat3>,
 }
 
+/// The face conditions and friction walls of one step (`Model::faces_during`,
+/// `Model::walls_during`).
+struct StepFaces<'a, const D: usize> {
+    conditions: Cow<'a, [FaceCondition<D>]>,
+    walls: Cow<'a, [FrictionFace<D>]>,
+}
+
+impl<'a, const D: usize> StepFaces<'a, D> {
+    fn of(m: &'a Model<D>, s: &Step<D>) -> Self {
+        StepFaces {
+            conditions: m.faces_during(s.t, s.dt),
+            walls: m.walls_during(s.t, s.dt),
+        }
+    }
+}
+
 /// A face node's conditions: its constraint and the friction faces it lies on.
 struct Conditions<const D: usize> {
     constraint: Constraint<D>,
@@ -126,7 +143,7 @@ impl<const D: usize> Backend<D> for ScatterStep<D> {
     }
 
     fn start_velocity(&mut self, m: &Model<D>, s: &Step<D>) {
-        self.start_velocity(m, &m.faces_during(s.t, s.dt));
+        self.start_velocity(m, &StepFaces::of(m, s));
     }
 
     fn start_forces(&mut self, m: &Model<D>, s: &Step<D>) {
@@ -134,7 +151,7 @@ impl<const D: usize> Backend<D> for ScatterStep<D> {
     }
 
     fn grid_update(&mut self, m: &Model<D>, s: &Step<D>, start: Start) {
-        let faces = m.faces_during(s.t, s.dt);
+        let faces = StepFaces::of(m, s);
         self.node_pass(m, &faces, start == Start::Formed, s.damping, s.tiny, s.dt);
     }
 
@@ -147,7 +164,7 @@ impl<const D: usize> Backend<D> for ScatterStep<D> {
     }
 
     fn remapped_velocity(&mut self, m: &Model<D>, s: &Step<D>) {
-        self.remapped_velocity(m, &m.faces_during(s.t, s.dt));
+        self.remapped_velocity(m, &StepFaces::of(m, s));
     }
 
     fn update_stress(
@@ -305,26 +322,26 @@ impl<const D: usize> ScatterStep<D> {
 
     /// The conditions of box node b at grid multi-index `ijk`, `None` for a
     /// node on no grid face (most nodes).
-    fn conditions(
-        m: &Model<D>,
-        faces: &[FaceCondition<D>],
-        ijk: [usize; D],
-    ) -> Option<Conditions<D>> {
+    fn conditions(m: &Model<D>, faces: &StepFaces<D>, ijk: [usize; D]) -> Option<Conditions<D>> {
         let grid = &m.grid;
         if !(0..D).any(|d| ijk[d] == 0 || ijk[d] + 1 == grid.nodes[d]) {
             return None;
         }
         let g = grid.node_index(ijk);
         Some(Conditions {
-            constraint: node_constraint(grid, faces, g),
+            constraint: node_constraint(grid, &faces.conditions, g),
             friction: node_friction(grid, &m.friction, g),
         })
     }
 
     /// v = p/m on a node with mass (2-25), with its conditions applied.
-    fn velocity(m: &Model<D>, raw: &Vector<D>, c: &Option<Conditions<D>>) -> Vector<D> {
+    fn velocity(
+        walls: &[FrictionFace<D>],
+        raw: &Vector<D>,
+        c: &Option<Conditions<D>>,
+    ) -> Vector<D> {
         match c {
-            Some(c) => with_conditions(raw, &c.constraint, &m.friction, &c.friction),
+            Some(c) => with_conditions(raw, &c.constraint, walls, &c.friction),
             None => *raw,
         }
     }
@@ -360,7 +377,7 @@ impl<const D: usize> ScatterStep<D> {
     fn node_pass(
         &mut self,
         m: &Model<D>,
-        faces: &[FaceCondition<D>],
+        faces: &StepFaces<D>,
         usf: bool,
         damping: f64,
         tiny: f64,
@@ -372,31 +389,32 @@ impl<const D: usize> ScatterStep<D> {
                 true => (n.momentum, *second),
                 false => {
                     let raw = nodal_velocity(n.mass, &n.momentum);
-                    (raw, Self::velocity(m, &raw, &c))
+                    (raw, Self::velocity(&faces.walls, &raw, &c))
                 }
             };
             let free = Constraint::free();
             let constraint = c.as_ref().map_or(&free, |c| &c.constraint);
             let acc = acceleration(n.mass, &n.force, &v, &raw, constraint, damping, tiny, dt);
             let on: &[u8] = c.as_ref().map_or(&[], |c| &c.friction);
-            (n.momentum, n.force) = updated_velocity(&raw, &acc, constraint, &m.friction, on, dt);
+            (n.momentum, n.force) = updated_velocity(&raw, &acc, constraint, &faces.walls, on, dt);
         });
     }
 
     /// USF: p/m into `momentum`, and the velocity with the conditions into `second`.
-    fn start_velocity(&mut self, m: &Model<D>, faces: &[FaceCondition<D>]) {
+    fn start_velocity(&mut self, m: &Model<D>, faces: &StepFaces<D>) {
         self.for_nodes(|n, second, ijk| {
             n.momentum = nodal_velocity(n.mass, &n.momentum);
-            *second = Self::velocity(m, &n.momentum, &Self::conditions(m, faces, ijk));
+            let c = Self::conditions(m, faces, ijk);
+            *second = Self::velocity(&faces.walls, &n.momentum, &c);
         });
     }
 
     /// MUSL: the remapped momentum in `second` becomes the velocity with the
     /// conditions.
-    fn remapped_velocity(&mut self, m: &Model<D>, faces: &[FaceCondition<D>]) {
+    fn remapped_velocity(&mut self, m: &Model<D>, faces: &StepFaces<D>) {
         self.for_nodes(|n, second, ijk| {
             let raw = nodal_velocity(n.mass, second);
-            *second = Self::velocity(m, &raw, &Self::conditions(m, faces, ijk));
+            *second = Self::velocity(&faces.walls, &raw, &Self::conditions(m, faces, ijk));
         });
     }
 

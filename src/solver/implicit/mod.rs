@@ -182,6 +182,7 @@ pub fn unknowns<const D: usize>(m: &Model<D>, shape: ShapeFunction, s: &SolverCo
     number_unknowns(
         m,
         &m.faces,
+        &m.friction,
         &st,
         &map,
         grid.node_fields(),

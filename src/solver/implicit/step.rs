@@ -19,7 +19,7 @@ use super::terms::list::step_terms;
 use super::terms::{Couplings, Restore, StepStart, StepTerm, StepView, TermReport};
 use super::ties::{merge, natural_end_ties, nodal_support, ties, NodeFields};
 use crate::dim::Vector;
-use crate::model::conditions::{Constraint, FaceCondition};
+use crate::model::conditions::{Constraint, FaceCondition, FrictionFace};
 use crate::model::loads::LoadTime;
 use crate::model::{load_factor, Model};
 use crate::parallel::MIN_PARALLEL_LEN;
@@ -310,8 +310,9 @@ impl StepSettings {
         }
         let (st, map) = (&sys.stencils, &sys.map);
         let fields = sys.grid.node_fields();
-        let faces = m.faces_during(t, dt);
-        let (constraint, dofs) = number_unknowns(m, &faces, st, map, fields, self.min_node_support);
+        let (faces, walls) = (m.faces_during(t, dt), m.walls_during(t, dt));
+        let (constraint, dofs) =
+            number_unknowns(m, &faces, &walls, st, map, fields, self.min_node_support);
         let n = map.len();
 
         // External force at the end of the step; inertia terms: the Newmark
@@ -488,6 +489,7 @@ impl StepSettings {
 pub fn number_unknowns<const D: usize>(
     m: &Model<D>,
     faces: &[FaceCondition<D>],
+    walls: &[FrictionFace<D>],
     st: &Stencils<D>,
     map: &NodeMap,
     fields: Option<&NodeFields>,
@@ -498,7 +500,7 @@ pub fn number_unknowns<const D: usize>(
         .par_iter()
         .enumerate()
         .with_min_len(MIN_PARALLEL_LEN)
-        .map(|(a, _)| implicit_node_constraint(&m.grid, faces, &m.friction, map.grid_node(a)))
+        .map(|(a, _)| implicit_node_constraint(&m.grid, faces, walls, map.grid_node(a)))
         .collect();
     let support = nodal_support(map, st, &m.particles.volume, m.grid.cell_volume());
     let fixed: Vec<[bool; D]> = constraint.iter().map(|c| c.fixed).collect();
