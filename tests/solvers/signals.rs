@@ -84,8 +84,11 @@ fn sigterm_stops_the_run_too_with_its_own_exit_code() {
 
 #[test]
 fn an_interrupted_run_restarts_from_its_checkpoint_to_the_same_bytes() {
-    // 2.5 s of work; SIGINT after a few history rows.
-    let sets = ["solver.end_time=0.05"];
+    // About 4 s of work on one thread (measured 1.0 s for 0.05 s of it on a
+    // quiet machine). History rows reach the disk once a second
+    // (`output::history`), so the run must outlast the first flush by a
+    // margin, or it ends before the signal is sent.
+    let sets = ["solver.end_time=0.2"];
     let (code, dir) = interrupt_with(libc::SIGINT, &sets);
     assert_eq!(code, Some(130));
     let s = Summary::read(&dir.path().join("summary.json")).unwrap();
