@@ -114,14 +114,14 @@ impl<const D: usize> Model<D> {
         absorbing
             .check_adjacent(&grid, &particles)
             .map_err(|(i, msg)| err((format!("boundary.{i}.face"), msg)))?;
-        let drained: Vec<(usize, FaceCondition<D>)> = (c.boundaries.iter().enumerate())
+        let drained: Vec<(usize, FaceCondition<D>, f64)> = (c.boundaries.iter().enumerate())
             .filter(|(_, b)| b.condition == Condition::Drained)
-            .map(|(i, b)| (i, face_condition(b, &vec)))
+            .map(|(i, b)| (i, face_condition(b, &vec), b.pore_pressure.unwrap_or(0.0)))
             .collect();
-        for (i, fc) in &drained {
+        for (i, fc, _) in &drained {
             holds_a_node(*i, fc, &grid).map_err(err)?;
         }
-        let drained = drained.into_iter().map(|(_, fc)| fc).collect();
+        let drained = drained.into_iter().map(|(_, fc, p)| (fc, p)).collect();
         let drainage = Drainage::new(&base_materials, drained);
         let gravity = c.gravity.as_deref().map_or(Vector::<D>::zeros(), vec);
         let loads = Loads::apply(c, &mut particles).map_err(err)?;

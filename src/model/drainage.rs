@@ -12,9 +12,10 @@ use crate::model::grid::Grid;
 #[derive(Clone, Debug)]
 pub struct Drainage<const D: usize> {
     /// Faces (`[[boundary]] condition = "drained"`, optionally within a
-    /// region) whose nodes hold the excess pore pressure at zero; every other
-    /// boundary of the saturated particles is impermeable (no flux).
-    pub drained: Vec<FaceCondition<D>>,
+    /// region) whose nodes hold the excess pore pressure at its value (0
+    /// unless `pore_pressure` is given); every other boundary of the saturated
+    /// particles is impermeable (no flux).
+    pub drained: Vec<(FaceCondition<D>, f64)>,
     /// max over the coupled materials of c_f = K_f k/γ_w, the diffusivity of
     /// the excess pore pressure at a fixed skeleton (m²/s).
     pub diffusivity: f64,
@@ -23,7 +24,10 @@ pub struct Drainage<const D: usize> {
 impl<const D: usize> Drainage<D> {
     /// The drainage of `materials` with the drained faces `drained`; None when
     /// no material lets its water flow.
-    pub fn new(materials: &[Box<dyn Material>], drained: Vec<FaceCondition<D>>) -> Option<Self> {
+    pub fn new(
+        materials: &[Box<dyn Material>],
+        drained: Vec<(FaceCondition<D>, f64)>,
+    ) -> Option<Self> {
         let diffusivity = (materials.iter())
             .filter_map(|m| m.pore_fluid())
             .map(|f| f.bulk_modulus * f.mobility)
@@ -34,9 +38,12 @@ impl<const D: usize> Drainage<D> {
         })
     }
 
-    /// Is grid node `ijk` drained?
-    pub fn drains(&self, grid: &Grid<D>, ijk: [usize; D]) -> bool {
-        self.drained.iter().any(|f| f.acts_on(grid, ijk))
+    /// The pressure grid node `ijk` holds, if it is drained (on a node of two
+    /// drained faces, the first listed).
+    pub fn drains(&self, grid: &Grid<D>, ijk: [usize; D]) -> Option<f64> {
+        (self.drained.iter())
+            .find(|(f, _)| f.acts_on(grid, ijk))
+            .map(|&(_, p)| p)
     }
 
     /// The explicit flow's stable step h²/(2 D c_f) (forward Euler of the

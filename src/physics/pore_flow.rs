@@ -27,9 +27,10 @@
 //! limit (k → 0) the increment is the projection of −K_f Δ ln J, a smoothed
 //! undrained response.
 //!
-//! A drained node (`model::drainage`) has P_I = 0 in the gradient, and its
-//! increment is the one that takes its projected value there, ΔP_I = −P_I
-//! (as a prescribed velocity does in the velocity update). Every other
+//! A drained node (`model::drainage`) has P_I = p_D in the gradient (its
+//! face's `pore_pressure`, 0 by default), and its increment is the one that
+//! takes its projected value there, ΔP_I = p_D − P_I (as a prescribed
+//! velocity does in the velocity update). Every other
 //! boundary is impermeable (the natural condition of the weak form). Only the
 //! particles whose water flows (mobility > 0) take part: a dry or undrained
 //! particle stores nothing and passes nothing. The particle's stored stress
@@ -85,14 +86,14 @@ pub fn darcy_step<const D: usize>(m: &mut Model<D>, st: &Stencils<D>, map: &Node
         }
         None => Vector::<3>::zeros(),
     });
-    let drained: Vec<bool> = (0..map.len())
+    let drained: Vec<Option<f64>> = (0..map.len())
         .map(|a| drainage.drains(&m.grid, m.grid.node_ijk(map.grid_node(a))))
         .collect();
     let projected: Vec<f64> = (storage.iter())
         .map(|c| if c[0] > 0.0 { c[1] / c[0] } else { 0.0 })
         .collect();
     let nodal: Vec<f64> = (0..map.len())
-        .map(|a| if drained[a] { 0.0 } else { projected[a] })
+        .map(|a| drained[a].unwrap_or(projected[a]))
         .collect();
     // w_p = −(k/γ_w) Σ_I P_I ∇S_Ip.
     let discharge: Vec<Vector<D>> = (0..p.len())
@@ -113,9 +114,9 @@ pub fn darcy_step<const D: usize>(m: &mut Model<D>, st: &Stencils<D>, map: &Node
     });
     let increment: Vec<f64> = (0..map.len())
         .map(|a| match (drained[a], storage[a][0] > 0.0) {
-            (true, _) => -projected[a],
-            (false, true) => (storage[a][2] + dt * inflow[a]) / storage[a][0],
-            (false, false) => 0.0,
+            (Some(held), _) => held - projected[a],
+            (None, true) => (storage[a][2] + dt * inflow[a]) / storage[a][0],
+            (None, false) => 0.0,
         })
         .collect();
     let change: Vec<f64> = (0..p.len())

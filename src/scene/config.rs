@@ -521,6 +521,8 @@ pub struct BoundaryConfig {
     pub spring_stiffness: Option<Vec<f64>>,
     /// Friction: the Coulomb coefficient μ of the rigid wall.
     pub friction_coefficient: Option<f64>,
+    /// Drained: the excess pore pressure its nodes hold (default 0).
+    pub pore_pressure: Option<f64>,
     /// Fixed, roller or velocity: only the face nodes in the box
     /// [region_min, region_max] (both or neither).
     pub region_min: Option<Vec<f64>>,

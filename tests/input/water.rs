@@ -209,6 +209,20 @@ fn coupled_flow_is_refused_where_it_cannot_apply() {
         "boundary.0.velocity",
         &["drained"],
     );
+    rejected_at(
+        &with(
+            coupled,
+            "[[boundary]]\nface = \"ymax\"\ncondition = \"roller\"\npore_pressure = 1.0\n",
+            explicit,
+        ),
+        "boundary.0.pore_pressure",
+        &["only to drained"],
+    );
+    accepted(&with(
+        coupled,
+        "[[boundary]]\nface = \"ymax\"\ncondition = \"drained\"\npore_pressure = 1.0e4\n",
+        explicit,
+    ));
     // A drained region must hold a node of its face (checked as the model is built).
     let off = with(
         coupled,

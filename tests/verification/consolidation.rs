@@ -211,3 +211,58 @@ fn undrained_column_takes_the_load_in_its_pore_water_in_an_explicit_run() {
     assert_within("max |p_ex − B q|/q", worst_p, 1e-3);
     assert_within("max |σ′_yy + (1 − B) q|/q", worst_s, 1e-3);
 }
+
+/// A prescribed pore pressure (`pore_pressure` on a drained face): the
+/// unloaded column drained at its top (p = 0) with the excess pressure P0 =
+/// 10 kPa held at its base from t = 0. The total stress stays zero, so p
+/// diffuses with the same c_v from p = 0 to the linear steady profile:
+///   p(z, t) = P0 z/H + Σ_n (2 P0 (−1)ⁿ/(nπ)) sin(nπ z/H) exp(−n²π² T_v),
+/// z the depth. Measured max |p − p_exact|/P0: 0.044 at T_v = 0.1 and 0.025
+/// at T_v = 0.5 (bounds 0.05 and 0.03), at the particles next to the two
+/// held faces (a held node pulls the projection of its one-sided particles to
+/// its value); 10 → 20 cells halves it at T_v = 0.5 (0.0502 → 0.0249, first
+/// order; asserted > 0.8).
+#[test]
+fn a_held_pore_pressure_diffuses_into_the_column_as_the_closed_form() {
+    let text = std::fs::read_to_string(crate::common::problem("terzaghi.toml")).unwrap();
+    let i = text.find("# The top row of particles").unwrap();
+    let j = text.find("[solver]").unwrap();
+    let held = "[[boundary]]\nface = \"ymin\"\ncondition = \"drained\"\npore_pressure = 1.0e4\n\n";
+    let text = format!("{}{held}{}", &text[..i], &text[j..]);
+    let p_exact = |z: f64, tv: f64| {
+        let series: f64 = (1..400)
+            .map(|n| {
+                let a = n as f64 * std::f64::consts::PI;
+                2.0 * Q * (-1f64).powi(n) / a * (a * z / H).sin() * (-a * a * tv).exp()
+            })
+            .sum();
+        Q * z / H + series
+    };
+    let worst = |cells: &str, times: &str| -> Vec<f64> {
+        let (summary, dir) =
+            crate::common::run_text(&text, &[cells, "solver.end_time=5.25", times]);
+        assert_eq!(summary.unwrap().status, Status::Completed);
+        let index = Table::read(&dir.path().join("particle_times.csv")).unwrap();
+        let files = index.text_column("file").unwrap();
+        (index.col("t").iter().zip(files))
+            .map(|(&t, file)| {
+                let p = Table::read(&dir.path().join(file)).unwrap();
+                let tv = c_v() * t / (H * H);
+                (p.col("Y0").iter().zip(p.col("p_excess")))
+                    .map(|(y, pex)| (pex - p_exact(H - y, tv)).abs() / Q)
+                    .fold(0.0, f64::max)
+            })
+            .collect()
+    };
+    let fine = worst("grid.cells=[1,20]", "output.particle_times=[1.05,5.25]");
+    println!("max |p − p_exact|/P0 at T_v = 0.1, 0.5: {fine:.4?}");
+    assert_within("max |p − p_exact|/P0 at T_v = 0.1", fine[0], 0.05);
+    assert_within("max |p − p_exact|/P0 at T_v = 0.5", fine[1], 0.03);
+    let coarse = worst("grid.cells=[1,10]", "output.particle_times=[5.25]");
+    let rate = (coarse[0] / fine[1]).log2();
+    println!(
+        "T_v = 0.5: {:.4} (10 cells), {:.4} (20 cells): rate {rate:.2}",
+        coarse[0], fine[1]
+    );
+    assert!(rate > 0.8, "rate {rate:.2} (measured 1.0)");
+}

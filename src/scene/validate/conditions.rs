@@ -26,6 +26,10 @@ pub fn boundary(b: &BoundaryConfig, i: usize, dim: usize) -> Check {
         let what = "a fixed, roller, velocity or absorbing condition (only to friction)";
         forbidden(&b.friction_coefficient, key("friction_coefficient"), what)?;
     }
+    if b.condition != Condition::Drained {
+        let what = "a fixed, roller, velocity, absorbing or friction condition (only to drained)";
+        forbidden(&b.pore_pressure, key("pore_pressure"), what)?;
+    }
     region(b, i, dim)?;
     if b.condition != Condition::Velocity {
         forbidden(
@@ -55,7 +59,13 @@ pub fn boundary(b: &BoundaryConfig, i: usize, dim: usize) -> Check {
         Condition::Drained => {
             let what = "a drained condition (it holds the pore pressure, not the velocity)";
             forbidden(&b.velocity, key("velocity"), what)?;
-            forbidden(&b.components, key("components"), what)
+            forbidden(&b.components, key("components"), what)?;
+            let p = b.pore_pressure.unwrap_or(0.0);
+            ensure(
+                p.is_finite(),
+                key("pore_pressure"),
+                format!("must be a finite pressure; got {p}"),
+            )
         }
         Condition::Velocity => {
             for (k, c) in b.components.iter().flatten().enumerate() {
