@@ -45,7 +45,7 @@ use crate::material::PoreFluid;
 use crate::model::Model;
 use crate::parallel::MIN_PARALLEL_LEN;
 use crate::physics::shape::Stencils;
-use crate::physics::transfer::NodeMap;
+use crate::physics::transfer::{interpolate_scalar, scalar_gradient, NodeMap};
 use rayon::prelude::*;
 
 /// Per particle, its pore water if it flows (mobility > 0).
@@ -100,12 +100,7 @@ pub fn darcy_step<const D: usize>(m: &mut Model<D>, st: &Stencils<D>, map: &Node
         .into_par_iter()
         .with_min_len(MIN_PARALLEL_LEN)
         .map(|q| match fluid[q] {
-            Some(f) => {
-                let grad = (st.range(q)).fold(Vector::<D>::zeros(), |g, e| {
-                    g + st.grad_at(q, e) * nodal[map.local_of(st, e)]
-                });
-                -grad * f.mobility
-            }
+            Some(f) => -scalar_gradient(map, st, q, &nodal) * f.mobility,
             None => Vector::<D>::zeros(),
         })
         .collect();
@@ -123,9 +118,7 @@ pub fn darcy_step<const D: usize>(m: &mut Model<D>, st: &Stencils<D>, map: &Node
         .into_par_iter()
         .with_min_len(MIN_PARALLEL_LEN)
         .map(|q| match fluid[q] {
-            Some(_) => (st.range(q)).fold(0.0, |s, e| {
-                s + st.weight_at(q, e) * increment[map.local_of(st, e)]
-            }),
+            Some(_) => interpolate_scalar(map, st, q, &increment),
             None => 0.0,
         })
         .collect();

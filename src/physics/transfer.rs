@@ -507,6 +507,30 @@ pub fn gradient<const D: usize>(
     })
 }
 
+/// Σ_I S_Ip u_I for particle p of a scalar nodal field.
+pub fn interpolate_scalar<const D: usize>(
+    map: &NodeMap,
+    st: &Stencils<D>,
+    p: usize,
+    u: &[f64],
+) -> f64 {
+    (st.range(p)).fold(0.0, |acc, e| {
+        acc + u[map.local_of(st, e)] * st.weight_at(p, e)
+    })
+}
+
+/// Σ_I u_I ∇S_Ip for particle p: the gradient of a scalar nodal field.
+pub fn scalar_gradient<const D: usize>(
+    map: &NodeMap,
+    st: &Stencils<D>,
+    p: usize,
+    u: &[f64],
+) -> Vector<D> {
+    (st.range(p)).fold(Vector::<D>::zeros(), |acc, e| {
+        acc + st.grad_at(p, e) * u[map.local_of(st, e)]
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -66,6 +66,16 @@ fn block_sticks_when_tan_theta_is_below_mu() {
     assert!(x.abs() < 2e-3, "block crept {x} m with tan θ < μ");
 }
 
+/// history.csv of `problems/NAME` with its solver lines `from` replaced by
+/// `to` (an implicit run of an explicit scene); the run must complete.
+fn history_with_solver(name: &str, from: &str, to: &str) -> Table {
+    let text = std::fs::read_to_string(crate::common::problem(name)).unwrap();
+    assert!(text.contains(from), "{name} has no `{from}`");
+    let (result, dir) = crate::common::run_text(&text.replace(from, to), &[]);
+    assert_eq!(result.unwrap().status, Status::Completed);
+    Table::read(&dir.path().join("history.csv")).unwrap()
+}
+
 /// Outputs of a run (for byte comparisons).
 fn outputs(dir: &tempfile::TempDir, files: &[&str]) -> Vec<Vec<u8>> {
     files
@@ -118,15 +128,11 @@ fn friction_face_is_fixed_in_implicit_steps() {
     // implicit step the base holds it: only the elastic shear of the block moves
     // its centre, by about ρ g sin θ H² / (3G) = 1.1e-4 m in 1D simple shear
     // (measured 1.3e-4 m; the slide would be 0.29 m in 0.5 s).
-    let text = std::fs::read_to_string(crate::common::problem("sliding_block.toml"))
-        .unwrap()
-        .replace(
-            "kind = \"explicit\"\nend_time = 0.5\ncfl = 0.5",
-            "kind = \"implicit\"\nintegrator = \"quasi_static\"\nend_time = 1.0\nload_steps = 2",
-        );
-    let (result, dir) = crate::common::run_text(&text, &[]);
-    result.unwrap();
-    let h = Table::read(&dir.path().join("history.csv")).unwrap();
+    let h = history_with_solver(
+        "sliding_block.toml",
+        "kind = \"explicit\"\nend_time = 0.5\ncfl = 0.5",
+        "kind = \"implicit\"\nintegrator = \"quasi_static\"\nend_time = 1.0\nload_steps = 2",
+    );
     let x = h.col("body0_x");
     let moved = x.last().unwrap() - x[0];
     println!("implicit block on a friction base tilted 30°, μ = 0.3: centre moved {moved:.2e} m");
@@ -193,15 +199,11 @@ fn shaken_block_slips_by_newmarks_displacement() {
     // Newmark implicit steps hold a friction face's nodes to the wall: the block
     // rides with the shaken base (which moves 0.98 m) up to its elastic shear
     // (measured |x − u_base| ≤ 3.8e-4 m).
-    let text = std::fs::read_to_string(crate::common::problem("newmark_sliding_block.toml"))
-        .unwrap()
-        .replace(
-            "kind = \"explicit\"\nend_time = 1.4\ncfl = 0.5\nflip = 0.0\n",
-            "kind = \"implicit\"\nintegrator = \"newmark\"\nend_time = 1.4\ndt = 0.01\n",
-        );
-    let (result, dir) = crate::common::run_text(&text, &[]);
-    assert_eq!(result.unwrap().status, Status::Completed);
-    let h = Table::read(&dir.path().join("history.csv")).unwrap();
+    let h = history_with_solver(
+        "newmark_sliding_block.toml",
+        "kind = \"explicit\"\nend_time = 1.4\ncfl = 0.5\nflip = 0.0\n",
+        "kind = \"implicit\"\nintegrator = \"newmark\"\nend_time = 1.4\ndt = 0.01\n",
+    );
     let (t, x) = (h.col("t"), h.col("body0_x"));
     let worst =
         (t.iter().zip(x)).fold(0.0f64, |w, (&s, &xs)| w.max((xs - x[0] - base(s, a)).abs()));
