@@ -20,11 +20,13 @@
 //! trial, in their ParaView frames and the stable one's particles_final.csv).
 
 use crate::output::{write_json, CsvWriter, Field};
+use crate::run::checkpoint::ParticleState;
 use crate::run::summary::Summary;
 use crate::run::{run, RunError, RunOptions};
-use crate::scene::Scene;
+use crate::scene::{BodyKindName, Integrator, Scene, SolverKind};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Growth of the search interval while F_low fails or F_high holds.
@@ -61,6 +63,10 @@ pub struct Trial {
     pub wall_seconds: f64,
     /// Its output directory, relative to the search's (`trials/NN_F…`).
     pub dir: String,
+    /// The stable trial whose end state it started from (none: the scene's
+    /// initial state).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub from: Option<String>,
     /// Why it failed (empty when stable).
     pub message: String,
 }
@@ -90,6 +96,8 @@ pub struct SearchSummary {
     pub mechanism_stable: Option<String>,
     pub mechanism_failed: Option<String>,
     pub particles: usize,
+    /// Whether the trials started from the last stable trial's end state.
+    pub continuation: bool,
     pub status: SearchStatus,
     /// The middle of the bracket.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -114,7 +122,7 @@ pub enum SearchError {
     },
 }
 
-const CSV_COLUMNS: [&str; 8] = [
+const CSV_COLUMNS: [&str; 9] = [
     "factor",
     "status",
     "steps",
@@ -123,21 +131,57 @@ const CSV_COLUMNS: [&str; 8] = [
     "monitor_displacement",
     "wall_seconds",
     "dir",
+    "from",
 ];
 
-/// Run one trial with the strengths divided by `factor` into `out/dir`; also
-/// returns the run's summary.
+/// Where a trial starts when it continues: the end state of the stable trial
+/// `dir` at `factor` (module docs).
+#[derive(Clone)]
+pub struct Start {
+    pub factor: f64,
+    pub dir: String,
+    pub particles: Arc<ParticleState>,
+}
+
+/// Whether the trials of `scene` may continue from each other, and if not, why:
+/// the scene is one implicit quasi-static stage (a staged scene's trial re-runs
+/// its stages) whose bodies carry no state besides their particles (continuum
+/// bodies only, no contact).
+pub fn continues(scene: &Scene) -> Result<(), &'static str> {
+    let cfg = &scene.config;
+    let Some(s) = cfg.solver.as_ref().filter(|_| cfg.stages.is_empty()) else {
+        return Err("a staged scene's trials re-run its stages");
+    };
+    if s.kind != SolverKind::Implicit || s.integrator() != Integrator::QuasiStatic {
+        return Err("only a quasi-static implicit solver is in equilibrium at its end");
+    }
+    // The implicit contact keeps state in the stepper (its contact points and
+    // tangential forces), which a trial's end state does not carry.
+    let plain = (0..cfg.bodies.len()).all(|i| cfg.body_kind(i) == BodyKindName::Continuum);
+    if !plain || !cfg.contacts.is_empty() {
+        return Err("rigid and peridynamic bodies and contact keep state besides the particles");
+    }
+    Ok(())
+}
+
+/// Run one trial with the strengths divided by `factor` into `out/dir`, from
+/// the scene's initial state or, with `from`, from a stable trial's end state;
+/// also returns the run's summary (with its end state when `keep`).
 pub fn trial(
     scene: &Scene,
     out: &Path,
     dir: &str,
     factor: f64,
+    from: Option<&Start>,
+    keep: bool,
 ) -> Result<(Trial, Summary), RunError> {
     let cfg = scene.config.strength_reduction.as_ref().expect("caller");
     let opts = RunOptions {
         progress: false,
         strength_factor: Some(factor),
         monitor: cfg.monitor.clone(),
+        start_from: from.map(|s| s.particles.clone()),
+        keep_final_particles: keep,
         ..Default::default()
     };
     let started = Instant::now();
@@ -163,23 +207,57 @@ pub fn trial(
         monitor_displacement: moved,
         wall_seconds: started.elapsed().as_secs_f64(),
         dir: dir.to_string(),
+        from: from.map(|s| s.dir.clone()),
         message,
     };
     Ok((trial, summary))
 }
 
+/// A trial gives up once Newton's residual has risen in this many consecutive
+/// iterations (`[solver] max_rising_iterations`, unless the scene sets it).
+pub const TRIAL_RISING_ITERATIONS: usize = 2;
+
+/// The scene as its trials run it: every implicit stage with the trial's
+/// `max_rising_iterations` unless the scene gives its own.
+fn trial_scene(scene: &Scene) -> Scene {
+    let mut trial = scene.clone();
+    let cfg = &mut trial.config;
+    for s in cfg.solver.iter_mut().chain(cfg.stages.iter_mut()) {
+        if s.kind == SolverKind::Implicit {
+            s.max_rising_iterations
+                .get_or_insert(TRIAL_RISING_ITERATIONS);
+        }
+    }
+    trial
+}
+
 /// Search for the factor of safety; outputs into `out` (module docs).
 pub fn search(scene: &Scene, out: &Path, opts: &RunOptions) -> Result<SearchSummary, SearchError> {
+    let given = scene;
+    let scene = &trial_scene(given);
     let cfg = scene.config.strength_reduction.as_ref().expect("caller");
     let started = Instant::now();
     std::fs::create_dir_all(out)?;
     let mut csv = CsvWriter::create(&out.join("strength_reduction.csv"), &CSV_COLUMNS)?;
     let mut trials: Vec<Trial> = Vec::new();
     let mut particles = 0;
+    let continuation = cfg.continuation() && continues(scene).is_ok();
+    // The stable trial with the largest factor, when the trials continue.
+    let mut last_stable: Option<Start> = None;
     let mut run_trial = |factor: f64, trials: &mut Vec<Trial>| -> Result<bool, SearchError> {
         let dir = format!("trials/{:02}_F{factor:.4}", trials.len());
-        let (t, summary) = trial(scene, out, &dir, factor)?;
+        let from = last_stable.as_ref().filter(|s| s.factor < factor);
+        let (t, summary) = trial(scene, out, &dir, factor, from, continuation)?;
         particles = summary.particles;
+        if let (TrialStatus::Stable, Some(p)) = (t.status, summary.final_particles) {
+            if last_stable.as_ref().is_none_or(|s| s.factor < factor) {
+                last_stable = Some(Start {
+                    factor,
+                    dir: dir.clone(),
+                    particles: p,
+                });
+            }
+        }
         let name = Path::new(&t.dir)
             .file_name()
             .unwrap()
@@ -194,11 +272,17 @@ pub fn search(scene: &Scene, out: &Path, opts: &RunOptions) -> Result<SearchSumm
             t.monitor_displacement.into(),
             t.wall_seconds.into(),
             Field::Text(&name),
+            Field::Text(
+                t.from
+                    .as_deref()
+                    .and_then(|f| f.strip_prefix("trials/"))
+                    .unwrap_or(""),
+            ),
         ])?;
         csv.flush()?;
         if opts.progress {
             eprintln!(
-                "strength reduction: F = {factor:.4} {} ({} steps, {} Newton iterations, {} cut-backs, {:.1} s)",
+                "strength reduction: F = {factor:.4} {} ({} steps, {} Newton iterations, {} cut-backs, {:.1} s{})",
                 match t.status {
                     TrialStatus::Stable => "holds",
                     TrialStatus::FailedNewton => "fails (Newton)",
@@ -207,7 +291,11 @@ pub fn search(scene: &Scene, out: &Path, opts: &RunOptions) -> Result<SearchSumm
                 t.steps,
                 t.newton_iterations,
                 t.cutbacks,
-                t.wall_seconds
+                t.wall_seconds,
+                match &t.from {
+                    Some(f) => format!(", from {f}"),
+                    None => String::new(),
+                }
             );
         }
         let failed = t.status.failed();
@@ -264,6 +352,7 @@ pub fn search(scene: &Scene, out: &Path, opts: &RunOptions) -> Result<SearchSumm
         mechanism_failed: find(failed),
         trials,
         particles,
+        continuation,
         status: SearchStatus::Completed,
         factor_of_safety: None,
         factor_of_safety_bracket: None,

@@ -96,7 +96,7 @@ pub struct Checkpoint {
 
 /// The particles as flat arrays: vectors D values each, 3×3 matrices 9 values
 /// each in column order.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ParticleState {
     pub count: usize,
     pub x: Vec<f64>,

@@ -4,7 +4,7 @@
 
 use crate::model::Model;
 use crate::output::write_particles_csv_with;
-use crate::run::checkpoint::Resume;
+use crate::run::checkpoint::{ParticleState, Resume};
 use crate::run::error::RunError;
 use crate::run::interrupt;
 use crate::run::options::RunOptions;
@@ -66,6 +66,8 @@ pub(super) fn summary<const D: usize>(
             step: r.checkpoint.step,
             time: r.checkpoint.time,
         }),
+        final_particles: (opts.keep_final_particles)
+            .then(|| std::sync::Arc::new(ParticleState::of(&model.particles))),
     }
 }
 

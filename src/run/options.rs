@@ -1,6 +1,8 @@
 //! What a run is asked from outside the scene (the command line).
 
+use crate::run::checkpoint::ParticleState;
 use std::path::PathBuf;
+use std::sync::Arc;
 
 /// Options that do not belong in the scene.
 #[derive(Clone, Debug, Default)]
@@ -18,4 +20,12 @@ pub struct RunOptions {
     pub memory_limit: Option<f64>,
     /// Continue from this checkpoint instead of starting at t = 0.
     pub restart: Option<PathBuf>,
+    /// Start at t = 0 from these particles instead of the scene's initial
+    /// state: the end state of an earlier run of the same scene (a strength
+    /// reduction search's last stable trial, `analyses::strength_reduction`).
+    /// No geostatic stresses are set and the history variables are those the
+    /// particles carry.
+    pub start_from: Option<Arc<ParticleState>>,
+    /// Keep the particles' end state in `Summary::final_particles`.
+    pub keep_final_particles: bool,
 }

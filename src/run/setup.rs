@@ -51,13 +51,31 @@ impl<const D: usize> SetUp<D> {
             restore_bonds(&r.checkpoint, &r.path, &mut model)?;
             model.update_pore_pressure();
         }
+        let started_from = match (&opts.start_from, resume) {
+            (Some(state), None) => {
+                model.particles = (state.particles::<D>())
+                    .ok()
+                    .filter(|p| p.len() == model.particles.len())
+                    .ok_or_else(|| {
+                        RunError::Checkpoint(format!(
+                            "{}: the state to start from does not fit the {} particles the scene builds",
+                            scene.file,
+                            model.particles.len()
+                        ))
+                    })?;
+                model.update_pore_pressure();
+                true
+            }
+            _ => false,
+        };
         if strength_factor != 1.0 {
             model.reduce_strength(strength_factor);
         }
-        if let (Some(g), None) = (&cfg.geostatic, resume) {
+        let fresh = resume.is_none() && !started_from;
+        if let (Some(g), true) = (&cfg.geostatic, fresh) {
             crate::physics::geostatic::initialise(&mut model, g);
         }
-        if resume.is_none() {
+        if fresh {
             model.initialise_history();
         }
         let monitor = opts

@@ -2,11 +2,13 @@
 //! it; `mpm bench`, strength reduction and the tests read it back).
 
 use crate::output::write_json;
+use crate::run::checkpoint::ParticleState;
 use crate::scene::ShapeFunction;
 use crate::solver::report::SolverReport;
 use serde::{Deserialize, Deserializer, Serialize};
 use std::io;
 use std::path::Path;
+use std::sync::Arc;
 
 /// How a run ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -73,6 +75,10 @@ pub struct Summary {
     /// The stages' warnings, each naming its stage.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
+    /// The particles at the end, when the run was asked to keep them
+    /// (`RunOptions::keep_final_particles`; not written to summary.json).
+    #[serde(skip)]
+    pub final_particles: Option<Arc<ParticleState>>,
 }
 
 /// Where a restarted run began.

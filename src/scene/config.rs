@@ -684,6 +684,11 @@ pub struct StrengthReductionConfig {
     pub max_displacement: Option<f64>,
     /// Most trials the search may run (default 20).
     pub max_trials: Option<usize>,
+    /// Start each trial from the last stable trial's end state, its strengths
+    /// reduced further (default true; `false`: every trial from the scene's
+    /// initial state). Only a scene of one implicit quasi-static stage
+    /// continues (`analyses::strength_reduction::continues`).
+    pub continuation: Option<bool>,
 }
 
 impl StrengthReductionConfig {
@@ -692,6 +697,9 @@ impl StrengthReductionConfig {
     }
     pub fn max_trials(&self) -> usize {
         self.max_trials.unwrap_or(20)
+    }
+    pub fn continuation(&self) -> bool {
+        self.continuation.unwrap_or(true)
     }
 }
 

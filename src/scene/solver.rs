@@ -156,6 +156,9 @@ pub struct SolverConfig {
     pub residual_tolerance: Option<f64>,
     pub displacement_tolerance: Option<f64>,
     pub max_iterations: Option<usize>,
+    /// Newton gives an attempt up once its residual has risen in this many
+    /// consecutive iterations (`max_rising_iterations()`).
+    pub max_rising_iterations: Option<usize>,
     pub line_search: Option<bool>,
     pub max_cutbacks: Option<usize>,
     pub min_node_support: Option<f64>,
@@ -336,6 +339,7 @@ pub const SCOPES: &[Scope] = &[
     scope!(residual_tolerance, IMPLICIT, &[], &[], ""),
     scope!(displacement_tolerance, IMPLICIT, &[], &[], ""),
     scope!(max_iterations, IMPLICIT, &[], &[], ""),
+    scope!(max_rising_iterations, IMPLICIT, &[], &[], ""),
     scope!(line_search, IMPLICIT, &[], &[], ""),
     scope!(max_cutbacks, IMPLICIT, &[], &[], ""),
     scope!(min_node_support, IMPLICIT, &[], &[], ""),
@@ -410,6 +414,13 @@ impl SolverConfig {
     /// Newton iteration cap per attempt (default 25).
     pub fn max_iterations(&self) -> usize {
         self.max_iterations.unwrap_or(25)
+    }
+    /// Newton fails an attempt (the step is cut back, or the run stops) once
+    /// ‖r‖ has risen in this many consecutive iterations, a divergence check
+    /// as in Abaqus's (default: none, only the iteration cap; a
+    /// strength-reduction trial takes 2, `analyses::strength_reduction`).
+    pub fn max_rising_iterations(&self) -> Option<usize> {
+        self.max_rising_iterations
     }
     /// Backtracking line search on the residual norm (default off).
     pub fn line_search(&self) -> bool {

@@ -194,6 +194,13 @@ fn implicit(s: &SolverConfig, prefix: &str) -> Check {
         MAX_NEWTON_ITERATIONS,
         format!("{prefix}.max_iterations"),
     )?;
+    if let Some(n) = s.max_rising_iterations() {
+        ensure(
+            n >= 1,
+            format!("{prefix}.max_rising_iterations"),
+            "must be at least 1 (consecutive iterations whose residual rose)",
+        )?;
+    }
     ensure(
         s.max_cutbacks() <= MAX_CUTBACKS,
         format!("{prefix}.max_cutbacks"),

@@ -11,7 +11,8 @@
 //!    that raised it least), keeping the residual it found for step 1;
 //! 5. updates u ← u + s δu; tied nodes follow their masters.
 //!
-//! A non-finite residual, an inverted particle, a failed linear solve or no
+//! A non-finite residual, an inverted particle, a failed linear solve, a
+//! residual that rose in `max_rising_iterations` consecutive iterations or no
 //! convergence in `max_iterations` fails the attempt: the caller cuts the step
 //! back. Every iteration is a row of newton.csv.
 
@@ -34,6 +35,9 @@ pub struct Newton {
     pub residual_tolerance: f64,
     pub displacement_tolerance: f64,
     pub max_iterations: usize,
+    /// The attempt fails once ‖r‖ has risen in this many consecutive
+    /// iterations (`usize::MAX`: never).
+    pub max_rising_iterations: usize,
     pub line_search: bool,
     /// How the corrections are solved.
     pub linear: Linear,
@@ -66,6 +70,7 @@ impl Newton {
             residual_tolerance: s.residual_tolerance(),
             displacement_tolerance: s.displacement_tolerance(),
             max_iterations: s.max_iterations(),
+            max_rising_iterations: s.max_rising_iterations().unwrap_or(usize::MAX),
             line_search: s.line_search(),
             linear: match KrylovConfig::of(s) {
                 Some(config) => Linear::Krylov(KrylovState::new(config)),
@@ -118,6 +123,8 @@ impl Newton {
         };
         let mut method = "none".to_string();
         let mut known = None;
+        // ‖r‖ of the previous iteration, and how many iterations in a row raised it.
+        let (mut previous, mut rising) = (f64::INFINITY, 0usize);
         for iteration in 0..=self.max_iterations {
             // Residual at the current iterate, from the step-start state (2-37),
             // unless the line search left it (and the trial state) there.
@@ -152,6 +159,18 @@ impl Newton {
             if test.converged(iteration, r_norm, reference, floor) {
                 self.log.push(row);
                 return Ok(Converged { u, reaction });
+            }
+            rising = if r_norm > previous { rising + 1 } else { 0 };
+            previous = r_norm;
+            if rising >= self.max_rising_iterations {
+                self.log.push(row);
+                return Err(Failure {
+                    particle: None,
+                    message: format!(
+                        "the residual rose in {rising} consecutive Newton iterations, to iteration {iteration} (max_rising_iterations = {})",
+                        self.max_rising_iterations
+                    ),
+                });
             }
             if iteration == self.max_iterations {
                 self.log.push(row);
