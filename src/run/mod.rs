@@ -16,6 +16,7 @@ pub(crate) mod footing;
 pub mod interrupt;
 pub(crate) mod options;
 mod particle_dumps;
+pub mod particle_state;
 pub(crate) mod recorders;
 mod schedule;
 mod setup;

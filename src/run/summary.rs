@@ -2,7 +2,7 @@
 //! it; `mpm bench`, strength reduction and the tests read it back).
 
 use crate::output::write_json;
-use crate::run::checkpoint::ParticleState;
+use crate::run::particle_state::ParticleState;
 use crate::scene::ShapeFunction;
 use crate::solver::report::SolverReport;
 use serde::{Deserialize, Deserializer, Serialize};
