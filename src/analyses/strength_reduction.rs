@@ -233,8 +233,7 @@ fn trial_scene(scene: &Scene) -> Scene {
 
 /// Search for the factor of safety; outputs into `out` (module docs).
 pub fn search(scene: &Scene, out: &Path, opts: &RunOptions) -> Result<SearchSummary, SearchError> {
-    let given = scene;
-    let scene = &trial_scene(given);
+    let scene = &trial_scene(scene);
     let cfg = scene.config.strength_reduction.as_ref().expect("caller");
     let started = Instant::now();
     std::fs::create_dir_all(out)?;

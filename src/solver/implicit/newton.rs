@@ -119,12 +119,11 @@ impl Newton {
             displacement_tolerance: self.displacement_tolerance,
             applied: norm(&sys.dofs.reduce(&sys.f_ext)).max(norm(&sys.dofs.reduce(&inertial))),
             previous_residual: f64::INFINITY,
+            rising: 0,
             last_increment: f64::NAN,
         };
         let mut method = "none".to_string();
         let mut known = None;
-        // ‖r‖ of the previous iteration, and how many iterations in a row raised it.
-        let (mut previous, mut rising) = (f64::INFINITY, 0usize);
         for iteration in 0..=self.max_iterations {
             // Residual at the current iterate, from the step-start state (2-37),
             // unless the line search left it (and the trial state) there.
@@ -160,8 +159,7 @@ impl Newton {
                 self.log.push(row);
                 return Ok(Converged { u, reaction });
             }
-            rising = if r_norm > previous { rising + 1 } else { 0 };
-            previous = r_norm;
+            let rising = test.rising;
             if rising >= self.max_rising_iterations {
                 self.log.push(row);
                 return Err(Failure {
@@ -258,6 +256,8 @@ struct Convergence {
     applied: f64,
     /// ‖r‖ of the previous iteration.
     previous_residual: f64,
+    /// How many iterations in a row raised ‖r‖.
+    rising: usize,
     /// ‖δu‖ / ‖u‖ of the last correction (NaN before the first).
     last_increment: f64,
 }
@@ -287,6 +287,11 @@ impl Convergence {
         // at round-off: a converged residual that a correction no longer halves
         // is at the round-off floor and accepted.
         let stalled = iteration >= 2 && r_norm >= 0.5 * self.previous_residual;
+        self.rising = if r_norm > self.previous_residual {
+            self.rising + 1
+        } else {
+            0
+        };
         self.previous_residual = r_norm;
         let increment_ok =
             iteration == 0 || self.last_increment <= self.displacement_tolerance || stalled;
