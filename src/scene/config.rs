@@ -815,6 +815,8 @@ pub enum ReferenceKind {
     VibratingBar,
     /// Cantilever with an end load: tip deflection against the elastica.
     Cantilever,
+    /// Any scene: the displacement field against a finer reference run's.
+    DisplacementField,
 }
 
 impl ReferenceKind {
@@ -847,6 +849,9 @@ pub struct ReferenceConfig {
     pub kind: ReferenceKind,
     /// Cantilever only: the beam model (default `reissner`).
     pub beam: Option<Beam>,
+    /// Displacement field only: the reference run's `particles_final.csv`,
+    /// relative to the scene file.
+    pub file: Option<String>,
 }
 
 /// The `[bench]` table (or the same table in a separate file given to

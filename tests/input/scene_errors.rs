@@ -614,6 +614,51 @@ fn a_reference_that_does_not_fit_is_rejected() {
     );
 }
 
+/// `[reference] file` belongs to `kind = "displacement_field"`, which needs it.
+#[test]
+fn a_reference_file_goes_with_the_displacement_field_kind() {
+    let dir = tempfile::tempdir().unwrap();
+    for (table, words) in [
+        (
+            "kind = \"column\"\nfile = \"ref.csv\"",
+            ["key `reference.file`", "displacement_field"],
+        ),
+        (
+            "kind = \"displacement_field\"",
+            ["key `reference.file`", "particles_final.csv"],
+        ),
+    ] {
+        let path = dir.path().join("bad.toml");
+        std::fs::write(&path, format!("{GOOD}\n[reference]\n{table}\n")).unwrap();
+        let result = Command::new(env!("CARGO_BIN_EXE_mpm"))
+            .arg("check")
+            .arg(&path)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&result.stderr);
+        assert_eq!(result.status.code(), Some(2), "{table}: {stderr}");
+        assert!(
+            words.iter().all(|w| stderr.contains(w)) && stderr.contains("bad.toml:"),
+            "{table}: {stderr}"
+        );
+    }
+    // Given, the file is read only when an error is measured (mpm bench): the
+    // reference run may come after the scene.
+    let path = dir.path().join("good.toml");
+    let table = "kind = \"displacement_field\"\nfile = \"later/particles_final.csv\"";
+    std::fs::write(&path, format!("{GOOD}\n[reference]\n{table}\n")).unwrap();
+    let result = Command::new(env!("CARGO_BIN_EXE_mpm"))
+        .arg("check")
+        .arg(&path)
+        .output()
+        .unwrap();
+    assert!(
+        result.status.success(),
+        "{}",
+        String::from_utf8_lossy(&result.stderr)
+    );
+}
+
 #[test]
 fn prism_mistakes_are_named() {
     let text = std::fs::read_to_string(crate::common::problem("slope_3d.toml")).unwrap();

@@ -417,7 +417,8 @@ fn run_point(
     read_outputs(&mut row, &run_dir);
     row.status = status(child.exit, &run_dir, timeout);
     if row.is_ok() {
-        match reference::from_scene(cfg) {
+        // The reference's files are beside the scene the bench was given.
+        match reference::from_scene(cfg, file) {
             Ok(Some(measure)) => match measure.error(&run_dir) {
                 Ok(e) => row.error = Some(e),
                 Err(m) => row.note = format!("no error: {m}"),
