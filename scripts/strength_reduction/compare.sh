@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Strength-reduction search with its defaults (continuation from the last
-# stable trial, a trial given up when Newton's residual rises twice in a row) against the
+# stable trial, a trial given up when Newton's residual rises twice in a row or falls by
+# less than 10 % over 10 iterations) against the
 # search as it was (every trial from the initial state, Newton to its cap),
 # alternated ROUNDS times per scene; prints factor, bracket, trials, Newton
 # iterations and wall seconds of each run, and the ratio of the medians.
@@ -25,7 +26,7 @@ for r in $(seq "$rounds"); do
   echo "round $r new: $(summarise "$out/new")"
   new+=("$(python3 -c "import json;print(json.load(open('$out/new/summary.json'))['wall_seconds'])")")
   "$mpm" run "$scene" --out "$out/old" "$@" --set strength_reduction.continuation=false \
-    --set solver.max_rising_iterations=1000 > /dev/null 2>&1 || true
+    --set solver.max_rising_iterations=1000 --set solver.stall_iterations=1000 > /dev/null 2>&1 || true
   echo "round $r old: $(summarise "$out/old")"
   old+=("$(python3 -c "import json;print(json.load(open('$out/old/summary.json'))['wall_seconds'])")")
 done

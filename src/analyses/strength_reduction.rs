@@ -217,8 +217,12 @@ pub fn trial(
 /// iterations (`[solver] max_rising_iterations`, unless the scene sets it).
 pub const TRIAL_RISING_ITERATIONS: usize = 2;
 
+/// A trial gives up once Newton's residual has fallen by less than 10 % over
+/// this many iterations (`[solver] stall_iterations`, unless the scene sets it).
+pub const TRIAL_STALL_ITERATIONS: usize = 10;
+
 /// The scene as its trials run it: every implicit stage with the trial's
-/// `max_rising_iterations` unless the scene gives its own.
+/// `max_rising_iterations` and `stall_iterations` unless the scene gives its own.
 fn trial_scene(scene: &Scene) -> Scene {
     let mut trial = scene.clone();
     let cfg = &mut trial.config;
@@ -226,6 +230,7 @@ fn trial_scene(scene: &Scene) -> Scene {
         if s.kind == SolverKind::Implicit {
             s.max_rising_iterations
                 .get_or_insert(TRIAL_RISING_ITERATIONS);
+            s.stall_iterations.get_or_insert(TRIAL_STALL_ITERATIONS);
         }
     }
     trial

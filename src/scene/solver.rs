@@ -159,6 +159,9 @@ pub struct SolverConfig {
     /// Newton gives an attempt up once its residual has risen in this many
     /// consecutive iterations (`max_rising_iterations()`).
     pub max_rising_iterations: Option<usize>,
+    /// Newton gives an attempt up once its residual has fallen by less than
+    /// 10 % over this many iterations (`stall_iterations()`).
+    pub stall_iterations: Option<usize>,
     pub line_search: Option<bool>,
     pub max_cutbacks: Option<usize>,
     pub min_node_support: Option<f64>,
@@ -340,6 +343,7 @@ pub const SCOPES: &[Scope] = &[
     scope!(displacement_tolerance, IMPLICIT, &[], &[], ""),
     scope!(max_iterations, IMPLICIT, &[], &[], ""),
     scope!(max_rising_iterations, IMPLICIT, &[], &[], ""),
+    scope!(stall_iterations, IMPLICIT, &[], &[], ""),
     scope!(line_search, IMPLICIT, &[], &[], ""),
     scope!(max_cutbacks, IMPLICIT, &[], &[], ""),
     scope!(min_node_support, IMPLICIT, &[], &[], ""),
@@ -421,6 +425,12 @@ impl SolverConfig {
     /// strength-reduction trial takes 2, `analyses::strength_reduction`).
     pub fn max_rising_iterations(&self) -> Option<usize> {
         self.max_rising_iterations
+    }
+    /// Newton fails an attempt once ‖r‖ has fallen by less than 10 % over
+    /// this many iterations (`newton::STALL_REDUCTION`): it creeps instead of
+    /// converging (default: none; a strength-reduction trial takes 10).
+    pub fn stall_iterations(&self) -> Option<usize> {
+        self.stall_iterations
     }
     /// Backtracking line search on the residual norm (default off).
     pub fn line_search(&self) -> bool {

@@ -201,6 +201,13 @@ fn implicit(s: &SolverConfig, prefix: &str) -> Check {
             "must be at least 1 (consecutive iterations whose residual rose)",
         )?;
     }
+    if let Some(n) = s.stall_iterations() {
+        ensure(
+            n >= 1,
+            format!("{prefix}.stall_iterations"),
+            "must be at least 1 (iterations over which the residual must fall by 10 %)",
+        )?;
+    }
     ensure(
         s.max_cutbacks() <= MAX_CUTBACKS,
         format!("{prefix}.max_cutbacks"),

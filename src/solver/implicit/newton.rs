@@ -12,9 +12,10 @@
 //! 5. updates u ← u + s δu; tied nodes follow their masters.
 //!
 //! A non-finite residual, an inverted particle, a failed linear solve, a
-//! residual that rose in `max_rising_iterations` consecutive iterations or no
-//! convergence in `max_iterations` fails the attempt: the caller cuts the step
-//! back. Every iteration is a row of newton.csv.
+//! residual that rose in `max_rising_iterations` consecutive iterations, one
+//! that fell by less than `STALL_REDUCTION` over the last `stall_iterations`
+//! iterations, or no convergence in `max_iterations` fails the attempt: the
+//! caller cuts the step back. Every iteration is a row of newton.csv.
 
 use super::assembly::{Storage, Tangent};
 use super::export::{Export, Iterate};
@@ -38,6 +39,9 @@ pub struct Newton {
     /// The attempt fails once ‖r‖ has risen in this many consecutive
     /// iterations (`usize::MAX`: never).
     pub max_rising_iterations: usize,
+    /// The attempt fails once ‖r‖ has fallen by less than `STALL_REDUCTION`
+    /// over this many iterations (`usize::MAX`: never).
+    pub stall_iterations: usize,
     pub line_search: bool,
     /// How the corrections are solved.
     pub linear: Linear,
@@ -71,6 +75,7 @@ impl Newton {
             displacement_tolerance: s.displacement_tolerance(),
             max_iterations: s.max_iterations(),
             max_rising_iterations: s.max_rising_iterations().unwrap_or(usize::MAX),
+            stall_iterations: s.stall_iterations().unwrap_or(usize::MAX),
             line_search: s.line_search(),
             linear: match KrylovConfig::of(s) {
                 Some(config) => Linear::Krylov(KrylovState::new(config)),
@@ -120,6 +125,7 @@ impl Newton {
             applied: norm(&sys.dofs.reduce(&sys.f_ext)).max(norm(&sys.dofs.reduce(&inertial))),
             previous_residual: f64::INFINITY,
             rising: 0,
+            history: Vec::new(),
             last_increment: f64::NAN,
         };
         let mut method = "none".to_string();
@@ -167,6 +173,17 @@ impl Newton {
                     message: format!(
                         "the residual rose in {rising} consecutive Newton iterations, to iteration {iteration} (max_rising_iterations = {})",
                         self.max_rising_iterations
+                    ),
+                });
+            }
+            if test.stalled_over(self.stall_iterations) {
+                self.log.push(row);
+                return Err(Failure {
+                    particle: None,
+                    message: format!(
+                        "the residual fell by less than {:.0} % over the last {} Newton iterations, to iteration {iteration} (stall_iterations)",
+                        100.0 * (1.0 - STALL_REDUCTION),
+                        self.stall_iterations
                     ),
                 });
             }
@@ -258,6 +275,8 @@ struct Convergence {
     previous_residual: f64,
     /// How many iterations in a row raised ‖r‖.
     rising: usize,
+    /// ‖r‖ of every iteration so far.
+    history: Vec<f64>,
     /// ‖δu‖ / ‖u‖ of the last correction (NaN before the first).
     last_increment: f64,
 }
@@ -293,11 +312,26 @@ impl Convergence {
             0
         };
         self.previous_residual = r_norm;
+        self.history.push(r_norm);
         let increment_ok =
             iteration == 0 || self.last_increment <= self.displacement_tolerance || stalled;
         residual_ok && increment_ok
     }
 }
+
+impl Convergence {
+    /// Has ‖r‖ fallen by less than `STALL_REDUCTION` over the last `n`
+    /// iterations (‖r_i‖ > STALL_REDUCTION ‖r_{i−n}‖)? Newton that creeps like
+    /// this is not converging within any useful number of iterations.
+    fn stalled_over(&self, n: usize) -> bool {
+        let h = &self.history;
+        n < h.len() && h[h.len() - 1] > STALL_REDUCTION * h[h.len() - 1 - n]
+    }
+}
+
+/// A residual that has not fallen below this fraction of its value
+/// `stall_iterations` iterations earlier has stalled (a fall of less than 10 %).
+pub const STALL_REDUCTION: f64 = 0.9;
 
 /// δu = −K⁻¹ r with the assembled consistent tangent (2-40), factorized by the
 /// direct solver; with `export`, K and −r are written too.
@@ -395,4 +429,41 @@ fn line_search<const D: usize>(
     // No length lowered ‖r‖: the one that raised it least. Its residual (and
     // the trial state) is the last evaluated only if it is the shortest.
     (best.1, last.filter(|_| best.1 == SHORTEST))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn after(residuals: &[f64]) -> Convergence {
+        let mut c = Convergence {
+            residual_tolerance: 1e-6,
+            displacement_tolerance: 1e-6,
+            applied: 1.0,
+            previous_residual: f64::INFINITY,
+            rising: 0,
+            history: Vec::new(),
+            last_increment: f64::NAN,
+        };
+        for (i, r) in residuals.iter().enumerate() {
+            assert!(!c.converged(i, *r, 1.0, 0.0));
+        }
+        c
+    }
+
+    #[test]
+    fn a_residual_creeping_down_by_less_than_ten_percent_over_the_window_has_stalled() {
+        // Falling 2 % per iteration: 0.98^5 = 0.904 > 0.9 over five iterations.
+        let creep: Vec<f64> = (0..8).map(|i| 1e-2 * 0.98f64.powi(i)).collect();
+        assert!(after(&creep).stalled_over(5));
+        // Not before the window is full, and not with a longer window.
+        assert!(!after(&creep[..5]).stalled_over(5));
+        assert!(!after(&creep).stalled_over(8));
+        // Falling 3 % per iteration: 0.97^5 = 0.859, still converging.
+        let falling: Vec<f64> = (0..8).map(|i| 1e-2 * 0.97f64.powi(i)).collect();
+        assert!(!after(&falling).stalled_over(5));
+        // A plateau broken by a fast fall within the window is not a stall.
+        let plateau = [1e-2, 9.9e-3, 9.8e-3, 9.7e-3, 9.6e-3, 1e-3];
+        assert!(!after(&plateau).stalled_over(5));
+    }
 }
