@@ -123,7 +123,6 @@ impl Newton {
             residual_tolerance: self.residual_tolerance,
             displacement_tolerance: self.displacement_tolerance,
             applied: norm(&sys.dofs.reduce(&sys.f_ext)).max(norm(&sys.dofs.reduce(&inertial))),
-            previous_residual: f64::INFINITY,
             rising: 0,
             history: Vec::new(),
             last_increment: f64::NAN,
@@ -165,26 +164,13 @@ impl Newton {
                 self.log.push(row);
                 return Ok(Converged { u, reaction });
             }
-            let rising = test.rising;
-            if rising >= self.max_rising_iterations {
+            let hopeless =
+                test.hopeless(iteration, self.max_rising_iterations, self.stall_iterations);
+            if let Some(message) = hopeless {
                 self.log.push(row);
                 return Err(Failure {
                     particle: None,
-                    message: format!(
-                        "the residual rose in {rising} consecutive Newton iterations, to iteration {iteration} (max_rising_iterations = {})",
-                        self.max_rising_iterations
-                    ),
-                });
-            }
-            if test.stalled_over(self.stall_iterations) {
-                self.log.push(row);
-                return Err(Failure {
-                    particle: None,
-                    message: format!(
-                        "the residual fell by less than {:.0} % over the last {} Newton iterations, to iteration {iteration} (stall_iterations)",
-                        100.0 * (1.0 - STALL_REDUCTION),
-                        self.stall_iterations
-                    ),
+                    message,
                 });
             }
             if iteration == self.max_iterations {
@@ -271,8 +257,6 @@ struct Convergence {
     /// The larger of the applied and the predictor's inertial force, ‖f_ext‖ and
     /// ‖M ũ/(βΔt²)‖ over the unknowns.
     applied: f64,
-    /// ‖r‖ of the previous iteration.
-    previous_residual: f64,
     /// How many iterations in a row raised ‖r‖.
     rising: usize,
     /// ‖r‖ of every iteration so far.
@@ -305,27 +289,44 @@ impl Convergence {
         // Near rest (e.g. settled on absorbing faces) ‖u‖ → 0 and ‖δu‖/‖u‖ stalls
         // at round-off: a converged residual that a correction no longer halves
         // is at the round-off floor and accepted.
-        let stalled = iteration >= 2 && r_norm >= 0.5 * self.previous_residual;
-        self.rising = if r_norm > self.previous_residual {
+        let previous = self.history.last().copied().unwrap_or(f64::INFINITY);
+        let stalled = iteration >= 2 && r_norm >= 0.5 * previous;
+        self.rising = if r_norm > previous {
             self.rising + 1
         } else {
             0
         };
-        self.previous_residual = r_norm;
         self.history.push(r_norm);
         let increment_ok =
             iteration == 0 || self.last_increment <= self.displacement_tolerance || stalled;
         residual_ok && increment_ok
     }
-}
 
-impl Convergence {
     /// Has ‖r‖ fallen by less than `STALL_REDUCTION` over the last `n`
     /// iterations (‖r_i‖ > STALL_REDUCTION ‖r_{i−n}‖)? Newton that creeps like
     /// this is not converging within any useful number of iterations.
     fn stalled_over(&self, n: usize) -> bool {
         let h = &self.history;
         n < h.len() && h[h.len() - 1] > STALL_REDUCTION * h[h.len() - 1 - n]
+    }
+
+    /// Why this attempt will not converge, if its residual history up to
+    /// `iteration` says so: ‖r‖ rose in `max_rising` consecutive iterations,
+    /// or fell by less than `STALL_REDUCTION` over the last `stall`
+    /// (`usize::MAX`: no such check).
+    fn hopeless(&self, iteration: usize, max_rising: usize, stall: usize) -> Option<String> {
+        if self.rising >= max_rising {
+            return Some(format!(
+                "the residual rose in {} consecutive Newton iterations, to iteration {iteration} (max_rising_iterations = {max_rising})",
+                self.rising
+            ));
+        }
+        self.stalled_over(stall).then(|| {
+            format!(
+                "the residual fell by less than {:.0} % over the last {stall} Newton iterations, to iteration {iteration} (stall_iterations)",
+                100.0 * (1.0 - STALL_REDUCTION)
+            )
+        })
     }
 }
 
@@ -440,7 +441,6 @@ mod tests {
             residual_tolerance: 1e-6,
             displacement_tolerance: 1e-6,
             applied: 1.0,
-            previous_residual: f64::INFINITY,
             rising: 0,
             history: Vec::new(),
             last_increment: f64::NAN,
