@@ -70,6 +70,30 @@ impl std::fmt::Display for NotClosed {
 type Edge = (usize, usize);
 
 impl TriangleSurface {
+    /// One vertex per distinct corner (−0 and +0 alike), and the triangles by
+    /// vertex index; a collapsed triangle (two equal corners) is left out.
+    pub fn from_facets(facets: &[[[f64; 3]; 3]]) -> TriangleSurface {
+        let mut index: std::collections::HashMap<[u64; 3], usize> = Default::default();
+        let mut vertices = Vec::new();
+        let mut triangles = Vec::with_capacity(facets.len());
+        for f in facets {
+            let t = f.map(|corner| {
+                let key = corner.map(|x| if x == 0.0 { 0 } else { x.to_bits() });
+                *index.entry(key).or_insert_with(|| {
+                    vertices.push(corner);
+                    vertices.len() - 1
+                })
+            });
+            if t[0] != t[1] && t[1] != t[2] && t[2] != t[0] {
+                triangles.push(t);
+            }
+        }
+        TriangleSurface {
+            vertices,
+            triangles,
+        }
+    }
+
     /// Whether every edge belongs to exactly two triangles that run it in
     /// opposite directions; else the first offending edge in the file's order.
     pub fn check_closed(&self) -> Result<(), NotClosed> {

@@ -248,6 +248,9 @@ pub struct BodyConfig {
     pub body_id: Option<u32>,
     /// A `terrain` body's bottom elevation (z).
     pub base: Option<f64>,
+    /// A `terrain` body's bottom surface: a raster file (the top of the layer
+    /// below), relative to the scene file's folder; instead of `base`.
+    pub base_file: Option<String>,
     /// A `mesh` body: the elements of this physical group only (its name or
     /// its number); without it, every element of the scene's dimension.
     pub physical: Option<PhysicalGroup>,

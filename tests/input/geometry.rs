@@ -334,13 +334,13 @@ end_time = 0.01
 frames = 0
 "#;
 
-type Facet = [[f32; 3]; 3];
+pub(crate) type Facet = [[f32; 3]; 3];
 
 /// The unit sphere as an icosahedron subdivided `levels` times, the new
 /// corners pushed out to the sphere (20 · 4^levels facets, each facing out).
 /// Each corner is computed from its edge's ends alone, so the facets are
 /// symmetric about the three coordinate planes to the bit.
-fn sphere(levels: usize) -> Vec<Facet> {
+pub(crate) fn sphere(levels: usize) -> Vec<Facet> {
     let g = (1.0 + 5f64.sqrt()) / 2.0;
     let unit = |v: [f64; 3]| {
         let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
@@ -415,7 +415,7 @@ fn sphere(levels: usize) -> Vec<Facet> {
 }
 
 /// The cube [−1, 1]³ moved by `shift`, two facets a face, facing out.
-fn cube(shift: [f32; 3]) -> Vec<Facet> {
+pub(crate) fn cube(shift: [f32; 3]) -> Vec<Facet> {
     let v = |k: usize| -> [f32; 3] {
         std::array::from_fn(|d| if (k >> d) & 1 == 1 { 1.0 } else { -1.0 } + shift[d])
     };
@@ -432,7 +432,7 @@ fn cube(shift: [f32; 3]) -> Vec<Facet> {
         .collect()
 }
 
-fn write_binary(path: &Path, facets: &[Facet]) {
+pub(crate) fn write_binary(path: &Path, facets: &[Facet]) {
     let mesh: Vec<stl_io::Triangle> = (facets.iter())
         .map(|f| stl_io::Triangle {
             normal: stl_io::Normal::new([0.0; 3]),
@@ -457,7 +457,7 @@ fn write_ascii(path: &Path, facets: &[Facet]) {
     std::fs::write(path, text).unwrap();
 }
 
-fn solid(dir: &Path, file: &str) -> Result<Model<3>, mpm::scene::SceneError> {
+pub(crate) fn solid(dir: &Path, file: &str) -> Result<Model<3>, mpm::scene::SceneError> {
     let body = format!("shape = \"surface\"\nfile = \"{file}\"");
     let text = SOLID.replace("BODY", &body);
     let scene = Scene::parse(dir.join("scene.toml").to_str().unwrap(), &text, &[])?;
@@ -465,7 +465,7 @@ fn solid(dir: &Path, file: &str) -> Result<Model<3>, mpm::scene::SceneError> {
 }
 
 /// The particles' total volume and volume-weighted centroid.
-fn volume_and_centroid(m: &Model<3>) -> (f64, [f64; 3]) {
+pub(crate) fn volume_and_centroid(m: &Model<3>) -> (f64, [f64; 3]) {
     let p = &m.particles;
     let v: f64 = p.volume.iter().sum();
     let c = std::array::from_fn(|d| (0..p.len()).map(|q| p.volume[q] * p.x[q][d]).sum::<f64>() / v);
@@ -621,7 +621,7 @@ fn check_prints_each_bodys_particles_volume_and_box() {
 /// grid of 1 m cells with 2 particles per cell: side faces on rollers, base
 /// fixed, K0 stresses, 0.05 s of explicit motion under gravity. `BODY` is
 /// replaced by the body's shape keys.
-const SLOPE: &str = r#"
+pub(crate) const SLOPE: &str = r#"
 dimension = 3
 gravity = [0.0, 0.0, -10.0]
 
@@ -677,7 +677,7 @@ const PRISM: &str = "shape = \"prism\"\naxis = \"y\"\nextent = [0.0, 2.0]\n\
 
 /// The slope's surface as an ESRI ASCII grid: 9 × 3 points 1 m apart from
 /// (0, 0), the northern row first.
-fn slope_raster() -> String {
+pub(crate) fn slope_raster() -> String {
     let mut text =
         "ncols 9\nnrows 3\nxllcenter 0\nyllcenter 0\ncellsize 1\nNODATA_value -9999\n".to_string();
     for _ in 0..3 {
@@ -689,7 +689,7 @@ fn slope_raster() -> String {
     text
 }
 
-fn slope(dir: &Path, body: &str) -> Result<Model<3>, mpm::scene::SceneError> {
+pub(crate) fn slope(dir: &Path, body: &str) -> Result<Model<3>, mpm::scene::SceneError> {
     let scene = Scene::parse(
         dir.join("scene.toml").to_str().unwrap(),
         &SLOPE.replace("BODY", body),
@@ -698,7 +698,7 @@ fn slope(dir: &Path, body: &str) -> Result<Model<3>, mpm::scene::SceneError> {
     Model::<3>::build(&scene)
 }
 
-const TERRAIN: &str = "shape = \"terrain\"\nfile = \"ground.asc\"\nbase = 0.0";
+pub(crate) const TERRAIN: &str = "shape = \"terrain\"\nfile = \"ground.asc\"\nbase = 0.0";
 
 #[test]
 fn a_raster_of_a_plane_slope_is_the_prism_of_the_same_slope() {
@@ -776,7 +776,7 @@ fn every_raster_error_names_the_file_and_line() {
     refused(
         &good.replacen("5 4.5 4", "5 4.5 -1", 1),
         "body.0.file",
-        "the elevation -1 at row 1, column 3 is not above the body's base 0",
+        "ground.asc:7: the elevation -1 at row 1, column 3 is not above the body's base 0",
     );
     // Above the grid's top (z = 6, no roller there).
     refused(

@@ -16,6 +16,8 @@ mod geometry;
 mod gmsh;
 mod impact;
 mod key_paths;
+mod obj;
+mod raster;
 mod robustness;
 mod scene_errors;
 mod shipped;

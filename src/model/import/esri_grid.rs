@@ -6,7 +6,7 @@
 //! With `xllcorner` the values belong to the centres of the raster's cells,
 //! half a cell in from the corner. Every error names the file and the line.
 
-use crate::model::terrain::Terrain;
+use crate::model::terrain::{Bottom, Raster};
 use std::path::Path;
 
 /// The header's values.
@@ -21,9 +21,9 @@ struct Header {
     nodata: Option<f64>,
 }
 
-/// Read the raster of `path` (`shown` names it in messages) as the surface
-/// of a body down to `base`.
-pub fn read(path: &Path, shown: &str, base: f64) -> Result<Terrain, String> {
+/// Read the raster of `path` (`shown` names it in messages): the surface of
+/// a body over `bottom`, or a body's bottom surface (`None`).
+pub fn read(path: &Path, shown: &str, bottom: Option<&Bottom>) -> Result<Raster, String> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| format!("cannot read the raster file {shown}: {e}"))?;
     let at = |line: usize, m: String| format!("{shown}:{line}: {m}");
@@ -45,7 +45,7 @@ pub fn read(path: &Path, shown: &str, base: f64) -> Result<Terrain, String> {
             values.push((v, n + 1));
         }
     }
-    terrain(header, &values, base).map_err(|(line, m)| at(line, m))
+    raster(header, &values, bottom).map_err(|(line, m)| at(line, m))
 }
 
 /// One header line's key and value.
@@ -86,9 +86,13 @@ fn header_line(h: &mut Header, words: &[&str]) -> Result<(), String> {
     Ok(())
 }
 
-/// The terrain of a header and its values (each with its line); an error
-/// with the line it concerns.
-fn terrain(h: Header, values: &[(f64, usize)], base: f64) -> Result<Terrain, (usize, String)> {
+/// The raster of a header and its values (each with its line), every
+/// elevation over `bottom`; an error with the line it concerns.
+fn raster(
+    h: Header,
+    values: &[(f64, usize)],
+    bottom: Option<&Bottom>,
+) -> Result<Raster, (usize, String)> {
     let missing = |k: &str| (1, format!("the header has no `{k}`"));
     let columns = h.columns.ok_or_else(|| missing("ncols"))?;
     let rows = h.rows.ok_or_else(|| missing("nrows"))?;
@@ -116,23 +120,25 @@ fn terrain(h: Header, values: &[(f64, usize)], base: f64) -> Result<Terrain, (us
             );
             return Err((line, m));
         }
-        if v <= base {
-            let m = format!(
-                "the elevation {v} at row {}, column {} is not above the body's base {base}",
-                row + 1,
-                column + 1
-            );
-            return Err((line, m));
-        }
         // Stored from the south.
         elevation[(rows - 1 - row) * columns + column] = v;
     }
-    Ok(Terrain {
+    let raster = Raster {
         origin: [x + half(x_centre), y + half(y_centre)],
         cell_size,
         columns,
         rows,
         elevation,
-        base,
-    })
+    };
+    let refused = bottom.and_then(|b| raster.first_refused(|x, y, z| b.refuses(x, y, z)));
+    if let Some((row, column, m)) = refused {
+        let (v, line) = values[row * columns + column];
+        let m = format!(
+            "the elevation {v} at row {}, column {} {m}",
+            row + 1,
+            column + 1
+        );
+        return Err((line, m));
+    }
+    Ok(raster)
 }

@@ -1,22 +1,27 @@
 //! Bodies whose geometry is read from a file (docs/geometry.md): a particle
 //! file (`shape = "particles"`, CSV, `particle_file.rs`), a closed
-//! triangulated surface (`shape = "surface"`, STL, `stl.rs`) and a terrain
-//! raster (`shape = "terrain"`, ESRI ASCII grid, `esri_grid.rs`) and finite
-//! elements (`shape = "mesh"`, Gmsh MSH 4.1, `gmsh.rs`). The `file` key
-//! is a path relative to the scene file's folder. A file error is a scene
-//! error at the body's `file` key whose message names the file and, where it
-//! can, the line and column (particle file), the facet and edge (STL) or the
-//! element (Gmsh).
+//! triangulated surface (`shape = "surface"`, STL `stl.rs` or Wavefront OBJ
+//! `obj.rs`), a terrain raster (`shape = "terrain"`, ESRI ASCII grid
+//! `esri_grid.rs` or GeoTIFF `geotiff.rs`, over a level or a second raster)
+//! and finite elements (`shape = "mesh"`, Gmsh MSH 4.1, `gmsh.rs`). The
+//! `file` and `base_file` keys are paths relative to the scene file's folder.
+//! A file error is a scene error at the body's key for the file, whose message
+//! names the file and, where it can, the line and column (particle file,
+//! ESRI grid, OBJ), the facet and edge (STL, OBJ), the element (Gmsh) or the
+//! raster's row and column (GeoTIFF).
 //! Nothing here runs for a scene without such a body.
 
 pub(crate) mod esri_grid;
+pub(crate) mod geotiff;
 pub(crate) mod gmsh;
+pub(crate) mod obj;
 pub(crate) mod particle_file;
 pub(crate) mod stl;
 
 use crate::material::parameters::FromParameters;
 use crate::material::rigid::Rigid;
 use crate::model::geometry::Geometry;
+use crate::model::terrain::{Bottom, Raster, Terrain};
 use crate::scene::{validate, BodyKindName, BodyShape, Scene, SceneError};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -36,12 +41,7 @@ pub fn body_geometry(scene: &Scene, i: usize) -> Result<Geometry, SceneError> {
         BodyShape::Particles => Geometry::Particles(Arc::new(
             particles(scene, i, &path, &shown).map_err(at_file)?,
         )),
-        BodyShape::Terrain => {
-            let base = b.base.expect("validated");
-            Geometry::Terrain(Arc::new(
-                esri_grid::read(&path, &shown, base).map_err(at_file)?,
-            ))
-        }
+        BodyShape::Terrain => Geometry::Terrain(Arc::new(terrain(scene, i, &path, &shown)?)),
         BodyShape::Mesh => {
             let c = &scene.config;
             let select = gmsh::Select {
@@ -54,6 +54,9 @@ pub fn body_geometry(scene: &Scene, i: usize) -> Result<Geometry, SceneError> {
                 gmsh::read(&path, &shown, &select).map_err(at_file)?,
             ))
         }
+        _ if has_extension(&path, &["obj"]) => {
+            Geometry::Surface(Arc::new(obj::read(&path, &shown).map_err(at_file)?))
+        }
         _ => Geometry::Surface(Arc::new(stl::read(&path, &shown).map_err(at_file)?)),
     };
     // A particle file's and a mesh's rows and nodes were checked one by one.
@@ -63,6 +66,51 @@ pub fn body_geometry(scene: &Scene, i: usize) -> Result<Geometry, SceneError> {
             .map_err(|(key, m)| scene.at_key(&key, format!("{shown}: {m}")))?;
     }
     Ok(geometry)
+}
+
+/// A terrain body: its surface raster (`file`) over its level `base` or its
+/// bottom raster (`base_file`), each checked against the other.
+fn terrain(scene: &Scene, i: usize, path: &Path, shown: &str) -> Result<Terrain, SceneError> {
+    let b = &scene.config.bodies[i];
+    let bottom = match &b.base_file {
+        None => Bottom::Level(b.base.expect("validated")),
+        Some(f) => {
+            let base_path = beside(&scene.file, f);
+            let base_shown = base_path.display().to_string();
+            let r = raster(&base_path, &base_shown, None)
+                .map_err(|m| scene.at_key(&format!("body.{i}.base_file"), m))?;
+            Bottom::Surface(r)
+        }
+    };
+    let surface = raster(path, shown, Some(&bottom))
+        .map_err(|m| scene.at_key(&format!("body.{i}.file"), m))?;
+    let t = Terrain { surface, bottom };
+    if let Some((row, column, m)) = t.bottom_above_surface() {
+        let base_file = b.base_file.as_deref().expect("only a raster bottom");
+        let m = format!(
+            "{}: the elevation at row {} (from the north), column {} {m} (`file`, {shown})",
+            beside(&scene.file, base_file).display(),
+            row + 1,
+            column + 1
+        );
+        return Err(scene.at_key(&format!("body.{i}.base_file"), m));
+    }
+    Ok(t)
+}
+
+/// A raster file: GeoTIFF for `.tif` or `.tiff`, else an ESRI ASCII grid;
+/// every elevation over `bottom` if one is given.
+fn raster(path: &Path, shown: &str, bottom: Option<&Bottom>) -> Result<Raster, String> {
+    match has_extension(path, &["tif", "tiff"]) {
+        true => geotiff::read(path, shown, bottom),
+        false => esri_grid::read(path, shown, bottom),
+    }
+}
+
+/// Does the path end in one of these extensions (in any case)?
+fn has_extension(path: &Path, extensions: &[&str]) -> bool {
+    let e = path.extension().and_then(|e| e.to_str());
+    e.is_some_and(|e| extensions.iter().any(|x| e.eq_ignore_ascii_case(x)))
 }
 
 /// `file` relative to the folder of the scene file `scene` (as given, if

@@ -6,7 +6,6 @@
 //! the error names the first open edge by its two corners.
 
 use crate::model::triangles::TriangleSurface;
-use std::collections::HashMap;
 use std::io::Cursor;
 use std::path::Path;
 
@@ -15,7 +14,10 @@ pub fn read(path: &Path, shown: &str) -> Result<TriangleSurface, String> {
     let bytes =
         std::fs::read(path).map_err(|e| format!("cannot read the STL file {shown}: {e}"))?;
     let facets = facets(&bytes).map_err(|e| format!("{shown}: {e}"))?;
-    let surface = indexed(&facets);
+    let corners: Vec<[[f64; 3]; 3]> = (facets.iter())
+        .map(|f| f.map(|c| c.map(f64::from)))
+        .collect();
+    let surface = TriangleSurface::from_facets(&corners);
     if surface.triangles.is_empty() {
         return Err(format!("{shown}: the STL file holds no triangle"));
     }
@@ -65,30 +67,5 @@ fn binary_length(bytes: &[u8]) -> bool {
     bytes.len() >= 84 && {
         let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]);
         bytes.len() as u64 == 84 + 50 * u64::from(n)
-    }
-}
-
-/// One vertex per distinct corner, and the triangles by vertex index; a
-/// collapsed triangle (two equal corners) is left out.
-fn indexed(facets: &[[[f32; 3]; 3]]) -> TriangleSurface {
-    let mut index: HashMap<[u32; 3], usize> = HashMap::new();
-    let mut vertices = Vec::new();
-    let mut triangles = Vec::with_capacity(facets.len());
-    for f in facets {
-        let t = f.map(|corner| {
-            // −0 and +0 are one coordinate.
-            let key = corner.map(|x| if x == 0.0 { 0 } else { x.to_bits() });
-            *index.entry(key).or_insert_with(|| {
-                vertices.push(corner.map(f64::from));
-                vertices.len() - 1
-            })
-        });
-        if t[0] != t[1] && t[1] != t[2] && t[2] != t[0] {
-            triangles.push(t);
-        }
-    }
-    TriangleSurface {
-        vertices,
-        triangles,
     }
 }

@@ -243,8 +243,20 @@ fn shape_keys(b: &BodyConfig, i: usize, dim: usize) -> Check {
     }
     if b.shape != BodyShape::Terrain {
         forbidden(&b.base, key("base"), &what)?;
+        forbidden(&b.base_file, key("base_file"), &what)?;
+    } else if let Some(f) = &b.base_file {
+        forbidden(&b.base, key("base"), "a body with `base_file`")?;
+        ensure(
+            !f.trim().is_empty(),
+            key("base_file"),
+            "needs the path of a raster file",
+        )?;
     } else {
-        required(&b.base, key("base"), &what)?;
+        ensure(
+            b.base.is_some(),
+            key("base"),
+            format!("is required for {what} (a level; or give `base_file`, a raster)"),
+        )?;
         ensure(
             b.base.unwrap().is_finite(),
             key("base"),
