@@ -10,9 +10,12 @@
 //! 2. the particle nearest to `monitor` has moved further than
 //!    `max_displacement` (when given): a converged but runaway mechanism.
 //!
-//! The search first makes sure that F_low holds and F_high fails (dividing F_low
-//! or multiplying F_high by 1.25 until it does), then bisects until the bracket
-//! [stable F, failed F] is narrower than `tolerance`. The factor of safety is the
+//! The search takes [F_low, F_high] as a presumed bracket (F_low holds, F_high
+//! fails) and bisects it until the bracket [stable F, failed F] is narrower
+//! than `tolerance`, running a presumed end only when the bracket has closed
+//! on it (so a range that brackets the factor costs two trials fewer); an end
+//! that turns out wrong widens the range beyond it (F_low divided or F_high
+//! multiplied by 1.25) and the bisection goes on there. The factor of safety is the
 //! middle of the bracket. Each trial writes its own outputs under `trials/`;
 //! `strength_reduction.csv` lists the trials and summary.json carries
 //! `factor_of_safety`, `factor_of_safety_bracket` and where the mechanism is
@@ -306,34 +309,35 @@ pub fn search(scene: &Scene, out: &Path, opts: &RunOptions) -> Result<SearchSumm
         trials.push(t);
         Ok(failed)
     };
+    // The search range is a presumed bracket: `lo` holds and `hi` fails until
+    // a trial says otherwise. Bisect it, and run a presumed end only when the
+    // bracket has closed on it; one that turns out wrong widens the range
+    // beyond it (by WIDEN) and the bisection goes on there.
     let (mut lo, mut hi) = (cfg.search[0], cfg.search[1]);
     let (mut stable, mut failed): (Option<f64>, Option<f64>) = (None, None);
     let budget = cfg.max_trials();
-    while stable.is_none() && trials.len() < budget {
-        if run_trial(lo, &mut trials)? {
-            failed = Some(lo);
-            lo /= WIDEN;
+    while trials.len() < budget {
+        let (s, f) = (stable.unwrap_or(lo), failed.unwrap_or(hi));
+        if f - s > cfg.tolerance() {
+            let mid = 0.5 * (s + f);
+            match run_trial(mid, &mut trials)? {
+                true => failed = Some(mid),
+                false => stable = Some(mid),
+            }
+        } else if stable.is_none() {
+            if run_trial(lo, &mut trials)? {
+                (failed, hi, lo) = (Some(lo), lo, lo / WIDEN);
+            } else {
+                stable = Some(lo);
+            }
+        } else if failed.is_none() {
+            if run_trial(hi, &mut trials)? {
+                failed = Some(hi);
+            } else {
+                (stable, lo, hi) = (Some(hi), hi, hi * WIDEN);
+            }
         } else {
-            stable = Some(lo);
-        }
-    }
-    while stable.is_some() && failed.is_none() && trials.len() < budget {
-        if run_trial(hi, &mut trials)? {
-            failed = Some(hi);
-        } else {
-            stable = Some(hi);
-            hi *= WIDEN;
-        }
-    }
-    while let (Some(s), Some(f)) = (stable, failed) {
-        if f - s <= cfg.tolerance() || trials.len() >= budget {
             break;
-        }
-        let mid = 0.5 * (s + f);
-        if run_trial(mid, &mut trials)? {
-            failed = Some(mid);
-        } else {
-            stable = Some(mid);
         }
     }
     let find = |f: Option<f64>| {

@@ -157,7 +157,8 @@ fn griffiths_lane_slope_factor_of_safety_coarse() {
     assert!(stable.iter().all(|s| failed.iter().all(|f| s < f)));
     assert_eq!(stable.len() + failed.len(), trials.len());
     // The crest runs away as F approaches the bracket: its displacement at the
-    // last stable F is many times the one at the lowest.
+    // last stable F is many times the one of a trial at F = 1.2 (the search
+    // itself need not run one that low).
     let crest = |f: f64| {
         trials
             .iter()
@@ -166,10 +167,19 @@ fn griffiths_lane_slope_factor_of_safety_coarse() {
             .monitor_displacement
             .unwrap()
     };
-    let lowest = stable.iter().cloned().fold(f64::INFINITY, f64::min);
-    let (u_low, u_high) = (crest(lowest), crest(bracket[0]));
+    let scene = Scene::load(
+        &problem("slope_griffiths_lane.toml"),
+        &["grid.cells=[40,12]".into()],
+    )
+    .unwrap();
+    let low = crate::common::one_thread(|| {
+        mpm::analyses::strength_reduction::trial(&scene, dir.path(), "low", 1.2, None, false)
+    });
+    let low = low.unwrap().0;
+    assert_eq!(low.status, TrialStatus::Stable);
+    let (u_low, u_high) = (low.monitor_displacement.unwrap(), crest(bracket[0]));
     eprintln!(
-        "crest displacement: {u_low:.3e} at F = {lowest}, {u_high:.3e} at F = {}",
+        "crest displacement: {u_low:.3e} at F = 1.2, {u_high:.3e} at F = {}",
         bracket[0]
     );
     assert!(u_high > 20.0 * u_low, "runaway of the crest near failure");
@@ -324,4 +334,36 @@ fn a_stalled_trial_is_given_up_without_moving_the_bracket() {
     );
     assert!(stalled >= 1);
     assert!(4 * stall.newton_iterations < 3 * creep.newton_iterations);
+}
+
+/// A search range that does not bracket the factor is widened beyond the end
+/// that turned out wrong (the ends are presumed, and run only once the
+/// bisection has closed on them): on the coarse slope (F ≈ 1.41) the ranges
+/// [1.0, 1.2] (every trial holds) and [1.6, 1.8] (every trial fails) end in
+/// brackets of the tolerance that overlap the one from [1.2, 1.6]; that one
+/// runs 6 trials, neither end among them.
+#[test]
+fn a_range_that_misses_the_factor_is_widened() {
+    let search = |range: &str| {
+        let set = format!("strength_reduction.search={range}");
+        let (r, _dir) = search_problem("slope_griffiths_lane.toml", &["grid.cells=[40,12]", &set]);
+        r.unwrap()
+    };
+    let shipped = search("[1.2,1.6]");
+    let b = shipped.factor_of_safety_bracket.unwrap();
+    let factors: Vec<f64> = shipped.trials.iter().map(|t| t.factor).collect();
+    eprintln!("[1.2, 1.6]: {b:?}, trials {factors:?}");
+    assert_eq!(factors.len(), 6);
+    assert!(!factors.contains(&1.2) && !factors.contains(&1.6));
+    for range in ["[1.0,1.2]", "[1.6,1.8]"] {
+        let s = search(range);
+        let w = s.factor_of_safety_bracket.unwrap();
+        let factors: Vec<f64> = s.trials.iter().map(|t| t.factor).collect();
+        eprintln!("{range}: {w:?}, trials {factors:?}");
+        assert!(w[1] - w[0] <= 0.01 + 1e-12, "{range}: width");
+        assert!(
+            w[0] < b[1] && b[0] < w[1],
+            "{range}: {w:?} does not overlap {b:?}"
+        );
+    }
 }
