@@ -69,7 +69,7 @@ fn an_open_or_unreadable_obj_names_the_file_and_the_edge() {
     let e = solid(dir.path(), "empty.obj").err().unwrap();
     assert!(
         e.to_string()
-            .contains("empty.obj: the OBJ file holds no face"),
+            .contains("empty.obj: the OBJ file holds no triangle"),
         "{e}"
     );
 }

@@ -116,28 +116,29 @@ fn every_geotiff_error_names_the_file_and_the_pixel() {
         assert!(e.to_string().contains(part), "`{part}` not in: {e}");
     };
     let p = |n: &str| dir.path().join(n);
-    let mut values = slope_values();
-    values[10] = -9999.0;
-    write_geotiff(&p("nodata.tif"), 9, &values, AREA_TIE, &keys(1, 1));
-    refused(
-        "nodata.tif",
-        "body.0.file",
-        "nodata.tif: no data at row 2 (from the north), column 2",
-    );
-    values[10] = f32::NAN;
-    write_geotiff(&p("nan.tif"), 9, &values, AREA_TIE, &keys(1, 1));
-    refused(
-        "nan.tif",
-        "body.0.file",
-        "nan.tif: no data at row 2 (from the north), column 2",
-    );
-    values[10] = -1.0;
-    write_geotiff(&p("low.tif"), 9, &values, AREA_TIE, &keys(1, 1));
-    refused(
-        "low.tif",
-        "body.0.file",
-        "low.tif: the elevation -1 at row 2, column 2 is not above the body's base 0",
-    );
+    // A bad pixel (row 2, column 2): no data by GDAL's value or NaN, below base.
+    for (name, value, part) in [
+        (
+            "nodata.tif",
+            -9999.0,
+            "no data at row 2 (from the north), column 2",
+        ),
+        (
+            "nan.tif",
+            f32::NAN,
+            "no data at row 2 (from the north), column 2",
+        ),
+        (
+            "low.tif",
+            -1.0,
+            "the elevation -1 at row 2, column 2 is not above the body's base 0",
+        ),
+    ] {
+        let mut values = slope_values();
+        values[10] = value;
+        write_geotiff(&p(name), 9, &values, AREA_TIE, &keys(1, 1));
+        refused(name, "body.0.file", &format!("{name}: {part}"));
+    }
     write_geotiff(&p("degrees.tif"), 9, &slope_values(), AREA_TIE, &keys(2, 1));
     refused(
         "degrees.tif",

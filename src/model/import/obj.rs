@@ -39,12 +39,5 @@ pub fn read(path: &Path, shown: &str) -> Result<TriangleSurface, String> {
             facets.push(f);
         }
     }
-    let surface = TriangleSurface::from_facets(&facets);
-    if surface.triangles.is_empty() {
-        return Err(format!("{shown}: the OBJ file holds no face"));
-    }
-    surface
-        .check_closed()
-        .map_err(|e| format!("{shown}: {e}"))?;
-    Ok(surface)
+    super::closed_surface(&facets, shown, "OBJ")
 }

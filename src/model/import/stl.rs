@@ -17,14 +17,7 @@ pub fn read(path: &Path, shown: &str) -> Result<TriangleSurface, String> {
     let corners: Vec<[[f64; 3]; 3]> = (facets.iter())
         .map(|f| f.map(|c| c.map(f64::from)))
         .collect();
-    let surface = TriangleSurface::from_facets(&corners);
-    if surface.triangles.is_empty() {
-        return Err(format!("{shown}: the STL file holds no triangle"));
-    }
-    surface
-        .check_closed()
-        .map_err(|e| format!("{shown}: {e}"))?;
-    Ok(surface)
+    super::closed_surface(&corners, shown, "STL")
 }
 
 /// The facets (three corners each) of an STL file's bytes. A binary file
