@@ -94,6 +94,23 @@ impl TriangleSurface {
         }
     }
 
+    /// The surface of the facets of a file (`shown`, of kind `format`),
+    /// checked: at least one triangle, closed and consistently oriented.
+    pub fn closed_from_facets(
+        facets: &[[[f64; 3]; 3]],
+        shown: &str,
+        format: &str,
+    ) -> Result<TriangleSurface, String> {
+        let surface = TriangleSurface::from_facets(facets);
+        if surface.triangles.is_empty() {
+            return Err(format!("{shown}: the {format} file holds no triangle"));
+        }
+        surface
+            .check_closed()
+            .map_err(|e| format!("{shown}: {e}"))?;
+        Ok(surface)
+    }
+
     /// Whether every edge belongs to exactly two triangles that run it in
     /// opposite directions; else the first offending edge in the file's order.
     pub fn check_closed(&self) -> Result<(), NotClosed> {

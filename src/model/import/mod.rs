@@ -22,7 +22,6 @@ use crate::material::parameters::FromParameters;
 use crate::material::rigid::Rigid;
 use crate::model::geometry::Geometry;
 use crate::model::terrain::{Bottom, Raster, Terrain};
-use crate::model::triangles::TriangleSurface;
 use crate::scene::{validate, BodyKindName, BodyShape, Scene, SceneError};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -106,23 +105,6 @@ fn raster(path: &Path, shown: &str, bottom: Option<&Bottom>) -> Result<Raster, S
         true => geotiff::read(path, shown, bottom),
         false => esri_grid::read(path, shown, bottom),
     }
-}
-
-/// The surface of a file's facets (`format` names the file's kind), checked:
-/// at least one triangle, closed and consistently oriented.
-fn closed_surface(
-    facets: &[[[f64; 3]; 3]],
-    shown: &str,
-    format: &str,
-) -> Result<TriangleSurface, String> {
-    let surface = TriangleSurface::from_facets(facets);
-    if surface.triangles.is_empty() {
-        return Err(format!("{shown}: the {format} file holds no triangle"));
-    }
-    surface
-        .check_closed()
-        .map_err(|e| format!("{shown}: {e}"))?;
-    Ok(surface)
 }
 
 /// Does the path end in one of these extensions (in any case)?

@@ -39,5 +39,5 @@ pub fn read(path: &Path, shown: &str) -> Result<TriangleSurface, String> {
             facets.push(f);
         }
     }
-    super::closed_surface(&facets, shown, "OBJ")
+    TriangleSurface::closed_from_facets(&facets, shown, "OBJ")
 }

@@ -17,7 +17,7 @@ pub fn read(path: &Path, shown: &str) -> Result<TriangleSurface, String> {
     let corners: Vec<[[f64; 3]; 3]> = (facets.iter())
         .map(|f| f.map(|c| c.map(f64::from)))
         .collect();
-    super::closed_surface(&corners, shown, "STL")
+    TriangleSurface::closed_from_facets(&corners, shown, "STL")
 }
 
 /// The facets (three corners each) of an STL file's bytes. A binary file
