@@ -70,6 +70,33 @@ impl Raster {
         (1.0 - t) * south + t * north
     }
 
+    /// Every point's position and elevation, from the south-west.
+    pub fn points(&self) -> impl Iterator<Item = ([f64; 2], f64)> + '_ {
+        (0..self.rows)
+            .flat_map(move |i| (0..self.columns).map(move |j| (i, j)))
+            .map(|(i, j)| (self.point(i, j), self.elevation[i * self.columns + j]))
+    }
+
+    /// Does (x, y) lie over the plan, its edges included?
+    pub fn over_plan(&self, [x, y]: [f64; 2]) -> bool {
+        let (lo, hi) = self.plan();
+        x >= lo[0] && x <= hi[0] && y >= lo[1] && y <= hi[1]
+    }
+
+    /// The first point not over `bottom` (`Bottom::refuses`), in the file's
+    /// order: its row from the north, its column (both from 0) and the
+    /// message naming its elevation and place.
+    pub fn first_below(&self, bottom: &Bottom) -> Option<(usize, usize, String)> {
+        let (row, column, m) = self.first_refused(|x, y, z| bottom.refuses(x, y, z))?;
+        let z = self.elevation[(self.rows - 1 - row) * self.columns + column];
+        let m = format!(
+            "the elevation {z} at row {}, column {} {m}",
+            row + 1,
+            column + 1
+        );
+        Some((row, column, m))
+    }
+
     /// The first point, in the file's order (the northernmost row first),
     /// for which `refuse(x, y, z)` gives a reason: its row from the north,
     /// its column (both from 0) and the reason.
@@ -104,11 +131,13 @@ impl Bottom {
             Bottom::Level(base) if z <= *base => {
                 Some(format!("is not above the body's base {base}"))
             }
-            Bottom::Surface(r) if z < r.at(x, y) => Some(format!(
-                "is below the body's base surface (`base_file`), {} there",
-                r.at(x, y)
-            )),
-            _ => None,
+            Bottom::Surface(r) => {
+                let below = r.at(x, y);
+                (z < below).then(|| {
+                    format!("is below the body's base surface (`base_file`), {below} there")
+                })
+            }
+            Bottom::Level(_) => None,
         }
     }
 }
@@ -142,27 +171,16 @@ impl Terrain {
     /// edge, where the surface raster's points are.
     pub fn bounds(&self) -> (Vec<f64>, Vec<f64>) {
         let (lo, hi) = self.surface.plan();
-        let highest = |v: &[f64]| v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let high = (self.surface.elevation.iter()).fold(f64::NEG_INFINITY, |m, &z| m.max(z));
         let low = match &self.bottom {
             Bottom::Level(z) => *z,
             Bottom::Surface(r) => {
-                let inside = |p: [f64; 2]| (0..2).all(|d| p[d] >= lo[d] && p[d] <= hi[d]);
-                let s = &self.surface;
-                let of_surface = (0..s.rows).flat_map(|i| (0..s.columns).map(move |j| (i, j)));
-                let at_surface = of_surface
-                    .map(|(i, j)| s.point(i, j))
-                    .map(|[x, y]| r.at(x, y));
-                let own = (0..r.rows).flat_map(|i| (0..r.columns).map(move |j| (i, j)));
-                let at_own = own
-                    .filter(|&(i, j)| inside(r.point(i, j)))
-                    .map(|(i, j)| r.elevation[i * r.columns + j]);
-                at_surface.chain(at_own).fold(f64::INFINITY, f64::min)
+                let under_surface = self.surface.points().map(|([x, y], _)| r.at(x, y));
+                let own = r.points().filter(|&(p, _)| self.surface.over_plan(p));
+                (under_surface.chain(own.map(|(_, z)| z))).fold(f64::INFINITY, f64::min)
             }
         };
-        (
-            vec![lo[0], lo[1], low],
-            vec![hi[0], hi[1], highest(&self.surface.elevation)],
-        )
+        (vec![lo[0], lo[1], low], vec![hi[0], hi[1], high])
     }
 
     /// The first point of a bottom surface's raster within the plan that lies
@@ -172,11 +190,10 @@ impl Terrain {
         let Bottom::Surface(r) = &self.bottom else {
             return None;
         };
-        let (lo, hi) = self.surface.plan();
         r.first_refused(|x, y, z| {
-            let over_plan = (0..2).all(|d| [x, y][d] >= lo[d] && [x, y][d] <= hi[d]);
             let top = self.surface.at(x, y);
-            (over_plan && z > top).then(|| format!("is above the body's surface, {top} there"))
+            (self.surface.over_plan([x, y]) && z > top)
+                .then(|| format!("is above the body's surface, {top} there"))
         })
     }
 }

@@ -130,15 +130,8 @@ fn raster(
         rows,
         elevation,
     };
-    let refused = bottom.and_then(|b| raster.first_refused(|x, y, z| b.refuses(x, y, z)));
-    if let Some((row, column, m)) = refused {
-        let (v, line) = values[row * columns + column];
-        let m = format!(
-            "the elevation {v} at row {}, column {} {m}",
-            row + 1,
-            column + 1
-        );
-        return Err((line, m));
+    if let Some((row, column, m)) = bottom.and_then(|b| raster.first_below(b)) {
+        return Err((values[row * columns + column].1, m));
     }
     Ok(raster)
 }

@@ -25,14 +25,8 @@ const RASTER_PIXEL_IS_POINT: u16 = 2;
 /// a body over `bottom`, or a body's bottom surface (`None`).
 pub fn read(path: &Path, shown: &str, bottom: Option<&Bottom>) -> Result<Raster, String> {
     let raster = decode(path).map_err(|m| format!("{shown}: {m}"))?;
-    let refused = bottom.and_then(|b| raster.first_refused(|x, y, z| b.refuses(x, y, z)));
-    if let Some((row, column, m)) = refused {
-        let z = raster.elevation[(raster.rows - 1 - row) * raster.columns + column];
-        return Err(format!(
-            "{shown}: the elevation {z} at row {}, column {} {m}",
-            row + 1,
-            column + 1
-        ));
+    if let Some((_, _, m)) = bottom.and_then(|b| raster.first_below(b)) {
+        return Err(format!("{shown}: {m}"));
     }
     Ok(raster)
 }
@@ -102,10 +96,16 @@ fn decode(path: &Path) -> Result<Raster, String> {
     };
     let x = |c: f64| tie[3] + (c + o - tie[0]) * sx;
     let y = |r: f64| tie[4] - (r + o - tie[1]) * sx;
+    if values.len() < columns * rows {
+        return Err(format!(
+            "the image holds {} samples, not {columns} × {rows}",
+            values.len()
+        ));
+    }
     let mut elevation = vec![0.0; columns * rows];
     for (k, &v) in values.iter().enumerate().take(columns * rows) {
         let (row, column) = (k / columns, k % columns);
-        if v.is_nan() || nodata == Some(v) || !v.is_finite() {
+        if !v.is_finite() || nodata == Some(v) {
             return Err(format!(
                 "no data at row {} (from the north), column {} (from 1): the body needs an \
                  elevation at every point",
@@ -115,12 +115,6 @@ fn decode(path: &Path) -> Result<Raster, String> {
         }
         // Stored from the south.
         elevation[(rows - 1 - row) * columns + column] = v;
-    }
-    if values.len() < columns * rows {
-        return Err(format!(
-            "the image holds {} samples, not {columns} × {rows}",
-            values.len()
-        ));
     }
     Ok(Raster {
         origin: [x(0.0), y((rows - 1) as f64)],

@@ -72,28 +72,24 @@ pub fn body_geometry(scene: &Scene, i: usize) -> Result<Geometry, SceneError> {
 /// bottom raster (`base_file`), each checked against the other.
 fn terrain(scene: &Scene, i: usize, path: &Path, shown: &str) -> Result<Terrain, SceneError> {
     let b = &scene.config.bodies[i];
-    let bottom = match &b.base_file {
-        None => Bottom::Level(b.base.expect("validated")),
-        Some(f) => {
-            let base_path = beside(&scene.file, f);
-            let base_shown = base_path.display().to_string();
-            let r = raster(&base_path, &base_shown, None)
-                .map_err(|m| scene.at_key(&format!("body.{i}.base_file"), m))?;
-            Bottom::Surface(r)
-        }
+    let at_base_file = |m: String| scene.at_key(&format!("body.{i}.base_file"), m);
+    let base_path = b.base_file.as_deref().map(|f| beside(&scene.file, f));
+    let base_shown = base_path.as_ref().map(|p| p.display().to_string());
+    let bottom = match (&base_path, &base_shown) {
+        (Some(p), Some(s)) => Bottom::Surface(raster(p, s, None).map_err(at_base_file)?),
+        _ => Bottom::Level(b.base.expect("validated")),
     };
     let surface = raster(path, shown, Some(&bottom))
         .map_err(|m| scene.at_key(&format!("body.{i}.file"), m))?;
     let t = Terrain { surface, bottom };
     if let Some((row, column, m)) = t.bottom_above_surface() {
-        let base_file = b.base_file.as_deref().expect("only a raster bottom");
         let m = format!(
             "{}: the elevation at row {} (from the north), column {} {m} (`file`, {shown})",
-            beside(&scene.file, base_file).display(),
+            base_shown.as_deref().expect("only a raster bottom"),
             row + 1,
             column + 1
         );
-        return Err(scene.at_key(&format!("body.{i}.base_file"), m));
+        return Err(at_base_file(m));
     }
     Ok(t)
 }
