@@ -162,6 +162,7 @@ fn mohr_coulomb_footing_reaches_prandtl() {
 /// 2 N_c(B/16) − N_c(B/8) = 8.384, 14.835, 30.201 (+0.46 %, +0.00 %, +0.20 %).
 /// At B/32 (papers/footing_prandtl): −0.33 %, −1.6 %.
 #[test]
+#[ignore = "slow tier, 62 s alone on 2 cores (2026-12-04): scripts/slow_tier.sh"]
 fn mohr_coulomb_footings_converge_to_prandtl_at_first_order() {
     let cases: [(f64, &str, Vec<&str>); 3] = [
         (
