@@ -19,6 +19,7 @@ use crate::model::loads::{LoadTime, Loads};
 use crate::model::mesh::ElementMesh;
 use crate::model::particle_set::ParticleSet;
 use crate::model::particles::Particles;
+use crate::model::peridynamics::bonds::Bonds;
 use crate::model::peridynamics::{PdBody, Peridynamics};
 use crate::model::triangles::{Cells, TriangleSurface};
 use crate::model::water::Water;
@@ -175,7 +176,14 @@ fn peridynamic_bodies<const D: usize>(
             let of: Vec<usize> = (0..p.len()).filter(|&q| p.body[q] as usize == i).collect();
             let x: Vec<Vector<D>> = of.iter().map(|&q| p.x[q]).collect();
             let volume = of.iter().map(|&q| p.volume[q]).collect();
-            PdBody::new(i, of, &x, volume, c.peridynamic(i))
+            // A bond stays inside its body (not across a notch), sampled every
+            // half particle spacing.
+            let (shape, step) = (&bodies[i].geometry, 0.5 * c.particle_spacing(i));
+            let inside =
+                |j: usize, k: usize| shape.holds_segment(x[j].as_slice(), x[k].as_slice(), step);
+            let law = c.peridynamic(i);
+            let bonds = Bonds::build_where(&x, law.horizon(), inside);
+            PdBody::with_bonds(i, of, &x, volume, law, bonds)
         })
         .collect();
     (!pd.is_empty()).then(|| Peridynamics::new(pd, &p.mass))

@@ -118,6 +118,26 @@ impl Geometry {
         }
     }
 
+    /// Does the segment from a to b (points inside) stay inside, sampled every
+    /// `step` or closer? True for the geometries without an inside (particle
+    /// files, meshes). A peridynamic body's bonds must not cross a notch or
+    /// a re-entrant corner (`model::build`).
+    pub fn holds_segment(&self, a: &[f64], b: &[f64], step: f64) -> bool {
+        if matches!(self, Geometry::Particles(_) | Geometry::Mesh(_)) {
+            return true;
+        }
+        let length: f64 = (0..a.len())
+            .map(|d| (b[d] - a[d]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let n = (length / step).ceil().max(1.0) as usize;
+        (1..n).all(|k| {
+            let t = k as f64 / n as f64;
+            let x: Vec<f64> = (0..a.len()).map(|d| a[d] + t * (b[d] - a[d])).collect();
+            self.contains(&x)
+        })
+    }
+
     /// Height (along `up` × axis v, `up` = ±1) of the top surface on the vertical
     /// line through x: the highest boundary point there.
     pub fn top(&self, x: &[f64], v: usize, up: f64) -> f64 {

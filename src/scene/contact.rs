@@ -59,6 +59,10 @@ pub struct ContactPlan {
     pub rigid: Vec<bool>,
     /// Whether each field is a free rigid body (`SceneConfig::rigid_motion`).
     pub free: Vec<bool>,
+    /// Whether each field holds a peridynamic body: its particles are advanced
+    /// by their bonds, not by the grid, so it meets rigid bodies by the rigid
+    /// projection alone and takes part in no nodal contact.
+    pub bonded: Vec<bool>,
 }
 
 impl ContactPlan {
@@ -87,7 +91,7 @@ fn body_index(s: &SceneConfig, name: &str, path: &str) -> Result<usize, KeyError
 }
 
 /// The declared pairs of table i, (body, body) with the smaller index first.
-fn table_pairs(s: &SceneConfig, i: usize) -> Result<Vec<(usize, usize)>, KeyError> {
+pub(crate) fn table_pairs(s: &SceneConfig, i: usize) -> Result<Vec<(usize, usize)>, KeyError> {
     let n = s.bodies.len();
     let Some(names) = &s.contacts[i].bodies else {
         return Ok((0..n)
@@ -133,6 +137,7 @@ fn check_law(c: &ContactConfig, i: usize) -> Result<(), KeyError> {
 pub fn plan(s: &SceneConfig) -> Result<Option<ContactPlan>, KeyError> {
     let rigid = |b: usize| s.body_kind(b) == BodyKindName::Rigid;
     let free = |b: usize| rigid(b) && s.rigid_motion(b) == Motion::Free;
+    let bonded = |b: usize| s.body_kind(b) == BodyKindName::Peridynamic;
     if s.contacts.is_empty() {
         return match (0..s.bodies.len()).find(|&b| rigid(b)) {
             Some(b) => Err((
@@ -252,17 +257,18 @@ pub fn plan(s: &SceneConfig) -> Result<Option<ContactPlan>, KeyError> {
             }
         }
     }
-    let field_rigid = (0..f)
-        .map(|k| (0..n).any(|b| field_of_body[b] as usize == k && rigid(b)))
-        .collect();
-    let field_free = (0..f)
-        .map(|k| (0..n).any(|b| field_of_body[b] as usize == k && free(b)))
-        .collect();
+    let field_of = |is: &dyn Fn(usize) -> bool| -> Vec<bool> {
+        (0..f)
+            .map(|k| (0..n).any(|b| field_of_body[b] as usize == k && is(b)))
+            .collect()
+    };
+    let (rigid, free, bonded) = (field_of(&rigid), field_of(&free), field_of(&bonded));
     Ok(Some(ContactPlan {
         field_of_body,
         laws: laws.into_iter().map(|l| l.map(|(law, _)| law)).collect(),
         fields: f,
-        rigid: field_rigid,
-        free: field_free,
+        rigid,
+        free,
+        bonded,
     }))
 }

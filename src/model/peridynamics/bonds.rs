@@ -31,6 +31,16 @@ pub struct Bonds {
 impl Bonds {
     /// The bonds of points `x` (reference positions) within horizon `delta`.
     pub fn build<const D: usize>(x: &[Vector<D>], delta: f64) -> Bonds {
+        Bonds::build_where(x, delta, |_, _| true)
+    }
+
+    /// The bonds of points `x` within horizon `delta` that `keep(i, j)` accepts
+    /// (e.g. those whose segment stays inside the body, `Geometry::holds_segment`).
+    pub fn build_where<const D: usize>(
+        x: &[Vector<D>],
+        delta: f64,
+        keep: impl Fn(usize, usize) -> bool,
+    ) -> Bonds {
         let reach = delta * (1.0 + 1e-10);
         let cell =
             |p: &Vector<D>| -> [i64; D] { std::array::from_fn(|d| (p[d] / delta).floor() as i64) };
@@ -53,7 +63,7 @@ impl Bonds {
             near.sort_unstable();
             for j in near {
                 let l = (x[j as usize] - p).norm();
-                if l <= reach {
+                if l <= reach && keep(i, j as usize) {
                     ends.push([i as u32, j]);
                     length.push(l);
                 }
@@ -214,5 +224,62 @@ mod tests {
             .filter(|&(i, j)| (x[j] - x[i]).norm() <= 0.3 * (1.0 + 1e-10))
             .count();
         assert_eq!(b.len(), brute);
+    }
+
+    /// A slit one lattice row wide, from the left edge to the middle: no bond
+    /// joins the rows on either side of it (they are δ = 3 Δx apart at the
+    /// lattice's x, so the plain horizon would bond them); beyond its tip the
+    /// bonds are those of the plain lattice, and a convex body keeps them all.
+    #[test]
+    fn no_bond_crosses_a_notch_of_its_body() {
+        use crate::model::geometry::Geometry;
+        let dx = 0.1;
+        // Points of a 9 × 9 lattice but for the slit's row y = 0.4, x < 0.45.
+        let x: Vec<Vector<2>> = lattice(9, dx)
+            .into_iter()
+            .filter(|p| !((p.y - 0.4).abs() < 1e-9 && p.x < 0.45))
+            .collect();
+        let body = Geometry::Polygon(vec![
+            vec![-0.05, -0.05],
+            vec![0.85, -0.05],
+            vec![0.85, 0.85],
+            vec![-0.05, 0.85],
+            vec![-0.05, 0.45],
+            vec![0.45, 0.45],
+            vec![0.45, 0.35],
+            vec![-0.05, 0.35],
+        ]);
+        let keep =
+            |i: usize, j: usize| body.holds_segment(x[i].as_slice(), x[j].as_slice(), dx / 2.0);
+        let (seen, plain) = (Bonds::build_where(&x, 0.3, keep), Bonds::build(&x, 0.3));
+        let crosses = |b: &Bonds| {
+            (b.ends.iter())
+                .filter(|[i, j]| {
+                    let (p, q) = (x[*i as usize], x[*j as usize]);
+                    (p.y - 0.4) * (q.y - 0.4) < 0.0 && p.x.max(q.x) < 0.45 - 1e-9
+                })
+                .count()
+        };
+        assert!(
+            crosses(&plain) > 0,
+            "the plain horizon bonds across the slit"
+        );
+        assert_eq!(crosses(&seen), 0);
+        // Away from the slit (both ends at x > 0.75: beyond δ from it) nothing changes.
+        let far = |b: &Bonds| {
+            (b.ends.iter())
+                .filter(|[i, j]| x[*i as usize].x > 0.75 && x[*j as usize].x > 0.75)
+                .count()
+        };
+        assert_eq!(far(&seen), far(&plain));
+        let square = Geometry::Box {
+            min: vec![-0.05; 2],
+            max: vec![0.85; 2],
+        };
+        let all = lattice(9, dx);
+        let kept = Bonds::build_where(&all, 0.3, |i, j| {
+            square.holds_segment(all[i].as_slice(), all[j].as_slice(), dx / 2.0)
+        });
+        assert_eq!(kept, Bonds::build(&all, 0.3));
     }
 }

@@ -47,6 +47,18 @@ impl<const D: usize> PdBody<D> {
         law: BondLaw,
     ) -> Self {
         let bonds = Bonds::build(x, law.horizon());
+        PdBody::with_bonds(body, particles, x, volume, law, bonds)
+    }
+
+    /// As [`PdBody::new`], with the bonds given (`Bonds::build_where`).
+    pub fn with_bonds(
+        body: usize,
+        particles: Vec<usize>,
+        x: &[Vector<D>],
+        volume: Vec<f64>,
+        law: BondLaw,
+        bonds: Bonds,
+    ) -> Self {
         PdBody {
             body,
             particles,

@@ -1,8 +1,9 @@
 //! The keys of a peridynamic body (`kind = "peridynamic"`,
 //! `physics::peridynamics`): its horizon, fracture and plane keys, its
-//! material's E and the PMB Poisson ratio, the scene around it (alone, on
-//! explicit stages only: contact with other bodies and implicit PD are later
-//! slices of issue 51), and none of these keys on other bodies.
+//! material's E and the PMB Poisson ratio, the scene around it (with rigid
+//! bodies met by the rigid projection alone, on explicit stages only: contact
+//! with continuum bodies and implicit PD are later slices of issue 51), and
+//! none of these keys on other bodies.
 
 use super::check::{ensure, forbidden, Check};
 use crate::material::bond::Space;
@@ -137,25 +138,24 @@ fn poisson_ratio(i: usize, k: usize, s: &SceneConfig) -> Check {
     }
 }
 
-/// The scene around it: no other body, explicit stages only.
+/// The scene around it: no continuum body (its contact with them through the
+/// grid is not built), rigid bodies met by the rigid projection alone, explicit
+/// stages only.
 fn scene(i: usize, s: &SceneConfig) -> Check {
-    let other =
-        (0..s.bodies.len()).find(|&j| j != i && s.body_kind(j) != BodyKindName::Peridynamic);
-    if let Some(j) = other {
+    let continuum = (0..s.bodies.len()).find(|&j| s.body_kind(j) == BodyKindName::Continuum);
+    if let Some(j) = continuum {
         return Err((
             format!("body.{j}.kind"),
             format!(
-                "a scene with a peridynamic body (body {i}) has peridynamic bodies only: \
-                 their contact with other bodies through the grid is not built yet \
-                 (issue 51)"
+                "a scene with a peridynamic body (body {i}) has peridynamic and rigid \
+                 bodies only: their contact with continuum bodies through the grid is not \
+                 built yet (issue 51)"
             ),
         ));
     }
-    ensure(
-        s.contacts.is_empty(),
-        "contact",
-        "peridynamic bodies meet no contact yet (issue 51)",
-    )?;
+    for k in 0..s.contacts.len() {
+        rigid_projection(k, s)?;
+    }
     let implicit = match &s.solver {
         Some(st) => (st.kind == SolverKind::Implicit).then(|| "solver.kind".to_string()),
         None => (s
@@ -174,4 +174,46 @@ fn scene(i: usize, s: &SceneConfig) -> Check {
         )),
         None => Ok(()),
     }
+}
+
+/// Contact table k in a scene with peridynamic bodies: between a peridynamic
+/// body and a rigid one, by the rigid projection alone (frictionless, no
+/// adhesion: `solver::explicit::contact`).
+fn rigid_projection(k: usize, s: &SceneConfig) -> Check {
+    let c = &s.contacts[k];
+    let key = |name: &str| format!("contact.{k}.{name}");
+    for (a, b) in crate::scene::contact::table_pairs(s, k)? {
+        let kinds = [s.body_kind(a), s.body_kind(b)];
+        if !kinds.contains(&BodyKindName::Peridynamic) {
+            continue;
+        }
+        ensure(
+            kinds.contains(&BodyKindName::Rigid),
+            key("bodies"),
+            format!(
+                "bodies {a} and {b} are both peridynamic: contact between peridynamic \
+                 bodies is not built yet (issue 51)"
+            ),
+        )?;
+        let what = format!("the contact of bodies {a} and {b}");
+        ensure(
+            c.rigid_projection,
+            key("rigid_projection"),
+            format!(
+                "{what} is the rigid projection (a peridynamic body takes part in no \
+                 nodal contact): leave rigid_projection = true"
+            ),
+        )?;
+        ensure(
+            c.friction_coefficient == 0.0,
+            key("friction_coefficient"),
+            format!("{what} is the rigid projection, which is frictionless: give 0"),
+        )?;
+        ensure(
+            c.adhesion == 0.0,
+            key("adhesion"),
+            format!("{what} is the rigid projection, which has no adhesion: give 0"),
+        )?;
+    }
+    Ok(())
 }

@@ -27,6 +27,13 @@
 //!
 //! With three or more fields at a node the pairs are corrected one after another,
 //! in field order.
+//!
+//! **Peridynamic bodies** meet no other field at the nodes: their particles are
+//! advanced by their bonds from the step start (`physics::peridynamics::advance`),
+//! so a nodal correction would not reach them and would give the other field
+//! momentum from nowhere. They meet rigid bodies by the rigid projection alone
+//! (`keep_out_of_rigid_bodies`, the push-out of seed 003 eqs. 28–29), which
+//! conserves momentum between the two to round-off.
 
 use crate::dim::Vector;
 use crate::model::particles::Particles;
@@ -106,6 +113,9 @@ impl<const D: usize> Contact<D> {
         let n_grid = m.grid.node_count();
         self.fields.split(st, map, n_grid);
         self.meetings = self.fields.meetings(&self.plan, m, st, map, false);
+        let bonded = &self.plan.bonded;
+        self.meetings
+            .retain(|mt| !mt.fields.iter().any(|&k| bonded[k]));
         self.node_impulse.clear();
         self.node_impulse.resize(map.len(), Vector::<D>::zeros());
         self.pushed.clear();
