@@ -6,6 +6,7 @@
 //! is reported here, at the scene key.
 
 use crate::dim::Vector;
+use crate::material::bond::BondLaw;
 use crate::material::Material;
 use crate::model::body::{Body, BodyKind};
 use crate::model::conditions::{
@@ -20,6 +21,7 @@ use crate::model::mesh::ElementMesh;
 use crate::model::particle_set::ParticleSet;
 use crate::model::particles::Particles;
 use crate::model::peridynamics::bonds::Bonds;
+use crate::model::peridynamics::state::StressState;
 use crate::model::peridynamics::{PdBody, Peridynamics};
 use crate::model::triangles::{Cells, TriangleSurface};
 use crate::model::water::Water;
@@ -52,7 +54,9 @@ impl<const D: usize> Model<D> {
             .map(|(i, m)| m.build(i))
             .collect::<Result<Vec<_>, _>>()
             .map_err(err)?;
-        // A rigid body's particles carry the zero-stress material (`model::body`).
+        // A rigid body's particles carry the zero-stress material (`model::body`);
+        // a correspondence body keeps its own (`model::peridynamics::state`).
+        let own_materials = tables.clone();
         let base_materials = c.particle_materials(tables);
         let bodies = (0..c.bodies.len())
             .map(|i| import::body_geometry(scene, i).map(|g| Body::of(c, i, g)))
@@ -82,7 +86,7 @@ impl<const D: usize> Model<D> {
                 return Err(err((format!("body.{i}.shape"), "the body holds no particle centre: refine the grid or raise particles_per_cell".into())));
             }
         }
-        let peridynamics = peridynamic_bodies(c, &bodies, &particles);
+        let peridynamics = peridynamic_bodies(c, &bodies, &particles, &own_materials);
         // The velocity conditions, with the index of their [[boundary]] table.
         let velocity: Vec<(usize, &BoundaryConfig)> = (c.boundaries.iter().enumerate())
             .filter(|(_, b)| b.condition.prescribes_velocity())
@@ -164,11 +168,14 @@ impl<const D: usize> Model<D> {
 }
 
 /// The peridynamic bodies with their bonds (`model::peridynamics`), built
-/// from the particles' reference positions and volumes; None without one.
+/// from the particles' reference positions and volumes, a correspondence
+/// body with its material of `materials` (one per table) at rest; None
+/// without one.
 fn peridynamic_bodies<const D: usize>(
     c: &SceneConfig,
     bodies: &[Body],
     p: &Particles<D>,
+    materials: &[Box<dyn Material>],
 ) -> Option<Peridynamics<D>> {
     let pd: Vec<PdBody<D>> = (0..bodies.len())
         .filter(|&i| bodies[i].kind == BodyKind::Peridynamic)
@@ -183,7 +190,15 @@ fn peridynamic_bodies<const D: usize>(
                 |j: usize, k: usize| shape.holds_segment(x[j].as_slice(), x[k].as_slice(), step);
             let law = c.peridynamic(i);
             let bonds = Bonds::build_where(&x, law.horizon(), inside);
-            PdBody::with_bonds(i, of, &x, volume, law, bonds)
+            let n = of.len();
+            let body = PdBody::with_bonds(i, of, &x, volume, law, bonds);
+            match law {
+                BondLaw::Correspondence(_) => {
+                    let k = p.material[body.particles[0]] as usize;
+                    body.with_stress(StressState::at_rest(materials[k].clone(), n))
+                }
+                _ => body,
+            }
         })
         .collect();
     (!pd.is_empty()).then(|| Peridynamics::new(pd, &p.mass))

@@ -84,6 +84,11 @@ pub struct Checkpoint {
     /// Per peridynamic body, the ids of its broken bonds, ascending
     /// (`model::peridynamics::Peridynamics::broken_bonds`); empty without one.
     pub broken_bonds: Vec<Vec<u32>>,
+    /// Per peridynamic body, its correspondence stress state
+    /// (`Peridynamics::stress_states`: F, σ and history per particle; empty
+    /// for a bond-based body).
+    #[serde(default)]
+    pub peridynamic_stress: Vec<Vec<f64>>,
     /// A staged scene's particles by their index as built, in the order of
     /// `particles` (`model::staging`); None in a scene that stages nothing.
     #[serde(default)]
@@ -257,6 +262,7 @@ pub(super) fn restore_bonds<const D: usize>(
         return Ok(());
     };
     (pd.restore_broken(&ck.broken_bonds))
+        .and_then(|()| pd.restore_stress(&ck.peridynamic_stress))
         .map_err(|e| RunError::Checkpoint(format!("checkpoint {}: {e}", path.display())))
 }
 

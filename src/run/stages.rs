@@ -178,6 +178,8 @@ impl Timeline {
             particles: ParticleState::of(&model.particles),
             broken_bonds: (model.peridynamics.as_ref())
                 .map_or_else(Vec::new, |pd| pd.broken_bonds()),
+            peridynamic_stress: (model.peridynamics.as_ref())
+                .map_or_else(Vec::new, |pd| pd.stress_states()),
             staged_particles: (model.staging.as_ref()).map(|s| s.built.clone()),
             solver: stepper.state(),
             recorders: self.recorders.saved()?,

@@ -7,6 +7,7 @@
 
 use super::BondModel;
 use super::{BodyKindName, MaterialConfig, Plane, SceneConfig};
+use crate::material::bond::correspondence::{Correspondence, ZERO_ENERGY_CONTROL};
 use crate::material::bond::{beam::Beam, pmb::Pmb, BondLaw, Space};
 use crate::material::parameters::FromParameters;
 use crate::material::rigid::{Motion, Rigid};
@@ -120,13 +121,15 @@ impl SceneConfig {
     }
 
     /// The bond law of peridynamic body i of a validated scene: its
-    /// `bond_model` with its material's E (and ν, beam), its horizon and its
-    /// critical stretch (`fracture_energy` or `critical_stretch`).
+    /// `bond_model` with its material's E (and ν, beam; the P-wave modulus,
+    /// correspondence), its horizon and its critical stretch (`fracture_energy`
+    /// or `critical_stretch`).
     pub fn peridynamic(&self, i: usize) -> BondLaw {
         let (b, space) = (&self.bodies[i], self.peridynamic_space(i));
-        let (e, delta) = (self.youngs_modulus(i).unwrap(), self.horizon(i));
+        let (e, delta) = (|| self.youngs_modulus(i).unwrap(), self.horizon(i));
         match b.bond_model.unwrap_or_default() {
             BondModel::Pmb => {
+                let e = e();
                 let pmb = Pmb::new(space, e, delta);
                 BondLaw::Pmb(match (b.fracture_energy, b.critical_stretch) {
                     (Some(g0), _) => pmb.with_fracture_energy(space, g0),
@@ -135,14 +138,34 @@ impl SceneConfig {
                 })
             }
             BondModel::Beam => {
-                let beam = Beam::new(space, e, self.poisson_ratio(i).unwrap(), delta);
+                let beam = Beam::new(space, e(), self.poisson_ratio(i).unwrap(), delta);
                 BondLaw::Beam(match (b.fracture_energy, b.critical_stretch) {
                     (Some(g0), _) => beam.with_fracture_energy(space, g0),
                     (_, Some(s0)) => beam.with_critical_stretch(s0),
                     _ => beam,
                 })
             }
+            BondModel::Correspondence => {
+                let g = b.zero_energy_control.unwrap_or(ZERO_ENERGY_CONTROL);
+                let c = Correspondence::new(space, self.p_wave_modulus(i), delta, g);
+                BondLaw::Correspondence(match (b.fracture_energy, b.critical_stretch) {
+                    (Some(g0), _) => c.with_fracture_energy(space, g0),
+                    (_, Some(s0)) => c.with_critical_stretch(s0),
+                    _ => c,
+                })
+            }
         }
+    }
+
+    /// The P-wave modulus of body i's material as built (`Material::p_wave_modulus`).
+    pub fn p_wave_modulus(&self, i: usize) -> f64 {
+        let k = (self.materials.iter())
+            .position(|m| m.name == self.bodies[i].material)
+            .expect("validated");
+        self.materials[k]
+            .build(k)
+            .expect("validated")
+            .p_wave_modulus()
     }
 
     /// The Poisson ratio of body i's material (`poisson_ratio`), if it has one.

@@ -200,6 +200,9 @@ pub enum BondModel {
     Pmb,
     /// Beam-based: axial and tangential micromoduli (`material::bond::beam`).
     Beam,
+    /// Non-ordinary state-based: the stress of the body's own material
+    /// (`material::bond::correspondence`).
+    Correspondence,
 }
 
 /// The 2D idealisation of a peridynamic body (`plane`).
@@ -281,6 +284,9 @@ pub struct BodyConfig {
     pub critical_stretch: Option<f64>,
     /// Peridynamic body in 2D: `strain` (default) or `stress`.
     pub plane: Option<Plane>,
+    /// Correspondence peridynamic body: G of its zero-energy control (default
+    /// `material::bond::correspondence::ZERO_ENERGY_CONTROL`).
+    pub zero_energy_control: Option<f64>,
 }
 
 /// A physical group of a Gmsh file, by its name or its number.

@@ -540,3 +540,16 @@ fn a_peridynamic_restart_keeps_the_broken_bonds() {
     let steps = restarts_are_exact("peridynamic_plate.toml", &["output.frames=2"], 7.0e-6, 2);
     assert!(steps[0] > 0 && steps[1] > steps[0], "{steps:?}");
 }
+
+/// A correspondence body's particles carry F, stress and history of their own
+/// (`model::peridynamics::state`): the checkpoint keeps them with the bonds.
+#[test]
+fn a_correspondence_restart_keeps_the_stress_state() {
+    let sets = [
+        "output.frames=2",
+        "body.0.bond_model=\"correspondence\"",
+        "body.0.plane=\"strain\"",
+    ];
+    let steps = restarts_are_exact("peridynamic_plate.toml", &sets, 7.0e-6, 2);
+    assert!(steps[0] > 0 && steps[1] > steps[0], "{steps:?}");
+}

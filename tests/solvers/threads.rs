@@ -123,6 +123,16 @@ fn apic_runs_give_identical_results_on_one_and_two_threads() {
 fn a_cracking_peridynamic_plate_is_the_same_on_one_and_two_threads() {
     let overrides = ["output.frames=0".to_string()];
     same_on_one_and_two_threads("peridynamic_plate.toml", &overrides, "peridynamic plate");
+    let correspondence = [
+        "output.frames=0".to_string(),
+        "body.0.bond_model=\"correspondence\"".to_string(),
+        "body.0.plane=\"strain\"".to_string(),
+    ];
+    same_on_one_and_two_threads(
+        "peridynamic_plate.toml",
+        &correspondence,
+        "correspondence plate",
+    );
 }
 
 /// Time histories (issue 55): the slope under a ground motion through its

@@ -103,9 +103,29 @@ fn the_beam_bond_bar_wave_speed_is_the_elastic_one_at_any_poisson_ratio() {
     }
 }
 
+/// The overrides that make the shipped plate a correspondence body (plane
+/// strain, its glass's own linear elastic update, the default zero-energy
+/// control).
+const CORRESPONDENCE_PLATE: [&str; 2] = [
+    "body.0.bond_model=\"correspondence\"",
+    "body.0.plane=\"strain\"",
+];
+
 #[test]
 fn the_notched_plate_cracks_from_its_notch() {
-    let (summary, dir) = run_problem("peridynamic_plate.toml", &[]);
+    notched_plate_cracks_from_its_notch(&[]);
+}
+
+/// The same plate as a correspondence body: the crack through the ligament,
+/// and no damage at its free ends (where a weaker zero-energy control lets
+/// the non-affine oscillations break bonds: material::bond::correspondence).
+#[test]
+fn the_correspondence_notched_plate_cracks_from_its_notch_only() {
+    notched_plate_cracks_from_its_notch(&CORRESPONDENCE_PLATE);
+}
+
+fn notched_plate_cracks_from_its_notch(sets: &[&str]) {
+    let (summary, dir) = run_problem("peridynamic_plate.toml", sets);
     let summary = summary.expect("the plate runs");
     println!("steps {}", summary.steps);
     let p = Table::read(&dir.path().join("particles_final.csv")).unwrap();
@@ -440,5 +460,50 @@ fn the_kalthoff_winkler_plate_cracks_from_its_notches_at_about_70_degrees() {
     assert!(
         lengths.last().unwrap() > &0.06,
         "the crack runs through the plate"
+    );
+}
+
+/// A correspondence bar (plane strain, ν = 1/4) in its first axial mode: a
+/// thin plane-strain bar's speed is √(E/((1 − ν²)ρ)).
+#[test]
+fn the_correspondence_bar_wave_speed_is_the_plane_strain_bar_speed() {
+    let (length, width, nu) = (0.1, 0.01, 0.25);
+    let c0 = (70e9 / ((1.0f64 - nu * nu) * 2700.0)).sqrt();
+    let scene = bar(length, width)
+        .replace("poisson_ratio = 0.333333", "poisson_ratio = 0.25")
+        .replace("plane = \"stress\"", "bond_model = \"correspondence\"");
+    let (summary, dir) = run_text(&scene, &[]);
+    summary.expect("the bar runs");
+    let h = Table::read(&dir.path().join("history.csv")).unwrap();
+    let c = length / (2.0 * first_minimum(h.col("t"), h.col("kinetic")));
+    // Measured −0.63 % (no surface correction needed: F is exact at the faces).
+    assert_within("correspondence bar: c/c0 − 1", c / c0 - 1.0, 0.03);
+}
+
+#[test]
+fn the_keys_of_a_correspondence_body_are_checked_by_key() {
+    let corr = |extra: &str| with(&format!("bond_model = \"correspondence\"\n{extra}"), "");
+    Scene::parse("scene.toml", &corr(""), &[]).expect("valid");
+    // Any ν: the material's own update.
+    Scene::parse(
+        "scene.toml",
+        &corr("").replace("poisson_ratio = 0.25", "poisson_ratio = 0.4"),
+        &[],
+    )
+    .expect("ν = 0.4");
+    rejected_at(
+        &corr("plane = \"stress\""),
+        "body.0.plane",
+        &["plane strain"],
+    );
+    rejected_at(
+        &corr("zero_energy_control = -1.0"),
+        "body.0.zero_energy_control",
+        &["≥ 0"],
+    );
+    rejected_at(
+        &with("zero_energy_control = 1.0", ""),
+        "body.0.zero_energy_control",
+        &["correspondence"],
     );
 }

@@ -7,15 +7,19 @@
 //!
 //! - `pmb`: bond-based prototype microelastic brittle (one micromodulus, one ν);
 //! - `beam`: beam-based, an axial and a tangential micromodulus (any ν up to
-//!   PMB's).
+//!   PMB's);
+//! - `correspondence`: non-ordinary state-based, the stress of the body's own
+//!   material carried by the bonds, with a zero-energy control.
 
 pub mod beam;
+pub mod correspondence;
 pub mod pmb;
 mod space;
 
 pub use space::{critical_stretch, Space, SAFETY};
 
 use beam::Beam;
+use correspondence::Correspondence;
 use pmb::Pmb;
 
 /// The bond law of a peridynamic body.
@@ -23,6 +27,7 @@ use pmb::Pmb;
 pub enum BondLaw {
     Pmb(Pmb),
     Beam(Beam),
+    Correspondence(Correspondence),
 }
 
 impl BondLaw {
@@ -30,6 +35,7 @@ impl BondLaw {
         match self {
             BondLaw::Pmb(p) => p.horizon,
             BondLaw::Beam(b) => b.horizon,
+            BondLaw::Correspondence(c) => c.horizon,
         }
     }
 
@@ -38,15 +44,18 @@ impl BondLaw {
         match self {
             BondLaw::Pmb(p) => p.critical_stretch,
             BondLaw::Beam(b) => b.critical_stretch,
+            BondLaw::Correspondence(c) => c.critical_stretch,
         }
     }
 
     /// The bond's spring constant times |ξ| for the Silling–Askari step: c
-    /// (PMB), max(c1, c2) (beam).
+    /// (PMB), max(c1, c2) (beam), c (1 + G) (correspondence: PMB's c of the
+    /// same P-wave modulus, stiffened by the zero-energy control).
     pub fn stiffness(&self) -> f64 {
         match self {
             BondLaw::Pmb(p) => p.micromodulus,
             BondLaw::Beam(b) => b.stiffness(),
+            BondLaw::Correspondence(c) => c.micromodulus * (1.0 + c.zero_energy_control),
         }
     }
 

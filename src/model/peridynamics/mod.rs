@@ -8,15 +8,19 @@
 //! - `bonds`: the families, built once in the reference configuration by cell
 //!   binning in a deterministic order; each bond stored once for both ends
 //!   (i < j), a CSR list of bond ids per particle; broken flags; damage.
+//! - `state`: a correspondence body's own material and its particles' F,
+//!   stress and history.
 //!
 //! A scene without a peridynamic body has `Model::peridynamics = None` and
 //! allocates nothing.
 
 pub mod bonds;
+pub mod state;
 
 use crate::dim::Vector;
 use crate::material::bond::BondLaw;
 use bonds::Bonds;
+use state::StressState;
 
 /// One peridynamic body: its particles, bonds and bond law.
 #[derive(Clone, Debug)]
@@ -34,6 +38,9 @@ pub struct PdBody<const D: usize> {
     /// Step start: positions and velocities of its particles (`begin_step`).
     pub start_x: Vec<Vector<D>>,
     pub start_v: Vec<Vector<D>>,
+    /// A correspondence body's stress state (`BondLaw::Correspondence`); None
+    /// for the bond-based laws.
+    pub stress: Option<StressState>,
 }
 
 impl<const D: usize> PdBody<D> {
@@ -68,6 +75,15 @@ impl<const D: usize> PdBody<D> {
             law,
             start_x: Vec::new(),
             start_v: Vec::new(),
+            stress: None,
+        }
+    }
+
+    /// With the stress state `stress` (a correspondence body).
+    pub fn with_stress(self, stress: StressState) -> Self {
+        PdBody {
+            stress: Some(stress),
+            ..self
         }
     }
 
@@ -132,6 +148,25 @@ impl<const D: usize> Peridynamics<D> {
                     .collect()
             })
             .collect()
+    }
+
+    /// Per body, its correspondence stress state as numbers (`StressState::numbers`;
+    /// empty for a bond-based body), for checkpoints.
+    pub fn stress_states(&self) -> Vec<Vec<f64>> {
+        (self.bodies.iter())
+            .map(|b| b.stress.as_ref().map_or_else(Vec::new, |s| s.numbers()))
+            .collect()
+    }
+
+    /// The stress states `numbers` gives (`stress_states` of the same scene).
+    pub fn restore_stress(&mut self, numbers: &[Vec<f64>]) -> Result<(), String> {
+        for (k, b) in self.bodies.iter_mut().enumerate() {
+            if let Some(s) = &mut b.stress {
+                let n = numbers.get(k).map_or(&[][..], |n| &n[..]);
+                s.restore(n).map_err(|e| format!("body {}: {e}", b.body))?;
+            }
+        }
+        Ok(())
     }
 
     /// Break the bonds `broken` lists (`broken_bonds` of the same scene).

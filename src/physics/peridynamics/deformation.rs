@@ -21,6 +21,17 @@ pub fn deformation_gradients<const D: usize>(
     b: &PdBody<D>,
     y: &[Vector<D>],
 ) -> Vec<Option<Tensor<D>>> {
+    (shapes(b, y).into_iter())
+        .map(|s| s.map(|(_, f)| f))
+        .collect()
+}
+
+/// K_i⁻¹ and F_i of each particle of `b` at positions `y` (local order); None
+/// where its intact bonds do not span the space.
+pub fn shapes<const D: usize>(
+    b: &PdBody<D>,
+    y: &[Vector<D>],
+) -> Vec<Option<(Tensor<D>, Tensor<D>)>> {
     let (x, v, bonds) = (&b.reference, &b.volume, &b.bonds);
     (0..y.len())
         .into_par_iter()
@@ -39,7 +50,10 @@ pub fn deformation_gradients<const D: usize>(
             if det.is_nan() || det <= DEGENERATE * scale {
                 return None;
             }
-            k3.try_inverse().map(|k_inv| n * restrict::<D>(&k_inv))
+            k3.try_inverse().map(|k_inv| {
+                let k_inv = restrict::<D>(&k_inv);
+                (k_inv, n * k_inv)
+            })
         })
         .collect()
 }

@@ -4,6 +4,7 @@
 //! order of `model::peridynamics::bonds` (so the sums do not depend on the
 //! threads), after breaking the bonds stretched past s0.
 
+pub mod correspondence;
 pub mod deformation;
 
 use crate::dim::Vector;
@@ -15,8 +16,9 @@ use rayon::prelude::*;
 /// The bond force on each particle of body `b` (V_i Σ_j f_ij V_j, its law's
 /// `pair_force`) at positions `y` (its local order), after breaking the bonds
 /// stretched past s0. The beam law first finds each particle's rotation
-/// (`deformation::rotations`, over the bonds left intact).
-pub fn bond_forces<const D: usize>(b: &mut PdBody<D>, y: &[Vector<D>]) -> Vec<Vector<D>> {
+/// (`deformation::rotations`, over the bonds left intact); the correspondence
+/// law updates its particles' stresses over the step `dt` (`correspondence`).
+pub fn bond_forces<const D: usize>(b: &mut PdBody<D>, y: &[Vector<D>], dt: f64) -> Vec<Vector<D>> {
     b.bonds.break_stretched(y, b.law.critical_stretch());
     let (bonds, v, x) = (&b.bonds, &b.volume, &b.reference);
     let sum = |force: &(dyn Fn(usize, usize, usize) -> Vector<D> + Sync)| -> Vec<Vector<D>> {
@@ -31,6 +33,16 @@ pub fn bond_forces<const D: usize>(b: &mut PdBody<D>, y: &[Vector<D>]) -> Vec<Ve
         BondLaw::Beam(beam) => {
             let r = deformation::rotations(b, y);
             sum(&|i, j, _| beam.pair_force(&y[i], &y[j], &(x[j] - x[i]), &r[i], &r[j]))
+        }
+        BondLaw::Correspondence(law) => {
+            let law = *law;
+            let mut state = b
+                .stress
+                .take()
+                .expect("a correspondence body has a stress state");
+            let f = correspondence::forces(b, &law, &mut state, y, dt);
+            b.stress = Some(state);
+            f
         }
     }
 }
@@ -49,7 +61,7 @@ pub fn advance<const D: usize>(
     dt: f64,
 ) {
     let y = std::mem::take(&mut b.start_x);
-    let bond = bond_forces(b, &y);
+    let bond = bond_forces(b, &y, dt);
     for (i, &q) in b.particles.iter().enumerate() {
         v[q] = b.start_v[i] + (bond[i] + applied(q)) * (dt / mass[q]);
         x[q] = y[i] + v[q] * dt;

@@ -3,10 +3,15 @@
 
 use super::*;
 use crate::dim::Tensor;
+use crate::material::bond::correspondence::{Correspondence, ZERO_ENERGY_CONTROL};
 use crate::material::bond::{beam::Beam, pmb::Pmb, BondLaw, Space};
+use crate::material::linear_elastic::LinearElastic;
+use crate::model::peridynamics::state::StressState;
 use crate::model::peridynamics::PdBody;
 
 const E: f64 = 70e9;
+/// The step handed to the bond forces (the correspondence law's stress update).
+const DT: f64 = 1e-8;
 
 /// A lattice of n^D points of spacing dx, each moved by `perturb` × dx
 /// times a deterministic pseudo-random number in [−1, 1).
@@ -38,6 +43,25 @@ fn body<const D: usize>(x: &[Vector<D>], dx: f64, space: Space) -> PdBody<D> {
     )
 }
 
+/// A body of law `law` on points x of volumes v; a correspondence body gets a
+/// linear elastic material of E and ν = 1/4 (ρ = 1) at rest.
+fn pd_body<const D: usize>(x: &[Vector<D>], v: Vec<f64>, law: BondLaw) -> PdBody<D> {
+    let b = PdBody::new(0, (0..x.len()).collect(), x, v, law);
+    match law {
+        BondLaw::Correspondence(_) => {
+            let elastic = LinearElastic::new(1.0, E, 0.25);
+            b.with_stress(StressState::at_rest(Box::new(elastic), x.len()))
+        }
+        _ => b,
+    }
+}
+
+/// The correspondence law of E, ν = 1/4, horizon 3 mm and zero-energy control `g`.
+fn correspondence(space: Space, g: f64) -> BondLaw {
+    let m = E * 0.75 / (1.25 * 0.5);
+    BondLaw::Correspondence(Correspondence::new(space, m, 3.0 * 1e-3, g))
+}
+
 fn pmb_of<const D: usize>(b: &PdBody<D>) -> Pmb {
     match b.law {
         BondLaw::Pmb(p) => p,
@@ -55,14 +79,14 @@ fn sum_of_forces_vanishes<const D: usize>(law: BondLaw) {
     let dx = 1e-3;
     let x = lattice::<D>(if D == 2 { 20 } else { 8 }, dx, 0.2);
     let v = vec![dx.powi(D as i32); x.len()];
-    let mut b = PdBody::new(0, (0..x.len()).collect(), &x, v, law);
+    let mut b = pd_body(&x, v, law);
     // A deformed state: each point moved by up to 1 % of dx at random.
     let n = if D == 2 { 20 } else { 8 };
     let jitter = lattice::<D>(n, dx, 0.01);
     let y: Vec<Vector<D>> = (x.iter().zip(&jitter))
         .map(|(p, l)| p + (l - lattice_point::<D>(l, dx)))
         .collect();
-    let f = bond_forces(&mut b, &y);
+    let f = bond_forces(&mut b, &y, DT);
     let total: Vector<D> = f.iter().sum();
     let scale: f64 = f.iter().map(|v| v.norm()).sum();
     println!("{law:?}: |Σ F| = {:.3e}, Σ |F| = {scale:.3e}", total.norm());
@@ -99,15 +123,18 @@ fn rigid_motion_gives_no_force<const D: usize>(law: BondLaw) -> (PdBody<D>, Vec<
     let dx = 1e-3;
     let x = lattice::<D>(if D == 2 { 15 } else { 7 }, dx, 0.2);
     let v = vec![dx.powi(D as i32); x.len()];
-    let mut b = PdBody::new(0, (0..x.len()).collect(), &x, v, law);
+    // A fresh body for each motion: a correspondence body's stress follows
+    // its history.
+    let fresh = || pd_body(&x, v.clone(), law);
     let stretched: Vec<Vector<D>> = x.iter().map(|p| p * 1.001).collect();
-    let scale = max_norm(&bond_forces(&mut b, &stretched));
+    let scale = max_norm(&bond_forces(&mut fresh(), &stretched, DT));
     let shift = Vector::<D>::from_element(0.37);
     let r = rotation::<D>(30f64.to_radians());
     let moved: Vec<Vector<D>> = x.iter().map(|p| r * p + shift).collect();
     let translated: Vec<Vector<D>> = x.iter().map(|p| p + shift).collect();
-    let ft = max_norm(&bond_forces(&mut b, &translated));
-    let fr = max_norm(&bond_forces(&mut b, &moved));
+    let ft = max_norm(&bond_forces(&mut fresh(), &translated, DT));
+    let mut b = fresh();
+    let fr = max_norm(&bond_forces(&mut b, &moved, DT));
     println!("{law:?}: max |F| translated {ft:.2e}, rotated 30° {fr:.2e}, at s = 1e-3 {scale:.2e}");
     assert!(ft <= 1e-9 * scale && fr <= 1e-9 * scale);
     (b, moved, scale)
@@ -129,15 +156,15 @@ fn a_single_bond_breaks_past_s0_and_never_heals() {
     let mut b = PdBody::new(0, vec![0, 1], &x, vec![dx * dx; 2], BondLaw::Pmb(pmb));
     assert_eq!(b.bonds.len(), 1);
     let at = |s: f64| vec![x[0], Vector::<2>::new(dx * (1.0 + s), 0.0)];
-    let f = bond_forces(&mut b, &at(0.999 * s0));
+    let f = bond_forces(&mut b, &at(0.999 * s0), DT);
     let expected = pmb.micromodulus * 0.999 * s0 * dx.powi(4);
     assert!((f[0][0] - expected).abs() <= 1e-9 * expected && f[1][0] == -f[0][0]);
     assert!(b.bonds.intact[0]);
-    bond_forces(&mut b, &at(1.001 * s0));
+    bond_forces(&mut b, &at(1.001 * s0), DT);
     assert!(!b.bonds.intact[0]);
     assert_eq!(b.damage(), vec![1.0, 1.0]);
     for s in [0.5 * s0, 0.0, -0.01] {
-        let f = bond_forces(&mut b, &at(s));
+        let f = bond_forces(&mut b, &at(s), DT);
         assert!(!b.bonds.intact[0] && f[0] == Vector::<2>::zeros() && f[1] == Vector::<2>::zeros());
     }
 }
@@ -217,7 +244,7 @@ fn plate_in_tension(
         .map(|q| Vector::<2>::new((q % nx) as f64 * dx, (q / nx) as f64 * dx))
         .collect();
     let v0 = dx * dx;
-    let mut b = PdBody::new(0, (0..x.len()).collect(), &x, vec![v0; x.len()], law);
+    let mut b = pd_body(&x, vec![v0; x.len()], law);
     let per = sigma * (ny as f64 * dx) / ny as f64;
     let load = |q: usize| match q % nx {
         0 => Vector::<2>::new(-per, 0.0),
@@ -231,7 +258,7 @@ fn plate_in_tension(
     let (mut y, mut v) = (x.clone(), vec![Vector::<2>::zeros(); x.len()]);
     let mut residual = f64::INFINITY;
     for _ in 0..100_000 {
-        let f = bond_forces(&mut b, &y);
+        let f = bond_forces(&mut b, &y, DT);
         residual = 0.0;
         for q in 0..y.len() {
             let total = f[q] + load(q);
@@ -337,4 +364,144 @@ fn the_beam_bond_forces_sum_to_zero_on_a_perturbed_lattice() {
     let beam = |space| BondLaw::Beam(Beam::new(space, E, 0.1, 3.0 * 1e-3));
     sum_of_forces_vanishes::<2>(beam(Space::PlaneStress));
     sum_of_forces_vanishes::<3>(beam(Space::ThreeD));
+}
+
+#[test]
+fn the_correspondence_forces_sum_to_zero_on_a_perturbed_lattice() {
+    sum_of_forces_vanishes::<2>(correspondence(Space::PlaneStrain, 0.1));
+    sum_of_forces_vanishes::<3>(correspondence(Space::ThreeD, 0.1));
+}
+
+/// The stress of a rigid rotation is none (the linear elastic update is
+/// objective), and the zero-energy control sees no non-affine motion.
+#[test]
+fn a_correspondence_body_resists_no_rigid_motion() {
+    rigid_motion_gives_no_force::<2>(correspondence(Space::PlaneStrain, 0.1));
+    rigid_motion_gives_no_force::<3>(correspondence(Space::ThreeD, 0.1));
+}
+
+/// Homogeneous uniaxial tension of a plane-strain correspondence plate 40Δx ×
+/// 20Δx (m = 3, linear elastic E, ν = 1/4): εxx against σ(1 − ν²)/E and the
+/// Poisson ratio −εyy/εxx = ν/(1 − ν); F is exact for affine maps at every
+/// particle, surface included, so no surface correction is needed.
+#[test]
+fn a_correspondence_plate_in_tension_stretches_as_the_continuum() {
+    let (dx, sigma, nu) = (1e-3, 7e6, 0.25);
+    let law = correspondence(Space::PlaneStrain, ZERO_ENERGY_CONTROL);
+    let (exx, eyy, residual) = plate_in_tension(law, 40, 20, dx, E, sigma);
+    let axial = exx / (sigma * (1.0 - nu * nu) / E) - 1.0;
+    let poisson = -eyy / exx / (nu / (1.0 - nu)) - 1.0;
+    println!(
+        "residual {residual:.1e}; εxx/(σ(1 − ν²)/E) − 1 = {axial:+.5}, ν' error {poisson:+.5}"
+    );
+    assert!(residual < 1e-6, "not converged: {residual:e}");
+    assert!(axial.abs() < 0.02, "{axial}");
+    assert!(poisson.abs() < 0.02, "{poisson}");
+}
+
+/// The checkerboard u_j = ±a e_x on a lattice has no affine part in any
+/// interior family (the neighbours at ±ξ move alike), so F = I and the stress
+/// forces vanish two horizons from the edges: a zero-energy mode. The control resists it: with G = 0.1 every
+/// interior particle is pulled back (f·u < 0) with a force of the order of
+/// G × the PMB force of a stretch a/Δx; with G = 0 the force is round-off.
+#[test]
+fn the_zero_energy_control_resists_the_checkerboard_mode() {
+    let (n, dx, a) = (21, 1e-3, 1e-6);
+    let x = lattice::<2>(n, dx, 0.0);
+    let sign = |q: usize| if (q % n + q / n) % 2 == 0 { 1.0 } else { -1.0 };
+    let y: Vec<Vector<2>> = (0..x.len())
+        .map(|q| x[q] + Vector::<2>::new(a * sign(q), 0.0))
+        .collect();
+    // Two horizons from the edges: the families of i and of its neighbours are whole.
+    let interior = |q: usize| (6..n - 6).contains(&(q % n)) && (6..n - 6).contains(&(q / n));
+    let v = vec![dx * dx; x.len()];
+    let pmb = pmb_of(&pd_body(
+        &x,
+        v.clone(),
+        BondLaw::Pmb(Pmb::new(Space::PlaneStrain, E, 3.0 * dx)),
+    ));
+    let scale = pmb.micromodulus * (a / dx) * dx.powi(4) * 28.0;
+    for g in [0.0, 0.1] {
+        let f = bond_forces(
+            &mut pd_body(&x, v.clone(), correspondence(Space::PlaneStrain, g)),
+            &y,
+            DT,
+        );
+        let (mut worst, mut weakest) = (f64::NEG_INFINITY, f64::INFINITY);
+        for q in (0..x.len()).filter(|&q| interior(q)) {
+            let along = f[q].x * sign(q);
+            worst = worst.max(along);
+            weakest = weakest.min(-along);
+            if g == 0.0 {
+                assert!(
+                    f[q].norm() < 1e-9 * scale,
+                    "G = 0: |f| {:e} against {scale:e}",
+                    f[q].norm()
+                );
+            }
+        }
+        println!("G = {g}: largest f·u/|u| {worst:.3e}, weakest pull-back {weakest:.3e}, scale {scale:.3e}");
+        if g > 0.0 {
+            assert!(
+                worst < 0.0,
+                "an interior particle is not pulled back: {worst:e}"
+            );
+            // Measured 0.32 G × scale.
+            assert!(
+                weakest > 0.1 * g * scale,
+                "pull-back {weakest:e} against {scale:e}"
+            );
+        }
+    }
+}
+
+/// Any material of `material/` on correspondence particles, through the
+/// update MPM particles take: under an affine map beyond yield (Johnson–Cook
+/// copper, plane strain), every particle of a perturbed lattice, surface
+/// included, has the stress and history of the single-point update under
+/// the same F, and it has yielded.
+#[test]
+fn correspondence_particles_take_the_stress_update_of_their_material() {
+    use crate::dim::{embed_deformation, Mat3};
+    use crate::material::Increment;
+    let text = "youngs_modulus = 117.0e9\npoisson_ratio = 0.35\nyield_stress = 157.0e6\n\
+                hardening_modulus = 425.0e6\nhardening_exponent = 1.0";
+    let values: toml::Table = toml::from_str(text).unwrap();
+    let copper =
+        crate::material::registry::build("material.0", "johnson_cook", 8930.0, &values).unwrap();
+    let dx = 1e-3;
+    let x = lattice::<2>(12, dx, 0.2);
+    let m = copper.p_wave_modulus();
+    let law = BondLaw::Correspondence(Correspondence::new(Space::PlaneStrain, m, 3.0 * dx, 0.1));
+    let b = PdBody::new(0, (0..x.len()).collect(), &x, vec![dx * dx; x.len()], law);
+    let mut b = b.with_stress(StressState::at_rest(copper.clone(), x.len()));
+    let f = Tensor::<2>::new(1.02, 0.01, 0.0, 0.99);
+    let y: Vec<Vector<2>> = x.iter().map(|p| f * p).collect();
+    bond_forces(&mut b, &y, DT);
+    let nh = copper.n_history();
+    let mut h = vec![0.0; nh];
+    copper.initial_history(&Mat3::zeros(), &mut h);
+    let h0 = h.clone();
+    let inc = Increment::new(
+        Mat3::identity(),
+        embed_deformation(&f),
+        DT,
+        Mat3::zeros(),
+        &h0,
+    );
+    let single = copper.update(&inc, &mut h);
+    let s = b.stress.as_ref().unwrap();
+    let worst = (0..x.len())
+        .map(|i| (s.stress[i] - single).norm() / single.norm())
+        .fold(0.0, f64::max);
+    let eps_p = copper.equivalent_plastic_strain(&h).unwrap_or(0.0);
+    println!("σ against the single point: worst relative {worst:.2e}; ε_p {eps_p:.4}");
+    assert!(eps_p > 0.005, "the map is beyond yield: ε_p = {eps_p}");
+    assert!(worst < 1e-10, "{worst:e}");
+    let history_worst = (0..x.len())
+        .flat_map(|i| (0..nh).map(move |k| (i, k)))
+        .map(|(i, k)| (s.history[i * nh + k] - h[k]).abs() / h[k].abs().max(1e-3))
+        .fold(0.0, f64::max);
+    println!("history {h:?}: worst relative {history_worst:.2e}");
+    assert!(history_worst < 1e-10, "{history_worst:e}");
 }

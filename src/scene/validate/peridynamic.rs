@@ -18,6 +18,7 @@ pub fn not_peridynamic(i: usize, s: &SceneConfig) -> Check {
     forbidden(&b.bond_model, key("bond_model"), what)?;
     forbidden(&b.fracture_energy, key("fracture_energy"), what)?;
     forbidden(&b.critical_stretch, key("critical_stretch"), what)?;
+    forbidden(&b.zero_energy_control, key("zero_energy_control"), what)?;
     forbidden(&b.plane, key("plane"), what)
 }
 
@@ -37,6 +38,26 @@ pub fn body(i: usize, s: &SceneConfig) -> Check {
     positive(b.horizon_factor, "horizon_factor")?;
     positive(b.fracture_energy, "fracture_energy")?;
     positive(b.critical_stretch, "critical_stretch")?;
+    let correspondence = b.bond_model == Some(BondModel::Correspondence);
+    if let Some(g) = b.zero_energy_control {
+        ensure(
+            correspondence,
+            key("zero_energy_control"),
+            "is the zero-energy control of bond_model = \"correspondence\"; the bond-based \
+             models have no zero-energy modes",
+        )?;
+        ensure(
+            g >= 0.0 && g.is_finite(),
+            key("zero_energy_control"),
+            format!("must be a finite number ≥ 0; got {g}"),
+        )?;
+    }
+    ensure(
+        !(correspondence && b.plane == Some(crate::scene::Plane::Stress)),
+        key("plane"),
+        "bond_model = \"correspondence\" takes its stress from the materials' update, \
+         which is 3D or plane strain: give plane = \"strain\"",
+    )?;
     ensure(
         b.horizon.is_none() || b.horizon_factor.is_none(),
         key("horizon_factor"),
@@ -72,13 +93,27 @@ pub fn body(i: usize, s: &SceneConfig) -> Check {
     scene(i, s)
 }
 
-/// Its material: a table of its own with E > 0 and the PMB ν of its space.
+/// Its material: a table of its own; with E > 0 and the PMB ν of its space
+/// (bond-based), or any continuum model (correspondence).
 fn material(i: usize, s: &SceneConfig) -> Check {
     let b = &s.bodies[i];
     let k = (s.materials.iter())
         .position(|m| m.name == b.material)
         .unwrap();
     let m = &s.materials[k];
+    if b.bond_model == Some(BondModel::Correspondence) {
+        let modulus = m.build(k).map(|built| built.p_wave_modulus());
+        ensure(
+            modulus.as_ref().is_ok_and(|&p| p > 0.0 && p.is_finite()),
+            format!("material.{k}.model"),
+            format!(
+                "the correspondence body {i} takes its stress from its material `{}`: give \
+                 it a continuum model with a positive stiffness, not model = \"{}\"",
+                m.name, m.model
+            ),
+        )?;
+        return own_table(i, s);
+    }
     let e = s.youngs_modulus(i);
     ensure(
         e.is_some_and(|e| e > 0.0 && e.is_finite()),
@@ -90,6 +125,12 @@ fn material(i: usize, s: &SceneConfig) -> Check {
         ),
     )?;
     poisson_ratio(i, k, s)?;
+    own_table(i, s)
+}
+
+/// Body i's material table is no other body's.
+fn own_table(i: usize, s: &SceneConfig) -> Check {
+    let b = &s.bodies[i];
     let shared = (0..s.bodies.len()).find(|&j| j != i && s.bodies[j].material == b.material);
     match shared {
         Some(j) => Err((
@@ -127,6 +168,7 @@ fn poisson_ratio(i: usize, k: usize, s: &SceneConfig) -> Check {
                  bond_model = \"beam\" for another ν, or, in 2D, the other `plane`"
             ),
         ),
+        BondModel::Correspondence => Ok(()),
         BondModel::Beam => ensure(
             nu.is_some_and(|nu| nu > -1.0 && nu <= want + 1e-4),
             key,
