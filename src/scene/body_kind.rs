@@ -147,7 +147,8 @@ impl SceneConfig {
             }
             BondModel::Correspondence => {
                 let g = b.zero_energy_control.unwrap_or(ZERO_ENERGY_CONTROL);
-                let c = Correspondence::new(space, self.p_wave_modulus(i), delta, g);
+                let c = Correspondence::new(space, self.p_wave_modulus(i), delta, g)
+                    .with_influence(b.influence.unwrap_or_default());
                 BondLaw::Correspondence(match (b.fracture_energy, b.critical_stretch) {
                     (Some(g0), _) => c.with_fracture_energy(space, g0),
                     (_, Some(s0)) => c.with_critical_stretch(s0),

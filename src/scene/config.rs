@@ -285,8 +285,10 @@ pub struct BodyConfig {
     /// Peridynamic body in 2D: `strain` (default) or `stress`.
     pub plane: Option<Plane>,
     /// Correspondence peridynamic body: G of its zero-energy control (default
-    /// `material::bond::correspondence::ZERO_ENERGY_CONTROL`).
+    /// `material::bond::correspondence::ZERO_ENERGY_CONTROL`) and its influence
+    /// function (default constant).
     pub zero_energy_control: Option<f64>,
+    pub influence: Option<crate::material::bond::correspondence::Influence>,
 }
 
 /// A physical group of a Gmsh file, by its name or its number.

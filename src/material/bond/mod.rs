@@ -50,12 +50,15 @@ impl BondLaw {
 
     /// The bond's spring constant times |ξ| for the Silling–Askari step: c
     /// (PMB), max(c1, c2) (beam), c (1 + G) (correspondence: PMB's c of the
-    /// same P-wave modulus, stiffened by the zero-energy control).
+    /// same P-wave modulus, stiffened by the zero-energy control and, for a
+    /// Gaussian influence, by `Influence::stiffening`).
     pub fn stiffness(&self) -> f64 {
         match self {
             BondLaw::Pmb(p) => p.micromodulus,
             BondLaw::Beam(b) => b.stiffness(),
-            BondLaw::Correspondence(c) => c.micromodulus * (1.0 + c.zero_energy_control),
+            BondLaw::Correspondence(c) => {
+                c.micromodulus * (1.0 + c.zero_energy_control) * c.influence.stiffening()
+            }
         }
     }
 

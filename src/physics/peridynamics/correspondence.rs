@@ -1,8 +1,8 @@
 //! The forces of a correspondence body's bonds (`material::bond::correspondence`
 //! has the equations): each particle's F over its intact bonds, its stress from
 //! the body's material under ΔF = F F_old⁻¹, then each intact bond's pair
-//! force (P_i K_i⁻¹ + P_j K_j⁻¹) ξ plus the zero-energy control, summed per
-//! particle in the CSR order of its bonds.
+//! force ω (P_i K_i⁻¹ + P_j K_j⁻¹) ξ plus the zero-energy control (weighted by
+//! the same ω), summed per particle in the CSR order of its bonds.
 
 use crate::dim::{embed_deformation, restrict, Mat3, Tensor, Vector};
 use crate::material::bond::correspondence::{Correspondence, FAMILY_LOST};
@@ -11,7 +11,7 @@ use crate::material::Increment;
 use crate::model::peridynamics::state::StressState;
 use crate::model::peridynamics::PdBody;
 use crate::parallel::MIN_PARALLEL_LEN;
-use crate::physics::peridynamics::deformation::shapes;
+use crate::physics::peridynamics::deformation::weighted_shapes;
 use rayon::prelude::*;
 
 /// The bond force on each particle of body `b` (correspondence law `law`, its
@@ -28,7 +28,8 @@ pub fn forces<const D: usize>(
     // A particle that has lost more than half its family (or whose bonds no
     // longer span the space) has no F worth the name: it takes no stress
     // update, and its bonds act as PMB bonds of the same P-wave modulus.
-    let shape: Vec<_> = (shapes(b, y).into_iter().enumerate())
+    let omega = |k: usize| law.weight(bonds.length[k]);
+    let shape: Vec<_> = (weighted_shapes(b, y, omega).into_iter().enumerate())
         .map(|(i, s)| s.filter(|_| bonds.damage(i, v) <= FAMILY_LOST))
         .collect();
     let a = stress_update(state, &shape, dt);
@@ -51,7 +52,8 @@ pub fn forces<const D: usize>(
                 let stress = (a[i] + a[j]) * xi;
                 let z = (y[j] - y[i]) - (fi + fj) * xi * 0.5;
                 let dir = (y[j] - y[i]).normalize();
-                (stress + dir * (control * z.dot(&dir) / bonds.length[k])) * (v[i] * v[j])
+                let resist = dir * (control * z.dot(&dir) / bonds.length[k]);
+                (stress + resist) * (omega(k) * v[i] * v[j])
             })
         })
         .collect()

@@ -32,16 +32,26 @@ pub fn shapes<const D: usize>(
     b: &PdBody<D>,
     y: &[Vector<D>],
 ) -> Vec<Option<(Tensor<D>, Tensor<D>)>> {
+    weighted_shapes(b, y, |_| 1.0)
+}
+
+/// As [`shapes`], each bond k weighted by ω(k) in K and N (the influence
+/// function; F stays exact for affine maps).
+pub fn weighted_shapes<const D: usize>(
+    b: &PdBody<D>,
+    y: &[Vector<D>],
+    omega: impl Fn(usize) -> f64 + Sync,
+) -> Vec<Option<(Tensor<D>, Tensor<D>)>> {
     let (x, v, bonds) = (&b.reference, &b.volume, &b.bonds);
     (0..y.len())
         .into_par_iter()
         .with_min_len(MIN_PARALLEL_LEN)
         .map(|i| {
             let (mut k, mut n) = (Tensor::<D>::zeros(), Tensor::<D>::zeros());
-            bonds.each_intact(i, |_, j| {
-                let xi = x[j] - x[i];
-                k += xi * xi.transpose() * v[j];
-                n += (y[j] - y[i]) * xi.transpose() * v[j];
+            bonds.each_intact(i, |bond, j| {
+                let (xi, w) = (x[j] - x[i], omega(bond) * v[j]);
+                k += xi * xi.transpose() * w;
+                n += (y[j] - y[i]) * xi.transpose() * w;
             });
             // In 3 × 3 (zz = 1 in 2D), where nalgebra has det and inverse.
             let k3 = embed_deformation(&k);

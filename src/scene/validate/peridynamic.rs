@@ -19,6 +19,7 @@ pub fn not_peridynamic(i: usize, s: &SceneConfig) -> Check {
     forbidden(&b.fracture_energy, key("fracture_energy"), what)?;
     forbidden(&b.critical_stretch, key("critical_stretch"), what)?;
     forbidden(&b.zero_energy_control, key("zero_energy_control"), what)?;
+    forbidden(&b.influence, key("influence"), what)?;
     forbidden(&b.plane, key("plane"), what)
 }
 
@@ -52,6 +53,12 @@ pub fn body(i: usize, s: &SceneConfig) -> Check {
             format!("must be a finite number ≥ 0; got {g}"),
         )?;
     }
+    ensure(
+        correspondence || b.influence.is_none(),
+        key("influence"),
+        "is the influence function of bond_model = \"correspondence\"; the bond-based \
+         micromoduli are those of a constant one",
+    )?;
     ensure(
         !(correspondence && b.plane == Some(crate::scene::Plane::Stress)),
         key("plane"),
