@@ -118,14 +118,29 @@ impl Geometry {
         }
     }
 
-    /// Does the segment from a to b (points inside) stay inside, sampled every
-    /// `step` or closer? True for the geometries without an inside (particle
-    /// files, meshes). A peridynamic body's bonds must not cross a notch or
-    /// a re-entrant corner (`model::build`).
+    /// Does the segment from a to b (points inside) stay inside? A peridynamic
+    /// body's bonds must not cross a notch or a re-entrant corner
+    /// (`model::build`). Convex shapes hold every such segment; a polygon (or a
+    /// prism's section) holds it unless it crosses an edge, tested exactly; a
+    /// closed surface or a terrain is sampled every `step` or closer (a slit
+    /// thinner than about `step` can be missed there); the geometries without
+    /// an inside (particle files, meshes) hold every segment.
     pub fn holds_segment(&self, a: &[f64], b: &[f64], step: f64) -> bool {
-        if matches!(self, Geometry::Particles(_) | Geometry::Mesh(_)) {
-            return true;
+        match self {
+            Geometry::Box { .. } | Geometry::Ball { .. } | Geometry::Cylinder { .. } => true,
+            Geometry::Particles(_) | Geometry::Mesh(_) => true,
+            Geometry::Polygon(v) => !crosses_an_edge([a[0], a[1]], [b[0], b[1]], v),
+            Geometry::Prism { section, axis, .. } => {
+                let plane = prism_plane(*axis);
+                let on = |p: &[f64]| [p[plane[0]], p[plane[1]]];
+                !crosses_an_edge(on(a), on(b), section)
+            }
+            Geometry::Surface(_) | Geometry::Terrain(_) => self.holds_sampled(a, b, step),
         }
+    }
+
+    /// Whether every point of the segment a–b at spacing `step` or closer is inside.
+    fn holds_sampled(&self, a: &[f64], b: &[f64], step: f64) -> bool {
         let length: f64 = (0..a.len())
             .map(|d| (b[d] - a[d]).powi(2))
             .sum::<f64>()
@@ -520,6 +535,22 @@ fn polygon_faces(
 }
 
 /// Even-odd rule (ray crossing to +x).
+/// Does the segment p–q cross an edge of the polygon `v` (a proper crossing,
+/// or touching it: p and q inside, so a segment that only touches an edge
+/// or a vertex grazes the boundary and is counted as leaving)?
+fn crosses_an_edge(p: [f64; 2], q: [f64; 2], v: &[Vec<f64>]) -> bool {
+    let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| {
+        (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+    };
+    let n = v.len();
+    (0..n).any(|k| {
+        let (a, b) = ([v[k][0], v[k][1]], [v[(k + 1) % n][0], v[(k + 1) % n][1]]);
+        let (d1, d2) = (cross(a, b, p), cross(a, b, q));
+        let (d3, d4) = (cross(p, q, a), cross(p, q, b));
+        d1 * d2 <= 0.0 && d3 * d4 <= 0.0 && (d1 != d2 || d3 != d4)
+    })
+}
+
 fn point_in_polygon(x: f64, y: f64, v: &[Vec<f64>]) -> bool {
     let mut inside = false;
     let n = v.len();

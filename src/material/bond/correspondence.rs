@@ -26,7 +26,8 @@
 //! `zero_energy_control` (default 1, as Silling's G is of order one). It
 //! vanishes under an affine motion (z = 0 when F_i = F_j = the map), so a
 //! homogeneous deformation does not feel it, and it raises the bond stiffness
-//! of the stable step to c (1 + G). Lower values let the zero-energy
+//! of the stable step to c (1 + G) (twice that with the Gaussian influence,
+//! `Influence::stiffening`). Lower values let the zero-energy
 //! oscillations break bonds: the notched glass plate
 //! (`problems/peridynamic_plate.toml` in plane strain) shatters at its free
 //! ends with G = 0 (1,807 damaged particles more than 8 mm from the notch)

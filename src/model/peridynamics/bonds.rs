@@ -282,4 +282,25 @@ mod tests {
         });
         assert_eq!(kept, Bonds::build(&all, 0.3));
     }
+
+    /// A polygon's edges are tested exactly: a slit far thinner than any
+    /// sampling step still cuts the segments across it, and only those.
+    #[test]
+    fn a_hair_thin_slit_cuts_the_segments_across_it() {
+        use crate::model::geometry::Geometry;
+        let slit = Geometry::Polygon(vec![
+            vec![0.0, 0.0],
+            vec![1.0, 0.0],
+            vec![1.0, 1.0],
+            vec![0.0, 1.0],
+            vec![0.0, 0.5005],
+            vec![0.5, 0.5005],
+            vec![0.5, 0.4995],
+            vec![0.0, 0.4995],
+        ]);
+        assert!(!slit.holds_segment(&[0.2, 0.3], &[0.2, 0.7], 0.5));
+        assert!(!slit.holds_segment(&[0.1, 0.45], &[0.45, 0.55], 0.5));
+        assert!(slit.holds_segment(&[0.8, 0.3], &[0.8, 0.7], 0.5));
+        assert!(slit.holds_segment(&[0.2, 0.3], &[0.4, 0.45], 0.5));
+    }
 }

@@ -160,10 +160,25 @@ impl<const D: usize> Peridynamics<D> {
 
     /// The stress states `numbers` gives (`stress_states` of the same scene).
     pub fn restore_stress(&mut self, numbers: &[Vec<f64>]) -> Result<(), String> {
+        let correspondence = self.bodies.iter().any(|b| b.stress.is_some());
+        if numbers.len() != self.bodies.len() && (correspondence || !numbers.is_empty()) {
+            return Err(format!(
+                "it holds the stress states of {} peridynamic bodies, the scene has {}",
+                numbers.len(),
+                self.bodies.len()
+            ));
+        }
         for (k, b) in self.bodies.iter_mut().enumerate() {
-            if let Some(s) = &mut b.stress {
-                let n = numbers.get(k).map_or(&[][..], |n| &n[..]);
-                s.restore(n).map_err(|e| format!("body {}: {e}", b.body))?;
+            let n = numbers.get(k).map_or(&[][..], |n| &n[..]);
+            match &mut b.stress {
+                Some(s) => s.restore(n).map_err(|e| format!("body {}: {e}", b.body))?,
+                None if !n.is_empty() => {
+                    return Err(format!(
+                        "it holds a stress state for body {}, which is bond-based here",
+                        b.body
+                    ))
+                }
+                None => {}
             }
         }
         Ok(())

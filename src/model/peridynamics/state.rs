@@ -15,6 +15,9 @@ pub struct StressState {
     /// `n_history` values per particle.
     pub history: Vec<f64>,
     pub n_history: usize,
+    /// The step-start history during a stress update (a buffer kept between
+    /// steps).
+    pub history_old: Vec<f64>,
 }
 
 impl StressState {
@@ -32,6 +35,7 @@ impl StressState {
             stress: vec![Mat3::zeros(); n],
             history,
             n_history,
+            history_old: Vec::new(),
         }
     }
 

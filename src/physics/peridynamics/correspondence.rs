@@ -67,7 +67,11 @@ fn stress_update<const D: usize>(
     shape: &[Option<(Tensor<D>, Tensor<D>)>],
     dt: f64,
 ) -> Vec<Tensor<D>> {
+    // The material reads the step-start history and writes the new one.
+    let mut old = std::mem::take(&mut state.history_old);
+    old.clone_from(&state.history);
     let (material, nh) = (state.material.as_ref(), state.n_history);
+    let history_old = &old;
     let update = |i: usize, f_old: &mut Mat3, stress: &mut Mat3, h: &mut [f64]| {
         let Some((k_inv, f)) = shape[i] else {
             return Tensor::<D>::zeros();
@@ -81,14 +85,14 @@ fn stress_update<const D: usize>(
         if j.is_nan() || j <= 0.0 {
             return Tensor::<D>::zeros();
         }
-        let old = h.to_vec();
-        let inc = Increment::new(*f_old, f3 * f_old_inv, dt, *stress, &old);
+        let old = &history_old[i * nh..(i + 1) * nh];
+        let inc = Increment::new(*f_old, f3 * f_old_inv, dt, *stress, old);
         *stress = material.update(&inc, h);
         *f_old = f3;
         restrict::<D>(&(*stress * f_inv.transpose() * j)) * k_inv
     };
     let (f, stress) = (&mut state.f, &mut state.stress);
-    match nh {
+    let a = match nh {
         0 => (f.par_iter_mut().zip(stress.par_iter_mut()).enumerate())
             .with_min_len(MIN_PARALLEL_LEN)
             .map(|(i, (f, s))| update(i, f, s, &mut []))
@@ -99,5 +103,7 @@ fn stress_update<const D: usize>(
             .with_min_len(MIN_PARALLEL_LEN)
             .map(|(i, ((f, s), h))| update(i, f, s, h))
             .collect(),
-    }
+    };
+    state.history_old = old;
+    a
 }

@@ -1,7 +1,8 @@
 //! The non-local deformation gradient of a peridynamic particle over its
 //! intact bonds (Silling et al. 2007, the correspondence model; digest Part 3):
 //! shape tensor K_i = Σ_j ξ⊗ξ V_j, N_i = Σ_j (y_j − y_i)⊗ξ V_j, F_i = N_i K_i⁻¹,
-//! with ξ = x_j − x_i and a constant influence function. F_i equals an applied
+//! with ξ = x_j − x_i and a constant influence function (`weighted_shapes`:
+//! any, each bond weighted by ω in K and N). F_i equals an applied
 //! affine map at every particle, surface included, since K and N run over the
 //! same bonds. The beam bond takes the rotation of its polar decomposition
 //! (`material::bond::beam`).

@@ -13,8 +13,8 @@ use crate::model::peridynamics::PdBody;
 use crate::parallel::MIN_PARALLEL_LEN;
 use rayon::prelude::*;
 
-/// The bond force on each particle of body `b` (V_i Σ_j f_ij V_j, its law's
-/// `pair_force`) at positions `y` (its local order), after breaking the bonds
+/// The bond force on each particle of body `b` (V_i Σ_j f_ij V_j, f_ij its
+/// law's pair force) at positions `y` (its local order), after breaking the bonds
 /// stretched past s0. The beam law first finds each particle's rotation
 /// (`deformation::rotations`, over the bonds left intact); the correspondence
 /// law updates its particles' stresses over the step `dt` (`correspondence`).

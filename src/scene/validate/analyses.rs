@@ -24,7 +24,8 @@ pub fn geostatic(g: &GeostaticConfig, s: &SceneConfig, materials: &[Box<dyn Mate
         )?;
     }
     for (i, b) in s.bodies.iter().enumerate() {
-        // A rigid or a peridynamic body carries no stress: it takes no K0 state.
+        // A rigid or a peridynamic body takes no K0 state (a correspondence
+        // body starts unstressed: docs/scene.md).
         if s.body_kind(i) != BodyKindName::Continuum {
             continue;
         }

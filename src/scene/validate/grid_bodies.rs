@@ -144,7 +144,8 @@ fn kind(i: usize, s: &SceneConfig) -> Check {
                 old_form.is_none(),
                 key("material"),
                 format!(
-                    "`{}` is a rigid material: a peridynamic body needs E and ν",
+                    "`{}` is a rigid material: a peridynamic body needs E and ν (bond-based) or \
+                     a continuum model (correspondence)",
                     b.material
                 ),
             )?;

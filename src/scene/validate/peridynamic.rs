@@ -1,6 +1,8 @@
 //! The keys of a peridynamic body (`kind = "peridynamic"`,
-//! `physics::peridynamics`): its horizon, fracture and plane keys, its
-//! material's E and the PMB Poisson ratio, the scene around it (with rigid
+//! `physics::peridynamics`): its horizon, fracture, plane, zero-energy and
+//! influence keys, its material (E and the PMB Poisson ratio for the
+//! bond-based laws; a continuum model without erosion or pore water for the
+//! correspondence law), the scene around it (with rigid
 //! bodies met by the rigid projection alone, on explicit stages only: contact
 //! with continuum bodies and implicit PD are later slices of issue 51), and
 //! none of these keys on other bodies.
@@ -109,15 +111,42 @@ fn material(i: usize, s: &SceneConfig) -> Check {
         .unwrap();
     let m = &s.materials[k];
     if b.bond_model == Some(BondModel::Correspondence) {
-        let modulus = m.build(k).map(|built| built.p_wave_modulus());
+        let built = m.build(k).ok();
+        let modulus = built.as_ref().map(|m| m.p_wave_modulus());
         ensure(
-            modulus.as_ref().is_ok_and(|&p| p > 0.0 && p.is_finite()),
+            modulus.is_some_and(|p| p > 0.0 && p.is_finite()),
             format!("material.{k}.model"),
             format!(
                 "the correspondence body {i} takes its stress from its material `{}`: give \
                  it a continuum model with a positive stiffness, not model = \"{}\"",
                 m.name, m.model
             ),
+        )?;
+        // What the grid's points do with a material and bonds do not.
+        let built = built.expect("built above");
+        ensure(
+            !built.erodes(),
+            format!("material.{k}"),
+            format!(
+                "the correspondence body {i}'s particles are not eroded (its bonds break \
+                 instead): give material `{}` no erosion key",
+                m.name
+            ),
+        )?;
+        ensure(
+            built.pore_fluid().is_none(),
+            format!("material.{k}.drainage"),
+            format!(
+                "the correspondence body {i} carries no pore water: give material `{}` no \
+                 drainage",
+                m.name
+            ),
+        )?;
+        ensure(
+            b.shape != crate::scene::BodyShape::Particles,
+            format!("body.{i}.shape"),
+            "a correspondence body starts unstressed, and a particle file's stress columns \
+             would be lost: fill its shape instead",
         )?;
         return own_table(i, s);
     }
