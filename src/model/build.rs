@@ -54,9 +54,7 @@ impl<const D: usize> Model<D> {
             .map(|(i, m)| m.build(i))
             .collect::<Result<Vec<_>, _>>()
             .map_err(err)?;
-        // A rigid body's particles carry the zero-stress material (`model::body`);
-        // a correspondence body keeps its own (`model::peridynamics::state`).
-        let own_materials = tables.clone();
+        // A rigid body's particles carry the zero-stress material (`model::body`).
         let base_materials = c.particle_materials(tables);
         let bodies = (0..c.bodies.len())
             .map(|i| import::body_geometry(scene, i).map(|g| Body::of(c, i, g)))
@@ -86,7 +84,7 @@ impl<const D: usize> Model<D> {
                 return Err(err((format!("body.{i}.shape"), "the body holds no particle centre: refine the grid or raise particles_per_cell".into())));
             }
         }
-        let peridynamics = peridynamic_bodies(c, &bodies, &particles, &own_materials);
+        let peridynamics = peridynamic_bodies(c, &bodies, &particles);
         // The velocity conditions, with the index of their [[boundary]] table.
         let velocity: Vec<(usize, &BoundaryConfig)> = (c.boundaries.iter().enumerate())
             .filter(|(_, b)| b.condition.prescribes_velocity())
@@ -169,13 +167,12 @@ impl<const D: usize> Model<D> {
 
 /// The peridynamic bodies with their bonds (`model::peridynamics`), built
 /// from the particles' reference positions and volumes, a correspondence
-/// body with its material of `materials` (one per table) at rest; None
-/// without one.
+/// body with its own material (built from its table: its particles carry the
+/// zero-stress one) at rest; None without one.
 fn peridynamic_bodies<const D: usize>(
     c: &SceneConfig,
     bodies: &[Body],
     p: &Particles<D>,
-    materials: &[Box<dyn Material>],
 ) -> Option<Peridynamics<D>> {
     let pd: Vec<PdBody<D>> = (0..bodies.len())
         .filter(|&i| bodies[i].kind == BodyKind::Peridynamic)
@@ -195,7 +192,8 @@ fn peridynamic_bodies<const D: usize>(
             match law {
                 BondLaw::Correspondence(_) => {
                     let k = p.material[body.particles[0]] as usize;
-                    body.with_stress(StressState::at_rest(materials[k].clone(), n))
+                    let material = c.materials[k].build(k).expect("validated");
+                    body.with_stress(StressState::at_rest(material, n))
                 }
                 _ => body,
             }

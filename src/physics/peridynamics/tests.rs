@@ -376,22 +376,37 @@ fn the_beam_bond_forces_sum_to_zero_on_a_perturbed_lattice() {
     sum_of_forces_vanishes::<3>(beam(Space::ThreeD));
 }
 
+/// The correspondence laws the exact checks run over, (2D, 3D): constant
+/// influence with G = 0.1, Gaussian with G = 1.
+fn correspondence_laws() -> [(BondLaw, BondLaw); 2] {
+    [
+        (
+            correspondence(Space::PlaneStrain, 0.1),
+            correspondence(Space::ThreeD, 0.1),
+        ),
+        (
+            gaussian(Space::PlaneStrain, 1.0),
+            gaussian(Space::ThreeD, 1.0),
+        ),
+    ]
+}
+
 #[test]
 fn the_correspondence_forces_sum_to_zero_on_a_perturbed_lattice() {
-    sum_of_forces_vanishes::<2>(correspondence(Space::PlaneStrain, 0.1));
-    sum_of_forces_vanishes::<3>(correspondence(Space::ThreeD, 0.1));
-    sum_of_forces_vanishes::<2>(gaussian(Space::PlaneStrain, 1.0));
-    sum_of_forces_vanishes::<3>(gaussian(Space::ThreeD, 1.0));
+    for (two, three) in correspondence_laws() {
+        sum_of_forces_vanishes::<2>(two);
+        sum_of_forces_vanishes::<3>(three);
+    }
 }
 
 /// The stress of a rigid rotation is none (the linear elastic update is
 /// objective), and the zero-energy control sees no non-affine motion.
 #[test]
 fn a_correspondence_body_resists_no_rigid_motion() {
-    rigid_motion_gives_no_force::<2>(correspondence(Space::PlaneStrain, 0.1));
-    rigid_motion_gives_no_force::<3>(correspondence(Space::ThreeD, 0.1));
-    rigid_motion_gives_no_force::<2>(gaussian(Space::PlaneStrain, 1.0));
-    rigid_motion_gives_no_force::<3>(gaussian(Space::ThreeD, 1.0));
+    for (two, three) in correspondence_laws() {
+        rigid_motion_gives_no_force::<2>(two);
+        rigid_motion_gives_no_force::<3>(three);
+    }
 }
 
 /// Homogeneous uniaxial tension of a plane-strain correspondence plate 40Δx ×
