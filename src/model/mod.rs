@@ -262,6 +262,26 @@ impl<const D: usize> Model<D> {
         fields
     }
 
+    /// The particles as the outputs write them (frames, particles_final.csv,
+    /// particle dumps): a correspondence body's particles with the stress and F
+    /// of their own state (`peridynamics::state`; on the grid they carry a
+    /// zero-stress material); borrowed, not copied, when no body has that state.
+    pub fn output_particles(&self) -> Cow<'_, Particles<D>> {
+        let own = |pd: &&Peridynamics<D>| pd.bodies.iter().any(|b| b.stress.is_some());
+        let Some(pd) = self.peridynamics.as_ref().filter(own) else {
+            return Cow::Borrowed(&self.particles);
+        };
+        let mut p = self.particles.clone();
+        for b in &pd.bodies {
+            let Some(state) = &b.stress else { continue };
+            for (i, &q) in b.particles.iter().enumerate() {
+                p.stress.set(q, &state.stress[i]);
+                p.f.set(q, &state.f[i]);
+            }
+        }
+        Cow::Owned(p)
+    }
+
     /// Set the particles' pore pressures at their current positions (the run
     /// calls this before every step); nothing without `[water]`.
     pub fn update_pore_pressure(&mut self) {

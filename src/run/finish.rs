@@ -150,7 +150,11 @@ fn final_outputs<const D: usize>(
             .zip(&components)
             .map(|(n, c)| (*n, c.as_slice())),
     );
-    write_particles_csv_with(&out.join("particles_final.csv"), &model.particles, &extra)
+    write_particles_csv_with(
+        &out.join("particles_final.csv"),
+        &model.output_particles(),
+        &extra,
+    )
 }
 
 /// A run that could not write an output: summary.json says so if it still can be

@@ -98,7 +98,7 @@ impl ParticleDumps {
         let name = file_name(self.written);
         let fields = m.point_fields();
         let extra: Vec<(&str, &[f64])> = (fields.iter()).map(|(n, v)| (*n, v.as_slice())).collect();
-        write_particles_csv_with(&self.dir.join(&name), &m.particles, &extra)?;
+        write_particles_csv_with(&self.dir.join(&name), &m.output_particles(), &extra)?;
         self.written += 1;
         self.index
             .row([Field::Text(&name), t.into(), Field::from(step)])?;

@@ -290,7 +290,7 @@ impl Recorders {
             let fields = m.point_fields();
             let extra: Vec<(&str, &[f64])> =
                 (fields.iter()).map(|(n, v)| (*n, v.as_slice())).collect();
-            self.frames.write_frame(t, &m.particles, &extra)?;
+            self.frames.write_frame(t, &m.output_particles(), &extra)?;
             while self.next_frame <= t + tolerance {
                 self.next_frame += interval;
             }
