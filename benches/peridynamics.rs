@@ -67,12 +67,13 @@ fn body<const D: usize>(x: &[Vector<D>], law: BondLaw) -> PdBody<D> {
 
 /// Bytes of `bonds` per bond, its vectors at their lengths.
 fn bytes_per_bond(bonds: &Bonds) -> f64 {
-    let bytes = std::mem::size_of_val(&bonds.ends[..])
+    let bytes = std::mem::size_of_val(&bonds.first[..])
+        + std::mem::size_of_val(&bonds.upper[..])
         + std::mem::size_of_val(&bonds.length[..])
         + std::mem::size_of_val(&bonds.intact[..])
-        + std::mem::size_of_val(&bonds.offset[..])
-        + std::mem::size_of_val(&bonds.entry[..])
-        + std::mem::size_of_val(&bonds.other[..]);
+        + std::mem::size_of_val(&bonds.below_offset[..])
+        + std::mem::size_of_val(&bonds.below_bond[..])
+        + std::mem::size_of_val(&bonds.below_end[..]);
     bytes as f64 / bonds.len() as f64
 }
 

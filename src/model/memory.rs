@@ -17,7 +17,8 @@
 //!   fill of the factor;
 //! - bonds (peridynamic bodies): the lattice points times half a family, πm²
 //!   (2D) or 4πm³/3 (3D) bonds for m = δ/Δx, each stored once at
-//!   `BYTES_PER_BOND` (its ends, length, intact flag and its two CSR entries).
+//!   `BYTES_PER_BOND` (its upper end, length, intact flag and its entry at the
+//!   upper end).
 //!
 //! It is an estimate to within a small factor, meant to catch the scenes that
 //! cannot fit, not to predict the peak. The limit defaults to the machine's
@@ -47,9 +48,10 @@ pub struct Estimate {
     pub bond_bytes: f64,
 }
 
-/// One bond of `model::peridynamics::bonds::Bonds`: ends 2 × u32, |ξ| f64,
-/// intact bool, two CSR entries (bond id and other end, u32 each).
-pub const BYTES_PER_BOND: f64 = 8.0 + 8.0 + 1.0 + 2.0 * 8.0;
+/// One bond of `model::peridynamics::bonds::Bonds`: its upper end u32, |ξ|
+/// f64, intact bool, its entry at the upper end (bond id and lower end, u32
+/// each).
+pub const BYTES_PER_BOND: f64 = 4.0 + 8.0 + 1.0 + 8.0;
 
 impl Estimate {
     pub fn of(c: &SceneConfig) -> Estimate {

@@ -2,10 +2,16 @@
 //! every pair (i, j), i < j, with |ξ| = |x_j − x_i| ≤ δ (up to a relative 1e-10,
 //! so lattice points at exactly δ are in: m = 3 gives 28 neighbours in 2D,
 //! against πm² = 28.3 of the continuum; no partial-volume correction), found by
-//! binning the points in cells of side δ. Bond k's state (its ends, |ξ|,
-//! intact) is stored once for both ends; each particle lists its bond ids in
-//! increasing order of the other end (`offset`/`entry`, CSR), the order in
-//! which every per-particle sum runs, so the sums do not depend on the threads.
+//! binning the points in cells of side δ. Bond k's state (|ξ|, intact) is
+//! stored once for both ends. Bonds are numbered in increasing (i, j), so the
+//! bonds whose lower end is i are the consecutive ids `first[i]..first[i + 1]`,
+//! with their upper ends in `upper`; a particle's bonds to lower ends are
+//! listed apart (`below_*`, in increasing lower end). A particle's family runs
+//! through both in increasing order of the other end, the order in which every
+//! per-particle sum runs, so the sums do not depend on the threads. That is
+//! 21 bytes per bond (`model::memory::BYTES_PER_BOND`) and two offsets per
+//! particle, against 33 for a list of both ends and a CSR of (bond, other end)
+//! at each end; the sums read a particle's own bonds in sequence.
 
 use crate::dim::Vector;
 use crate::parallel::MIN_PARALLEL_LEN;
@@ -14,18 +20,19 @@ use std::collections::BTreeMap;
 
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Bonds {
-    /// The ends (i, j), i < j, of each bond, in increasing (i, j).
-    pub ends: Vec<[u32; 2]>,
+    /// The bonds whose lower end is particle i are the ids `first[i]..first[i + 1]`.
+    pub first: Vec<u32>,
+    /// The upper end j of each bond.
+    pub upper: Vec<u32>,
     /// Reference length |ξ| of each bond.
     pub length: Vec<f64>,
     /// Whether each bond is intact (a broken bond never heals).
     pub intact: Vec<bool>,
-    /// Particle i's entries are `offset[i]..offset[i + 1]` of `entry` and `other`.
-    pub offset: Vec<u32>,
-    /// The bond id of each entry.
-    pub entry: Vec<u32>,
-    /// The other end of each entry's bond.
-    pub other: Vec<u32>,
+    /// Particle j's bonds to lower ends are entries `below_offset[j]..below_offset[j + 1]`
+    /// of `below_bond` (their ids) and `below_end` (their lower ends, increasing).
+    pub below_offset: Vec<u32>,
+    pub below_bond: Vec<u32>,
+    pub below_end: Vec<u32>,
 }
 
 impl Bonds {
@@ -48,9 +55,11 @@ impl Bonds {
         for (i, p) in x.iter().enumerate() {
             cells.entry(cell(p)).or_default().push(i as u32);
         }
-        let mut ends = Vec::new();
+        let mut first = Vec::with_capacity(x.len() + 1);
+        let mut upper = Vec::new();
         let mut length = Vec::new();
         for (i, p) in x.iter().enumerate() {
+            first.push(upper.len() as u32);
             let mut near: Vec<u32> = Vec::new();
             let c = cell(p);
             for around in 0..3usize.pow(D as u32) {
@@ -64,52 +73,71 @@ impl Bonds {
             for j in near {
                 let l = (x[j as usize] - p).norm();
                 if l <= reach && keep(i, j as usize) {
-                    ends.push([i as u32, j]);
+                    upper.push(j);
                     length.push(l);
                 }
             }
         }
-        let (offset, entry, other) = adjacency(x.len(), &ends);
+        first.push(upper.len() as u32);
+        let (below_offset, below_bond, below_end) = below(x.len(), &first, &upper);
         Bonds {
-            intact: vec![true; ends.len()],
-            ends,
+            intact: vec![true; upper.len()],
+            first,
+            upper,
             length,
-            offset,
-            entry,
-            other,
+            below_offset,
+            below_bond,
+            below_end,
         }
     }
 
     pub fn len(&self) -> usize {
-        self.ends.len()
+        self.upper.len()
     }
 
     pub fn is_empty(&self) -> bool {
-        self.ends.is_empty()
+        self.upper.is_empty()
     }
 
-    /// Σ over particle i's intact bonds k (other end j), in CSR order, of f(k, j).
+    /// The ends (i, j), i < j, of bond k (a search over `first`: for checks and
+    /// reports, not for the per-step sums).
+    pub fn ends(&self, k: usize) -> [usize; 2] {
+        let i = self.first.partition_point(|&f| f as usize <= k) - 1;
+        [i, self.upper[k] as usize]
+    }
+
+    /// Particle i's bonds (bond id, other end), intact or not, in increasing
+    /// order of the other end.
+    pub fn family(&self, i: usize) -> impl Iterator<Item = (usize, usize)> + '_ {
+        let below = self.below_offset[i] as usize..self.below_offset[i + 1] as usize;
+        let own = self.first[i] as usize..self.first[i + 1] as usize;
+        (below.map(|e| (self.below_bond[e] as usize, self.below_end[e] as usize)))
+            .chain(own.map(|k| (k, self.upper[k] as usize)))
+    }
+
+    /// Σ over particle i's intact bonds k (other end j), in family order, of f(k, j).
     pub fn gather<const D: usize>(
         &self,
         i: usize,
         f: impl Fn(usize, usize) -> Vector<D>,
     ) -> Vector<D> {
         let mut sum = Vector::<D>::zeros();
-        for e in self.offset[i] as usize..self.offset[i + 1] as usize {
-            let k = self.entry[e] as usize;
-            if self.intact[k] {
-                sum += f(k, self.other[e] as usize);
-            }
-        }
+        self.each_intact(i, |k, j| sum += f(k, j));
         sum
     }
 
-    /// f(k, j) for each of particle i's intact bonds k (other end j), in CSR order.
+    /// f(k, j) for each of particle i's intact bonds k (other end j), in family
+    /// order (two loops, not `family`'s chain: this is the per-step sum).
     pub fn each_intact(&self, i: usize, mut f: impl FnMut(usize, usize)) {
-        for e in self.offset[i] as usize..self.offset[i + 1] as usize {
-            let k = self.entry[e] as usize;
+        for e in self.below_offset[i] as usize..self.below_offset[i + 1] as usize {
+            let k = self.below_bond[e] as usize;
             if self.intact[k] {
-                f(k, self.other[e] as usize);
+                f(k, self.below_end[e] as usize);
+            }
+        }
+        for k in self.first[i] as usize..self.first[i + 1] as usize {
+            if self.intact[k] {
+                f(k, self.upper[k] as usize);
             }
         }
     }
@@ -117,19 +145,25 @@ impl Bonds {
     /// As `gather`, of a scalar.
     pub fn gather_scalar(&self, i: usize, f: impl Fn(usize, usize) -> f64) -> f64 {
         let mut sum = 0.0;
-        for e in self.offset[i] as usize..self.offset[i + 1] as usize {
-            let k = self.entry[e] as usize;
-            if self.intact[k] {
-                sum += f(k, self.other[e] as usize);
-            }
-        }
+        self.each_intact(i, |k, j| sum += f(k, j));
         sum
     }
 
-    /// The stretch s = (|y_j − y_i| − |ξ|)/|ξ| of bond k at positions y.
+    /// The stretch s = (|y_j − y_i| − |ξ|)/|ξ| of bond k between i and j at positions y.
+    fn stretch_between<const D: usize>(
+        &self,
+        k: usize,
+        i: usize,
+        j: usize,
+        y: &[Vector<D>],
+    ) -> f64 {
+        ((y[j] - y[i]).norm() - self.length[k]) / self.length[k]
+    }
+
+    /// The stretch of bond k at positions y.
     pub fn stretch<const D: usize>(&self, k: usize, y: &[Vector<D>]) -> f64 {
-        let [i, j] = self.ends[k];
-        ((y[j as usize] - y[i as usize]).norm() - self.length[k]) / self.length[k]
+        let [i, j] = self.ends(k);
+        self.stretch_between(k, i, j, y)
     }
 
     /// Break, irreversibly, the intact bonds with s > s0 at positions y (no
@@ -138,24 +172,26 @@ impl Bonds {
         if s0.is_infinite() {
             return 0;
         }
-        let stretched: Vec<bool> = (0..self.len())
+        let this = &*self;
+        let stretched: Vec<usize> = (0..y.len())
             .into_par_iter()
             .with_min_len(MIN_PARALLEL_LEN)
-            .map(|k| self.intact[k] && self.stretch(k, y) > s0)
+            .flat_map_iter(|i| {
+                (this.first[i] as usize..this.first[i + 1] as usize).filter(move |&k| {
+                    this.intact[k] && this.stretch_between(k, i, this.upper[k] as usize, y) > s0
+                })
+            })
             .collect();
-        let mut broke = 0;
-        for (k, _) in stretched.iter().enumerate().filter(|(_, &s)| s) {
+        for &k in &stretched {
             self.intact[k] = false;
-            broke += 1;
         }
-        broke
+        stretched.len()
     }
 
     /// Damage φ_i = 1 − Σ_intact V_j / Σ_all V_j (digest Part 2 §2.2); 0 for a
     /// particle without bonds.
     pub fn damage(&self, i: usize, volume: &[f64]) -> f64 {
-        let range = self.offset[i] as usize..self.offset[i + 1] as usize;
-        let all: f64 = range.clone().map(|e| volume[self.other[e] as usize]).sum();
+        let all: f64 = self.family(i).map(|(_, j)| volume[j]).sum();
         if all == 0.0 {
             return 0.0;
         }
@@ -164,13 +200,13 @@ impl Bonds {
     }
 }
 
-/// CSR of the bonds of each of `n` particles: offsets, bond ids and other ends,
-/// each particle's in increasing order of the other end (bonds come in
-/// increasing (i, j), so i's bonds to lower j' arrive before its own).
-fn adjacency(n: usize, ends: &[[u32; 2]]) -> (Vec<u32>, Vec<u32>, Vec<u32>) {
+/// Each of the `n` particles' bonds to lower ends, from the bonds' lower-end
+/// ranges `first` and upper ends `upper`: offsets, bond ids and lower ends,
+/// each particle's in increasing lower end (the bonds come in increasing
+/// (i, j)).
+fn below(n: usize, first: &[u32], upper: &[u32]) -> (Vec<u32>, Vec<u32>, Vec<u32>) {
     let mut count = vec![0u32; n + 1];
-    for &[i, j] in ends {
-        count[i as usize + 1] += 1;
+    for &j in upper {
         count[j as usize + 1] += 1;
     }
     for i in 0..n {
@@ -178,16 +214,16 @@ fn adjacency(n: usize, ends: &[[u32; 2]]) -> (Vec<u32>, Vec<u32>, Vec<u32>) {
     }
     let offset = count.clone();
     let mut next = count;
-    let mut entry = vec![0u32; 2 * ends.len()];
-    let mut other = vec![0u32; 2 * ends.len()];
-    for (k, &[i, j]) in ends.iter().enumerate() {
-        for (a, b) in [(i, j), (j, i)] {
-            let e = next[a as usize] as usize;
-            (entry[e], other[e]) = (k as u32, b);
-            next[a as usize] += 1;
+    let mut bond = vec![0u32; upper.len()];
+    let mut end = vec![0u32; upper.len()];
+    for i in 0..n {
+        for k in first[i] as usize..first[i + 1] as usize {
+            let e = next[upper[k] as usize] as usize;
+            (bond[e], end[e]) = (k as u32, i as u32);
+            next[upper[k] as usize] += 1;
         }
     }
-    (offset, entry, other)
+    (offset, bond, end)
 }
 
 #[cfg(test)]
@@ -205,19 +241,23 @@ mod tests {
         let x = lattice(9, 0.1);
         let b = Bonds::build(&x, 0.3);
         let centre = 4 * 9 + 4;
-        assert_eq!(b.offset[centre + 1] - b.offset[centre], 28);
-        // Each bond once, i < j, its entries at both ends; ends sorted.
-        assert!(b.ends.windows(2).all(|w| w[0] < w[1]));
-        assert!(b.ends.iter().all(|[i, j]| i < j));
-        assert_eq!(b.entry.len(), 2 * b.len());
+        assert_eq!(b.family(centre).count(), 28);
+        // Each bond once, i < j, in increasing (i, j); in the family of both
+        // ends, each family in increasing other end.
+        let ends: Vec<[usize; 2]> = (0..b.len()).map(|k| b.ends(k)).collect();
+        assert!(ends.windows(2).all(|w| w[0] < w[1]));
+        assert!(ends.iter().all(|[i, j]| i < j));
+        let mut seen = vec![0; b.len()];
         for i in 0..x.len() {
-            let r = b.offset[i] as usize..b.offset[i + 1] as usize;
-            assert!(b.other[r.clone()].windows(2).all(|w| w[0] < w[1]));
-            for e in r {
-                let [p, q] = b.ends[b.entry[e] as usize];
-                assert!(p as usize == i && q == b.other[e] || q as usize == i && p == b.other[e]);
+            let family: Vec<(usize, usize)> = b.family(i).collect();
+            assert!(family.windows(2).all(|w| w[0].1 < w[1].1));
+            for (k, j) in family {
+                let [p, q] = ends[k];
+                assert!(p == i && q == j || q == i && p == j);
+                seen[k] += 1;
             }
         }
+        assert!(seen.iter().all(|&s| s == 2));
         // Against a brute-force count.
         let brute = (0..x.len())
             .flat_map(|i| (i + 1..x.len()).map(move |j| (i, j)))
@@ -253,9 +293,10 @@ mod tests {
             |i: usize, j: usize| body.holds_segment(x[i].as_slice(), x[j].as_slice(), dx / 2.0);
         let (seen, plain) = (Bonds::build_where(&x, 0.3, keep), Bonds::build(&x, 0.3));
         let crosses = |b: &Bonds| {
-            (b.ends.iter())
+            (0..b.len())
+                .map(|k| b.ends(k))
                 .filter(|[i, j]| {
-                    let (p, q) = (x[*i as usize], x[*j as usize]);
+                    let (p, q) = (x[*i], x[*j]);
                     (p.y - 0.4) * (q.y - 0.4) < 0.0 && p.x.max(q.x) < 0.45 - 1e-9
                 })
                 .count()
@@ -267,8 +308,9 @@ mod tests {
         assert_eq!(crosses(&seen), 0);
         // Away from the slit (both ends at x > 0.75: beyond δ from it) nothing changes.
         let far = |b: &Bonds| {
-            (b.ends.iter())
-                .filter(|[i, j]| x[*i as usize].x > 0.75 && x[*j as usize].x > 0.75)
+            (0..b.len())
+                .map(|k| b.ends(k))
+                .filter(|[i, j]| x[*i].x > 0.75 && x[*j].x > 0.75)
                 .count()
         };
         assert_eq!(far(&seen), far(&plain));

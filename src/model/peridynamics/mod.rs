@@ -7,7 +7,8 @@
 //!
 //! - `bonds`: the families, built once in the reference configuration by cell
 //!   binning in a deterministic order; each bond stored once for both ends
-//!   (i < j), a CSR list of bond ids per particle; broken flags; damage.
+//!   (i < j), numbered by the lower end, with each particle's bonds to lower
+//!   ends listed apart; broken flags; damage.
 //! - `state`: a correspondence body's own material and its particles' F,
 //!   stress and history.
 //!

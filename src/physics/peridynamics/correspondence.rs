@@ -2,7 +2,7 @@
 //! has the equations): each particle's F over its intact bonds, its stress from
 //! the body's material under ΔF = F F_old⁻¹, then each intact bond's pair
 //! force ω (P_i K_i⁻¹ + P_j K_j⁻¹) ξ plus the zero-energy control (weighted by
-//! the same ω), summed per particle in the CSR order of its bonds.
+//! the same ω), summed per particle in the order of its family (`Bonds::each_intact`).
 
 use crate::dim::{embed_deformation, restrict, Mat3, Tensor, Vector};
 use crate::material::bond::correspondence::{Correspondence, FAMILY_LOST};

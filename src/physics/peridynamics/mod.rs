@@ -1,6 +1,6 @@
 //! The forces of a peridynamic body's bonds on its particles and the explicit
 //! step that advances them (issue 51): each bond's pairwise force from its law
-//! (`material::bond`), summed per particle over its intact bonds in the CSR
+//! (`material::bond`), summed per particle over its intact bonds in the family
 //! order of `model::peridynamics::bonds` (so the sums do not depend on the
 //! threads), after breaking the bonds stretched past s0.
 

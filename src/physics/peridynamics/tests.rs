@@ -194,7 +194,7 @@ fn the_bonds_cut_by_a_straight_crack_hold_g0_per_unit_area() {
     let (y0, y1) = (10.0 * dx, 20.0 * dx);
     let energy: f64 = (0..b.bonds.len())
         .filter(|&k| {
-            let [i, j] = b.bonds.ends[k].map(|e| x[e as usize]);
+            let [i, j] = b.bonds.ends(k).map(|e| x[e]);
             let mid = 0.5 * (i[1] + j[1]);
             (i[0] - xc) * (j[0] - xc) < 0.0 && mid >= y0 && mid < y1
         })
