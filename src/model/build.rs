@@ -188,7 +188,8 @@ fn peridynamic_bodies<const D: usize>(
             let law = c.peridynamic(i);
             let bonds = Bonds::build_where(&x, law.horizon(), inside);
             let n = of.len();
-            let body = PdBody::with_bonds(i, of, &x, volume, law, bonds);
+            let body = PdBody::with_bonds(i, of, &x, volume, law, bonds)
+                .with_short_range(c.short_range(i));
             match law {
                 BondLaw::Correspondence(_) => {
                     let k = p.material[body.particles[0]] as usize;

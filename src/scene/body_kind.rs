@@ -8,6 +8,7 @@
 use super::BondModel;
 use super::{BodyKindName, MaterialConfig, Plane, SceneConfig};
 use crate::material::bond::correspondence::{Correspondence, ZERO_ENERGY_CONTROL};
+use crate::material::bond::short_range::{self, ShortRange};
 use crate::material::bond::{beam::Beam, pmb::Pmb, BondLaw, Space};
 use crate::material::parameters::FromParameters;
 use crate::material::rigid::{Motion, Rigid};
@@ -156,6 +157,16 @@ impl SceneConfig {
                 })
             }
         }
+    }
+
+    /// The short-range repulsion of peridynamic body i: c_S = `short_range_force`
+    /// (default `short_range::FACTOR`) × its law's micromodulus; None at 0.
+    pub fn short_range(&self, i: usize) -> Option<ShortRange> {
+        let factor = self.bodies[i]
+            .short_range_force
+            .unwrap_or(short_range::FACTOR);
+        let law = self.peridynamic(i);
+        (factor > 0.0).then(|| ShortRange::new(factor, law.micromodulus(), law.horizon()))
     }
 
     /// The P-wave modulus of body i's material as built (`Material::p_wave_modulus`).

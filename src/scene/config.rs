@@ -289,6 +289,10 @@ pub struct BodyConfig {
     /// function (default constant).
     pub zero_energy_control: Option<f64>,
     pub influence: Option<crate::material::bond::correspondence::Influence>,
+    /// Peridynamic body: c_S/c of the repulsion of its particles that no
+    /// intact bond joins (default `material::bond::short_range::FACTOR`; 0:
+    /// none).
+    pub short_range_force: Option<f64>,
 }
 
 /// A physical group of a Gmsh file, by its name or its number.

@@ -224,6 +224,12 @@ fn the_scene_keys_of_a_peridynamic_body_are_checked_by_key() {
         "body.0.motion",
         &["peridynamic"],
     );
+    Scene::parse("scene.toml", &with("short_range_force = 0.0", ""), &[]).expect("no repulsion");
+    rejected_at(
+        &with("short_range_force = -15.0", ""),
+        "body.0.short_range_force",
+        &["≥ 0"],
+    );
     let implicit = with("", "").replace("kind = \"explicit\"", "kind = \"implicit\"");
     rejected_at(&implicit, "solver.kind", &["explicit stages only"]);
     // Its keys on a continuum body.
@@ -242,6 +248,22 @@ fn the_scene_keys_of_a_peridynamic_body_are_checked_by_key() {
         with("", "")
     );
     rejected_at(&two, "body.1.kind", &["peridynamic and rigid bodies only"]);
+    // Two peridynamic bodies meet by their repulsion, not a contact table.
+    let pair = bars_meeting(1.0, 1e-6);
+    Scene::parse("scene.toml", &pair, &[]).expect("two peridynamic bodies");
+    rejected_at(
+        &format!("{pair}\n[[contact]]\nfriction_coefficient = 0.0\n"),
+        "contact.0.bodies",
+        &["short-range repulsion", "short_range_force"],
+    );
+    rejected_at(
+        &continuum.replace(
+            "shape = \"rectangle\"",
+            "shape = \"rectangle\"\nshort_range_force = 1.0",
+        ),
+        "body.0.short_range_force",
+        &["not kind = \"peridynamic\""],
+    );
 }
 
 /// The bar of [`bar`] at rest, struck at x = 0 by a rigid piston: a body of
@@ -554,5 +576,126 @@ fn the_keys_of_a_correspondence_body_are_checked_by_key() {
     assert!(
         Scene::parse("scene.toml", &bad, &[]).is_err(),
         "an unknown influence is refused"
+    );
+}
+
+/// Two equal plane-stress PMB bars, L = 50 mm × 10 mm, laid face to face,
+/// the first striking at V (bodies 0 and 1 of a plain scene: no contact
+/// table, the default short-range repulsion).
+fn bars_meeting(v: f64, end: f64) -> String {
+    let (length, width) = (0.05, 0.01);
+    let one = bar(length, width);
+    let body = |name: &str, from: f64, velocity: f64| {
+        format!(
+            r#"
+[[body]]
+name = "{name}"
+kind = "peridynamic"
+plane = "stress"
+material = "al"
+shape = "rectangle"
+min = [{from}, 0.0]
+max = [{to}, {width}]
+particles_per_cell = 2
+velocity = [{velocity}, 0.0]
+"#,
+            to = from + length
+        )
+    };
+    let start = one.find("[[body]]").unwrap();
+    let solver = one.find("[solver]").unwrap();
+    let head = one[..start]
+        .replace(
+            &format!("max = [{}, {}]", length + 0.002, width + 0.002),
+            &format!("max = [{}, {}]", 2.0 * length + 0.002, width + 0.002),
+        )
+        .replace(
+            &format!("cells = [{}, ", (length / 1e-3).round() as usize + 4),
+            &format!("cells = [{}, ", (2.0 * length / 1e-3).round() as usize + 4),
+        );
+    let tail = one[solver..].replace(
+        &format!("end_time = {}", 0.7 * length / (70e9f64 / 2700.0).sqrt()),
+        &format!("end_time = {end}"),
+    );
+    format!(
+        "{head}{}{}{tail}",
+        body("striker", 0.0, v),
+        body("target", length, 0.0)
+    )
+}
+
+/// The 1D impact of two equal bars, PD against PD through the short-range
+/// repulsion (`material::bond::short_range`): while they touch, the target's
+/// velocity rises at the rate the interface stress ρ c0 V/2 gives it
+/// (c0 V/(2L)), through V/2 at L/c0, and contact ends at 2L/c0 with the
+/// velocities exchanged; the bars never pass into each other and momentum is
+/// kept to round-off. Without the repulsion (`short_range_force = 0`) the
+/// target takes nothing.
+#[test]
+fn two_peridynamic_bars_meet_as_the_one_dimensional_impact() {
+    let (c0, v, length) = ((70e9f64 / 2700.0).sqrt(), 1.0, 0.05);
+    let contact = 2.0 * length / c0;
+    let scene = bars_meeting(v, 1.5 * contact);
+    let (summary, dir) = run_text(&scene, &[]);
+    summary.expect("the bars run");
+    let h = Table::read(&dir.path().join("history.csv")).unwrap();
+    let (t, target) = (h.col("t"), h.col("body1_vx"));
+    // The time the target passes V/2, interpolated between rows.
+    let k = (1..t.len())
+        .find(|&k| target[k] >= 0.5 * v)
+        .expect("the target moves");
+    let half =
+        t[k - 1] + (t[k] - t[k - 1]) * (0.5 * v - target[k - 1]) / (target[k] - target[k - 1]);
+    // Its acceleration over the middle half of the contact, a least-squares slope.
+    let window: Vec<usize> = (0..t.len())
+        .filter(|&k| t[k] > 0.25 * contact && t[k] < 0.75 * contact)
+        .collect();
+    let n = window.len() as f64;
+    let (mt, mv) = (
+        window.iter().map(|&k| t[k]).sum::<f64>() / n,
+        window.iter().map(|&k| target[k]).sum::<f64>() / n,
+    );
+    let slope = window
+        .iter()
+        .map(|&k| (t[k] - mt) * (target[k] - mv))
+        .sum::<f64>()
+        / window.iter().map(|&k| (t[k] - mt).powi(2)).sum::<f64>();
+    let p = Table::read(&dir.path().join("particles_final.csv")).unwrap();
+    let (x, vx, mass, body) = (p.col("x"), p.col("vx"), p.col("mass"), p.col("body"));
+    let of = |b: f64| (0..x.len()).filter(move |&q| body[q] == b);
+    let momentum = |b: f64| of(b).map(|q| mass[q] * vx[q]).sum::<f64>();
+    let total: f64 = of(0.0).map(|q| mass[q]).sum();
+    let (striker, hit) = (momentum(0.0) / total, momentum(1.0) / total);
+    let front = of(0.0).map(|q| x[q]).fold(f64::NEG_INFINITY, f64::max);
+    let back = of(1.0).map(|q| x[q]).fold(f64::INFINITY, f64::min);
+    println!(
+        "V/2 at {half:.4e} s (L/c0 {:.4e}); slope {slope:.4e} (c0 V/2L {:.4e}); \
+         after: striker {striker:.4} m/s, target {hit:.4} m/s; gap {:.3} mm",
+        length / c0,
+        c0 * v / (2.0 * length),
+        (back - front) * 1e3
+    );
+    assert_within("time of V/2 / (L/c0) − 1", half / (length / c0) - 1.0, 0.03);
+    assert_within(
+        "target acceleration / (c0 V/2L) − 1",
+        slope / (c0 * v / (2.0 * length)) - 1.0,
+        0.05,
+    );
+    assert_within("striker's velocity after / V", striker / v, 0.03);
+    assert_within("target's velocity after / V − 1", hit / v - 1.0, 0.03);
+    assert_within("momentum / (M V) − 1", (striker + hit) / v - 1.0, 1e-12);
+    assert!(front < back, "the bars overlap: {front} ≥ {back}");
+    // The control.
+    let (summary, dir) = run_text(&scene, &["body.0.short_range_force=0"]);
+    summary.expect("the bars run");
+    let p = Table::read(&dir.path().join("particles_final.csv")).unwrap();
+    let (vx, mass, body) = (p.col("vx"), p.col("mass"), p.col("body"));
+    let hit: f64 = (0..vx.len())
+        .filter(|&q| body[q] == 1.0)
+        .map(|q| mass[q] * vx[q])
+        .sum();
+    assert!(
+        hit.abs() < 1e-9 * total * v,
+        "without repulsion the target took {hit:e}"
     );
 }

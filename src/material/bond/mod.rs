@@ -9,11 +9,14 @@
 //! - `beam`: beam-based, an axial and a tangential micromodulus (any ν up to
 //!   PMB's);
 //! - `correspondence`: non-ordinary state-based, the stress of the body's own
-//!   material carried by the bonds, with a zero-energy control.
+//!   material carried by the bonds, with a zero-energy control;
+//! - `short_range`: the repulsion of particles that no intact bond joins
+//!   (fragments of a body, two bodies).
 
 pub mod beam;
 pub mod correspondence;
 pub mod pmb;
+pub mod short_range;
 mod space;
 
 pub use space::{critical_stretch, Space, SAFETY};
@@ -45,6 +48,16 @@ impl BondLaw {
             BondLaw::Pmb(p) => p.critical_stretch,
             BondLaw::Beam(b) => b.critical_stretch,
             BondLaw::Correspondence(c) => c.critical_stretch,
+        }
+    }
+
+    /// The PMB micromodulus of the law's bonds: c (PMB), the axial c1 (beam),
+    /// PMB's c of the material's P-wave modulus (correspondence).
+    pub fn micromodulus(&self) -> f64 {
+        match self {
+            BondLaw::Pmb(p) => p.micromodulus,
+            BondLaw::Beam(b) => b.axial,
+            BondLaw::Correspondence(c) => c.micromodulus,
         }
     }
 

@@ -28,6 +28,11 @@ pub struct Bonds {
     pub length: Vec<f64>,
     /// Whether each bond is intact (a broken bond never heals).
     pub intact: Vec<bool>,
+    /// Whether each particle is exposed: fewer bonds than the most any
+    /// particle of the points has (near a face or a notch), or one broken. Only
+    /// an exposed particle can come near a particle it is not bonded to
+    /// (`physics::peridynamics::short_range`).
+    pub exposed: Vec<bool>,
     /// Particle j's bonds to lower ends are entries `below_offset[j]..below_offset[j + 1]`
     /// of `below_bond` (their ids) and `below_end` (their lower ends, increasing).
     pub below_offset: Vec<u32>,
@@ -80,7 +85,12 @@ impl Bonds {
         }
         first.push(upper.len() as u32);
         let (below_offset, below_bond, below_end) = below(x.len(), &first, &upper);
+        let count = |i: usize| {
+            (first[i + 1] - first[i]) as usize + (below_offset[i + 1] - below_offset[i]) as usize
+        };
+        let most = (0..x.len()).map(count).max().unwrap_or(0);
         Bonds {
+            exposed: (0..x.len()).map(|i| count(i) < most).collect(),
             intact: vec![true; upper.len()],
             first,
             upper,
@@ -173,19 +183,45 @@ impl Bonds {
             return 0;
         }
         let this = &*self;
-        let stretched: Vec<usize> = (0..y.len())
+        let stretched: Vec<(usize, usize)> = (0..y.len())
             .into_par_iter()
             .with_min_len(MIN_PARALLEL_LEN)
             .flat_map_iter(|i| {
-                (this.first[i] as usize..this.first[i + 1] as usize).filter(move |&k| {
-                    this.intact[k] && this.stretch_between(k, i, this.upper[k] as usize, y) > s0
-                })
+                (this.first[i] as usize..this.first[i + 1] as usize)
+                    .filter(move |&k| {
+                        this.intact[k] && this.stretch_between(k, i, this.upper[k] as usize, y) > s0
+                    })
+                    .map(move |k| (i, k))
             })
             .collect();
-        for &k in &stretched {
-            self.intact[k] = false;
+        for &(i, k) in &stretched {
+            self.break_between(k, i);
         }
         stretched.len()
+    }
+
+    /// Break bond k for good (its ends exposed).
+    pub fn break_bond(&mut self, k: usize) {
+        let [i, _] = self.ends(k);
+        self.break_between(k, i);
+    }
+
+    /// Break bond k, whose lower end is i.
+    fn break_between(&mut self, k: usize, i: usize) {
+        self.intact[k] = false;
+        self.exposed[i] = true;
+        self.exposed[self.upper[k] as usize] = true;
+    }
+
+    /// Does an intact bond join particles i and j? (A binary search among the
+    /// lower one's own bonds, whose upper ends increase.)
+    pub fn joined(&self, i: usize, j: usize) -> bool {
+        let (lo, hi) = (i.min(j), i.max(j));
+        let own = self.first[lo] as usize..self.first[lo + 1] as usize;
+        match self.upper[own.clone()].binary_search(&(hi as u32)) {
+            Ok(e) => self.intact[own.start + e],
+            Err(_) => false,
+        }
     }
 
     /// Damage φ_i = 1 − Σ_intact V_j / Σ_all V_j (digest Part 2 §2.2); 0 for a

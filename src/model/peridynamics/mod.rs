@@ -19,6 +19,7 @@ pub mod bonds;
 pub mod state;
 
 use crate::dim::Vector;
+use crate::material::bond::short_range::ShortRange;
 use crate::material::bond::BondLaw;
 use bonds::Bonds;
 use state::StressState;
@@ -42,6 +43,10 @@ pub struct PdBody<const D: usize> {
     /// A correspondence body's stress state (`BondLaw::Correspondence`); None
     /// for the bond-based laws.
     pub stress: Option<StressState>,
+    /// The repulsion of its particles that no intact bond joins, among
+    /// themselves and with the other bodies' (`material::bond::short_range`);
+    /// None: they pass through each other.
+    pub short_range: Option<ShortRange>,
 }
 
 impl<const D: usize> PdBody<D> {
@@ -77,6 +82,15 @@ impl<const D: usize> PdBody<D> {
             start_x: Vec::new(),
             start_v: Vec::new(),
             stress: None,
+            short_range: None,
+        }
+    }
+
+    /// With the short-range repulsion `short_range`.
+    pub fn with_short_range(self, short_range: Option<ShortRange>) -> Self {
+        PdBody {
+            short_range,
+            ..self
         }
     }
 
@@ -196,9 +210,10 @@ impl<const D: usize> Peridynamics<D> {
         }
         for (b, ids) in self.bodies.iter_mut().zip(broken) {
             for &k in ids {
-                let bond = (b.bonds.intact.get_mut(k as usize))
-                    .ok_or_else(|| format!("bond {k} of body {} does not exist", b.body))?;
-                *bond = false;
+                if k as usize >= b.bonds.len() {
+                    return Err(format!("bond {k} of body {} does not exist", b.body));
+                }
+                b.bonds.break_bond(k as usize);
             }
         }
         Ok(())

@@ -6,6 +6,7 @@
 
 pub mod correspondence;
 pub mod deformation;
+pub mod short_range;
 
 use crate::dim::Vector;
 use crate::material::bond::BondLaw;
@@ -48,22 +49,32 @@ pub fn bond_forces<const D: usize>(b: &mut PdBody<D>, y: &[Vector<D>], dt: f64) 
 }
 
 /// Advance body `b`'s particles over Δt from the step start (`PdBody::begin_step`)
-/// by central differences, v_{n+1} = v_n + Δt (f_bond + f_applied)/m,
+/// by central differences, v_{n+1} = v_n + Δt (f_bond + f_applied + f_short)/m,
 /// x_{n+1} = x_n + Δt v_{n+1} (thesis 2-29, 2-30 with the bond force in
 /// place of the grid's), replacing what G2P gave them. `applied(q)` is the
-/// applied force on global particle q (gravity and loads).
+/// applied force on global particle q (gravity and loads); `repulsion` the
+/// short-range force on each of its particles (`short_range::forces`), if any
+/// is pressed.
 pub fn advance<const D: usize>(
     b: &mut PdBody<D>,
     x: &mut [Vector<D>],
     v: &mut [Vector<D>],
     mass: &[f64],
     applied: impl Fn(usize) -> Vector<D>,
+    repulsion: Option<&[Vector<D>]>,
     dt: f64,
 ) {
     let y = std::mem::take(&mut b.start_x);
     let bond = bond_forces(b, &y, dt);
     for (i, &q) in b.particles.iter().enumerate() {
-        v[q] = b.start_v[i] + (bond[i] + applied(q)) * (dt / mass[q]);
+        let mut f = bond[i] + applied(q);
+        if let Some(r) = repulsion
+            .map(|r| r[i])
+            .filter(|r| *r != Vector::<D>::zeros())
+        {
+            f += r;
+        }
+        v[q] = b.start_v[i] + f * (dt / mass[q]);
         x[q] = y[i] + v[q] * dt;
     }
     b.start_x = y;

@@ -22,6 +22,7 @@ pub fn not_peridynamic(i: usize, s: &SceneConfig) -> Check {
     forbidden(&b.critical_stretch, key("critical_stretch"), what)?;
     forbidden(&b.zero_energy_control, key("zero_energy_control"), what)?;
     forbidden(&b.influence, key("influence"), what)?;
+    forbidden(&b.short_range_force, key("short_range_force"), what)?;
     forbidden(&b.plane, key("plane"), what)
 }
 
@@ -41,6 +42,13 @@ pub fn body(i: usize, s: &SceneConfig) -> Check {
     positive(b.horizon_factor, "horizon_factor")?;
     positive(b.fracture_energy, "fracture_energy")?;
     positive(b.critical_stretch, "critical_stretch")?;
+    if let Some(f) = b.short_range_force {
+        ensure(
+            f >= 0.0 && f.is_finite(),
+            key("short_range_force"),
+            format!("must be a finite number ≥ 0 (0: no repulsion); got {f}"),
+        )?;
+    }
     let correspondence = b.bond_model == Some(BondModel::Correspondence);
     if let Some(g) = b.zero_energy_control {
         ensure(
@@ -164,17 +172,21 @@ fn material(i: usize, s: &SceneConfig) -> Check {
     own_table(i, s)
 }
 
-/// Body i's material table is no other body's.
+/// Body i's material table is no other kind of body's (peridynamic bodies
+/// may share one: each builds its bond law, and a correspondence body its
+/// own material, from the table).
 fn own_table(i: usize, s: &SceneConfig) -> Check {
     let b = &s.bodies[i];
-    let shared = (0..s.bodies.len()).find(|&j| j != i && s.bodies[j].material == b.material);
+    let shared = (0..s.bodies.len()).find(|&j| {
+        j != i && s.bodies[j].material == b.material && s.body_kind(j) != BodyKindName::Peridynamic
+    });
     match shared {
         Some(j) => Err((
             format!("body.{i}.material"),
             format!(
-                "material `{}` is also the material of body {j}: a peridynamic body's \
-                 particles carry no stress of their material, so give it a [[material]] \
-                 table of its own",
+                "material `{}` is also the material of body {j}, which is not \
+                 peridynamic: a peridynamic body's particles carry no stress of their \
+                 material, so give it a [[material]] table of its own",
                 b.material
             ),
         )),
@@ -269,8 +281,8 @@ fn rigid_projection(k: usize, s: &SceneConfig) -> Check {
             kinds.contains(&BodyKindName::Rigid),
             key("bodies"),
             format!(
-                "bodies {a} and {b} are both peridynamic: contact between peridynamic \
-                 bodies is not built yet (issue 51)"
+                "bodies {a} and {b} are both peridynamic: they meet through their \
+                 short-range repulsion (body.N.short_range_force), without a contact table"
             ),
         )?;
         let what = format!("the contact of bodies {a} and {b}");

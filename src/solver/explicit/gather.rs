@@ -104,8 +104,12 @@ impl<const D: usize> NodeMapStep<D> {
             let p = &mut m.particles;
             let (ramp_of, mass, load) = (&m.load_ramp_of, &p.mass, &p.load);
             let applied = |q: usize| s.applied(ramp_of, mass, load, q);
-            for b in &mut pd.bodies {
-                crate::physics::peridynamics::advance(b, &mut p.x, &mut p.v, mass, applied, s.dt);
+            let repulsion = crate::physics::peridynamics::short_range::forces(&pd.bodies);
+            for (b, r) in pd.bodies.iter_mut().zip(&repulsion) {
+                let r = r.as_deref();
+                crate::physics::peridynamics::advance(
+                    b, &mut p.x, &mut p.v, mass, applied, r, s.dt,
+                );
             }
         }
         let Some(c) = &mut self.contact else {
