@@ -4,20 +4,28 @@
 //! intact bonds), for the PMB and the correspondence laws, in 2D (200², 560,000
 //! bonds) and 3D (40³, 3.9 million bonds), under a small uniform stretch that
 //! breaks none. Criterion's throughput is in bonds per second: a "bond update"
-//! is one bond's force found and applied to both its ends in one step (the CSR
-//! sums visit each bond from both ends, so twice its pair force). The bytes per
-//! bond of `model::peridynamics::bonds::Bonds` beyond the particle data are
-//! printed before the runs.
+//! is one bond's force found and applied to both its ends in one step (the
+//! per-particle sums visit each bond from both ends, so twice its pair force).
+//! The bytes per bond of `model::peridynamics::bonds::Bonds` beyond the
+//! particle data are printed before the runs.
+//!
+//! `short_range`: one evaluation of `physics::peridynamics::short_range::forces`
+//! on the 2D 200² PMB lattice cut in two along its middle (no bond across),
+//! the right part pressed 0.2 Δx into the left: the search among the exposed
+//! particles (faces and the cut) and the repulsion of the pressed pairs, in
+//! exposed particles per second.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use mpm::dim::Vector;
 use mpm::material::bond::correspondence::{Correspondence, ZERO_ENERGY_CONTROL};
+use mpm::material::bond::short_range::{self, ShortRange};
 use mpm::material::bond::{pmb::Pmb, BondLaw, Space};
 use mpm::material::linear_elastic::LinearElastic;
 use mpm::model::peridynamics::bonds::Bonds;
 use mpm::model::peridynamics::state::StressState;
 use mpm::model::peridynamics::PdBody;
 use mpm::physics::peridynamics::bond_forces;
+use mpm::physics::peridynamics::short_range::forces;
 
 const E: f64 = 70e9;
 const NU: f64 = 0.25;
@@ -73,7 +81,8 @@ fn bytes_per_bond(bonds: &Bonds) -> f64 {
         + std::mem::size_of_val(&bonds.intact[..])
         + std::mem::size_of_val(&bonds.below_offset[..])
         + std::mem::size_of_val(&bonds.below_bond[..])
-        + std::mem::size_of_val(&bonds.below_end[..]);
+        + std::mem::size_of_val(&bonds.below_end[..])
+        + std::mem::size_of_val(&bonds.exposed[..]);
     bytes as f64 / bonds.len() as f64
 }
 
@@ -104,5 +113,32 @@ fn bonds(c: &mut Criterion) {
     run::<3>(c, 40);
 }
 
-criterion_group!(benches, bonds);
+fn short_range(c: &mut Criterion) {
+    let n = 200;
+    let x = lattice::<2>(n);
+    let right = |i: usize| i % n >= n / 2;
+    let law = pmb(2);
+    let cut = Bonds::build_where(&x, law.horizon(), |i, j| right(i) == right(j));
+    let v = vec![DX * DX; x.len()];
+    let repulsion = ShortRange::new(short_range::FACTOR, law.micromodulus(), law.horizon());
+    let mut b = PdBody::with_bonds(0, (0..x.len()).collect(), &x, v, law, cut)
+        .with_short_range(Some(repulsion));
+    b.start_x = (x.iter().enumerate())
+        .map(|(i, p)| p - Vector::<2>::new(if right(i) { 0.2 * DX } else { 0.0 }, 0.0))
+        .collect();
+    let exposed = b.bonds.exposed.iter().filter(|&&e| e).count();
+    let bodies = [b];
+    let pressed = forces(&bodies)[0].as_ref().map_or(0, |f| {
+        f.iter().filter(|f| **f != Vector::<2>::zeros()).count()
+    });
+    eprintln!("short range 2D {n}^2: {exposed} exposed particles, {pressed} pressed");
+    assert!(pressed > 0, "the cut is pressed");
+    let mut group = c.benchmark_group(format!("short_range_2d_{n}"));
+    group.sample_size(10);
+    group.throughput(Throughput::Elements(exposed as u64));
+    group.bench_function("cut_pressed", |bench| bench.iter(|| forces(&bodies)));
+    group.finish();
+}
+
+criterion_group!(benches, bonds, short_range);
 criterion_main!(benches);

@@ -381,4 +381,30 @@ mod tests {
         assert!(slit.holds_segment(&[0.8, 0.3], &[0.8, 0.7], 0.5));
         assert!(slit.holds_segment(&[0.2, 0.3], &[0.4, 0.45], 0.5));
     }
+
+    /// The particles near a face are exposed, the interior ones not; a bond
+    /// broken by stretch and the same bond broken by id (a restart) leave the
+    /// same state, its ends exposed.
+    #[test]
+    fn faces_and_broken_bonds_expose_their_particles() {
+        let x = lattice(9, 0.1);
+        let mut b = Bonds::build(&x, 0.3);
+        // Within δ = 3 Δx of a face: all but the 3 × 3 in the middle.
+        let interior: Vec<usize> = (0..x.len()).filter(|&i| !b.exposed[i]).collect();
+        assert_eq!(interior, vec![30, 31, 32, 39, 40, 41, 48, 49, 50]);
+        let mut by_id = b.clone();
+        // Stretch the bond between the centre 40 and 41 only.
+        let k = (0..b.len()).find(|&k| b.ends(k) == [40, 41]).unwrap();
+        let mut y = x.clone();
+        y[41].x += 0.01;
+        let s0 = 0.75 * b.stretch(k, &y);
+        let others = (0..b.len())
+            .filter(|&q| q != k)
+            .all(|q| b.stretch(q, &y) < s0);
+        assert!(others);
+        assert_eq!(b.break_stretched(&y, s0), 1);
+        by_id.break_bond(k);
+        assert_eq!(b, by_id);
+        assert!(b.exposed[40] && b.exposed[41] && !b.exposed[31]);
+    }
 }
