@@ -189,7 +189,7 @@ fn peridynamic_bodies<const D: usize>(
             let bonds = Bonds::build_where(&x, law.horizon(), inside);
             let n = of.len();
             let body = PdBody::with_bonds(i, of, &x, volume, law, bonds)
-                .with_short_range(c.short_range(i));
+                .with_short_range(c.short_range(i, &law));
             match law {
                 BondLaw::Correspondence(_) => {
                     let k = p.material[body.particles[0]] as usize;

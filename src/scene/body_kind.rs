@@ -159,13 +159,13 @@ impl SceneConfig {
         }
     }
 
-    /// The short-range repulsion of peridynamic body i: c_S = `short_range_force`
-    /// (default `short_range::FACTOR`) × its law's micromodulus; None at 0.
-    pub fn short_range(&self, i: usize) -> Option<ShortRange> {
+    /// The short-range repulsion of peridynamic body i of bond law `law`
+    /// (`peridynamic(i)`): c_S = `short_range_force` (default
+    /// `short_range::FACTOR`) × the law's micromodulus; None at 0.
+    pub fn short_range(&self, i: usize, law: &BondLaw) -> Option<ShortRange> {
         let factor = self.bodies[i]
             .short_range_force
             .unwrap_or(short_range::FACTOR);
-        let law = self.peridynamic(i);
         (factor > 0.0).then(|| ShortRange::new(factor, law.micromodulus(), law.horizon()))
     }
 

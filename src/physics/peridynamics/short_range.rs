@@ -39,13 +39,9 @@ pub fn forces<const D: usize>(bodies: &[PdBody<D>]) -> Vec<Option<Vec<Vector<D>>
     if points.is_empty() {
         return out;
     }
-    let radius: Vec<Vec<f64>> = (bodies.iter())
-        .map(|b| {
-            b.volume
-                .iter()
-                .map(|&v| ShortRange::radius::<D>(v))
-                .collect()
-        })
+    // Half the particle spacing of each point.
+    let radius: Vec<f64> = (points.iter())
+        .map(|&(a, i)| ShortRange::radius::<D>(bodies[a].volume[i]))
         .collect();
     let bins = Bins::new(bodies, &radius, &points);
     let on: Vec<Option<Vector<D>>> = (0..points.len())
@@ -72,12 +68,10 @@ struct Bins<const D: usize> {
 }
 
 impl<const D: usize> Bins<D> {
-    fn new(bodies: &[PdBody<D>], radius: &[Vec<f64>], points: &[(usize, usize)]) -> Self {
-        let r_max = (points.iter())
-            .map(|&(a, i)| radius[a][i])
-            .fold(0.0, f64::max);
+    fn new(bodies: &[PdBody<D>], radius: &[f64], points: &[(usize, usize)]) -> Self {
+        let r_max = radius.iter().copied().fold(0.0, f64::max);
         // The largest contact distance: 1.35 (r_i + r_j) within a body, r_i + r_j between two.
-        let reach = 2.7 * r_max;
+        let reach = 2.0 * short_range::OF_RADII * r_max;
         let low = (points.iter())
             .map(|&(a, i)| bodies[a].start_x[i])
             .fold(Vector::<D>::repeat(f64::INFINITY), |m, y| m.inf(&y));
@@ -107,7 +101,7 @@ impl<const D: usize> Bins<D> {
     fn repulsion(
         &self,
         bodies: &[PdBody<D>],
-        radius: &[Vec<f64>],
+        radius: &[f64],
         points: &[(usize, usize)],
         e: usize,
     ) -> Option<Vector<D>> {
@@ -134,7 +128,7 @@ impl<const D: usize> Bins<D> {
                 }
                 let other = &bodies[b];
                 let yj = &other.start_x[j];
-                let (ri, rj) = (radius[a][i], radius[b][j]);
+                let (ri, rj) = (radius[e], radius[f as usize]);
                 // The cheap tests first, on squares: beyond the largest d the
                 // pair can have; within a body, beyond 0.9 |ξ| or bonded.
                 let y2 = (yj - yi).norm_squared();
