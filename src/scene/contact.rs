@@ -59,9 +59,10 @@ pub struct ContactPlan {
     pub rigid: Vec<bool>,
     /// Whether each field is a free rigid body (`SceneConfig::rigid_motion`).
     pub free: Vec<bool>,
-    /// Whether each field holds a peridynamic body: its particles are advanced
-    /// by their bonds, not by the grid, so it meets rigid bodies by the rigid
-    /// projection alone and takes part in no nodal contact.
+    /// Whether each field holds peridynamic bodies: their particles are
+    /// advanced by their bonds, not by the grid. They meet rigid bodies by the
+    /// rigid projection alone and continuum bodies by the nodal contact
+    /// (`solver::explicit::contact`).
     pub bonded: Vec<bool>,
 }
 
@@ -69,6 +70,24 @@ impl ContactPlan {
     /// The law between fields i and j (None for i = j).
     pub fn law(&self, i: u32, j: u32) -> Option<ContactLaw> {
         self.laws[i as usize * self.fields + j as usize]
+    }
+
+    /// Do fields i and j meet at the nodes? Not a rigid field and a
+    /// peridynamic one (the rigid projection alone keeps them apart), nor two
+    /// peridynamic ones (their short-range repulsion does).
+    pub fn meet_at_nodes(&self, i: usize, j: usize) -> bool {
+        let (b, r) = (&self.bonded, &self.rigid);
+        !((b[i] || b[j]) && (r[i] || r[j] || (b[i] && b[j])))
+    }
+
+    /// Does peridynamic field k meet a continuum field at the nodes? Then its
+    /// bond forces go to its nodes, and the nodal contact's exchange to its
+    /// particles.
+    pub fn bonded_meets_continuum(&self, k: usize) -> bool {
+        self.bonded[k]
+            && (0..self.fields).any(|j| {
+                j != k && self.law(k as u32, j as u32).is_some() && self.meet_at_nodes(k, j)
+            })
     }
 }
 

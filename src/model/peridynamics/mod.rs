@@ -40,6 +40,10 @@ pub struct PdBody<const D: usize> {
     /// Step start: positions and velocities of its particles (`begin_step`).
     pub start_x: Vec<Vector<D>>,
     pub start_v: Vec<Vector<D>>,
+    /// This step's bond forces on its particles, and the short-range
+    /// repulsion if any particle is pressed (`physics::peridynamics::step_forces`).
+    pub bond_force: Vec<Vector<D>>,
+    pub repulsion: Option<Vec<Vector<D>>>,
     /// A correspondence body's stress state (`BondLaw::Correspondence`); None
     /// for the bond-based laws.
     pub stress: Option<StressState>,
@@ -81,6 +85,8 @@ impl<const D: usize> PdBody<D> {
             law,
             start_x: Vec::new(),
             start_v: Vec::new(),
+            bond_force: Vec::new(),
+            repulsion: None,
             stress: None,
             short_range: None,
         }

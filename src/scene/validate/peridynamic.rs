@@ -2,10 +2,10 @@
 //! `physics::peridynamics`): its horizon, fracture, plane, zero-energy and
 //! influence keys, its material (E and the PMB Poisson ratio for the
 //! bond-based laws; a continuum model without erosion or pore water for the
-//! correspondence law), the scene around it (with rigid
-//! bodies met by the rigid projection alone, on explicit stages only: contact
-//! with continuum bodies and implicit PD are later slices of issue 51), and
-//! none of these keys on other bodies.
+//! correspondence law), the scene around it (continuum bodies met through
+//! the nodal contact, rigid bodies by the rigid projection alone, on explicit
+//! stages only: implicit PD is a later slice of issue 51), and none of these
+//! keys on other bodies.
 
 use super::check::{ensure, forbidden, Check};
 use crate::material::bond::Space;
@@ -228,20 +228,28 @@ fn poisson_ratio(i: usize, k: usize, s: &SceneConfig) -> Check {
     }
 }
 
-/// The scene around it: no continuum body (its contact with them through the
-/// grid is not built), rigid bodies met by the rigid projection alone, explicit
-/// stages only.
+/// The scene around it: continuum bodies met through the nodal contact, in
+/// velocity fields of their own (a `[[contact]]` with each); rigid bodies met
+/// by the rigid projection alone; explicit stages only.
 fn scene(i: usize, s: &SceneConfig) -> Check {
-    let continuum = (0..s.bodies.len()).find(|&j| s.body_kind(j) == BodyKindName::Continuum);
-    if let Some(j) = continuum {
-        return Err((
-            format!("body.{j}.kind"),
-            format!(
-                "a scene with a peridynamic body (body {i}) has peridynamic and rigid \
-                 bodies only: their contact with continuum bodies through the grid is not \
-                 built yet (issue 51)"
-            ),
-        ));
+    let continuum: Vec<usize> = (0..s.bodies.len())
+        .filter(|&j| s.body_kind(j) == BodyKindName::Continuum)
+        .collect();
+    if !continuum.is_empty() {
+        let plan = crate::scene::contact::plan(s)?;
+        for j in continuum {
+            let apart = (plan.as_ref()).is_some_and(|p| p.field_of_body[i] != p.field_of_body[j]);
+            ensure(
+                apart,
+                "contact",
+                format!(
+                    "peridynamic body {i} and continuum body {j} meet through the grid's \
+                     contact only: declare a [[contact]] between them (bodies without one \
+                     share a velocity field, and a peridynamic body's particles do not move \
+                     with the grid)"
+                ),
+            )?;
+        }
     }
     for k in 0..s.contacts.len() {
         rigid_projection(k, s)?;
@@ -268,13 +276,14 @@ fn scene(i: usize, s: &SceneConfig) -> Check {
 
 /// Contact table k in a scene with peridynamic bodies: between a peridynamic
 /// body and a rigid one, by the rigid projection alone (frictionless, no
-/// adhesion: `solver::explicit::contact`).
+/// adhesion: `solver::explicit::contact`); with a continuum body, any nodal
+/// law; never between two peridynamic bodies.
 fn rigid_projection(k: usize, s: &SceneConfig) -> Check {
     let c = &s.contacts[k];
     let key = |name: &str| format!("contact.{k}.{name}");
     for (a, b) in crate::scene::contact::table_pairs(s, k)? {
         let kinds = [s.body_kind(a), s.body_kind(b)];
-        if !kinds.contains(&BodyKindName::Peridynamic) {
+        if !kinds.contains(&BodyKindName::Peridynamic) || kinds.contains(&BodyKindName::Continuum) {
             continue;
         }
         ensure(

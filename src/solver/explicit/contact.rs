@@ -28,12 +28,21 @@
 //! With three or more fields at a node the pairs are corrected one after another,
 //! in field order.
 //!
-//! **Peridynamic bodies** meet no other field at the nodes: their particles are
-//! advanced by their bonds from the step start (`physics::peridynamics::advance`),
-//! so a nodal correction would not reach them and would give the other field
-//! momentum from nowhere. They meet rigid bodies by the rigid projection alone
-//! (`keep_out_of_rigid_bodies`, the push-out of seed 003 eqs. 28–29), which
-//! conserves momentum between the two to round-off.
+//! **Peridynamic bodies** are advanced by their bonds from the step start
+//! (`physics::peridynamics::advance`), not by G2P. They meet continuum bodies
+//! at the nodes all the same: their particles bring their mass, momentum and
+//! this step's bond and short-range forces to the nodes of their own field
+//! (`physics::peridynamics::grid_force`), so that field's updated velocity is
+//! where the bonds take them. The momentum J_I exchanged at each of its nodes
+//! reaches its particles through the consistent mass (`bonded_kicks`), so that
+//! their momentum projected back on the nodes changes by J_I, as the
+//! correction asked; it sums to Σ_I J_I, what the continuum field lost, so
+//! momentum is conserved to round-off. (A continuum field takes its share by
+//! FLIP: its stress follows the corrected nodal velocities; a peridynamic
+//! field's bond forces follow its particles alone.) They meet rigid bodies
+//! by the rigid projection alone (`keep_out_of_rigid_bodies`, the push-out of
+//! seed 003 eqs. 28–29), which conserves momentum between the two to
+//! round-off, and other peridynamic bodies by their short-range repulsion.
 
 use crate::dim::Vector;
 use crate::model::particles::Particles;
@@ -47,6 +56,29 @@ use crate::physics::shape::{ShapeFunction, Stencils};
 use crate::physics::transfer::NodeMap;
 use crate::scene::contact::ContactPlan;
 use rayon::prelude::*;
+
+/// The nodal velocities a contact pass corrects (`Contact::correct`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Pass {
+    /// After P2G, the step-start velocities: the PIC fraction `delivered`
+    /// (1 − FLIP) of the exchange reaches the particles.
+    StepStart { delivered: f64 },
+    /// After the grid update: all of it reaches the particles.
+    Updated,
+    /// MUSL's remapped velocities, for the stress update alone: none does.
+    Remapped,
+}
+
+impl Pass {
+    /// The fraction of the exchange that reaches the particles.
+    pub fn delivered(self) -> f64 {
+        match self {
+            Pass::StepStart { delivered } => delivered,
+            Pass::Updated => 1.0,
+            Pass::Remapped => 0.0,
+        }
+    }
+}
 
 /// The contact state of an explicit run.
 #[derive(Debug)]
@@ -71,6 +103,9 @@ pub struct Contact<const D: usize> {
     /// the step's Δt: the per-particle forces (`particle_forces`).
     node_impulse: Vec<Vector<D>>,
     pushed: Vec<(usize, Vector<D>)>,
+    /// This step's velocity change of the peridynamic particles the exchange
+    /// reached, by particle (`deliver_to_bonded`).
+    kicks: Vec<(usize, Vector<D>)>,
     dt: f64,
 }
 
@@ -94,6 +129,7 @@ impl<const D: usize> Contact<D> {
             rigid_nodes: Vec::new(),
             node_impulse: Vec::new(),
             pushed: Vec::new(),
+            kicks: Vec::new(),
             dt: 0.0,
             totals,
         }
@@ -113,12 +149,13 @@ impl<const D: usize> Contact<D> {
         let n_grid = m.grid.node_count();
         self.fields.split(st, map, n_grid);
         self.meetings = self.fields.meetings(&self.plan, m, st, map, false);
-        let bonded = &self.plan.bonded;
+        let plan = &self.plan;
         self.meetings
-            .retain(|mt| !mt.fields.iter().any(|&k| bonded[k]));
+            .retain(|mt| plan.meet_at_nodes(mt.fields[0], mt.fields[1]));
         self.node_impulse.clear();
         self.node_impulse.resize(map.len(), Vector::<D>::zeros());
         self.pushed.clear();
+        self.kicks.clear();
         self.rigid_nodes.clear();
         if let Some(free) = &mut self.free {
             free.start(p, m.axisymmetric);
@@ -151,19 +188,26 @@ impl<const D: usize> Contact<D> {
     }
 
     /// Give the nodes of rigid bodies their body's velocity, then correct the
-    /// nodal velocities `v` (masses `mass`) at the meetings where the fields
-    /// approach within the gap; return the nodes changed (both). The
-    /// fraction `delivered` of the momentum change and of the kinetic energy taken
-    /// counts as reaching the particles (`Explicit::step`: 1 − FLIP after P2G, 1
-    /// after the grid update, 0 for MUSL's remapped velocities); a pass that
-    /// delivers something also counts the nodes in contact.
+    /// nodal velocities `v` (masses `mass`) of the pass `pass` at the meetings
+    /// where the fields approach within the gap; return the nodes changed
+    /// (both). The fraction of the momentum change and of the kinetic energy
+    /// taken that reaches the particles (`Pass::delivered`) is counted; a pass
+    /// that delivers something also counts the nodes in contact.
+    ///
+    /// A peridynamic field meets at the nodes after the grid update alone:
+    /// its particles advance from their own step-start velocities, so a
+    /// correction of its step-start nodal velocities would not reach them
+    /// (but for the PIC fraction) and would hide their approach from the
+    /// pass that does.
     pub fn correct(
         &mut self,
         mass: &[f64],
         v: &mut [Vector<D>],
         dt: f64,
-        delivered: f64,
+        pass: Pass,
     ) -> Vec<usize> {
+        let delivered = pass.delivered();
+        let bonded = &self.plan.bonded;
         if delivered > 0.0 {
             for t in &mut self.totals {
                 t.nodes = 0;
@@ -177,6 +221,9 @@ impl<const D: usize> Contact<D> {
         for mt in &self.meetings {
             let (mr, ms) = (mass[mt.r], mass[mt.s]);
             if !(mt.close && mr > 0.0 && ms > 0.0) {
+                continue;
+            }
+            if matches!(pass, Pass::StepStart { .. }) && mt.fields.iter().any(|&k| bonded[k]) {
                 continue;
             }
             // A rigid field has infinite mass: it keeps its velocity.
@@ -292,6 +339,137 @@ impl<const D: usize> Contact<D> {
             .collect()
     }
 
+    /// Do the peridynamic particles meet continuum ones at the nodes
+    /// (`ContactPlan::bonded_meets_continuum`)? Then their bond forces go to
+    /// their nodes and the exchange there to them.
+    pub fn bonded_meets_continuum(&self) -> bool {
+        (0..self.plan.fields).any(|k| self.plan.bonded_meets_continuum(k))
+    }
+
+    /// The force of this step's nodal exchange on continuum particle q,
+    /// Σ_I (m_q S_Iq / m_I) J_I / Δt (its FLIP share), m_q its mass. `st`,
+    /// `map` and `mass` are the step's.
+    fn node_force_on(
+        &self,
+        st: &Stencils<D>,
+        map: &NodeMap,
+        mass: &[f64],
+        q: usize,
+        mass_q: f64,
+        dt: f64,
+    ) -> Vector<D> {
+        let mut f = Vector::<D>::zeros();
+        if self.node_impulse.len() != map.len() {
+            return f;
+        }
+        for e in st.range(q) {
+            let a = map.local_of(st, e);
+            if mass[a] > 0.0 {
+                f += self.node_impulse[a] * (mass_q * st.weight_at(q, e) / mass[a]);
+            }
+        }
+        f / dt
+    }
+
+    /// After the grid update's pass: the velocity changes the exchange gives
+    /// the peridynamic particles this step (`bonded_kicks`), kept for
+    /// `bonded_force` and `particle_forces`.
+    pub fn deliver_to_bonded(&mut self, st: &Stencils<D>, map: &NodeMap, particle_mass: &[f64]) {
+        self.kicks = self.bonded_kicks(st, map, particle_mass);
+    }
+
+    /// The contact force on peridynamic particle q (mass `mass_q`) over this
+    /// step Δt (`deliver_to_bonded`): m_q Δv_q / Δt.
+    pub fn bonded_force(&self, q: usize, mass_q: f64, dt: f64) -> Vector<D> {
+        match self.kicks.binary_search_by_key(&q, |(p, _)| *p) {
+            Ok(i) => self.kicks[i].1 * (mass_q / dt),
+            Err(_) => Vector::<D>::zeros(),
+        }
+    }
+
+    /// The velocity change this step's nodal exchange gives the peridynamic
+    /// particles, per particle touched (global index, ascending). The
+    /// exchange J_I at the nodes of a peridynamic field reaches its particles
+    /// through nodal increments u: Δv_p = Σ_I S_Ip u_I with the consistent
+    /// mass M_IJ = Σ_p m_p S_Ip S_Jp, M u = J, so that the particles' momentum
+    /// projected on the nodes changes by J_I at every node, as the nodal
+    /// correction asked. (The lumped share u_I = J_I / m_I, the FLIP
+    /// increment, reaches the nodes as Σ_p m_p S_Ip² / m_I of J_I only, about
+    /// 0.6 with linear shape functions: an interface whose particles keep
+    /// approaching.) M is assembled over the particles that touch a node with
+    /// an exchange alone, exact for them; it is solved by conjugate gradients
+    /// preconditioned by the lumped mass, and what the iterations leave of
+    /// Σ J is shared by mass, so momentum is conserved to round-off.
+    fn bonded_kicks(
+        &self,
+        st: &Stencils<D>,
+        map: &NodeMap,
+        particle_mass: &[f64],
+    ) -> Vec<(usize, Vector<D>)> {
+        let (plan, field, impulse) = (&self.plan, &self.field, &self.node_impulse);
+        if impulse.len() != map.len() {
+            return Vec::new();
+        }
+        let zero = Vector::<D>::zeros();
+        let touched: Vec<usize> = (0..field.len())
+            .filter(|&q| plan.bonded[field[q] as usize])
+            .filter(|&q| st.range(q).any(|e| impulse[map.local_of(st, e)] != zero))
+            .collect();
+        if touched.is_empty() {
+            return Vec::new();
+        }
+        // The nodes the touched particles reach, numbered compactly.
+        let mut index = std::collections::HashMap::new();
+        let entries: Vec<Vec<(usize, f64)>> = (touched.iter())
+            .map(|&q| {
+                st.range(q)
+                    .map(|e| {
+                        let a = map.local_of(st, e);
+                        let n = index.len();
+                        (*index.entry(a).or_insert(n), st.weight_at(q, e))
+                    })
+                    .collect()
+            })
+            .collect();
+        let mut b = vec![zero; index.len()];
+        for (&a, &k) in &index {
+            b[k] = impulse[a];
+        }
+        let mass_of = |i: usize| particle_mass[touched[i]];
+        let lumped = {
+            let mut m = vec![0.0; b.len()];
+            for (i, en) in entries.iter().enumerate() {
+                for &(k, w) in en {
+                    m[k] += mass_of(i) * w;
+                }
+            }
+            m
+        };
+        let at_particles = |u: &[Vector<D>]| -> Vec<Vector<D>> {
+            (entries.iter())
+                .map(|en| en.iter().fold(zero, |acc, &(k, w)| acc + u[k] * w))
+                .collect()
+        };
+        let consistent = |u: &[Vector<D>]| -> Vec<Vector<D>> {
+            let mut y = vec![zero; u.len()];
+            for (i, vp) in at_particles(u).into_iter().enumerate() {
+                for &(k, w) in &entries[i] {
+                    y[k] += vp * (mass_of(i) * w);
+                }
+            }
+            y
+        };
+        let u = consistent_solve(&consistent, &lumped, &b);
+        let mut dv = at_particles(&u);
+        // What the iterations leave of Σ J, shared by mass.
+        let total: Vector<D> = b.iter().sum();
+        let given = (dv.iter().enumerate()).fold(zero, |acc, (i, v)| acc + v * mass_of(i));
+        let m_all: f64 = (0..touched.len()).map(mass_of).sum();
+        let rest = (total - given) / m_all;
+        dv.iter_mut().for_each(|v| *v += rest);
+        touched.into_iter().zip(dv).collect()
+    }
+
     /// The contact force on every particle in the last step: the momentum
     /// exchanged at each node, J_I, shared by the particles of its field by
     /// their mass, f_p = Σ_I (m_p S_Ip / m_I) J_I / Δt, plus a push out of a
@@ -309,13 +487,12 @@ impl<const D: usize> Contact<D> {
         if self.dt <= 0.0 || self.node_impulse.len() != map.len() {
             return f;
         }
+        let bonded = |q: usize| self.plan.bonded[self.field[q] as usize];
         for (q, fq) in f.iter_mut().enumerate() {
-            for e in st.range(q) {
-                let a = map.local_of(st, e);
-                if mass[a] > 0.0 {
-                    *fq += self.node_impulse[a] * (p.mass[q] * st.weight_at(q, e) / mass[a]);
-                }
-            }
+            *fq = match bonded(q) {
+                true => self.bonded_force(q, p.mass[q], 1.0),
+                false => self.node_force_on(st, map, mass, q, p.mass[q], 1.0),
+            };
         }
         for &(q, dp) in &self.pushed {
             f[q] += dp;
@@ -333,6 +510,34 @@ impl<const D: usize> Contact<D> {
         }
         out
     }
+}
+
+/// M u = b for the consistent mass M (`consistent`, applied to nodal vectors)
+/// by conjugate gradients preconditioned by the lumped mass `lumped`, over
+/// the D components at once (M ⊗ I), to 1e-12 of ‖b‖ or 200 iterations.
+fn consistent_solve<const D: usize>(
+    consistent: &dyn Fn(&[Vector<D>]) -> Vec<Vector<D>>,
+    lumped: &[f64],
+    b: &[Vector<D>],
+) -> Vec<Vector<D>> {
+    use crate::solver::linear::iterative::Settings;
+    let flat = |v: &[Vector<D>]| -> Vec<f64> { v.iter().flat_map(|x| x.iter().copied()).collect() };
+    let vectors =
+        |f: &[f64]| -> Vec<Vector<D>> { f.chunks(D).map(Vector::<D>::from_column_slice).collect() };
+    let diagonal: Vec<f64> = lumped.iter().flat_map(|&m| [m; D]).collect();
+    let precond = crate::solver::linear::preconditioner::Jacobi::new(diagonal);
+    let settings = Settings {
+        tolerance: 1e-12,
+        max_iterations: 200,
+        restart: 0,
+    };
+    let mut x = vec![0.0; b.len() * D];
+    let apply = |v: &[f64], out: &mut [f64]| -> Result<(), ()> {
+        out.copy_from_slice(&flat(&consistent(&vectors(v))));
+        Ok(())
+    };
+    let _ = crate::solver::linear::cg::cg(apply, &precond, &flat(b), &mut x, &settings);
+    vectors(&x)
 }
 
 /// The rigid fields whose contact with some other field keeps that field's

@@ -23,7 +23,7 @@ use crate::physics::transfer::{
 use crate::scene::Scheme;
 use crate::solver::divergence::{check_state, inverted, Divergence};
 use crate::solver::explicit::apic::{self, AffineMomentum};
-use crate::solver::explicit::contact::Contact;
+use crate::solver::explicit::contact::{Contact, Pass};
 use crate::solver::explicit::grid_update::{
     acceleration, local_damping, updated_velocity, with_conditions,
 };
@@ -104,11 +104,15 @@ impl<const D: usize> NodeMapStep<D> {
             let p = &mut m.particles;
             let (ramp_of, mass, load) = (&m.load_ramp_of, &p.mass, &p.load);
             let applied = |q: usize| s.applied(ramp_of, mass, load, q);
-            let repulsion = crate::physics::peridynamics::short_range::forces(&pd.bodies);
-            for (b, r) in pd.bodies.iter_mut().zip(&repulsion) {
-                let r = r.as_deref();
+            if let Some(c) = (self.contact.as_mut()).filter(|c| c.bonded_meets_continuum()) {
+                c.deliver_to_bonded(&self.stencils, &self.map, mass);
+            }
+            let meets = (self.contact.as_ref()).filter(|c| c.bonded_meets_continuum());
+            let kick = meets.map(|c| move |q: usize| c.bonded_force(q, mass[q], s.dt));
+            for b in pd.bodies.iter_mut() {
+                let contact = kick.as_ref().map(|k| k as &dyn Fn(usize) -> Vector<D>);
                 crate::physics::peridynamics::advance(
-                    b, &mut p.x, &mut p.v, mass, applied, r, s.dt,
+                    b, &mut p.x, &mut p.v, mass, applied, contact, s.dt,
                 );
             }
         }
@@ -123,6 +127,32 @@ impl<const D: usize> NodeMapStep<D> {
             free.advance(&mut m.particles, &force, m.axisymmetric, s.dt);
         }
         c.keep_out_of_rigid_bodies(m);
+    }
+
+    /// Peridynamic bodies that meet continuum ones at the nodes
+    /// (`Contact::bonded_meets_continuum`): their particles' bond and
+    /// short-range forces to their nodes (`physics::peridynamics::grid_force`),
+    /// so that their field's updated velocity is where the bonds take them.
+    fn add_bond_forces(&mut self, m: &Model<D>) {
+        let (Some(pd), Some(c)) = (&m.peridynamics, &self.contact) else {
+            return;
+        };
+        if !c.bonded_meets_continuum() {
+            return;
+        }
+        let mut on: Vec<Option<Vector<D>>> = vec![None; m.particles.len()];
+        for b in &pd.bodies {
+            for (i, &q) in b.particles.iter().enumerate() {
+                on[q] = Some(crate::physics::peridynamics::grid_force(b, i));
+            }
+        }
+        let st = &self.stencils;
+        let bonds = self.map.gather(st.stride, Vector::<D>::zeros(), |q, e| {
+            on[q].map_or_else(Vector::<D>::zeros, |f| f * st.weight_at(q, e))
+        });
+        for (f, b) in self.force.iter_mut().zip(bonds) {
+            *f += b;
+        }
     }
 
     /// Does particle q take a share of the loads' work? Not when it is
@@ -243,19 +273,18 @@ impl<const D: usize> NodeMapStep<D> {
     }
 
     /// Nodal velocities of `momentum` over the nodal masses, with the mirror
-    /// (`mirror`), contact delivering the fraction `delivered` of its
-    /// exchange (`Contact::correct`) and the conditions: the raw one and the
-    /// conditioned one.
+    /// (`mirror`), contact correcting them as pass `pass` (`Contact::correct`)
+    /// and the conditions: the raw one and the conditioned one.
     fn velocity_of(
         &mut self,
         momentum: &[Vector<D>],
         dt: f64,
-        delivered: f64,
+        pass: Pass,
     ) -> (Vec<Vector<D>>, Vec<Vector<D>>) {
         let mut raw = mass_average(&self.mass, momentum);
         self.mirror.velocity(&self.mass, momentum, &mut raw);
         if let Some(c) = &mut self.contact {
-            c.correct(&self.mass, &mut raw, dt, delivered);
+            c.correct(&self.mass, &mut raw, dt, pass);
         }
         let velocity = self.conditioned(&raw);
         (raw, velocity)
@@ -300,6 +329,7 @@ impl<const D: usize> Backend<D> for NodeMapStep<D> {
         self.removed = removed_particles(m);
         if let Some(pd) = &mut m.peridynamics {
             pd.begin_step(&m.particles.x, &m.particles.v);
+            crate::physics::peridynamics::step_forces(&mut pd.bodies, s.dt);
         }
         if let (None, Some(plan)) = (&self.contact, &m.contact) {
             self.contact = Some(Contact::new(plan.clone(), m));
@@ -334,13 +364,20 @@ impl<const D: usize> Backend<D> for NodeMapStep<D> {
         if what != P2g::Motion {
             let factor = |q: usize| load_factor(&m.load_ramp_of, q, &s.scales);
             self.force = nodal_force(map, st, p, &s.gravity, &factor);
+            self.add_bond_forces(m);
         }
     }
 
     fn start_velocity(&mut self, _m: &Model<D>, s: &Step<D>) {
         // Contact after P2G: its momentum reaches the particles through the PIC part.
         let momentum = std::mem::take(&mut self.momentum);
-        (self.raw_velocity, self.velocity) = self.velocity_of(&momentum, s.dt, 1.0 - s.flip);
+        (self.raw_velocity, self.velocity) = self.velocity_of(
+            &momentum,
+            s.dt,
+            Pass::StepStart {
+                delivered: 1.0 - s.flip,
+            },
+        );
         self.momentum = momentum;
     }
 
@@ -409,7 +446,7 @@ impl<const D: usize> Backend<D> for NodeMapStep<D> {
         // Contact after the grid update (rigid bodies' nodes keep their velocity:
         // zero acceleration); prescribed components win.
         if let Some(c) = &mut self.contact {
-            for a in c.correct(mass, &mut self.velocity_new, s.dt, 1.0) {
+            for a in c.correct(mass, &mut self.velocity_new, s.dt, Pass::Updated) {
                 constraint[a].apply_velocity(&mut self.velocity_new[a]);
                 self.accel[a] = (self.velocity_new[a] - raw[a]) / s.dt;
             }
@@ -438,7 +475,7 @@ impl<const D: usize> Backend<D> for NodeMapStep<D> {
 
     fn remapped_velocity(&mut self, _m: &Model<D>, s: &Step<D>) {
         let momentum = std::mem::take(&mut self.momentum);
-        (_, self.velocity) = self.velocity_of(&momentum, s.dt, 0.0);
+        (_, self.velocity) = self.velocity_of(&momentum, s.dt, Pass::Remapped);
         self.momentum = momentum;
     }
 
