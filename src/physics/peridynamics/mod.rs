@@ -6,6 +6,7 @@
 
 pub mod correspondence;
 pub mod deformation;
+pub mod energy;
 pub mod short_range;
 
 use crate::dim::Vector;
