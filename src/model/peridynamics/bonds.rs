@@ -160,7 +160,7 @@ impl Bonds {
     }
 
     /// The stretch s = (|y_j − y_i| − |ξ|)/|ξ| of bond k between i and j at positions y.
-    fn stretch_between<const D: usize>(
+    pub fn stretch_between<const D: usize>(
         &self,
         k: usize,
         i: usize,

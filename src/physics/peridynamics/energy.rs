@@ -37,8 +37,8 @@ pub fn stored<const D: usize>(b: &PdBody<D>, y: &[Vector<D>]) -> f64 {
     };
     match &b.law {
         BondLaw::Pmb(pmb) => deterministic_sum(y.len(), |i| {
-            of_lower(i, &|k, _| {
-                pmb.bond_energy(bonds.stretch(k, y), bonds.length[k])
+            of_lower(i, &|k, j| {
+                pmb.bond_energy(bonds.stretch_between(k, i, j, y), bonds.length[k])
             })
         }),
         BondLaw::Beam(beam) => {
