@@ -553,3 +553,12 @@ fn a_correspondence_restart_keeps_the_stress_state() {
     let steps = restarts_are_exact("peridynamic_plate.toml", &sets, 7.0e-6, 2);
     assert!(steps[0] > 0 && steps[1] > steps[0], "{steps:?}");
 }
+
+/// A peridynamic body meeting a continuum one through the nodal contact
+/// restarts byte-identically, in contact (the exchange and its delivery are
+/// rebuilt every step from the particles).
+#[test]
+fn a_peridynamic_and_continuum_contact_restarts_byte_identically() {
+    let steps = restarts_are_exact("peridynamic_strikes_mpm.toml", &[], 8.0e-6, 2);
+    assert!(steps[0] > 0 && steps[1] > steps[0], "{steps:?}");
+}

@@ -241,3 +241,16 @@ fn coupled_pore_flow_is_the_same_on_one_and_two_threads() {
     ];
     same_on_one_and_two_threads("terzaghi.toml", &overrides, "coupled pore flow");
 }
+
+/// A peridynamic bar striking a continuum one through the nodal contact: the
+/// exchange's delivery through the consistent mass is solved serially
+/// (`solver::explicit::contact`), so the run is the same on 1 and 2 threads.
+#[test]
+fn a_peridynamic_bar_striking_a_continuum_bar_is_the_same_on_one_and_two_threads() {
+    let overrides = ["solver.end_time=1.5e-5".to_string()];
+    same_on_one_and_two_threads(
+        "peridynamic_strikes_mpm.toml",
+        &overrides,
+        "peridynamic striker",
+    );
+}
