@@ -76,8 +76,12 @@ impl ContactPlan {
     /// peridynamic one (the rigid projection alone keeps them apart), nor two
     /// peridynamic ones (their short-range repulsion does).
     pub fn meet_at_nodes(&self, i: usize, j: usize) -> bool {
-        let (b, r) = (&self.bonded, &self.rigid);
-        !((b[i] || b[j]) && (r[i] || r[j] || (b[i] && b[j])))
+        match (self.bonded[i], self.bonded[j]) {
+            (false, false) => true,
+            (true, false) => !self.rigid[j],
+            (false, true) => !self.rigid[i],
+            (true, true) => false,
+        }
     }
 
     /// Does peridynamic field k meet a continuum field at the nodes? Then its

@@ -346,43 +346,37 @@ impl<const D: usize> Contact<D> {
         (0..self.plan.fields).any(|k| self.plan.bonded_meets_continuum(k))
     }
 
-    /// The force of this step's nodal exchange on continuum particle q,
-    /// Σ_I (m_q S_Iq / m_I) J_I / Δt (its FLIP share), m_q its mass. `st`,
-    /// `map` and `mass` are the step's.
-    fn node_force_on(
+    /// The impulse of this step's nodal exchange on continuum particle q of
+    /// mass m_q, Σ_I (m_q S_Iq / m_I) J_I (its FLIP share). `st`, `map` and
+    /// `mass` are the step's.
+    fn node_impulse_on(
         &self,
         st: &Stencils<D>,
         map: &NodeMap,
         mass: &[f64],
         q: usize,
         mass_q: f64,
-        dt: f64,
     ) -> Vector<D> {
-        let mut f = Vector::<D>::zeros();
-        if self.node_impulse.len() != map.len() {
-            return f;
-        }
-        for e in st.range(q) {
-            let a = map.local_of(st, e);
-            if mass[a] > 0.0 {
-                f += self.node_impulse[a] * (mass_q * st.weight_at(q, e) / mass[a]);
-            }
-        }
-        f / dt
+        (st.range(q))
+            .map(|e| (map.local_of(st, e), st.weight_at(q, e)))
+            .filter(|&(a, _)| mass[a] > 0.0)
+            .fold(Vector::<D>::zeros(), |f, (a, w)| {
+                f + self.node_impulse[a] * (mass_q * w / mass[a])
+            })
     }
 
     /// After the grid update's pass: the velocity changes the exchange gives
     /// the peridynamic particles this step (`bonded_kicks`), kept for
-    /// `bonded_force` and `particle_forces`.
+    /// `bonded_kick` and `particle_forces`.
     pub fn deliver_to_bonded(&mut self, st: &Stencils<D>, map: &NodeMap, particle_mass: &[f64]) {
         self.kicks = self.bonded_kicks(st, map, particle_mass);
     }
 
-    /// The contact force on peridynamic particle q (mass `mass_q`) over this
-    /// step Δt (`deliver_to_bonded`): m_q Δv_q / Δt.
-    pub fn bonded_force(&self, q: usize, mass_q: f64, dt: f64) -> Vector<D> {
+    /// The velocity change Δv_q the exchange gives peridynamic particle q
+    /// this step (`deliver_to_bonded`; zero where it reached none).
+    pub fn bonded_kick(&self, q: usize) -> Vector<D> {
         match self.kicks.binary_search_by_key(&q, |(p, _)| *p) {
-            Ok(i) => self.kicks[i].1 * (mass_q / dt),
+            Ok(i) => self.kicks[i].1,
             Err(_) => Vector::<D>::zeros(),
         }
     }
@@ -411,10 +405,16 @@ impl<const D: usize> Contact<D> {
             return Vec::new();
         }
         let zero = Vector::<D>::zeros();
-        let touched: Vec<usize> = (0..field.len())
+        // The particles of the peridynamic fields at the nodes that exchanged
+        // momentum (a split node holds one field's entries).
+        let owner = st.owner();
+        let mut touched: Vec<usize> = (0..map.len())
+            .filter(|&a| impulse[a] != zero)
+            .flat_map(|a| map.node_entries(a).iter().map(|&e| owner.of(e)))
             .filter(|&q| plan.bonded[field[q] as usize])
-            .filter(|&q| st.range(q).any(|e| impulse[map.local_of(st, e)] != zero))
             .collect();
+        touched.sort_unstable();
+        touched.dedup();
         if touched.is_empty() {
             return Vec::new();
         }
@@ -472,8 +472,9 @@ impl<const D: usize> Contact<D> {
 
     /// The contact force on every particle in the last step: the momentum
     /// exchanged at each node, J_I, shared by the particles of its field by
-    /// their mass, f_p = Σ_I (m_p S_Ip / m_I) J_I / Δt, plus a push out of a
-    /// rigid body, Δp/Δt. Over a field's particles they sum to the nodes'
+    /// their mass, f_p = Σ_I (m_p S_Ip / m_I) J_I / Δt (a peridynamic
+    /// particle: m_p Δv_p / Δt of `bonded_kicks`, which shares J_I the same
+    /// in sum), plus a push out of a rigid body, Δp/Δt. Over a field's particles they sum to the nodes'
     /// J_I/Δt (Σ_p m_p S_Ip = m_I), the pair's force in contact.csv over
     /// that step. `st`, `map` and `mass` are the step's.
     pub fn particle_forces(
@@ -490,8 +491,8 @@ impl<const D: usize> Contact<D> {
         let bonded = |q: usize| self.plan.bonded[self.field[q] as usize];
         for (q, fq) in f.iter_mut().enumerate() {
             *fq = match bonded(q) {
-                true => self.bonded_force(q, p.mass[q], 1.0),
-                false => self.node_force_on(st, map, mass, q, p.mass[q], 1.0),
+                true => self.bonded_kick(q) * p.mass[q],
+                false => self.node_impulse_on(st, map, mass, q, p.mass[q]),
             };
         }
         for &(q, dp) in &self.pushed {

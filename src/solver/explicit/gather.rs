@@ -104,11 +104,12 @@ impl<const D: usize> NodeMapStep<D> {
             let p = &mut m.particles;
             let (ramp_of, mass, load) = (&m.load_ramp_of, &p.mass, &p.load);
             let applied = |q: usize| s.applied(ramp_of, mass, load, q);
-            if let Some(c) = (self.contact.as_mut()).filter(|c| c.bonded_meets_continuum()) {
+            let meets = (self.contact.as_mut()).filter(|c| c.bonded_meets_continuum());
+            let meets = meets.map(|c| {
                 c.deliver_to_bonded(&self.stencils, &self.map, mass);
-            }
-            let meets = (self.contact.as_ref()).filter(|c| c.bonded_meets_continuum());
-            let kick = meets.map(|c| move |q: usize| c.bonded_force(q, mass[q], s.dt));
+                &*c
+            });
+            let kick = meets.map(|c| move |q: usize| c.bonded_kick(q) * (mass[q] / s.dt));
             for b in pd.bodies.iter_mut() {
                 let contact = kick.as_ref().map(|k| k as &dyn Fn(usize) -> Vector<D>);
                 crate::physics::peridynamics::advance(
